@@ -1,0 +1,1 @@
+"""Wiring of processes: run_constellation, campaigns, scenarios and Zenoh configs."""

@@ -1,0 +1,50 @@
+"""The whole constellation in one process on the in-process transport (tests, campaigns).
+
+Same apps, messages, channel model and lockstep as the multi-process run; ticks run
+synchronously inside the sim's publish, so no threads are involved.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+
+from fsw.spacecraft import spacecraft_executive
+from ground.station import ground_executive
+from interfaces import topics
+from interfaces.bus import Bus
+from interfaces.channel import ChannelModel
+from interfaces.executive import Executive, TickClient
+from interfaces.scenario import Scenario
+from interfaces.transport import InprocNetwork, RawHandler
+from sim.node import SimNode
+
+
+def run_inproc(
+    scenario: Scenario,
+    mission: str | None = None,
+    tap: RawHandler | None = None,
+    ground: bool = True,
+) -> tuple[SimNode, dict[str, Executive]]:
+    """Run ``scenario`` to the end in this process.  ``tap`` receives every message raw (key,
+    type, payload), as the recorder does.  Returns the sim and the executives by node."""
+    mission = mission or scenario.name
+    net = InprocNetwork()
+    if tap is not None:
+        Bus("ground", mission, net.endpoint()).subscribe_raw(topics.mission_wildcard(mission), tap)
+    builders: dict[str, Callable[[Bus, Scenario], Executive]] = {
+        topics.sc_node(i): (lambda b, s, i=i: spacecraft_executive(b, s, i))
+        for i in range(1, scenario.observers.count + 1)
+    }
+    if ground:
+        builders[topics.GROUND] = ground_executive
+    executives: dict[str, Executive] = {}
+    for node, build in builders.items():
+        bus = Bus(node, mission, net.endpoint(),
+                  channel=ChannelModel(node, scenario.comms, scenario.seed))
+        executives[node] = build(bus, scenario)
+        TickClient(executives[node], synchronous=True)
+    sim = SimNode(Bus(topics.SIM, mission, net.endpoint()), scenario, list(builders),
+                  log=logging.getLogger("insp.sim"))
+    sim.run()
+    return sim, executives

@@ -1,0 +1,102 @@
+"""Supervision of the constellation's OS processes: start, watch, stop, report deaths."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO
+
+
+@dataclass
+class Child:
+    """One supervised process, its output going to ``log_path``."""
+
+    name: str
+    argv: list[str]
+    log_path: Path
+    proc: subprocess.Popen[bytes] | None = None
+    _log: IO[bytes] | None = None
+
+    def start(self, cwd: Path) -> None:
+        self.log_path.parent.mkdir(parents=True, exist_ok=True)
+        self._log = self.log_path.open("wb")
+        self.proc = subprocess.Popen(
+            [sys.executable, *self.argv], cwd=cwd, stdout=self._log, stderr=subprocess.STDOUT,
+            start_new_session=True,  # a Ctrl-C at the launcher does not hit children directly
+        )
+
+    @property
+    def returncode(self) -> int | None:
+        return None if self.proc is None else self.proc.poll()
+
+    def signal(self, sig: int) -> None:
+        if self.proc is not None and self.proc.poll() is None:
+            try:
+                self.proc.send_signal(sig)
+            except ProcessLookupError:
+                pass
+
+    def wait(self, timeout_s: float) -> int | None:
+        if self.proc is None:
+            return None
+        try:
+            return self.proc.wait(timeout=timeout_s)
+        except subprocess.TimeoutExpired:
+            return None
+
+    def stop(self, timeout_s: float = 5.0) -> int | None:
+        """SIGINT, then SIGTERM, then SIGKILL, each given ``timeout_s`` to work."""
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGKILL):
+            if self.returncode is not None:
+                break
+            self.signal(sig)
+            self.wait(timeout_s)
+        self.close_log()
+        return self.returncode
+
+    def close_log(self) -> None:
+        if self._log is not None:
+            self._log.close()
+            self._log = None
+
+    def describe_exit(self) -> str:
+        code = self.returncode
+        if code is None:
+            return "still running"
+        if code < 0:
+            try:
+                return f"killed by {signal.Signals(-code).name}"
+            except ValueError:
+                return f"killed by signal {-code}"
+        return f"exited with code {code}"
+
+    def log_tail(self, lines: int = 15) -> str:
+        try:
+            text = self.log_path.read_text(errors="replace").splitlines()
+        except OSError:
+            return ""
+        return "\n".join(text[-lines:])
+
+
+@dataclass
+class Supervisor:
+    """Starts children and reports the first unexpected death."""
+
+    cwd: Path
+    children: list[Child] = field(default_factory=list)
+
+    def start(self, child: Child) -> Child:
+        child.start(self.cwd)
+        self.children.append(child)
+        return child
+
+    def stop_all(self, order: list[str] | None = None, exclude: set[str] | None = None,
+                 timeout_s: float = 5.0) -> None:
+        """Stop children (those named in ``order`` first, in that order), except ``exclude``."""
+        rank = {n: i for i, n in enumerate(order or [])}
+        for c in sorted(self.children, key=lambda c: rank.get(c.name, len(rank))):
+            if c.name not in (exclude or set()):
+                c.stop(timeout_s)

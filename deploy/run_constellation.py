@@ -1,0 +1,223 @@
+"""Run one scenario: the sim, one flight-software process per observer, the ground and the
+recorder as separate OS processes over Zenoh (default), or all in one process (--transport inproc).
+
+    python deploy/run_constellation.py [--scenario deploy/scenarios/default.toml] --out runs/x
+        [--transport zenoh|inproc] [--seed N] [--duration S] [--realtime SPEED]
+
+Writes <out>/run.mcap (every bus message, JSON schemas; opens in Foxglove), <out>/summary.json,
+<out>/report.md with PNG plots, and <out>/logs/ (one log per process).  While it runs, any Zenoh
+client can connect to the endpoint (default tcp/127.0.0.1:7447) and subscribe to insp/**.
+Exits 0 on success; non-zero, with the reason, if a process dies or the run cannot start.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+import threading
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+if str(REPO) not in sys.path:  # run as a script from a checkout
+    sys.path.insert(0, str(REPO))
+
+from deploy.processes import Child, Supervisor  # noqa: E402
+from ground.record import run_metadata  # noqa: E402
+from ground.recorder import McapRecorder  # noqa: E402
+from ground.report import write_report  # noqa: E402
+from ground.summary import write_summary  # noqa: E402
+from interfaces import topics  # noqa: E402
+from interfaces.messages import SimStatus, Tick  # noqa: E402
+from interfaces.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
+from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
+
+DEFAULT_SCENARIO = REPO / "deploy" / "scenarios" / "default.toml"
+log = logging.getLogger("insp.launcher")
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO, help="scenario TOML")
+    p.add_argument("--out", type=Path, help="output directory (default runs/<scenario>-<time>)")
+    p.add_argument("--transport", choices=("zenoh", "inproc"), default="zenoh")
+    p.add_argument("--seed", type=int, help="override the scenario seed")
+    p.add_argument("--duration", type=float, help="override duration_s (s)")
+    p.add_argument("--realtime", type=float, metavar="SPEED",
+                   help="pace the sim to the wall clock times SPEED (default: lockstep, max speed)")
+    p.add_argument("--endpoint", default=DEFAULT_ENDPOINT,
+                   help=f"Zenoh endpoint the constellation listens on (default {DEFAULT_ENDPOINT})")
+    p.add_argument("--mission", help="key-space name (default: scenario name)")
+    p.add_argument("--no-report", action="store_true", help="skip report.md and plots")
+    p.add_argument("--log-level", default="INFO")
+    return p.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    logging.basicConfig(level=getattr(logging, args.log_level.upper(), logging.INFO),
+                        format="%(asctime)s launcher %(levelname)s %(message)s", datefmt="%H:%M:%S")
+    try:
+        scenario = load_scenario(args.scenario).with_overrides(args.seed, args.duration)
+    except ScenarioError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    out = args.out or REPO / "runs" / f"{scenario.name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    out.mkdir(parents=True, exist_ok=True)
+    mission = args.mission or scenario.name
+    scenario_text = args.scenario.read_text(encoding="utf-8")
+    wall0 = time.monotonic()
+    if args.transport == "inproc":
+        status, error = _run_inproc(scenario, mission, out, scenario_text, args)
+    else:
+        status, error = _run_zenoh(scenario, mission, out, args)
+    wall_s = time.monotonic() - wall0
+    summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
+                            status=status, error=error)
+    if not args.no_report:
+        write_report(out, scenario)
+    rtf = summary.get("real_time_factor")
+    print(f"{status}: {scenario.name} seed {scenario.seed}, {scenario.duration_s:.0f} s simulated in "
+          f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time)" if rtf else "") + f"\n  {out}/run.mcap"
+          f"\n  {out}/summary.json" + ("" if args.no_report else f"\n  {out}/report.md"))
+    if error:
+        print(f"error: {error}", file=sys.stderr)
+    return 0 if status == "completed" else 1
+
+
+def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
+                args: argparse.Namespace) -> tuple[str, str | None]:
+    from deploy.inproc import run_inproc
+
+    if args.realtime:
+        log.warning("--realtime is ignored with --transport inproc (lockstep only)")
+    with McapRecorder(out / "run.mcap", run_metadata(scenario, "inproc", scenario_text)) as rec:
+        run_inproc(scenario, mission, tap=rec.record)
+    return "completed", None
+
+
+def _run_zenoh(scenario: Scenario, mission: str, out: Path,
+               args: argparse.Namespace) -> tuple[str, str | None]:
+    try:
+        hub = ZenohTransport(ZenohSettings.hub(args.endpoint))
+    except Exception as e:  # noqa: BLE001 - zenoh raises ZError
+        return "failed", f"cannot listen on {args.endpoint}: {e} (is another run using it?)"
+    progress = _Progress(scenario)
+    try:
+        hub.session.declare_subscriber(topics.tick(mission), progress.on_tick)
+        hub.session.declare_subscriber(topics.sim_status(mission), progress.on_status)
+        return _supervise(scenario, mission, out, args, progress, hub)
+    finally:
+        hub.close()
+
+
+def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
+               progress: _Progress, hub: ZenohTransport) -> tuple[str, str | None]:
+    common = ["--scenario", str(args.scenario.resolve()), "--mission", mission,
+              "--connect", args.endpoint, "--log-level", args.log_level]
+    if args.seed is not None:
+        common += ["--seed", str(args.seed)]
+    if args.duration is not None:
+        common += ["--duration", str(args.duration)]
+    sup = Supervisor(REPO)
+    logs = out / "logs"
+    recorder = sup.start(Child("recorder", ["-m", "ground.record", *common, "--out",
+                                            str(out / "run.mcap"), "--transport-name", "zenoh"],
+                               logs / "recorder.log"))
+    if not _wait_token(hub, topics.recorder_token(mission), recorder, timeout_s=30.0):
+        sup.stop_all()
+        return "failed", f"recorder did not start ({recorder.describe_exit()}):\n{recorder.log_tail()}"
+    sim_argv = ["-m", "sim", *common] + (["--realtime", str(args.realtime)] if args.realtime else [])
+    sup.start(Child("sim", sim_argv, logs / "sim.log"))
+    nodes = [f"sc{i}" for i in range(1, scenario.observers.count + 1)]
+    for i, node in enumerate(nodes, start=1):
+        sup.start(Child(node, ["-m", "fsw", "--spacecraft", str(i), *common], logs / f"{node}.log"))
+    sup.start(Child("ground", ["-m", "ground", *common], logs / "ground.log"))
+    participants = [c for c in sup.children if c.name != "recorder"]
+    error: str | None = None
+    done_since: float | None = None
+    try:
+        while True:
+            sim_done = progress.finished.is_set() or participants[0].returncode == 0
+            failed = next((c for c in participants if c.returncode is not None
+                           and (c.returncode != 0 or not sim_done)), None)
+            if failed is not None:
+                error = (f"{failed.name} (pid {failed.proc.pid if failed.proc else '?'}) "
+                         f"{failed.describe_exit()} at sim t≈{progress.t_sim:.1f} s; stopping the "
+                         f"constellation.\n--- last lines of {failed.log_path}:\n{failed.log_tail()}")
+                break
+            if all(c.returncode == 0 for c in participants):
+                break
+            if sim_done:
+                done_since = done_since or time.monotonic()
+                if time.monotonic() - done_since > 15.0:
+                    error = "processes still running 15 s after the run finished: " + ", ".join(
+                        c.name for c in participants if c.returncode is None)
+                    break
+            time.sleep(0.1)
+            progress.report()
+    except KeyboardInterrupt:
+        error = "interrupted by the user"
+    progress.report(final=True)
+    # Stop the flight side first, then the recorder, so the archive holds everything sent.
+    sup.stop_all(order=["sim", *nodes, "ground"], exclude={"recorder"})
+    time.sleep(0.2)
+    recorder.stop(timeout_s=10.0)
+    if recorder.returncode != 0 and error is None:
+        error = f"recorder {recorder.describe_exit()}:\n{recorder.log_tail()}"
+    return ("failed", error) if error else ("completed", None)
+
+
+def _wait_token(hub: ZenohTransport, token: str, child: Child, timeout_s: float) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if child.returncode is not None:
+            return False
+        if any(r.ok is not None for r in hub.session.liveliness().get(token, timeout=0.5)):
+            return True
+        time.sleep(0.1)
+    return False
+
+
+class _Progress:
+    """Progress of the run from the sim's ticks (one line every few seconds)."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.n_ticks = scenario.n_ticks
+        self.duration = scenario.duration_s
+        self.t_sim = 0.0
+        self.k = 0
+        self.finished = threading.Event()
+        self._wall0 = time.monotonic()
+        self._last = 0.0
+
+    def on_tick(self, sample: object) -> None:
+        try:
+            tick = Tick.model_validate_json(sample.payload.to_bytes())  # type: ignore[attr-defined]
+        except Exception:  # noqa: BLE001 - progress display only
+            return
+        self.k, self.t_sim = tick.k, tick.t_sim
+
+    def on_status(self, sample: object) -> None:
+        try:
+            status = SimStatus.model_validate_json(sample.payload.to_bytes())  # type: ignore[attr-defined]
+        except Exception:  # noqa: BLE001
+            return
+        if status.state in ("finished", "aborted"):
+            self.finished.set()
+
+    def report(self, final: bool = False) -> None:
+        now = time.monotonic()
+        if not final and now - self._last < 5.0:
+            return
+        self._last = now
+        wall = now - self._wall0
+        frac = self.t_sim / self.duration if self.duration else 0.0
+        eta = wall * (1 - frac) / frac if frac > 0 else float("nan")
+        log.info("t_sim %7.1f / %.0f s (%3.0f%%)  %6.0fx real time  ETA %5.0f s", self.t_sim,
+                 self.duration, 100 * frac, self.t_sim / max(wall, 1e-9), eta)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,26 @@
+"""One spacecraft's flight software: its apps on one executive."""
+
+from __future__ import annotations
+
+import logging
+
+from fsw.apps.nav import NavApp
+from interfaces import topics
+from interfaces.app import App, AppContext
+from interfaces.bus import Bus
+from interfaces.executive import Executive
+from interfaces.rng import stream
+from interfaces.scenario import Scenario
+
+APPS: tuple[type[App], ...] = (NavApp,)
+"""The onboard apps, in execution order within a rate group."""
+
+
+def spacecraft_executive(bus: Bus, scenario: Scenario, spacecraft: int) -> Executive:
+    """The executive of spacecraft ``spacecraft`` (1-based) with every onboard app wired."""
+    node = topics.sc_node(spacecraft)
+    log = logging.getLogger(f"insp.{node}")
+    ctx = AppContext(bus=bus, scenario=scenario, node=node, spacecraft=spacecraft,
+                     rng=stream(scenario.seed, "fsw", spacecraft), log=log)
+    return Executive(bus, scenario, [a(ctx) for a in APPS], log=log,
+                     barrier_timeout_s=scenario.sim.lockstep_timeout_s)

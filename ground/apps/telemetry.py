@@ -1,0 +1,63 @@
+"""Telemetry monitor: the ground's view of what each spacecraft has sent.
+
+Rate group low.  Inputs: every spacecraft's state estimate and heartbeat.  Output: per
+spacecraft the messages received, the messages missing by sequence count (lost on the link or
+out of range) and whether it has gone silent.  Missing telemetry is a fact to report (a link
+problem), never a zero.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from interfaces import topics
+from interfaces.app import App, AppContext, Input, Output
+from interfaces.messages import Heartbeat, Message, StateEstimate, TelemetryStatus
+
+
+@dataclass
+class _Track:
+    received: int = 0
+    gaps: int = 0
+    last_t: float | None = None
+    last_seq: dict[str, int] = field(default_factory=dict)
+
+
+class TelemetryMonitor(App):
+    NAME = "tlm_monitor"
+    RATE = "low"
+    INPUTS = (
+        Input(lambda c: topics.all_spacecraft(c.mission, "nav", "estimate"), StateEstimate, "on_tlm"),
+        Input(lambda c: topics.all_spacecraft(c.mission, "exec", "heartbeat"), Heartbeat, "on_tlm"),
+    )
+    OUTPUTS = (
+        Output("status", lambda c: topics.key(c.mission, c.node, "tlm", "status"), TelemetryStatus),
+    )
+    STALE_AFTER_S = 10.0
+    """A spacecraft silent for longer than this (sim seconds) is reported stale."""
+
+    def __init__(self, ctx: AppContext) -> None:
+        super().__init__(ctx)
+        self.tracks = {i: _Track() for i in range(1, ctx.scenario.observers.count + 1)}
+
+    def on_tlm(self, msg: Message) -> None:
+        sc = topics.spacecraft_of(msg.sender)
+        track = self.tracks.get(sc) if sc is not None else None
+        if track is None:
+            return
+        kind = type(msg).__name__
+        last = track.last_seq.get(kind, 0)
+        if msg.seq > last + 1:
+            track.gaps += msg.seq - last - 1
+        track.last_seq[kind] = max(last, msg.seq)
+        track.received += 1
+        track.last_t = msg.t_sim if track.last_t is None else max(track.last_t, msg.t_sim)
+
+    def step(self, t: float) -> None:
+        entries = [
+            TelemetryStatus.Entry(
+                spacecraft=sc, received=tr.received, seq_gaps=tr.gaps, last_t_sim=tr.last_t,
+                stale=tr.last_t is None or t - tr.last_t > self.STALE_AFTER_S)
+            for sc, tr in self.tracks.items()
+        ]
+        self.publish("status", TelemetryStatus(sender=self.ctx.node, t_sim=t, entries=entries))

@@ -1,0 +1,68 @@
+"""Evaluation of a run from its archive: navigation error against the sim's truth."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from fsw.lib.kalman import nees
+from ground.reader import RunArchive
+from interfaces import topics
+from interfaces.messages import StateEstimate, TruthState
+
+
+@dataclass(frozen=True)
+class NavErrors:
+    """Estimate minus truth of one spacecraft at each estimate time."""
+
+    t_s: np.ndarray  # (K,)
+    error: np.ndarray  # (K, 6) m, m/s
+    sigma: np.ndarray  # (K, 6) sqrt(diag P)
+    nees: np.ndarray  # (K,)
+    nis: np.ndarray  # (K,) NaN where no update
+
+    def stats(self, skip_s: float = 0.0) -> dict[str, float]:
+        """RMS/max errors and consistency figures after ``skip_s`` seconds."""
+        m = self.t_s >= skip_s
+        if not m.any():
+            return {}
+        e, q = self.error[m], self.nees[m]
+        pos, vel = np.linalg.norm(e[:, :3], axis=1), np.linalg.norm(e[:, 3:], axis=1)
+        lo, hi = chi2.ppf([0.025, 0.975], 6)
+        nis = self.nis[m][np.isfinite(self.nis[m])]
+        return {
+            "samples": int(m.sum()),
+            "pos_rms_m": float(np.sqrt(np.mean(pos**2))),
+            "pos_max_m": float(pos.max()),
+            "vel_rms_mps": float(np.sqrt(np.mean(vel**2))),
+            "nees_mean": float(q.mean()),
+            "nees_in_95_bounds": float(np.mean((q >= lo) & (q <= hi))),
+            "nis_mean": float(nis.mean()) if nis.size else float("nan"),
+        }
+
+
+def nav_errors(archive: RunArchive, mission: str) -> dict[int, NavErrors]:
+    """Per spacecraft, the state estimates compared with the truth at the same sim time."""
+    truth: dict[float, tuple[list[int], np.ndarray]] = {}
+    for ts in archive.messages(topics.truth(mission), TruthState):
+        truth[round(ts.t_sim, 6)] = (ts.spacecraft, np.hstack([ts.r_lvlh_m, ts.v_lvlh_mps]))
+    out: dict[int, NavErrors] = {}
+    by_sc: dict[int, list[StateEstimate]] = {}
+    for est in archive.messages(topics.all_spacecraft(mission, "nav", "estimate"), StateEstimate):
+        by_sc.setdefault(est.spacecraft, []).append(est)
+    for sc, ests in sorted(by_sc.items()):
+        rows = []
+        for est in ests:
+            tr = truth.get(round(est.t_sim, 6))
+            if tr is None or sc not in tr[0]:
+                continue
+            x_true = tr[1][tr[0].index(sc)]
+            x, P = np.array(est.x), np.array(est.P)
+            rows.append((est.t_sim, x - x_true, np.sqrt(np.diag(P)), nees(x, P, x_true),
+                         np.nan if est.nis is None else est.nis))
+        if rows:
+            t, e, s, q, nis = zip(*rows)
+            out[sc] = NavErrors(np.array(t), np.array(e), np.array(s), np.array(q), np.array(nis))
+    return out

@@ -1,0 +1,23 @@
+"""The ground station: the central agent's apps on one executive."""
+
+from __future__ import annotations
+
+import logging
+
+from ground.apps.telemetry import TelemetryMonitor
+from interfaces import topics
+from interfaces.app import App, AppContext
+from interfaces.bus import Bus
+from interfaces.executive import Executive
+from interfaces.rng import stream
+from interfaces.scenario import Scenario
+
+APPS: tuple[type[App], ...] = (TelemetryMonitor,)
+
+
+def ground_executive(bus: Bus, scenario: Scenario) -> Executive:
+    log = logging.getLogger("insp.ground")
+    ctx = AppContext(bus=bus, scenario=scenario, node=topics.GROUND, spacecraft=None,
+                     rng=stream(scenario.seed, "ground"), log=log)
+    return Executive(bus, scenario, [a(ctx) for a in APPS], log=log,
+                     barrier_timeout_s=scenario.sim.lockstep_timeout_s)

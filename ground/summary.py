@@ -1,0 +1,84 @@
+"""summary.json of a run (DESIGN.md contract), computed from the archive read back."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from ground.evaluation import nav_errors
+from ground.reader import ArchiveError, RunArchive, load_run
+from interfaces import topics
+from interfaces.messages import ExecStats, LinkStats, TelemetryStatus, Tick
+from interfaces.scenario import Scenario
+
+NAV_SETTLE_S = 10.0
+"""Nav statistics skip the filter's first seconds (initial transient)."""
+
+
+def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[str, Any]:
+    """The run's figures from its archive (no transport or wall-clock information)."""
+    ticks = archive.messages(topics.tick(mission), Tick)
+    execs = {m.node: m for m in archive.messages(f"{topics.ROOT}/{mission}/**/exec/stats", ExecStats)}
+    links = {m.node: m for m in archive.messages(f"{topics.ROOT}/{mission}/**/bus/link_stats", LinkStats)}
+    tlm = archive.messages(topics.key(mission, topics.GROUND, "tlm", "status"), TelemetryStatus)
+    return {
+        "ticks": len(ticks),
+        "t_sim_final_s": ticks[-1].t_sim if ticks else 0.0,
+        "messages": {"total": len(archive), "by_type": _by_type(archive)},
+        "nav": {str(sc): e.stats(skip_s=NAV_SETTLE_S)
+                for sc, e in nav_errors(archive, mission).items()},
+        "links": [c.model_dump() for node in sorted(links) for c in links[node].links],
+        "exec": {node: {"cycle_slips": {g: s.cycle_slips for g, s in m.groups.items()},
+                        "max_exec_ms": {g: round(s.max_exec_ms, 3) for g, s in m.groups.items()},
+                        "app_errors": m.app_errors, "invalid_dropped": m.invalid_dropped,
+                        "barrier_timeouts": m.barrier_timeouts}
+                 for node, m in sorted(execs.items())},
+        "telemetry": [e.model_dump() for e in tlm[-1].entries] if tlm else [],
+    }
+
+
+def _by_type(archive: RunArchive) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for type_name, count in archive.topics().values():
+        out[type_name] = out.get(type_name, 0) + count
+    return dict(sorted(out.items()))
+
+
+def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, status: str,
+                  error: str | None = None, mission: str | None = None) -> dict[str, Any]:
+    """Write ``<out>/summary.json`` and return it.  A damaged or missing archive is reported in
+    the summary (``archive_error``), never hidden."""
+    summary: dict[str, Any] = {
+        "scenario": scenario.name,
+        "seed": scenario.seed,
+        "transport": transport,
+        "duration_s": scenario.duration_s,
+        "wall_s": round(wall_s, 3),
+        "status": status,
+        "error": error,
+        "injected_faults": [f.model_dump() for f in scenario.faults],
+    }
+    try:
+        archive = load_run(out / "run.mcap")
+        summary["archive"] = {"truncated": archive.truncated}
+        summary.update(build_summary(archive, scenario, mission or scenario.name))
+        t_final = summary["t_sim_final_s"]
+        summary["real_time_factor"] = round(t_final / wall_s, 2) if wall_s > 0 else None
+    except (ArchiveError, OSError) as e:
+        summary["archive_error"] = str(e)
+    summary = _finite(summary)
+    (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    return summary
+
+
+def _finite(o: Any) -> Any:
+    """JSON has no NaN/inf: non-finite floats become null."""
+    if isinstance(o, float):
+        return o if math.isfinite(o) else None
+    if isinstance(o, dict):
+        return {k: _finite(v) for k, v in o.items()}
+    if isinstance(o, (list, tuple)):
+        return [_finite(v) for v in o]
+    return o

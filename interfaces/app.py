@@ -1,0 +1,89 @@
+"""The application model shared by flight and ground software (DESIGN.md, "Runtime model").
+
+An app declares at class level its rate group, what it subscribes to and what it publishes; the
+executive wires the declarations to the bus and runs ``step(t)`` when the group is due.  Apps talk
+to each other only through the bus.  Algorithms belong in pure functions (``fsw/lib``), so that
+an app's step stays short.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from interfaces.bus import Bus
+from interfaces.messages import Message, RateGroupName
+from interfaces.scenario import Scenario
+
+RATE_GROUPS: tuple[RateGroupName, ...] = ("high", "mid", "low")
+
+
+@dataclass(frozen=True)
+class AppContext:
+    """What an app gets from its executive."""
+
+    bus: Bus
+    scenario: Scenario
+    node: str
+    spacecraft: int | None
+    rng: np.random.Generator
+    log: logging.Logger
+
+    @property
+    def mission(self) -> str:
+        return self.bus.mission
+
+
+TopicFn = Callable[[AppContext], str]
+
+
+@dataclass(frozen=True)
+class Input:
+    """A subscription: messages of ``msg_type`` on ``topic(ctx)`` go to method ``handler``."""
+
+    topic: TopicFn
+    msg_type: type[Message]
+    handler: str
+
+
+@dataclass(frozen=True)
+class Output:
+    """A publication named ``name``: messages of ``msg_type`` on ``topic(ctx)``."""
+
+    name: str
+    topic: TopicFn
+    msg_type: type[Message]
+
+
+class App:
+    """Base of every app.  Subclasses set NAME, RATE, INPUTS, OUTPUTS and implement step()."""
+
+    NAME: ClassVar[str]
+    RATE: ClassVar[RateGroupName]
+    INPUTS: ClassVar[tuple[Input, ...]] = ()
+    OUTPUTS: ClassVar[tuple[Output, ...]] = ()
+
+    def __init__(self, ctx: AppContext) -> None:
+        self.ctx = ctx
+        self.log = ctx.log.getChild(self.NAME)
+        self._outputs = {o.name: (o.topic(ctx), o.msg_type) for o in self.OUTPUTS}
+
+    def wire(self) -> None:
+        """Subscribe the declared inputs (called once by the executive)."""
+        for i in self.INPUTS:
+            self.ctx.bus.subscribe(i.topic(self.ctx), i.msg_type, getattr(self, i.handler))
+
+    def publish(self, name: str, msg: Message) -> None:
+        """Publish on a declared output; anything else is a programming error."""
+        key, msg_type = self._outputs[name]
+        if not isinstance(msg, msg_type):
+            raise TypeError(f"{self.NAME}.{name} publishes {msg_type.__name__}, got {type(msg).__name__}")
+        self.ctx.bus.publish(key, msg)
+
+    def step(self, t: float) -> None:
+        """Run one cycle at simulation time ``t`` (s)."""
+        raise NotImplementedError

@@ -1,0 +1,288 @@
+"""The software bus: typed publish/subscribe over a transport (Zenoh or in-process).
+
+What the Bus guarantees, identically on every transport:
+
+* **Own key space.** A node publishes only under its own prefix (``topics.node_prefix``).
+* **Sequence numbers.** Each key has its own sequence count starting at 1, set on publish.
+* **Validation.** A received message that is not valid JSON of the subscribed model (wrong
+  fields, NaN, oversize) is dropped, counted in ``invalid_dropped`` and logged; nothing else
+  happens, the node goes on.
+* **Deterministic delivery.** Deferred subscriptions (the default) are delivered by
+  ``dispatch(t_now)`` on the caller's thread, sorted by (send time, key, sequence).  Messages of
+  other flight/ground nodes become eligible one tick after they were sent (at the earliest) and
+  after the channel delay; sim messages (sensors, truth) as soon as the tick they belong to runs.
+  Immediate subscriptions run on the transport thread (the executive's tick, the recorder).
+* **Channel.** Messages between two different spacecraft/ground nodes pass the receiver's
+  ``ChannelModel`` (range at send time, loss, cuts, delay) at dispatch.
+* **Barrier.** ``wait_for(expect)`` blocks until the messages announced in a Tick have arrived.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TypeVar
+
+from pydantic import ValidationError
+
+from interfaces import topics
+from interfaces.channel import ChannelModel, Verdict, applies
+from interfaces.messages import Message, TruthState, json_schema, registry
+from interfaces.transport import LivenessHandler, RawHandler, Transport
+
+M = TypeVar("M", bound=Message)
+MAX_PAYLOAD_BYTES = 1 << 20
+_EPS_S = 1e-6
+
+
+@dataclass
+class _Sub:
+    key_expr: str
+    msg_type: type[Message]
+    handler: Callable[[Message], None]
+    immediate: bool
+
+
+@dataclass
+class _Envelope:
+    msg: Message
+    key: str
+    src: str | None
+    local: bool
+    subs: list[_Sub]
+
+    @property
+    def order(self) -> tuple[float, str, int]:
+        return (self.msg.t_sim, self.key, self.msg.seq)
+
+
+@dataclass
+class BusStats:
+    published: int = 0
+    received: int = 0
+    invalid_dropped: int = 0
+    handler_errors: int = 0
+    channel_dropped: int = 0
+
+
+@dataclass(eq=False)
+class Bus:
+    node: str
+    mission: str
+    transport: Transport
+    channel: ChannelModel | None = None
+    log: logging.Logger = field(default=None)  # type: ignore[assignment]
+    stats: BusStats = field(default_factory=BusStats)
+    _seq: dict[str, int] = field(default_factory=dict)
+    _published_since: dict[str, int] = field(default_factory=dict)
+    _groups: dict[str, list[_Sub]] = field(default_factory=dict)
+    _raw: dict[str, list[RawHandler]] = field(default_factory=dict)
+    _local_cache: dict[str, list[_Sub]] = field(default_factory=dict)
+    _pending: list[_Envelope] = field(default_factory=list)
+    _received_seq: dict[str, int] = field(default_factory=dict)
+    _await_cache: dict[str, bool] = field(default_factory=dict)
+    _cond: threading.Condition = field(default_factory=threading.Condition)
+
+    def __post_init__(self) -> None:
+        self.prefix = topics.node_prefix(self.mission, self.node)
+        if self.log is None:
+            self.log = logging.getLogger(f"insp.bus.{self.node}")
+        if self.channel is not None:
+            self.subscribe(topics.truth(self.mission), TruthState, self._on_truth, immediate=True)
+
+    # --- publishing ------------------------------------------------------------------------
+
+    def publish(self, key: str, msg: Message, announce: bool = True) -> None:
+        """Publish ``msg`` on ``key`` (which must be in this node's key space).
+
+        Sets ``sender``, ``seq`` and ``t_wall``.  Treat a published message as immutable.
+        ``announce=False`` leaves the key out of ``published_since_last`` (lockstep control
+        messages that nobody must wait for)."""
+        if not key.startswith(self.prefix + "/"):
+            raise ValueError(f"node {self.node} may not publish on {key!r} (own space: {self.prefix})")
+        seq = self._seq.get(key, 0) + 1
+        self._seq[key] = seq
+        if announce:
+            self._published_since[key] = seq
+        msg.sender, msg.seq, msg.t_wall = self.node, seq, time.time()
+        self.stats.published += 1
+        for sub in self._local_subs(key):
+            self._enqueue(_Envelope(msg, key, self.node, True, [sub]))
+        self.transport.publish(key, type(msg).__name__, msg.model_dump_json().encode())
+
+    def published_since_last(self) -> dict[str, int]:
+        """Keys published since the previous call, with their last sequence number."""
+        out, self._published_since = self._published_since, {}
+        return out
+
+    # --- subscribing -----------------------------------------------------------------------
+
+    def subscribe(
+        self,
+        key_expr: str,
+        msg_type: type[M],
+        handler: Callable[[M], None],
+        immediate: bool = False,
+    ) -> None:
+        """Deliver messages of ``msg_type`` on ``key_expr`` to ``handler``: at ``dispatch`` time
+        (default) or at once on the transport thread (``immediate``)."""
+        sub = _Sub(key_expr, msg_type, handler, immediate)  # type: ignore[arg-type]
+        group = self._groups.get(key_expr)
+        if group is None:
+            self._groups[key_expr] = group = []
+            self.transport.subscribe(key_expr, lambda k, t, p, e=key_expr: self._on_raw(e, k, p))
+        group.append(sub)
+        self._local_cache.clear()
+        self._await_cache.clear()
+
+    def subscribe_raw(self, key_expr: str, handler: RawHandler) -> None:
+        """Raw samples (key, type name, payload) at once, unvalidated (recorder, tools)."""
+        self._raw.setdefault(key_expr, []).append(handler)
+        self.transport.subscribe(key_expr, handler)
+
+    def _local_subs(self, key: str) -> list[_Sub]:
+        subs = self._local_cache.get(key)
+        if subs is None:
+            subs = [s for e, g in self._groups.items() if topics.matches(e, key) for s in g]
+            self._local_cache[key] = subs
+        return subs
+
+    def _on_raw(self, key_expr: str, key: str, payload: bytes) -> None:
+        """Transport callback (any thread): validate, count, queue or call."""
+        self.stats.received += 1
+        if len(payload) > MAX_PAYLOAD_BYTES:
+            self._invalid(key, f"payload of {len(payload)} bytes exceeds {MAX_PAYLOAD_BYTES}")
+            return
+        subs = self._groups.get(key_expr, [])
+        decoded: dict[type[Message], Message] = {}
+        for sub in subs:
+            msg = decoded.get(sub.msg_type)
+            if msg is None:
+                try:
+                    msg = sub.msg_type.model_validate_json(payload)
+                except ValidationError as e:
+                    self._invalid(key, f"not a valid {sub.msg_type.__name__}: {_first_error(e)}")
+                    return
+                decoded[sub.msg_type] = msg
+                with self._cond:
+                    if msg.seq > self._received_seq.get(key, 0):
+                        self._received_seq[key] = msg.seq
+                    self._cond.notify_all()
+            if sub.immediate:
+                self._call(sub, msg, key)
+            else:
+                self._enqueue(_Envelope(msg, key, topics.node_of_key(key), False, [sub]))
+
+    def _enqueue(self, env: _Envelope) -> None:
+        with self._cond:
+            self._pending.append(env)
+
+    def _invalid(self, key: str, why: str) -> None:
+        self.stats.invalid_dropped += 1
+        n = self.stats.invalid_dropped
+        if n <= 5 or n % 100 == 0:
+            self.log.warning("%s dropped invalid message #%d on %s: %s", self.node, n, key, why)
+
+    def _call(self, sub: _Sub, msg: Message, key: str) -> None:
+        try:
+            sub.handler(msg)
+        except Exception:  # noqa: BLE001 - a handler's failure must not stop the node
+            self.stats.handler_errors += 1
+            self.log.exception("%s: handler for %s failed", self.node, key)
+
+    def _on_truth(self, msg: TruthState) -> None:
+        assert self.channel is not None
+        self.channel.observe_truth(msg.t_sim, msg.spacecraft, msg.r_lvlh_m)
+
+    # --- delivery --------------------------------------------------------------------------
+
+    def dispatch(self, t_now: float, include_now: bool = False) -> int:
+        """Deliver the deferred messages that are due at ``t_now`` (s), in deterministic order.
+
+        Messages from other spacecraft/ground nodes are due once sent strictly before ``t_now``
+        (or at ``t_now`` with ``include_now``) and their channel delay has elapsed; local and sim
+        messages once their time is ``<= t_now``.  Returns the number of messages delivered."""
+        delay = self.channel.delay_s if self.channel is not None else 0.0
+        with self._cond:
+            due, keep = [], []
+            for env in self._pending:
+                (due if self._is_due(env, t_now, include_now, delay) else keep).append(env)
+            self._pending = keep
+        due.sort(key=lambda e: e.order)
+        delivered = 0
+        for env in due:
+            if not env.local and self.channel is not None and applies(env.src, self.node):
+                if self.channel.decide(env.src or "", env.msg.t_sim) is not Verdict.DELIVER:
+                    self.stats.channel_dropped += 1
+                    continue
+            for sub in env.subs:
+                self._call(sub, env.msg, env.key)
+            delivered += 1
+        return delivered
+
+    def _is_due(self, env: _Envelope, t_now: float, include_now: bool, delay: float) -> bool:
+        t = env.msg.t_sim
+        if env.local or env.src == topics.SIM:
+            return t <= t_now + _EPS_S
+        link_delay = delay if applies(env.src, self.node) else 0.0
+        sent_before = t <= t_now + _EPS_S if include_now else t < t_now - _EPS_S
+        return sent_before and t + link_delay <= t_now + _EPS_S
+
+    def wait_for(self, expect: dict[str, int], timeout_s: float) -> list[str]:
+        """Block until every key of ``expect`` that this node subscribes to (and does not own)
+        has arrived up to its sequence number; return the keys still missing at the timeout."""
+        wanted = {k: s for k, s in expect.items() if self._awaits(k)}
+        deadline = time.monotonic() + timeout_s
+        with self._cond:
+            while True:
+                missing = [k for k, s in wanted.items() if self._received_seq.get(k, 0) < s]
+                left = deadline - time.monotonic()
+                if not missing or left <= 0:
+                    return missing
+                self._cond.wait(left)
+
+    def _awaits(self, key: str) -> bool:
+        """Whether ``key`` is another node's key that a deferred/immediate subscription covers."""
+        hit = self._await_cache.get(key)
+        if hit is None:
+            hit = not key.startswith(self.prefix + "/") and any(
+                topics.matches(e, key) for e in self._groups
+            )
+            self._await_cache[key] = hit
+        return hit
+
+    # --- services --------------------------------------------------------------------------
+
+    def serve_schemas(self) -> None:
+        """Answer ``<prefix>/schema/<Type>`` queries with the message type's JSON schema."""
+        reg = registry()
+
+        def respond(k: str) -> bytes | None:
+            t = reg.get(k.rsplit("/", 1)[-1])
+            return None if t is None else _json_bytes(json_schema(t))
+
+        self.transport.serve(topics.schema_queryable(self.mission, self.node), respond)
+
+    def declare_alive(self) -> None:
+        """Announce this node (Zenoh liveliness token ``<prefix>/alive``)."""
+        self.transport.declare_alive(self.node, f"{self.prefix}/alive")
+
+    def watch_alive(self, handler: LivenessHandler) -> None:
+        self.transport.watch_alive(f"{topics.ROOT}/{self.mission}/**/alive", handler)
+
+    def close(self) -> None:
+        self.transport.close()
+
+
+def _first_error(e: ValidationError) -> str:
+    err = e.errors()[0]
+    where = ".".join(str(x) for x in err["loc"])
+    return f"{where}: {err['msg']}" if where else err["msg"]
+
+
+def _json_bytes(obj: object) -> bytes:
+    return json.dumps(obj).encode()

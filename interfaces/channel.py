@@ -1,0 +1,214 @@
+"""Channel model of the links between spacecraft and between spacecraft and ground.
+
+Applied by the receiving node's Bus to every message from another spacecraft/ground node, in a
+deterministic order (sorted by send time, key, sequence), so results do not depend on the
+transport or on arrival order:
+
+* range: delivered only when the two ends are within ``comms.range_m`` at the *send* time, using
+  the sim's truth positions (LVLH, m).  The ground is reached through the target, at the origin.
+* cuts: scheduled link cuts (``comms.cuts``) and injected ones (``cut``) drop everything.
+* loss: Bernoulli with ``comms.packet_loss``, or Gilbert-Elliott bursts with the same mean loss
+  rate and a mean burst length ``comms.burst.mean_length_packets`` (Gilbert 1960, Elliott 1963:
+  two-state Markov chain, loss in the bad state).  Every directed link has its own generator
+  seeded from the scenario seed and the link name.
+* delay: a fixed ``comms.delay_s``; the Bus holds a message until the receiver's time reaches
+  send time + delay (and at least one tick).
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+import threading
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+
+from interfaces.messages import LinkCounter
+from interfaces.rng import stream
+from interfaces.scenario import Comms, LinkCut
+from interfaces.topics import GROUND, spacecraft_of
+
+
+class Verdict(Enum):
+    DELIVER = "delivered"
+    RANGE = "dropped_range"
+    LOSS = "dropped_loss"
+    CUT = "dropped_cut"
+
+
+def gilbert_elliott_rates(loss_rate: float, mean_burst_packets: float) -> tuple[float, float]:
+    """Transition probabilities (good→bad p, bad→good r) of a Gilbert channel whose stationary
+    loss rate is ``loss_rate`` = p/(p+r) and whose mean loss-burst length is 1/r packets."""
+    if not 0.0 <= loss_rate < 1.0:
+        raise ValueError(f"loss rate must be in [0, 1), got {loss_rate}")
+    if mean_burst_packets < 1.0:
+        raise ValueError(f"mean burst length must be >= 1 packet, got {mean_burst_packets}")
+    r = 1.0 / mean_burst_packets
+    p = r * loss_rate / (1.0 - loss_rate)
+    if p > 1.0:
+        raise ValueError(
+            f"loss rate {loss_rate} with bursts of {mean_burst_packets} packets is not realizable "
+            f"(needs P(good→bad) = {p:.3f} > 1)"
+        )
+    return p, r
+
+
+@dataclass
+class _Link:
+    rng: np.random.Generator
+    counter: LinkCounter
+    bad: bool = False
+
+
+@dataclass
+class _Cut:
+    a: str
+    b: str
+    start_s: float
+    end_s: float
+
+    def covers(self, src: str, dst: str, t: float) -> bool:
+        if not self.start_s <= t < self.end_s:
+            return False
+        return (_end_matches(self.a, src) and _end_matches(self.b, dst)) or (
+            _end_matches(self.a, dst) and _end_matches(self.b, src)
+        )
+
+
+def _end_matches(pattern: str, node: str) -> bool:
+    return pattern == "*" or pattern == node
+
+
+@dataclass
+class ChannelModel:
+    """The channel as seen by one receiving node (``receiver``: "sc<N>" or "ground")."""
+
+    receiver: str
+    comms: Comms
+    seed: int
+    _links: dict[str, _Link] = field(default_factory=dict)
+    _truth_t: list[float] = field(default_factory=list)
+    _truth_pos: list[dict[str, np.ndarray]] = field(default_factory=list)
+    _cuts: list[_Cut] = field(default_factory=list)
+    _extra_loss: dict[str, float] = field(default_factory=dict)
+    _lock: threading.Lock = field(default_factory=threading.Lock)
+
+    def __post_init__(self) -> None:
+        self._cuts = [_Cut(c.a, c.b, c.start_s, c.end_s) for c in self.comms.cuts]
+        self._ge = (
+            gilbert_elliott_rates(self.comms.packet_loss, self.comms.burst.mean_length_packets)
+            if self.comms.burst is not None and self.comms.packet_loss > 0.0
+            else None
+        )
+
+    @property
+    def delay_s(self) -> float:
+        return self.comms.delay_s
+
+    # --- inputs --------------------------------------------------------------------------
+
+    def observe_truth(self, t_sim: float, spacecraft: list[int], r_lvlh_m: list[list[float]]) -> None:
+        """Record true positions at ``t_sim`` (from the sim's TruthState); thread-safe."""
+        pos = {f"sc{sc}": np.asarray(r, dtype=float) for sc, r in zip(spacecraft, r_lvlh_m)}
+        pos[GROUND] = np.zeros(3)
+        with self._lock:
+            i = bisect.bisect_right(self._truth_t, t_sim)
+            if i > 0 and self._truth_t[i - 1] == t_sim:
+                self._truth_pos[i - 1] = pos
+                return
+            self._truth_t.insert(i, t_sim)
+            self._truth_pos.insert(i, pos)
+
+    def cut(self, a: str, b: str = "*", start_s: float = 0.0, end_s: float = math.inf) -> None:
+        """Inject a link cut (e.g. a ``link_loss`` fault)."""
+        LinkCut(a=a, b=b, start_s=start_s, end_s=end_s)  # validates the ends
+        self._cuts.append(_Cut(a, b, start_s, end_s))
+
+    def set_extra_loss(self, node: str, probability: float) -> None:
+        """Additional Bernoulli loss on every link touching ``node`` (``packet_loss`` fault)."""
+        if not 0.0 <= probability < 1.0:
+            raise ValueError(f"loss probability must be in [0, 1), got {probability}")
+        self._extra_loss[node] = probability
+
+    # --- decision ------------------------------------------------------------------------
+
+    def decide(self, src: str, t_send: float) -> Verdict:
+        """Fate of one message from ``src`` sent at ``t_send``; updates the link counters.
+
+        Call in a deterministic order (the Bus sorts by send time, key, sequence)."""
+        link = self._link(src)
+        link.counter.sent += 1
+        verdict = self._verdict(link, src, t_send)
+        if verdict is Verdict.DELIVER:
+            link.counter.delivered += 1
+        elif verdict is Verdict.RANGE:
+            link.counter.dropped_range += 1
+        elif verdict is Verdict.LOSS:
+            link.counter.dropped_loss += 1
+        else:
+            link.counter.dropped_cut += 1
+        return verdict
+
+    def _verdict(self, link: _Link, src: str, t_send: float) -> Verdict:
+        if any(c.covers(src, self.receiver, t_send) for c in self._cuts):
+            return Verdict.CUT
+        if not self._in_range(src, t_send):
+            return Verdict.RANGE
+        # Every message advances the link's random stream by the same draws whatever the
+        # outcome, so one verdict never shifts the randomness of the next.
+        lost = False
+        if self._ge is not None:
+            p, r = self._ge
+            u = link.rng.random()
+            link.bad = (u >= r) if link.bad else (u < p)
+            lost = link.bad
+        elif self.comms.packet_loss > 0.0:
+            lost = link.rng.random() < self.comms.packet_loss
+        extra = max(self._extra_loss.get(src, 0.0), self._extra_loss.get(self.receiver, 0.0))
+        if extra > 0.0 and link.rng.random() < extra:
+            lost = True
+        return Verdict.LOSS if lost else Verdict.DELIVER
+
+    def _in_range(self, src: str, t_send: float) -> bool:
+        pos = self._positions_at(t_send)
+        if pos is None:
+            return False
+        a, b = pos.get(src), pos.get(self.receiver)
+        if a is None or b is None:
+            return False
+        return float(np.linalg.norm(a - b)) <= self.comms.range_m
+
+    def _positions_at(self, t: float) -> dict[str, np.ndarray] | None:
+        """Truth at the latest time <= t (+1 µs tolerance); prunes history older than needed."""
+        with self._lock:
+            i = bisect.bisect_right(self._truth_t, t + 1e-6)
+            if i == 0:
+                return None
+            pos = self._truth_pos[i - 1]
+            keep_from = max(0, i - 1 - 4)  # messages are decided in time order: keep a margin
+            if keep_from > 0:
+                del self._truth_t[:keep_from]
+                del self._truth_pos[:keep_from]
+            return pos
+
+    def _link(self, src: str) -> _Link:
+        link = self._links.get(src)
+        if link is None:
+            rng = stream(self.seed, f"link:{src}->{self.receiver}")
+            link = _Link(rng, LinkCounter(src=src, dst=self.receiver))
+            self._links[src] = link
+        return link
+
+    def counters(self) -> list[LinkCounter]:
+        """Copies of the per-link counters, sorted by source."""
+        return [self._links[s].counter.model_copy() for s in sorted(self._links)]
+
+
+def applies(src: str | None, dst: str) -> bool:
+    """Whether a message from node ``src`` to node ``dst`` crosses a modelled link: between two
+    different nodes that are each a spacecraft or the ground (sim traffic is hardware-internal)."""
+    if src is None or src == dst:
+        return False
+    return all(n == GROUND or spacecraft_of(n) is not None for n in (src, dst))

@@ -1,0 +1,91 @@
+"""Command-line plumbing shared by the node processes (sim, fsw, ground, recorder)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import threading
+from collections.abc import Callable
+
+from interfaces.bus import Bus
+from interfaces.channel import ChannelModel
+from interfaces.executive import Executive, TickClient
+from interfaces.scenario import Scenario, ScenarioError, load_scenario
+from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
+
+
+def add_node_args(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--scenario", required=True, help="scenario TOML file")
+    parser.add_argument("--mission", help="key-space name (default: the scenario name)")
+    parser.add_argument("--seed", type=int, help="override the scenario seed")
+    parser.add_argument("--duration", type=float, help="override duration_s (s)")
+    parser.add_argument("--connect", default=DEFAULT_ENDPOINT,
+                        help=f"Zenoh endpoint to join (default {DEFAULT_ENDPOINT})")
+    parser.add_argument("--zenoh-config", help="Zenoh JSON5 config file (overrides --connect)")
+    parser.add_argument("--log-level", default="INFO")
+
+
+def load_node_scenario(args: argparse.Namespace) -> Scenario:
+    """The scenario with command-line overrides; exits with a readable message if invalid."""
+    try:
+        return load_scenario(args.scenario).with_overrides(args.seed, args.duration)
+    except ScenarioError as e:
+        raise SystemExit(str(e)) from None
+
+
+def mission_of(args: argparse.Namespace, scenario: Scenario) -> str:
+    return str(args.mission or scenario.name)
+
+
+def open_zenoh(args: argparse.Namespace) -> ZenohTransport:
+    return ZenohTransport(ZenohSettings(connect=(args.connect,), config_file=args.zenoh_config))
+
+
+def setup_logging(level: str, name: str) -> logging.Logger:
+    logging.basicConfig(level=getattr(logging, level.upper(), logging.INFO),
+                        format=f"%(asctime)s {name:>7} %(levelname)s %(message)s",
+                        datefmt="%H:%M:%S")
+    return logging.getLogger(f"insp.{name}")
+
+
+def stop_on_signals() -> threading.Event:
+    """An event set by SIGINT/SIGTERM, so a node finishes its loop and closes cleanly."""
+    stop = threading.Event()
+
+    def handler(signum: int, _frame: object) -> None:
+        stop.set()
+
+    signal.signal(signal.SIGINT, handler)
+    signal.signal(signal.SIGTERM, handler)
+    return stop
+
+
+def run_participant(
+    args: argparse.Namespace,
+    node: str,
+    build: Callable[[Bus, Scenario], Executive],
+) -> int:
+    """Main loop of a lockstep node process (a spacecraft or the ground) over Zenoh.
+
+    Joins the network, wires the executive (with the channel model of ``node``), serves the
+    message schemas, announces itself, and runs ticks until the sim finishes (exit 0), the sim
+    disappears (exit 3) or a signal stops it (exit 0).  The Zenoh session is always closed."""
+    log = setup_logging(args.log_level, node)
+    scenario = load_node_scenario(args)
+    stop = stop_on_signals()
+    bus = Bus(node, mission_of(args, scenario), open_zenoh(args),
+              channel=ChannelModel(node, scenario.comms, scenario.seed))
+    try:
+        client = TickClient(build(bus, scenario))
+        bus.watch_alive(client.on_liveness)
+        bus.serve_schemas()
+        bus.declare_alive()
+        log.info("ready")
+        client.serve(stop)
+        if client.sim_lost and not client.finished.is_set():
+            log.error("sim lost before the end of the run")
+            return 3
+        return 0
+    finally:
+        bus.close()

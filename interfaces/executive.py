@@ -1,0 +1,163 @@
+"""The rate-group executive: hosts a node's apps and runs them on the sim's ticks.
+
+Per tick k (t = k·dt): wait until the messages announced in the Tick have arrived (barrier), then
+for each due rate group (high every tick, mid every ω_high/ω_mid ticks, low every ω_high/ω_low),
+deliver the due messages and run the group's apps in declaration order; a group whose wall time
+exceeds its period × ``sim.cycle_budget_scale`` counts a cycle slip (an overrun is reported, never
+absorbed).  At ω_mid the node publishes its heartbeat, executive stats and link stats.  Finally it
+answers the sim with TickDone(k), announcing what it published.
+
+The same executive runs onboard (one per spacecraft) and on the ground.
+"""
+
+from __future__ import annotations
+
+import logging
+import queue
+import threading
+import time
+from dataclasses import dataclass, field
+
+from interfaces import topics
+from interfaces.app import RATE_GROUPS, App
+from interfaces.bus import Bus
+from interfaces.messages import (
+    ExecStats,
+    GroupStats,
+    Heartbeat,
+    LinkStats,
+    SimStatus,
+    Tick,
+    TickDone,
+)
+from interfaces.scenario import Scenario
+
+
+@dataclass(eq=False)
+class Executive:
+    bus: Bus
+    scenario: Scenario
+    apps: list[App]
+    log: logging.Logger = field(default_factory=lambda: logging.getLogger("insp.exec"))
+    barrier_timeout_s: float = 5.0
+
+    def __post_init__(self) -> None:
+        rates = self.scenario.rates
+        scale = self.scenario.sim.cycle_budget_scale
+        self.period = {g: rates.ticks_per(g) for g in RATE_GROUPS}
+        self.groups = {g: [a for a in self.apps if a.RATE == g] for g in RATE_GROUPS}
+        self.stats = {
+            g: GroupStats(budget_ms=1e3 * self.period[g] * rates.dt_s * scale) for g in RATE_GROUPS
+        }
+        self.app_errors = 0
+        self.barrier_timeouts = 0
+        self.ticks = 0
+        m, n = self.bus.mission, self.bus.node
+        self._keys = {
+            "done": topics.tick_done(m, n),
+            "heartbeat": topics.key(m, n, "exec", "heartbeat"),
+            "stats": topics.key(m, n, "exec", "stats"),
+            "links": topics.key(m, n, "bus", "link_stats"),
+        }
+        for app in self.apps:
+            app.wire()
+
+    def run_tick(self, tick: Tick) -> None:
+        """Run every due rate group for ``tick`` and answer with TickDone."""
+        t, k = tick.t_sim, tick.k
+        missing = self.bus.wait_for(tick.expect, self.barrier_timeout_s)
+        if missing:
+            self.barrier_timeouts += 1
+            self.log.warning("%s tick %d: announced messages missing after %.1f s: %s",
+                             self.bus.node, k, self.barrier_timeout_s, ", ".join(sorted(missing)))
+        for g in RATE_GROUPS:
+            if k % self.period[g] == 0:
+                self._run_group(g, t)
+        self.ticks += 1
+        if k % self.period["mid"] == 0:
+            self._publish_housekeeping(t, k)
+        done = TickDone(sender=self.bus.node, t_sim=t, k=k,
+                        published=self.bus.published_since_last())
+        self.bus.publish(self._keys["done"], done, announce=False)
+
+    def _run_group(self, g: str, t: float) -> None:
+        self.bus.dispatch(t)
+        start = time.perf_counter()
+        for app in self.groups[g]:
+            try:
+                app.step(t)
+            except Exception:  # noqa: BLE001 - one app's failure must not stop the node
+                self.app_errors += 1
+                if self.app_errors <= 5 or self.app_errors % 100 == 0:
+                    self.log.exception("%s: app %s failed at t=%.3f s (error #%d)",
+                                       self.bus.node, app.NAME, t, self.app_errors)
+        ms = 1e3 * (time.perf_counter() - start)
+        s = self.stats[g]
+        s.runs += 1
+        s.max_exec_ms = max(s.max_exec_ms, ms)
+        if ms > s.budget_ms:
+            s.cycle_slips += 1
+
+    def _publish_housekeeping(self, t: float, k: int) -> None:
+        node = self.bus.node
+        self.bus.publish(self._keys["heartbeat"], Heartbeat(
+            sender=node, t_sim=t, node=node, apps=[a.NAME for a in self.apps], k=k))
+        self.bus.publish(self._keys["stats"], ExecStats(
+            sender=node, t_sim=t, node=node,
+            groups={g: s.model_copy() for g, s in self.stats.items()},
+            app_errors=self.app_errors + self.bus.stats.handler_errors,
+            invalid_dropped=self.bus.stats.invalid_dropped,
+            barrier_timeouts=self.barrier_timeouts, ticks=self.ticks))
+        if self.bus.channel is not None:
+            self.bus.publish(self._keys["links"], LinkStats(
+                sender=node, t_sim=t, node=node, links=self.bus.channel.counters()))
+
+
+@dataclass(eq=False)
+class TickClient:
+    """Lockstep participation of a node: receives the sim's ticks, runs them on the executive.
+
+    ``synchronous`` (in-process transport): a tick runs inside the sim's publish call.
+    Otherwise ticks queue up and ``serve()`` runs them on the calling (main) thread until the sim
+    reports the run finished, or the sim's liveliness token disappears."""
+
+    executive: Executive
+    synchronous: bool = False
+    _ticks: queue.Queue[Tick | None] = field(default_factory=queue.Queue)
+    finished: threading.Event = field(default_factory=threading.Event)
+    sim_lost: bool = False
+
+    def __post_init__(self) -> None:
+        bus = self.executive.bus
+        bus.subscribe(topics.tick(bus.mission), Tick, self._on_tick, immediate=True)
+        bus.subscribe(topics.sim_status(bus.mission), SimStatus, self._on_status, immediate=True)
+
+    def _on_tick(self, tick: Tick) -> None:
+        if self.synchronous:
+            self.executive.run_tick(tick)
+        else:
+            self._ticks.put(tick)
+
+    def _on_status(self, status: SimStatus) -> None:
+        if status.state in ("finished", "aborted"):
+            self.finished.set()
+            self._ticks.put(None)
+
+    def on_liveness(self, node: str, alive: bool) -> None:
+        """Liveliness handler: losing the sim ends the node's loop (nothing waits forever)."""
+        if node == topics.SIM and not alive:
+            self.sim_lost = True
+            self._ticks.put(None)
+
+    def serve(self, stop: threading.Event | None = None) -> None:
+        """Run ticks until finished, the sim is lost, or ``stop`` is set."""
+        while not (stop is not None and stop.is_set()):
+            try:
+                tick = self._ticks.get(timeout=0.5)
+            except queue.Empty:
+                continue
+            if tick is None:
+                if self.finished.is_set() or self.sim_lost:
+                    return
+                continue
+            self.executive.run_tick(tick)

@@ -1,0 +1,158 @@
+"""Zenoh transport of the Bus (eclipse-zenoh 1.x).
+
+Default network: every process is a Zenoh *peer* on loopback with multicast scouting off.  One
+process (the launcher, ``deploy/run_constellation.py``) listens on the well-known endpoint
+(``tcp/127.0.0.1:7447`` by default); every other process listens on a free loopback port and
+connects to it, and gossip scouting completes the peer mesh.  Any Zenoh client can connect to the
+well-known endpoint and subscribe to ``insp/**``.  For several hosts, pass a Zenoh JSON5 config
+file (router, endpoints) instead.
+
+Messages are JSON with encoding ``application/json;<MessageType>``; publications use the BLOCK
+congestion control so that nothing is dropped under pressure (the channel model, not the
+middleware, decides what is lost).  Zenoh sessions must be closed explicitly: an open session
+keeps the interpreter from exiting.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import zenoh
+
+from interfaces.transport import LivenessHandler, RawHandler, Responder
+
+DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
+
+
+@dataclass(frozen=True)
+class ZenohSettings:
+    """Where a process joins the Zenoh network."""
+
+    connect: tuple[str, ...] = (DEFAULT_ENDPOINT,)
+    listen: tuple[str, ...] = ("tcp/127.0.0.1:0",)
+    mode: Literal["peer", "client", "router"] = "peer"
+    config_file: str | None = None
+
+    def config(self) -> zenoh.Config:
+        if self.config_file:
+            return zenoh.Config.from_file(str(Path(self.config_file)))
+        c = zenoh.Config()
+        c.insert_json5("mode", json.dumps(self.mode))
+        c.insert_json5("scouting/multicast/enabled", "false")
+        c.insert_json5("connect/endpoints", json.dumps(list(self.connect)))
+        if self.mode != "client":
+            c.insert_json5("listen/endpoints", json.dumps(list(self.listen)))
+        return c
+
+    @staticmethod
+    def hub(endpoint: str = DEFAULT_ENDPOINT) -> ZenohSettings:
+        """Settings of the process that listens on the well-known endpoint."""
+        return ZenohSettings(connect=(), listen=(endpoint,))
+
+
+def type_of_encoding(encoding: zenoh.Encoding) -> str:
+    """Message type name carried in the encoding schema (``application/json;<Type>``)."""
+    s = str(encoding)
+    return s.split(";", 1)[1] if ";" in s else ""
+
+
+@dataclass(eq=False)
+class ZenohTransport:
+    settings: ZenohSettings = field(default_factory=ZenohSettings)
+    _session: Any = None
+    _publishers: dict[tuple[str, str], Any] = field(default_factory=dict)
+    _entities: list[Any] = field(default_factory=list)
+    _lock: threading.Lock = field(default_factory=threading.Lock)
+    _closed: bool = False
+
+    def __post_init__(self) -> None:
+        self._session = zenoh.open(self.settings.config())
+
+    @property
+    def session(self) -> Any:
+        return self._session
+
+    def publish(self, key: str, type_name: str, payload: bytes) -> None:
+        pub = self._publishers.get((key, type_name))
+        if pub is None:
+            with self._lock:
+                pub = self._session.declare_publisher(
+                    key,
+                    encoding=zenoh.Encoding.APPLICATION_JSON.with_schema(type_name),
+                    congestion_control=zenoh.CongestionControl.BLOCK,
+                    allowed_destination=zenoh.Locality.REMOTE,
+                )
+                self._publishers[(key, type_name)] = pub
+        pub.put(payload)
+
+    def subscribe(self, key_expr: str, handler: RawHandler) -> None:
+        def on_sample(sample: zenoh.Sample) -> None:
+            handler(str(sample.key_expr), type_of_encoding(sample.encoding),
+                    sample.payload.to_bytes())
+
+        sub = self._session.declare_subscriber(
+            key_expr, on_sample, allowed_origin=zenoh.Locality.REMOTE
+        )
+        self._entities.append(sub)
+
+    def serve(self, key_expr: str, responder: Responder) -> None:
+        def on_query(query: zenoh.Query) -> None:
+            k = str(query.key_expr) if query.key_expr is not None else str(query.selector)
+            reply = responder(k)
+            if reply is not None:
+                query.reply(k, reply, encoding=zenoh.Encoding.APPLICATION_JSON)
+
+        self._entities.append(self._session.declare_queryable(key_expr, on_query))
+
+    def query(self, selector: str, timeout_s: float = 2.0) -> list[tuple[str, bytes]]:
+        out = []
+        for reply in self._session.get(selector, timeout=timeout_s):
+            if reply.ok is not None:
+                out.append((str(reply.ok.key_expr), reply.ok.payload.to_bytes()))
+        return out
+
+    def declare_alive(self, node: str, token_key: str) -> None:
+        self._entities.append(self._session.liveliness().declare_token(token_key))
+
+    def watch_alive(self, key_expr: str, handler: LivenessHandler) -> None:
+        def on_sample(sample: zenoh.Sample) -> None:
+            node = _node_from_token(str(sample.key_expr))
+            if node is not None:
+                handler(node, sample.kind == zenoh.SampleKind.PUT)
+
+        self._entities.append(
+            self._session.liveliness().declare_subscriber(key_expr, on_sample, history=True)
+        )
+
+    def close(self) -> None:
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+        for e in reversed(self._entities):
+            try:
+                e.undeclare()
+            except Exception:  # noqa: BLE001 - best effort on shutdown
+                pass
+        for p in self._publishers.values():
+            try:
+                p.undeclare()
+            except Exception:  # noqa: BLE001
+                pass
+        self._session.close()
+
+
+def _node_from_token(token_key: str) -> str | None:
+    """Liveliness tokens are ``<node prefix>/alive``: recover the node name."""
+    parts = token_key.split("/")
+    if parts[-1] != "alive":
+        return None
+    if len(parts) == 5 and parts[2] == "sc" and parts[3].isdigit():
+        return f"sc{int(parts[3])}"
+    if len(parts) == 4 and parts[2] in ("sim", "ground"):
+        return parts[2]
+    return None

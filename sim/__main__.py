@@ -1,0 +1,52 @@
+"""Sim process (time master, truth, sensors): ``python -m sim --scenario F --participants ...``."""
+
+from __future__ import annotations
+
+import argparse
+
+from interfaces import topics
+from interfaces.bus import Bus
+from interfaces.cli import (
+    add_node_args,
+    load_node_scenario,
+    mission_of,
+    open_zenoh,
+    setup_logging,
+    stop_on_signals,
+)
+from sim.node import SimNode
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m sim", description=__doc__)
+    add_node_args(parser)
+    parser.add_argument("--no-ground", action="store_true",
+                        help="do not wait for a ground node (spacecraft only)")
+    parser.add_argument("--realtime", type=float, metavar="SPEED",
+                        help="pace ticks to the wall clock times SPEED instead of lockstep")
+    args = parser.parse_args(argv)
+    log = setup_logging(args.log_level, "sim")
+    scenario = load_node_scenario(args)
+    stop = stop_on_signals()
+    participants = [topics.sc_node(i) for i in range(1, scenario.observers.count + 1)]
+    if not args.no_ground:
+        participants.append(topics.GROUND)
+    bus = Bus(topics.SIM, mission_of(args, scenario), open_zenoh(args))
+    try:
+        sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime, log=log, stop=stop)
+        bus.watch_alive(sim.on_liveness)
+        bus.serve_schemas()
+        bus.declare_alive()
+        try:
+            sim.wait_for_participants(scenario.sim.startup_timeout_s)
+        except TimeoutError as e:
+            log.error("%s", e)
+            return 2
+        stop.wait(0.5)  # let the last subscriptions propagate through the mesh
+        return 0 if sim.run() else 1
+    finally:
+        bus.close()
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

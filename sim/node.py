@@ -1,0 +1,188 @@
+"""The sim process: time master and hardware stand-in.
+
+Each tick k (t = k·dt, dt = 1/ω_high): publish the truth and the sensors due at t, publish
+Tick k announcing them (and what the nodes published in tick k-1), wait for every participant's
+TickDone(k) — lockstep — or until the per-tick timeout (the missing answer is logged and its
+last command held) or, in real-time mode, until the next tick is due on the wall clock; then
+apply the commands and integrate the truth to t + dt.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fsw.lib.hcw import mean_motion, pro_state
+from interfaces import topics
+from interfaces.bus import Bus
+from interfaces.messages import RelNavMeasurement, SimStatus, Tick, TickDone, TruthState
+from interfaces.rng import stream
+from interfaces.scenario import Scenario
+from sim.dynamics import RelativeTruth, circular_chief_eci
+from sim.sensors import RelNavSensor
+
+
+def initial_states(scenario: Scenario) -> np.ndarray:
+    """Initial LVLH relative states (N, 6) of the observers on their scenario PROs."""
+    n = mean_motion(scenario.orbit.altitude_km * 1e3)
+    obs = scenario.observers
+    return np.array([pro_state(n, *obs.pro(i)) for i in range(1, obs.count + 1)])
+
+
+@dataclass(eq=False)
+class SimNode:
+    bus: Bus
+    scenario: Scenario
+    participants: list[str]
+    realtime_speed: float | None = None
+    log: logging.Logger = field(default_factory=lambda: logging.getLogger("insp.sim"))
+    stop: threading.Event = field(default_factory=threading.Event)
+
+    def __post_init__(self) -> None:
+        sc = self.scenario
+        chief = circular_chief_eci(sc.orbit.altitude_km * 1e3, np.radians(sc.orbit.inclination_deg))
+        self.truth = RelativeTruth(chief, initial_states(sc), j2=sc.orbit.j2,
+                                   energy_match=sc.observers.energy_match)
+        self.ids = list(range(1, sc.observers.count + 1))
+        self.sensors = [
+            RelNavSensor(sc.sensors.relnav_sigma_r_m, sc.sensors.relnav_sigma_v_mps,
+                         stream(sc.seed, "relnav", i)) for i in self.ids
+        ]
+        self.accel_lvlh = np.zeros((len(self.ids), 3))
+        m = self.bus.mission
+        self._keys = {
+            "tick": topics.tick(m), "status": topics.sim_status(m), "truth": topics.truth(m),
+            "relnav": [topics.relnav(m, i) for i in self.ids],
+        }
+        self._cond = threading.Condition()
+        self._answers: dict[str, dict[str, int]] = {}
+        self._answer_k = -1
+        self._alive: set[str] = set()
+        self._dead: set[str] = set()
+        self.missed_answers = 0
+        for node in self.participants:
+            self.bus.subscribe(topics.tick_done(m, node), TickDone, self._on_done, immediate=True)
+
+    # --- lockstep bookkeeping -------------------------------------------------------------
+
+    def _on_done(self, msg: TickDone) -> None:
+        with self._cond:
+            if msg.k == self._answer_k and msg.sender in self.participants:
+                self._answers[msg.sender] = msg.published
+                self._cond.notify_all()
+
+    def on_liveness(self, node: str, alive: bool) -> None:
+        """Liveliness handler: a participant that disappears is not waited for any more."""
+        with self._cond:
+            if alive:
+                self._alive.add(node)
+            elif node in self.participants and node in self._alive:
+                self._alive.discard(node)
+                if self._answer_k < self.scenario.n_ticks - 1:
+                    self._dead.add(node)
+                    self.log.error("participant %s lost (process died or disconnected)", node)
+            self._cond.notify_all()
+
+    def wait_for_participants(self, timeout_s: float) -> None:
+        """Block until every participant has announced itself (Zenoh liveliness)."""
+        deadline = time.monotonic() + timeout_s
+        with self._cond:
+            while not set(self.participants) <= self._alive:
+                left = deadline - time.monotonic()
+                if left <= 0 or self.stop.is_set():
+                    missing = sorted(set(self.participants) - self._alive)
+                    raise TimeoutError(f"participants never joined: {', '.join(missing)}")
+                self._cond.wait(min(left, 0.2))
+
+    # --- the run --------------------------------------------------------------------------
+
+    def run(self) -> bool:
+        """Run all ticks; True if the run completed, False if it was stopped."""
+        sc = self.scenario
+        dt, n_ticks = sc.rates.dt_s, sc.n_ticks
+        self._status("running", 0)
+        expect: dict[str, int] = {}
+        wall0 = time.monotonic()
+        for k in range(n_ticks):
+            if self.stop.is_set():
+                self._status("aborted", k, "stopped by signal")
+                return False
+            t = k * dt
+            if self.realtime_speed:
+                _sleep_until(wall0 + t / self.realtime_speed)
+            self._publish_hardware(k, t)
+            expect.update(self.bus.published_since_last())
+            with self._cond:
+                self._answers, self._answer_k = {}, k
+            self.bus.publish(self._keys["tick"], Tick(
+                sender=topics.SIM, t_sim=t, k=k, dt_s=dt, expect=expect, final=k == n_ticks - 1),
+                announce=False)
+            deadline = (wall0 + (t + dt) / self.realtime_speed if self.realtime_speed
+                        else time.monotonic() + sc.sim.lockstep_timeout_s)
+            expect = self._collect_answers(k, deadline)
+            self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
+            self.bus.dispatch(t, include_now=True)
+            if k < n_ticks - 1:
+                self.truth.step(dt, self.accel_lvlh, substeps=sc.sim.substeps)
+            if k % max(1, n_ticks // 10) == 0:
+                rate = (k + 1) / max(1e-9, time.monotonic() - wall0)
+                self.log.info("tick %d/%d  t=%.1f s  %.0f ticks/s", k, n_ticks, t, rate)
+        self._status("finished", n_ticks - 1)
+        self._await_departure(timeout_s=10.0)
+        return True
+
+    def _await_departure(self, timeout_s: float) -> None:
+        """After ``finished``, wait until the participants have left (their liveliness tokens
+        gone), so none of them sees the sim vanish before it has read the status."""
+        deadline = time.monotonic() + timeout_s
+        with self._cond:
+            while self._alive & set(self.participants) and time.monotonic() < deadline:
+                self._cond.wait(0.1)
+
+    def _publish_hardware(self, k: int, t: float) -> None:
+        rel = self.truth.rel_lvlh()
+        self.bus.publish(self._keys["truth"], TruthState(
+            sender=topics.SIM, t_sim=t, spacecraft=self.ids,
+            r_lvlh_m=rel[:, :3].tolist(), v_lvlh_mps=rel[:, 3:].tolist()))
+        if k % self.scenario.rates.ticks_per("mid") == 0:
+            for i, sensor in enumerate(self.sensors):
+                r, v = sensor.measure(rel[i, :3], rel[i, 3:])
+                self.bus.publish(self._keys["relnav"][i], RelNavMeasurement(
+                    sender=topics.SIM, t_sim=t, spacecraft=self.ids[i], r_m=r.tolist(),
+                    v_mps=v.tolist(), sigma_r_m=sensor.sigma_r_m, sigma_v_mps=sensor.sigma_v_mps))
+
+    def _collect_answers(self, k: int, deadline: float) -> dict[str, int]:
+        """Wait for TickDone(k) from every live participant; merge what they announced."""
+        with self._cond:
+            while True:
+                waiting = [p for p in self.participants
+                           if p not in self._answers and p not in self._dead]
+                left = deadline - time.monotonic()
+                if not waiting or left <= 0 or self.stop.is_set():
+                    break
+                self._cond.wait(left)
+            answers = dict(self._answers)
+        if waiting and not self.stop.is_set():
+            self.missed_answers += 1
+            if not self.realtime_speed:
+                self.log.warning("tick %d: no answer from %s; holding last commands",
+                                 k, ", ".join(waiting))
+        merged: dict[str, int] = {}
+        for published in answers.values():
+            merged.update(published)
+        return merged
+
+    def _status(self, state: str, k: int, reason: str = "") -> None:
+        t = k * self.scenario.rates.dt_s
+        self.bus.publish(self._keys["status"], SimStatus(
+            sender=topics.SIM, t_sim=t, state=state, k=k, reason=reason), announce=False)  # type: ignore[arg-type]
+
+
+def _sleep_until(wall: float) -> None:
+    left = wall - time.monotonic()
+    if left > 0:
+        time.sleep(left)
