@@ -189,6 +189,12 @@ class McapRecorder:
 
     Counters (read-only properties): :attr:`recorded`, :attr:`invalid`, :attr:`unknown_type`,
     :attr:`dropped`, :attr:`after_close`, :attr:`counts` (messages per key).
+
+    Threads: :meth:`record` may be called from any number of threads.  When another thread is
+    writing at that moment, the sample is handed to it (it is written before that thread lets go
+    of the file) and ``record`` returns at once, so the counters can lag a concurrent ``record``
+    by a few microseconds; file order is the order in which samples were handed in, and one
+    thread's samples keep their order.  :meth:`close` writes every sample handed in before it.
     """
 
     def __init__(

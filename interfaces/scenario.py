@@ -155,7 +155,7 @@ class Sensors(_Section):
 
 class Nav(_Section):
     q_accel_m2_s3: float = Field(
-        default=1e-10, gt=0.0, description="spectral density of unmodelled acceleration, m²/s³"
+        default=1e-12, gt=0.0, description="spectral density of unmodelled acceleration, m²/s³"
     )
 
 

@@ -1,0 +1,61 @@
+"""Shared fixtures: small scenarios, free loopback ports."""
+
+from __future__ import annotations
+
+import socket
+from pathlib import Path
+
+import pytest
+
+from interfaces.scenario import Scenario, parse_scenario
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+def small_scenario(name: str = "t", **sections: object) -> Scenario:
+    """A fast scenario (2 Hz high rate) with section overrides as dicts."""
+    base: dict[str, object] = {
+        "name": name, "seed": 3, "duration_s": 20.0,
+        "rates": {"high_hz": 2.0, "mid_hz": 1.0, "low_hz": 0.1},
+        "observers": {"count": 3, "rho_x_m": 20.0, "rho_z_m": 25.0},
+    }
+    for k, v in sections.items():
+        base[k] = {**base[k], **v} if isinstance(v, dict) and isinstance(base.get(k), dict) else v
+    return Scenario.model_validate(base)
+
+
+def write_scenario(path: Path, scenario: Scenario) -> Path:
+    """Write a scenario as TOML (via its JSON dump; only simple tables are needed here)."""
+    lines: list[str] = []
+    data = scenario.model_dump(exclude_none=True)
+    top = {k: v for k, v in data.items() if not isinstance(v, (dict, list))}
+    for k, v in top.items():
+        lines.append(f"{k} = {_toml(v)}")
+    for k, v in data.items():
+        if isinstance(v, dict):
+            lines.append(f"[{k}]")
+            for kk, vv in v.items():
+                if isinstance(vv, dict):
+                    lines.append(f"{kk} = {{ " + ", ".join(f"{a} = {_toml(b)}" for a, b in vv.items()) + " }")
+                elif not (isinstance(vv, list) and not vv):
+                    lines.append(f"{kk} = {_toml(vv)}")
+    path.write_text("\n".join(lines) + "\n")
+    assert parse_scenario(path.read_text()) == scenario
+    return path
+
+
+def _toml(v: object) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, float) and v == float("inf"):
+        return "inf"
+    return repr(v)
+
+
+@pytest.fixture
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])

@@ -1,0 +1,169 @@
+"""The constellation as real OS processes over a real Zenoh network (deploy/run_constellation.py)."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+from deploy.inproc import run_inproc
+from ground.reader import load_run
+from ground.recorder import McapRecorder
+from interfaces import topics
+from interfaces.messages import ExecStats, LinkStats, StateEstimate, TruthState
+from interfaces.zenoh_transport import ZenohSettings, ZenohTransport
+from tests.conftest import REPO, small_scenario, write_scenario
+
+LAUNCHER = [sys.executable, str(REPO / "deploy" / "run_constellation.py"), "--no-report"]
+
+
+def _launch(scenario_path: Path, out: Path, port: int, *extra: str) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [*LAUNCHER, "--scenario", str(scenario_path), "--out", str(out),
+         "--endpoint", f"tcp/127.0.0.1:{port}", *extra],
+        cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _comparable(path: Path) -> dict[str, list[dict]]:
+    """Per key, the payloads without wall-clock fields.  ExecStats is left out: it reports
+    execution times, which are wall-clock measurements by nature."""
+    out: dict[str, list[dict]] = {}
+    for r in load_run(path).records("**"):
+        if r.type_name == "ExecStats":
+            continue
+        d = json.loads(r.payload)
+        d.pop("t_wall", None)
+        out.setdefault(r.key, []).append(d)
+    return out
+
+
+def test_same_seed_same_messages_on_zenoh_and_inproc(tmp_path: Path, free_port: int) -> None:
+    sc = small_scenario("det", duration_s=30.0,
+                        comms={"range_m": 36.0, "packet_loss": 0.25, "burst": {"mean_length_packets": 3.0}})
+    path = write_scenario(tmp_path / "det.toml", sc)
+    runs = {}
+    for transport in ("zenoh", "inproc"):
+        out = tmp_path / transport
+        p = _launch(path, out, free_port, "--transport", transport)
+        stdout, stderr = p.communicate(timeout=180)
+        assert p.returncode == 0, stderr
+        runs[transport] = _comparable(out / "run.mcap")
+    z, i = runs["zenoh"], runs["inproc"]
+    assert sorted(z) == sorted(i)
+    for key in z:
+        assert z[key] == i[key], f"{key} differs between transports"
+    # the channel really acted (range and loss) on the compared traffic
+    links = [c for m in z[topics.key("det", "ground", "bus", "link_stats")][-1:] for c in m["links"]]
+    assert sum(c["dropped_loss"] for c in links) > 0 and sum(c["delivered"] for c in links) > 0
+
+
+def test_killed_fsw_process_fails_the_run_and_keeps_the_archive(tmp_path: Path, free_port: int) -> None:
+    sc = small_scenario("kill", duration_s=400.0)
+    path = write_scenario(tmp_path / "kill.toml", sc)
+    out = tmp_path / "out"
+    p = _launch(path, out, free_port, "--realtime", "20")  # 20 s of wall time if undisturbed
+    victim = _wait_pid(["fsw", "--spacecraft", "2", "--scenario", str(path)], timeout_s=30.0)
+    time.sleep(3.0)
+    os.kill(victim, signal.SIGKILL)
+    stdout, stderr = p.communicate(timeout=60)
+    assert p.returncode != 0
+    assert "sc2" in stderr and "SIGKILL" in stderr
+    archive = load_run(out / "run.mcap")
+    assert not archive.truncated  # the recorder was stopped cleanly
+    est = archive.messages(topics.key("kill", "sc1", "nav", "estimate"), StateEstimate)
+    assert len(est) >= 5  # what was recorded before the death is kept
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and "sc2" in summary["error"]
+
+
+def test_malformed_messages_are_dropped_and_the_app_goes_on(tmp_path: Path, free_port: int) -> None:
+    sc = small_scenario("bad", duration_s=200.0)
+    path = write_scenario(tmp_path / "bad.toml", sc)
+    out = tmp_path / "out"
+    p = _launch(path, out, free_port, "--realtime", "20")
+    _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
+    hostile = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",), mode="client"))
+    key = topics.relnav("bad", 1)  # what sc1's nav app subscribes to
+    stop = threading.Event()
+
+    def inject() -> None:
+        while not stop.wait(0.3):
+            hostile.publish(key, "RelNavMeasurement", b'{"garbage": true}')
+            hostile.publish(key, "RelNavMeasurement", b"\xff\xfe")
+
+    try:
+        time.sleep(2.0)
+        th = threading.Thread(target=inject)
+        th.start()
+        time.sleep(3.0)
+        stop.set()
+        th.join()
+    finally:
+        hostile.close()
+    stdout, stderr = p.communicate(timeout=60)
+    assert p.returncode == 0, stderr
+    archive = load_run(out / "run.mcap")
+    stats = archive.messages(topics.key("bad", "sc1", "exec", "stats"), ExecStats)
+    assert stats[-1].invalid_dropped >= 10 and stats[-1].app_errors == 0
+    est = archive.messages(topics.key("bad", "sc1", "nav", "estimate"), StateEstimate)
+    assert est[-1].t_sim == sc.duration_s  # nav kept running to the end
+
+
+def test_range_limited_link_cuts_and_restores_with_distance() -> None:
+    """Ground link of each observer over half an orbit: delivered exactly while within range."""
+    sc = small_scenario("range", duration_s=2900.0, comms={"range_m": 36.0},
+                        rates={"high_hz": 1.0, "mid_hz": 1.0, "low_hz": 0.1})
+    truth: dict[float, np.ndarray] = {}
+    links: list[LinkStats] = []
+
+    def tap(key: str, type_name: str, payload: bytes) -> None:
+        if type_name == "TruthState":
+            m = TruthState.model_validate_json(payload)
+            truth[m.t_sim] = np.linalg.norm(np.array(m.r_lvlh_m), axis=1)
+        elif type_name == "LinkStats" and "/ground/" in key:
+            links.append(LinkStats.model_validate_json(payload))
+
+    run_inproc(sc, tap=tap)
+    for sc_id in (1, 2, 3):
+        prev = None
+        pattern = []
+        for m in links:
+            c = next((c for c in m.links if c.src == f"sc{sc_id}"), None)
+            if c is None:
+                continue
+            if prev is not None:
+                d_dist = c.delivered - prev.delivered
+                d_range = c.dropped_range - prev.dropped_range
+                dist = truth[m.t_sim - 1.0][sc_id - 1]  # sent one tick before delivery
+                if abs(dist - sc.comms.range_m) > 0.05:  # away from the boundary
+                    assert (d_dist > 0) == (dist <= sc.comms.range_m), (sc_id, m.t_sim, dist)
+                pattern.append("D" if d_dist > 0 else "R")
+            prev = c
+        runs = "".join(ch for i, ch in enumerate(pattern) if i == 0 or pattern[i - 1] != ch)
+        assert "DRD" in runs or "RDR" in runs, f"sc{sc_id} link never cut and restored: {runs}"
+
+
+def _wait_pid(argv_parts: list[str], timeout_s: float) -> int:
+    """PID of the process whose command line contains ``argv_parts`` consecutively."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        for pid in os.listdir("/proc"):
+            if not pid.isdigit():
+                continue
+            try:
+                cmd = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+            except OSError:
+                continue
+            text = [c.decode(errors="replace") for c in cmd]
+            n = len(argv_parts)
+            if any(text[i:i + n] == argv_parts for i in range(len(text) - n + 1)):
+                return int(pid)
+        time.sleep(0.1)
+    raise TimeoutError(f"no process with {argv_parts}")
