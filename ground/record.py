@@ -58,7 +58,8 @@ def main(argv: list[str] | None = None) -> int:
         transport.subscribe(topics.mission_wildcard(mission), rec.record)
         transport.declare_alive("recorder", topics.recorder_token(mission))
         log.info("recording %s to %s", topics.mission_wildcard(mission), args.out)
-        stop.wait()
+        while not stop.wait(2.0):
+            rec.flush()  # a killed recorder loses at most the last 2 s
     finally:
         transport.close()  # no callback can write after this
         rec.close()
