@@ -143,7 +143,6 @@ class LinkCounter(BaseModel):
     dropped_range: int = 0
     dropped_loss: int = 0
     dropped_cut: int = 0
-    pending: int = 0
 
 
 class LinkStats(Message):

@@ -53,6 +53,9 @@ class SimNode:
                          stream(sc.seed, "relnav", i)) for i in self.ids
         ]
         self.accel_lvlh = np.zeros((len(self.ids), 3))
+        if sc.faults:
+            self.log.warning("%d fault(s) in the scenario are NOT injected: fault injection is "
+                             "not implemented yet (issue 5)", len(sc.faults))
         m = self.bus.mission
         self._keys = {
             "tick": topics.tick(m), "status": topics.sim_status(m), "truth": topics.truth(m),

@@ -1,0 +1,50 @@
+"""Scenario files: defaults, clear errors for unknown keys and bad values, the shipped scenarios."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from interfaces.scenario import ScenarioError, load_scenario, parse_scenario
+from tests.conftest import REPO
+
+
+def test_defaults_and_pro_phasing() -> None:
+    s = parse_scenario('name = "x"\nduration_s = 10\n[observers]\ncount = 4\n')
+    assert s.rates.ticks_per("mid") == 10 and s.rates.ticks_per("low") == 100
+    assert s.n_ticks == 101
+    assert s.observers.pro(3)[1] == pytest.approx(3.141592653589793)  # 180° for sc3 of 4
+
+
+@pytest.mark.parametrize("text, needle", [
+    ('name = "x"\nduration_s = 10\n[orbit]\naltitud_km = 500\n', "orbit.altitud_km"),
+    ('name = "x"\nduration_s = -1\n', "duration_s"),
+    ('name = "x"\nduration_s = 10\n[rates]\nmid_hz = 3\n', "must divide"),
+    ('name = "x"\nduration_s = 10\n[[faults]]\nspacecraft = 9\nkind = "link_loss"\nstart_s = 0\n',
+     "observers.count"),
+    ('name = "x"\nduration_s = 10\n[[faults]]\nspacecraft = 1\nkind = "camera_degradation"\n'
+     'start_s = 0\nmagnitude = 1.5\n', "(0, 1)"),
+    ('name = "x"\nduration_s = 10\n[[faults]]\nspacecraft = 1\nkind = "melted"\nstart_s = 0\n', "kind"),
+    ('name = "x"\nduration_s = [', "not valid TOML"),
+])
+def test_invalid_scenarios_name_the_field(text: str, needle: str) -> None:
+    with pytest.raises(ScenarioError) as e:
+        parse_scenario(text, source="s.toml")
+    assert needle in str(e.value) and "s.toml" in str(e.value)
+
+
+def test_shipped_scenarios_load() -> None:
+    for path in (REPO / "deploy" / "scenarios").glob("*.toml"):
+        assert load_scenario(path).name
+
+
+def test_launcher_rejects_a_bad_scenario_clearly(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\nduration_s = 10\n[comms]\nrange = 5\n')
+    p = subprocess.run([sys.executable, str(REPO / "deploy" / "run_constellation.py"),
+                        "--scenario", str(bad), "--out", str(tmp_path / "o")],
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 2 and "comms.range" in p.stderr
