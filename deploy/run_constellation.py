@@ -29,7 +29,7 @@ from ground.recorder import McapRecorder  # noqa: E402
 from ground.report import write_report  # noqa: E402
 from ground.summary import write_summary  # noqa: E402
 from interfaces import topics  # noqa: E402
-from interfaces.messages import SimStatus, Tick  # noqa: E402
+from interfaces.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
 from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
 
@@ -105,7 +105,8 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
         return "failed", f"cannot listen on {args.endpoint}: {e} (is another run using it?)"
     progress = _Progress(scenario)
     try:
-        hub.session.declare_subscriber(topics.tick(mission), progress.on_tick)
+        hub.session.declare_subscriber(topics.key(mission, topics.GROUND, "exec", "heartbeat"),
+                                       progress.on_heartbeat)
         hub.session.declare_subscriber(topics.sim_status(mission), progress.on_status)
         return _supervise(scenario, mission, out, args, progress, hub)
     finally:
@@ -181,7 +182,7 @@ def _wait_token(hub: ZenohTransport, token: str, child: Child, timeout_s: float)
 
 
 class _Progress:
-    """Progress of the run from the sim's ticks (one line every few seconds)."""
+    """Progress of the run (one line every few seconds)."""
 
     def __init__(self, scenario: Scenario) -> None:
         self.n_ticks = scenario.n_ticks
@@ -192,12 +193,13 @@ class _Progress:
         self._wall0 = time.monotonic()
         self._last = 0.0
 
-    def on_tick(self, sample: object) -> None:
+    def on_heartbeat(self, sample: object) -> None:
+        """Progress from the ground's heartbeat (ω_mid), not from every tick: no per-tick work."""
         try:
-            tick = Tick.model_validate_json(sample.payload.to_bytes())  # type: ignore[attr-defined]
+            hb = Heartbeat.model_validate_json(sample.payload.to_bytes())  # type: ignore[attr-defined]
         except Exception:  # noqa: BLE001 - progress display only
             return
-        self.k, self.t_sim = tick.k, tick.t_sim
+        self.k, self.t_sim = hb.k, hb.t_sim
 
     def on_status(self, sample: object) -> None:
         try:

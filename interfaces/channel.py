@@ -92,7 +92,6 @@ class ChannelModel:
     _truth_t: list[float] = field(default_factory=list)
     _truth_pos: list[dict[str, np.ndarray]] = field(default_factory=list)
     _cuts: list[_Cut] = field(default_factory=list)
-    _extra_loss: dict[str, float] = field(default_factory=dict)
     _lock: threading.Lock = field(default_factory=threading.Lock)
 
     def __post_init__(self) -> None:
@@ -126,12 +125,6 @@ class ChannelModel:
         LinkCut(a=a, b=b, start_s=start_s, end_s=end_s)  # validates the ends
         self._cuts.append(_Cut(a, b, start_s, end_s))
 
-    def set_extra_loss(self, node: str, probability: float) -> None:
-        """Additional Bernoulli loss on every link touching ``node`` (``packet_loss`` fault)."""
-        if not 0.0 <= probability < 1.0:
-            raise ValueError(f"loss probability must be in [0, 1), got {probability}")
-        self._extra_loss[node] = probability
-
     # --- decision ------------------------------------------------------------------------
 
     def decide(self, src: str, t_send: float) -> Verdict:
@@ -156,8 +149,8 @@ class ChannelModel:
             return Verdict.CUT
         if not self._in_range(src, t_send):
             return Verdict.RANGE
-        # Every message advances the link's random stream by the same draws whatever the
-        # outcome, so one verdict never shifts the randomness of the next.
+        # A message in range and not cut draws exactly once from its link's stream; cut and
+        # out-of-range messages draw nothing (the Gilbert-Elliott state advances per packet sent).
         lost = False
         if self._ge is not None:
             p, r = self._ge
@@ -166,9 +159,6 @@ class ChannelModel:
             lost = link.bad
         elif self.comms.packet_loss > 0.0:
             lost = link.rng.random() < self.comms.packet_loss
-        extra = max(self._extra_loss.get(src, 0.0), self._extra_loss.get(self.receiver, 0.0))
-        if extra > 0.0 and link.rng.random() < extra:
-            lost = True
         return Verdict.LOSS if lost else Verdict.DELIVER
 
     def _in_range(self, src: str, t_send: float) -> bool:
