@@ -71,7 +71,14 @@ def test_killed_fsw_process_fails_the_run_and_keeps_the_archive(tmp_path: Path, 
     out = tmp_path / "out"
     p = _launch(path, out, free_port, "--realtime", "20")  # 20 s of wall time if undisturbed
     victim = _wait_pid(["fsw", "--spacecraft", "2", "--scenario", str(path)], timeout_s=30.0)
-    time.sleep(3.0)
+    seen = threading.Semaphore(0)
+    watcher = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",), mode="client"))
+    try:
+        watcher.subscribe(topics.key("kill", "sc1", "nav", "estimate"), lambda *_: seen.release())
+        for _ in range(5):  # kill only once the run is demonstrably under way
+            assert seen.acquire(timeout=60), "the run never got going"
+    finally:
+        watcher.close()
     os.kill(victim, signal.SIGKILL)
     stdout, stderr = p.communicate(timeout=60)
     assert p.returncode != 0
