@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import logging
 
+from fsw.apps.attitude import AttitudeApp
+from fsw.apps.guidance import GuidanceApp
 from fsw.apps.nav import NavApp
 from interfaces import topics
 from interfaces.app import App, AppContext
@@ -12,7 +14,7 @@ from interfaces.executive import Executive
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
 
-APPS: tuple[type[App], ...] = (NavApp,)
+APPS: tuple[type[App], ...] = (AttitudeApp, NavApp, GuidanceApp)
 """The onboard apps, in execution order within a rate group."""
 
 

@@ -12,6 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ground.evaluation import NavErrors, nav_errors  # noqa: E402
+from ground.gnc_evaluation import GncSeries, gnc_series  # noqa: E402
 from ground.reader import ArchiveError, RunArchive, load_run  # noqa: E402
 from interfaces import topics  # noqa: E402
 from interfaces.messages import TruthState  # noqa: E402
@@ -37,6 +38,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None) -> P
         return _write(out, lines)
     lines += _trajectory_section(out, archive, mission)
     lines += _nav_section(out, nav_errors(archive, mission), summary)
+    lines += _gnc_section(out, gnc_series(archive, scenario, mission), summary)
     lines += _links_section(summary) + _exec_section(summary)
     return _write(out, lines)
 
@@ -96,6 +98,43 @@ def _nav_section(out: Path, errs: dict[int, NavErrors], summary: dict) -> list[s
                         f"{st['vel_rms_mps']:.4f} | {st['nees_mean']:.2f} | "
                         f"{100 * st['nees_in_95_bounds']:.0f}% | {st['nis_mean'] or float('nan'):.2f} |")
     return ["## Navigation", "", "![nav error](nav_error.png)", "", *rows, ""]
+
+
+def _gnc_section(out: Path, series: dict[int, GncSeries], summary: dict) -> list[str]:
+    if not any(s.dv_t_s or s.point_t_s for s in series.values()):
+        return ["No guidance or attitude data recorded.", ""]
+    fig, axes = plt.subplots(3, 1, figsize=(10, 8.5), sharex=True)
+    for sc, s in series.items():
+        axes[0].plot(s.dv_t_s, 1e3 * np.array(s.dv_mps), lw=1.0, label=f"sc{sc}")
+        axes[1].semilogy(s.hold_t_s, np.maximum(s.hold_error_m, 1e-4), ".", ms=3, label=f"sc{sc}")
+        axes[2].semilogy(s.point_t_s, np.maximum(np.degrees(s.pointing_error_rad), 1e-4), lw=0.8,
+                         label=f"sc{sc}")
+    axes[0].set_ylabel("Δv delivered (mm/s)")
+    axes[1].set_ylabel("|r − r_PRO| holding (m)")
+    axes[2].set_ylabel("pointing error (deg)")
+    axes[2].set_xlabel("sim time (s)")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(loc="upper left", fontsize=8, ncol=5)
+    fig.suptitle("Guidance and attitude control against truth")
+    fig.tight_layout()
+    fig.savefig(out / "gnc.png", dpi=110)
+    plt.close(fig)
+
+    def f(v: float | None, fmt: str) -> str:
+        return "–" if v is None else format(v, fmt)
+
+    rows = ["| sc | Δv delivered (mm/s) | Δv planned L1 (mm/s) | transfers | min range (m) | "
+            "hold error RMS / max (m) | pointing error mean / p95 (deg, tracking) | "
+            "attitude knowledge RMS (arcsec) |", "|---|---|---|---|---|---|---|---|"]
+    for sc, g in summary.get("gnc", {}).items():
+        rows.append(
+            f"| {sc} | {1e3 * g['dv_delivered_mps']:.1f} | {1e3 * g['dv_planned_l1_mps']:.1f} | "
+            f"{g['transfers']} | {f(g['min_range_m'], '.1f')} | "
+            f"{f(g['hold_error_rms_m'], '.3f')} / {f(g['hold_error_max_m'], '.3f')} | "
+            f"{f(g['pointing_error_mean_deg'], '.3f')} / {f(g['pointing_error_p95_deg'], '.3f')} | "
+            f"{f(g['knowledge_error_rms_arcsec'], '.1f')} |")
+    return ["## Guidance and attitude", "", "![gnc](gnc.png)", "", *rows, ""]
 
 
 def _links_section(summary: dict) -> list[str]:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 
+from ground.apps.planner import MissionPlanner
 from ground.apps.telemetry import TelemetryMonitor
 from interfaces import topics
 from interfaces.app import App, AppContext
@@ -12,7 +13,7 @@ from interfaces.executive import Executive
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
 
-APPS: tuple[type[App], ...] = (TelemetryMonitor,)
+APPS: tuple[type[App], ...] = (MissionPlanner, TelemetryMonitor)
 
 
 def ground_executive(bus: Bus, scenario: Scenario) -> Executive:

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from ground.evaluation import nav_errors
+from ground.gnc_evaluation import gnc_series, gnc_summary
 from ground.reader import ArchiveError, RunArchive, load_run
 from interfaces import topics
 from interfaces.messages import ExecStats, LinkStats, TelemetryStatus, Tick
@@ -29,6 +30,7 @@ def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict
         "messages": {"total": len(archive), "by_type": _by_type(archive)},
         "nav": {str(sc): e.stats(skip_s=NAV_SETTLE_S)
                 for sc, e in nav_errors(archive, mission).items()},
+        "gnc": gnc_summary(gnc_series(archive, scenario, mission)),
         "links": [c.model_dump() for node in sorted(links) for c in links[node].links],
         "exec": {node: {"cycle_slips": {g: s.cycle_slips for g, s in m.groups.items()},
                         "max_exec_ms": {g: round(s.max_exec_ms, 3) for g, s in m.groups.items()},

@@ -18,6 +18,8 @@ from pydantic import BaseModel, ConfigDict, Field
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec6 = Annotated[list[float], Field(min_length=6, max_length=6)]
+Quat = Annotated[list[float], Field(min_length=4, max_length=4)]
+"""Quaternion, scalar last [x, y, z, w] (scipy and Foxglove convention)."""
 Mat6 = Annotated[list[Vec6], Field(min_length=6, max_length=6)]
 RateGroupName = Literal["high", "mid", "low"]
 
@@ -27,6 +29,7 @@ class Message(BaseModel):
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
     WALL_CLOCK_FIELDS: ClassVar[frozenset[str]] = frozenset({"t_wall"})
+    """Fields that measure the wall clock (not reproducible); subclasses may add their own."""
 
     sender: str = Field(max_length=64, description="node that published the message")
     seq: int = Field(default=0, ge=0, description="per-key sequence count, set by the Bus")
@@ -72,11 +75,18 @@ class SimStatus(Message):
 class TruthState(Message):
     """True relative states of all observers in the target's LVLH frame (x radial, y along-track,
     z cross-track).  Used by the channel model (range) and archived as truth for evaluation.
+
+    ``q_lvlh_body``: true attitude, the rotation taking body vectors into LVLH; ``w_body_radps``:
+    true inertial angular velocity in body axes; ``dv_mps``: velocity increment delivered by the
+    thrusters since the start (Σ|F|/m·dt, Euclidean), m/s.  Empty when the sim has no attitude.
     """
 
     spacecraft: list[int]
     r_lvlh_m: list[Vec3]
     v_lvlh_mps: list[Vec3]
+    q_lvlh_body: list[Quat] = Field(default_factory=list)
+    w_body_radps: list[Vec3] = Field(default_factory=list)
+    dv_mps: list[float] = Field(default_factory=list)
 
 
 class RelNavMeasurement(Message):
@@ -87,6 +97,41 @@ class RelNavMeasurement(Message):
     v_mps: Vec3
     sigma_r_m: float = Field(gt=0.0)
     sigma_v_mps: float = Field(gt=0.0)
+
+
+class AttitudeMeasurement(Message):
+    """Attitude sensors of one observer at ω_high: gyro rate (body axes, rad/s, averaged over the
+    last tick) and, when the star tracker has a fix this tick, its measured attitude
+    (rotation body -> ECI, scalar last) with its 1σ noise about the cross-boresight and boresight
+    axes (rad)."""
+
+    spacecraft: int = Field(ge=1)
+    gyro_radps: Vec3
+    star_tracker: Quat | None = None
+    st_sigma_cross_rad: float = Field(default=0.0, ge=0.0)
+    st_sigma_roll_rad: float = Field(default=0.0, ge=0.0)
+
+
+# --- commands (flight software -> hardware) --------------------------------------------------
+
+
+class ThrustCommand(Message):
+    """Thruster command of one observer: force in body axes (N) to hold for ``duration_s`` from
+    ``t_sim`` (then zero).  The hardware clips each axis to its limit and drops impulses below the
+    minimum impulse bit."""
+
+    spacecraft: int = Field(ge=1)
+    force_body_n: Vec3
+    duration_s: float = Field(gt=0.0, le=3600.0)
+
+
+class WheelCommand(Message):
+    """Reaction-wheel command of one observer: torque on the body (body axes, N·m), held until the
+    next command (the wheels realise it as dh/dt = -torque, within their torque and momentum
+    limits)."""
+
+    spacecraft: int = Field(ge=1)
+    torque_body_nm: Vec3
 
 
 # --- flight software -------------------------------------------------------------------------
@@ -100,6 +145,100 @@ class StateEstimate(Message):
     spacecraft: int = Field(ge=1)
     x: Vec6
     P: Mat6
+    nis: float | None = None
+
+
+class ProElements(BaseModel):
+    """A passive relative orbit: x = ρx sin(nt+αx), y = ρy + 2ρx cos(nt+αx), z = ρz sin(nt+αz),
+    t from the mission start (s); m and rad."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    rho_x_m: float = Field(ge=0.0)
+    alpha_x_rad: float
+    rho_y_m: float
+    rho_z_m: float = Field(ge=0.0)
+    alpha_z_rad: float
+
+
+class ProAssignment(BaseModel):
+    """Be on ``pro`` from ``t_arrive_s``, leaving the current orbit at ``t_depart_s`` (s, mission
+    time).  A spacecraft acts on a new ``assignment_id`` once (commands are idempotent)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    spacecraft: int = Field(ge=1)
+    assignment_id: int = Field(ge=1)
+    phase: str = Field(max_length=64)
+    pro: ProElements
+    t_depart_s: float = Field(ge=0.0)
+    t_arrive_s: float = Field(ge=0.0)
+
+
+class ProAssignments(Message):
+    """Ground command: the current PRO assignment of every observer, repeated by the ground until
+    superseded (each spacecraft reads its own entry; the link decides per receiver)."""
+
+    assignments: list[ProAssignment]
+
+
+class TransferPlanMsg(Message):
+    """A planned transfer (SCP, L1 fuel): node times (s, mission time), LVLH states (m, m/s) and
+    ZOH accelerations (m/s², one per interval) — the nominal plan the ground's twin replays."""
+
+    WALL_CLOCK_FIELDS: ClassVar[frozenset[str]] = frozenset({"t_wall", "solve_ms"})
+
+    spacecraft: int = Field(ge=1)
+    assignment_id: int = Field(ge=1)
+    t_s: list[float]
+    x: list[Vec6]
+    u_mps2: list[Vec3]
+    dv_mps: float = Field(ge=0.0, description="planned L1 fuel, Σ|u|·h, m/s")
+    status: str
+    iterations: int = Field(ge=0)
+    min_range_m: float = Field(ge=0.0)
+    solve_ms: float = Field(ge=0.0)
+
+
+class GuidanceStatus(Message):
+    """Guidance state of one observer at ω_low: mode, current assignment, tracking error of the
+    estimate against the reference (m, m/s), the acceleration commanded (LVLH, m/s²), Δv
+    commanded so far (m/s, Σ|u|₁·dt) and the MPC solver status and time."""
+
+    WALL_CLOCK_FIELDS: ClassVar[frozenset[str]] = frozenset({"t_wall", "mpc_ms"})
+
+    spacecraft: int = Field(ge=1)
+    mode: Literal["idle", "transfer", "hold"]
+    assignment_id: int = Field(default=0, ge=0)
+    phase: str = ""
+    pos_error_m: float = Field(default=0.0, ge=0.0)
+    vel_error_mps: float = Field(default=0.0, ge=0.0)
+    accel_lvlh_mps2: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    dv_commanded_mps: float = Field(default=0.0, ge=0.0)
+    mpc_status: str = ""
+    mpc_ms: float = Field(default=0.0, ge=0.0)
+
+
+class PointingTarget(Message):
+    """Where the camera wants the boresight: a point in LVLH (m) — from the camera app."""
+
+    spacecraft: int = Field(ge=1)
+    target_lvlh_m: Vec3
+
+
+class AttitudeEstimate(Message):
+    """Attitude determination and control state of one observer: estimated attitude (body ->
+    ECI and body -> LVLH, scalar last), gyro bias (rad/s) and 1σ attitude uncertainty (rad);
+    the pointing target (LVLH, m), the estimated pointing error (rad), the controller mode and
+    the commanded torque (N·m)."""
+
+    spacecraft: int = Field(ge=1)
+    q_eci_body: Quat
+    q_lvlh_body: Quat
+    gyro_bias_radps: Vec3
+    sigma_att_rad: float = Field(ge=0.0)
+    target_lvlh_m: Vec3
+    pointing_error_rad: float = Field(ge=0.0)
+    mode: Literal["init", "slew", "track"]
+    torque_body_nm: Vec3
     nis: float | None = None
 
 
@@ -172,7 +311,15 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     SimStatus,
     TruthState,
     RelNavMeasurement,
+    AttitudeMeasurement,
+    ThrustCommand,
+    WheelCommand,
     StateEstimate,
+    ProAssignments,
+    TransferPlanMsg,
+    GuidanceStatus,
+    PointingTarget,
+    AttitudeEstimate,
     Heartbeat,
     ExecStats,
     LinkStats,

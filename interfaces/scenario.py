@@ -123,22 +123,21 @@ class ObserverOverride(_Section):
     alpha_z_deg: float | None = None
 
 
-class Observers(_Section):
-    """Observers start on passive relative orbits (HCW form, DESIGN/REFERENCE):
-    x = ρx sin(nt+αx), y = ρy + 2ρx cos(nt+αx), z = ρz sin(nt+αz).  By default spacecraft i of N
-    has αx = αz = 360°·(i-1)/N; ``overrides`` set any parameter of one spacecraft."""
+class _ProFormation(_Section):
+    """A set of passive relative orbits, one per observer (HCW form, DESIGN/REFERENCE):
+    x = ρx sin(nt+αx), y = ρy + 2ρx cos(nt+αx), z = ρz sin(nt+αz), t from the mission start.
+    By default spacecraft i of N has αx = αz = phase0_deg + 360°·(i-1)/N; ``overrides`` set any
+    parameter of one spacecraft."""
 
-    count: int = Field(default=5, ge=1, le=64)
     rho_x_m: float = Field(default=20.0, ge=0.0)
     rho_y_m: float = 0.0
     rho_z_m: float = Field(default=20.0, ge=0.0)
-    energy_match: bool = Field(default=True, description="match the target's semi-major axis")
-    mass_kg: float = Field(default=10.0, gt=0.0)
+    phase0_deg: float = 0.0
     overrides: list[ObserverOverride] = Field(default_factory=list)
 
-    def pro(self, spacecraft: int) -> tuple[float, float, float, float, float]:
-        """(ρx m, αx rad, ρy m, ρz m, αz rad) of ``spacecraft`` (1-based)."""
-        phase = 360.0 * (spacecraft - 1) / self.count
+    def pro_of(self, spacecraft: int, count: int) -> tuple[float, float, float, float, float]:
+        """(ρx m, αx rad, ρy m, ρz m, αz rad) of ``spacecraft`` (1-based) of ``count``."""
+        phase = self.phase0_deg + 360.0 * (spacecraft - 1) / count
         p = {"rho_x_m": self.rho_x_m, "alpha_x_deg": phase, "rho_y_m": self.rho_y_m,
              "rho_z_m": self.rho_z_m, "alpha_z_deg": phase}
         for o in self.overrides:
@@ -148,9 +147,90 @@ class Observers(_Section):
                 math.radians(p["alpha_z_deg"]))
 
 
+class Observers(_ProFormation):
+    """The observers and their initial conditions.  ``start = "pro"``: they start on the PROs of
+    this section; ``start = "deploy"``: they are released from the target (Fig. 7, phase 1) at
+    ``deploy_radius_m`` from its centre with ``deploy_speed_mps`` outward, directions fanned
+    evenly in the along-track/cross-track plane, and drift until the first phase.  The initial
+    attitude is drawn from the seed (``initial_attitude = "random"``) or aligned with LVLH, with
+    a 1σ tumble rate per axis."""
+
+    count: int = Field(default=5, ge=1, le=64)
+    energy_match: bool = Field(default=True, description="match the target's semi-major axis")
+    mass_kg: float = Field(default=10.0, gt=0.0)
+    inertia_kg_m2: tuple[float, float, float] = Field(
+        default=(0.10, 0.12, 0.08), description="principal moments of inertia, kg·m²")
+    start: Literal["pro", "deploy"] = "pro"
+    deploy_radius_m: float = Field(default=5.0, gt=0.0)
+    deploy_speed_mps: float = Field(default=0.05, ge=0.0)
+    initial_attitude: Literal["random", "lvlh"] = "random"
+    tumble_rate_dps: float = Field(default=0.2, ge=0.0, description="1σ initial rate per axis")
+
+    @model_validator(mode="after")
+    def _inertia(self) -> Observers:
+        a, b, c = self.inertia_kg_m2
+        if min(a, b, c) <= 0 or a + b < c or a + c < b or b + c < a:
+            raise ValueError("observers.inertia_kg_m2 must be positive and satisfy the triangle "
+                             "inequality of principal moments")
+        return self
+
+    def pro(self, spacecraft: int) -> tuple[float, float, float, float, float]:
+        """(ρx m, αx rad, ρy m, ρz m, αz rad) of ``spacecraft`` (1-based)."""
+        return self.pro_of(spacecraft, self.count)
+
+
+class Phase(_ProFormation):
+    """A phase of the mission plan (Fig. 7): at ``start_s`` every observer leaves its orbit for
+    the PRO of this phase, arriving ``transfer_s`` later (fuel-optimal SCP transfer, then held)."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
+    start_s: float = Field(ge=0.0)
+    transfer_s: float = Field(default=900.0, gt=0.0)
+
+
+class Actuators(_Section):
+    """Thrusters (body-fixed, ± each body axis) and three reaction wheels along the body axes."""
+
+    thruster_max_force_n: float = Field(default=0.02, gt=0.0, description="per axis, N")
+    thruster_min_impulse_ns: float = Field(default=1e-4, ge=0.0, description="minimum impulse bit")
+    thruster_noise_frac: float = Field(default=0.01, ge=0.0, lt=1.0, description="1σ, of force")
+    wheel_max_torque_nm: float = Field(default=2e-3, gt=0.0, description="per wheel, N·m")
+    wheel_max_momentum_nms: float = Field(default=0.02, gt=0.0, description="per wheel, N·m·s")
+
+
+class Guidance(_Section):
+    """Orbit guidance: SCP transfers (L1 fuel, keep-out sphere) tracked by MPC at ω_low."""
+
+    keep_out_m: float = Field(default=8.0, gt=0.0, description="keep-out sphere radius d_min, m")
+    node_spacing_s: float = Field(default=20.0, gt=0.0, description="SCP interval, s")
+    mpc_horizon: int = Field(default=20, ge=2, le=200, description="MPC steps of 1/ω_low")
+    plan_thrust_fraction: float = Field(
+        default=0.5, gt=0.0, le=1.0,
+        description="fraction of the thrust limit the plan may use (the rest is MPC margin)")
+
+
+class Attitude(_Section):
+    """Attitude guidance and control (ω_high): slews planned by SCP, nonlinear tracking."""
+
+    settling_time_s: float = Field(default=30.0, gt=0.0)
+    slew_rate_max_dps: float = Field(default=2.0, gt=0.0)
+    slew_threshold_deg: float = Field(default=10.0, gt=0.0,
+                                      description="errors above this are slewed on a plan")
+    boresight_body: tuple[float, float, float] = (0.0, 0.0, 1.0)
+
+
 class Sensors(_Section):
     relnav_sigma_r_m: float = Field(default=0.1, gt=0.0, description="1σ position noise, m")
     relnav_sigma_v_mps: float = Field(default=0.002, gt=0.0, description="1σ velocity noise, m/s")
+    gyro_arw_rad_rts: float = Field(default=4.4e-5, ge=0.0,
+                                    description="angle random walk σv, rad/√s (0.15°/√h)")
+    gyro_bias_rw_rad_s15: float = Field(default=3e-7, ge=0.0,
+                                        description="bias random walk σu, rad/s^1.5")
+    gyro_bias_sigma_radps: float = Field(default=1e-4, ge=0.0,
+                                         description="1σ initial gyro bias, rad/s")
+    star_tracker_hz: float = Field(default=1.0, gt=0.0)
+    star_tracker_cross_arcsec: float = Field(default=10.0, gt=0.0, description="1σ")
+    star_tracker_roll_arcsec: float = Field(default=60.0, gt=0.0, description="1σ, about boresight")
 
 
 class Nav(_Section):
@@ -200,6 +280,10 @@ class Scenario(_Section):
     observers: Observers = Observers()
     sensors: Sensors = Sensors()
     nav: Nav = Nav()
+    actuators: Actuators = Actuators()
+    guidance: Guidance = Guidance()
+    attitude: Attitude = Attitude()
+    phases: list[Phase] = Field(default_factory=list)
     sim: SimSettings = SimSettings()
     faults: list[Fault] = Field(default_factory=list)
 
@@ -209,9 +293,19 @@ class Scenario(_Section):
         for f in self.faults:
             if f.spacecraft > n:
                 raise ValueError(f"fault on spacecraft {f.spacecraft} but observers.count = {n}")
-        for o in self.observers.overrides:
-            if o.spacecraft > n:
-                raise ValueError(f"override of spacecraft {o.spacecraft} but observers.count = {n}")
+        for where, formation in [("observers", self.observers)] + [
+                (f"phase {p.name!r}", p) for p in self.phases]:
+            for o in formation.overrides:
+                if o.spacecraft > n:
+                    raise ValueError(f"{where}: override of spacecraft {o.spacecraft} but "
+                                     f"observers.count = {n}")
+        starts = [p.start_s for p in self.phases]
+        if starts != sorted(starts) or len(set(starts)) != len(starts):
+            raise ValueError("phases must have strictly increasing start_s")
+        ratio = self.rates.high_hz / self.sensors.star_tracker_hz
+        if abs(ratio - round(ratio)) > 1e-9 or ratio < 1.0 - 1e-9:
+            raise ValueError(f"sensors.star_tracker_hz = {self.sensors.star_tracker_hz} must "
+                             f"divide rates.high_hz = {self.rates.high_hz}")
         for c in self.comms.cuts:
             for end in (c.a, c.b):
                 if end.startswith("sc") and int(end[2:]) > n:

@@ -89,6 +89,20 @@ def relnav(mission: str, spacecraft: int) -> str:
     return key(mission, SIM, "sensors", f"sc{spacecraft}", "relnav")
 
 
+def attitude_sensors(mission: str, spacecraft: int) -> str:
+    return key(mission, SIM, "sensors", f"sc{spacecraft}", "attitude")
+
+
+def actuator(mission: str, spacecraft: int, device: str) -> str:
+    """Command to the hardware of a spacecraft: ``sc/<id>/act/<device>`` (thrust, wheels)."""
+    return key(mission, sc_node(spacecraft), "act", device)
+
+
+def assignments(mission: str) -> str:
+    """The ground's PRO assignments (mission planner, later orbit assignment)."""
+    return key(mission, GROUND, "planner", "assignments")
+
+
 def tick_done(mission: str, node: str) -> str:
     return key(mission, node, "exec", "tick_done")
 

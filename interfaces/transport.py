@@ -40,23 +40,35 @@ class Transport(Protocol):
 
 @dataclass
 class InprocNetwork:
-    """The shared medium of in-process transports: synchronous delivery in subscription order."""
+    """The shared medium of in-process transports: synchronous delivery in subscription order.
+    The handlers of each (publisher, key) pair are resolved once and cached until a subscription
+    or an endpoint changes."""
 
     _endpoints: list[InprocTransport] = field(default_factory=list)
     _lock: threading.RLock = field(default_factory=threading.RLock)
+    _routes: dict[tuple[int, str], list[RawHandler]] = field(default_factory=dict)
 
     def endpoint(self) -> InprocTransport:
         t = InprocTransport(self)
         with self._lock:
             self._endpoints.append(t)
+            self._routes.clear()
         return t
+
+    def invalidate(self) -> None:
+        """Forget the cached routes (a subscription was added or an endpoint closed)."""
+        with self._lock:
+            self._routes.clear()
 
     def _deliver(self, origin: InprocTransport, key: str, type_name: str, payload: bytes) -> None:
         with self._lock:
-            targets = [
-                h for ep in self._endpoints if ep is not origin and not ep.closed
-                for expr, h in ep.subs if matches(expr, key)
-            ]
+            targets = self._routes.get((id(origin), key))
+            if targets is None:
+                targets = [
+                    h for ep in self._endpoints if ep is not origin and not ep.closed
+                    for expr, h in ep.subs if matches(expr, key)
+                ]
+                self._routes[(id(origin), key)] = targets
         for h in targets:
             h(key, type_name, payload)
 
@@ -94,6 +106,7 @@ class InprocTransport:
 
     def subscribe(self, key_expr: str, handler: RawHandler) -> None:
         self.subs.append((key_expr, handler))
+        self.network.invalidate()
 
     def serve(self, key_expr: str, responder: Responder) -> None:
         self.servers.append((key_expr, responder))
@@ -111,5 +124,6 @@ class InprocTransport:
     def close(self) -> None:
         if not self.closed:
             self.closed = True
+            self.network.invalidate()
             for node in self.alive:
                 self.network._liveness(node, False)

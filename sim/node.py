@@ -4,7 +4,8 @@ Each tick k (t = k·dt, dt = 1/ω_high): publish the truth and the sensors due a
 Tick k announcing them (and what the nodes published in tick k-1), wait for every participant's
 TickDone(k) — lockstep — or until the per-tick timeout (the missing answer is logged and its
 last command held) or, in real-time mode, until the next tick is due on the wall clock; then
-apply the commands and integrate the truth to t + dt.
+apply the commands (thrust, wheel torques: ``sim.hardware``) and integrate the truth (orbit and
+attitude) to t + dt.
 """
 
 from __future__ import annotations
@@ -15,21 +16,39 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from fsw.lib.hcw import mean_motion, pro_state
 from interfaces import topics
 from interfaces.bus import Bus
-from interfaces.messages import RelNavMeasurement, SimStatus, Tick, TickDone, TruthState
+from interfaces.messages import (
+    AttitudeMeasurement,
+    RelNavMeasurement,
+    SimStatus,
+    ThrustCommand,
+    Tick,
+    TickDone,
+    TruthState,
+    WheelCommand,
+)
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
-from sim.dynamics import RelativeTruth, circular_chief_eci
+from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
+from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
 
 
 def initial_states(scenario: Scenario) -> np.ndarray:
-    """Initial LVLH relative states (N, 6) of the observers on their scenario PROs."""
-    n = mean_motion(scenario.orbit.altitude_km * 1e3)
+    """Initial LVLH relative states (N, 6) of the observers: on their scenario PROs, or just
+    released from the target (``observers.start = "deploy"``: at ``deploy_radius_m`` moving
+    outward at ``deploy_speed_mps``, directions fanned evenly in the along-track/cross-track
+    plane)."""
     obs = scenario.observers
+    if obs.start == "deploy":
+        theta = 2.0 * np.pi * np.arange(obs.count) / obs.count
+        d = np.stack([np.zeros(obs.count), np.cos(theta), np.sin(theta)], axis=1)
+        return np.hstack([obs.deploy_radius_m * d, obs.deploy_speed_mps * d])
+    n = mean_motion(scenario.orbit.altitude_km * 1e3)
     return np.array([pro_state(n, *obs.pro(i)) for i in range(1, obs.count + 1)])
 
 
@@ -45,14 +64,15 @@ class SimNode:
     def __post_init__(self) -> None:
         sc = self.scenario
         chief = circular_chief_eci(sc.orbit.altitude_km * 1e3, np.radians(sc.orbit.inclination_deg))
-        self.truth = RelativeTruth(chief, initial_states(sc), j2=sc.orbit.j2,
-                                   energy_match=sc.observers.energy_match)
+        self.truth = RelativeTruth(
+            chief, initial_states(sc), j2=sc.orbit.j2,
+            energy_match=sc.observers.energy_match and sc.observers.start == "pro")
         self.ids = list(range(1, sc.observers.count + 1))
+        self.hw = ObserverHardware(sc, self._r_lvlh_eci().inv())
         self.sensors = [
             RelNavSensor(sc.sensors.relnav_sigma_r_m, sc.sensors.relnav_sigma_v_mps,
                          stream(sc.seed, "relnav", i)) for i in self.ids
         ]
-        self.accel_lvlh = np.zeros((len(self.ids), 3))
         if sc.faults:
             self.log.warning("%d fault(s) in the scenario are NOT injected: fault injection is "
                              "not implemented yet (issue 5)", len(sc.faults))
@@ -60,6 +80,7 @@ class SimNode:
         self._keys = {
             "tick": topics.tick(m), "status": topics.sim_status(m), "truth": topics.truth(m),
             "relnav": [topics.relnav(m, i) for i in self.ids],
+            "attitude": [topics.attitude_sensors(m, i) for i in self.ids],
         }
         self._cond = threading.Condition()
         self._answers: dict[str, dict[str, int]] = {}
@@ -69,6 +90,33 @@ class SimNode:
         self.missed_answers = 0
         for node in self.participants:
             self.bus.subscribe(topics.tick_done(m, node), TickDone, self._on_done, immediate=True)
+        for index, i in enumerate(self.ids):
+            self.bus.subscribe(topics.actuator(m, i, "thrust"), ThrustCommand,
+                               lambda msg, index=index: self._on_thrust(index, msg))
+            self.bus.subscribe(topics.actuator(m, i, "wheels"), WheelCommand,
+                               lambda msg, index=index: self._on_wheels(index, msg))
+
+    # --- commands to the hardware ---------------------------------------------------------
+
+    def _commanded_by_owner(self, index: int, msg: ThrustCommand | WheelCommand) -> bool:
+        """A command counts only if its body names the spacecraft whose key it came on."""
+        ok = msg.spacecraft == self.ids[index] and msg.sender == topics.sc_node(self.ids[index])
+        if not ok:
+            self.log.warning("command for sc%d from %s naming sc%d ignored", self.ids[index],
+                             msg.sender, msg.spacecraft)
+        return ok
+
+    def _on_thrust(self, index: int, msg: ThrustCommand) -> None:
+        if self._commanded_by_owner(index, msg):
+            self.hw.command_thrust(index, msg.force_body_n, msg.duration_s, msg.t_sim)
+
+    def _on_wheels(self, index: int, msg: WheelCommand) -> None:
+        if self._commanded_by_owner(index, msg):
+            self.hw.command_wheels(index, msg.torque_body_nm)
+
+    def _r_lvlh_eci(self) -> Rotation:
+        """Rotation taking ECI vectors into the true LVLH frame of the target now."""
+        return Rotation.from_matrix(lvlh_basis(self.truth.chief_eci))
 
     # --- lockstep bookkeeping -------------------------------------------------------------
 
@@ -130,7 +178,9 @@ class SimNode:
             self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
             self.bus.dispatch(t, include_now=True)
             if k < n_ticks - 1:
-                self.truth.step(dt, self.accel_lvlh, substeps=sc.sim.substeps)
+                accel = self.hw.accel_lvlh(t, self._r_lvlh_eci())
+                self.truth.step(dt, accel, substeps=sc.sim.substeps)
+                self.hw.step(t, dt)
             if k % max(1, n_ticks // 10) == 0:
                 rate = (k + 1) / max(1e-9, time.monotonic() - wall0)
                 self.log.info("tick %d/%d  t=%.1f s  %.0f ticks/s", k, n_ticks, t, rate)
@@ -148,9 +198,18 @@ class SimNode:
 
     def _publish_hardware(self, k: int, t: float) -> None:
         rel = self.truth.rel_lvlh()
+        hw = self.hw
         self.bus.publish(self._keys["truth"], TruthState(
             sender=topics.SIM, t_sim=t, spacecraft=self.ids,
-            r_lvlh_m=rel[:, :3].tolist(), v_lvlh_mps=rel[:, 3:].tolist()))
+            r_lvlh_m=rel[:, :3].tolist(), v_lvlh_mps=rel[:, 3:].tolist(),
+            q_lvlh_body=hw.q_lvlh_body(self._r_lvlh_eci()).tolist(),
+            w_body_radps=hw.attitude.w.tolist(), dv_mps=hw.dv_mps.tolist()))
+        gyro, st = hw.measure(t, self.scenario.rates.dt_s)
+        for i, sc_id in enumerate(self.ids):
+            self.bus.publish(self._keys["attitude"][i], AttitudeMeasurement(
+                sender=topics.SIM, t_sim=t, spacecraft=sc_id, gyro_radps=gyro[i].tolist(),
+                star_tracker=None if st is None else st[i].tolist(),
+                st_sigma_cross_rad=hw.st_sigma_rad[0], st_sigma_roll_rad=hw.st_sigma_rad[1]))
         if k % self.scenario.rates.ticks_per("mid") == 0:
             for i, sensor in enumerate(self.sensors):
                 r, v = sensor.measure(rel[i, :3], rel[i, 3:])

@@ -25,20 +25,16 @@ def small_scenario(name: str = "t", **sections: object) -> Scenario:
 
 
 def write_scenario(path: Path, scenario: Scenario) -> Path:
-    """Write a scenario as TOML (via its JSON dump; only simple tables are needed here)."""
+    """Write a scenario as TOML (tables for the sections, inline tables/arrays inside)."""
     lines: list[str] = []
     data = scenario.model_dump(exclude_none=True)
-    top = {k: v for k, v in data.items() if not isinstance(v, (dict, list))}
-    for k, v in top.items():
-        lines.append(f"{k} = {_toml(v)}")
+    for k, v in data.items():
+        if not isinstance(v, dict):
+            lines.append(f"{k} = {_toml(v)}")
     for k, v in data.items():
         if isinstance(v, dict):
             lines.append(f"[{k}]")
-            for kk, vv in v.items():
-                if isinstance(vv, dict):
-                    lines.append(f"{kk} = {{ " + ", ".join(f"{a} = {_toml(b)}" for a, b in vv.items()) + " }")
-                elif not (isinstance(vv, list) and not vv):
-                    lines.append(f"{kk} = {_toml(vv)}")
+            lines += [f"{kk} = {_toml(vv)}" for kk, vv in v.items()]
     path.write_text("\n".join(lines) + "\n")
     assert parse_scenario(path.read_text()) == scenario
     return path
@@ -51,6 +47,10 @@ def _toml(v: object) -> str:
         return f'"{v}"'
     if isinstance(v, float) and v == float("inf"):
         return "inf"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{a} = {_toml(b)}" for a, b in v.items()) + " }"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
     return repr(v)
 
 

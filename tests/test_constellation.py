@@ -17,7 +17,7 @@ from deploy.inproc import run_inproc
 from ground.reader import load_run
 from ground.recorder import McapRecorder
 from interfaces import topics
-from interfaces.messages import ExecStats, LinkStats, Message, StateEstimate, TruthState
+from interfaces.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry
 from interfaces.zenoh_transport import ZenohSettings, ZenohTransport
 from tests.conftest import REPO, small_scenario, write_scenario
 
@@ -39,7 +39,7 @@ def _comparable(path: Path) -> dict[str, list[dict]]:
         if r.type_name == "ExecStats":
             continue
         d = json.loads(r.payload)
-        for f in Message.WALL_CLOCK_FIELDS:
+        for f in registry()[r.type_name].WALL_CLOCK_FIELDS:
             d.pop(f)
         out.setdefault(r.key, []).append(d)
     return out

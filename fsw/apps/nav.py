@@ -1,8 +1,11 @@
 """Navigation app: relative-state Kalman filter on the HCW model.
 
-Rate group mid (ω_mid).  Input: the relative navigation sensor (LVLH position and velocity).
-Output: the state estimate [x y z vx vy vz] (m, m/s, LVLH) with its covariance and NIS.
-The model is the flight model (HCW, exact discretization Φ = expm(A·dt)), not the truth.
+Rate group mid (ω_mid).  Inputs: the relative navigation sensor (LVLH position and velocity)
+and the guidance status, whose commanded LVLH acceleration (held for one ω_low period) enters
+the prediction as a known input.  Output: the state estimate [x y z vx vy vz] (m, m/s, LVLH)
+with its covariance and NIS.  The model is the flight model (HCW, exact ZOH discretization
+expm([[A, B], [0, 0]]·dt)), not the truth.  A commanded acceleration u adds process noise for its
+execution error, ``(THRUST_ERROR_FRAC·|u|)²`` m²/s³ (thruster noise and thrust direction error).
 """
 
 from __future__ import annotations
@@ -12,7 +15,10 @@ import numpy as np
 from fsw.lib import hcw, kalman
 from interfaces import topics
 from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import RelNavMeasurement, StateEstimate
+from interfaces.messages import GuidanceStatus, RelNavMeasurement, StateEstimate
+
+THRUST_ERROR_FRAC = 0.05
+"""1σ execution error of a commanded acceleration, as a fraction of it."""
 
 
 class NavApp(App):
@@ -20,6 +26,8 @@ class NavApp(App):
     RATE = "mid"
     INPUTS = (
         Input(lambda c: topics.relnav(c.mission, c.spacecraft or 0), RelNavMeasurement, "on_relnav"),
+        Input(lambda c: topics.key(c.mission, c.node, "guidance", "status"), GuidanceStatus,
+              "on_guidance"),
     )
     OUTPUTS = (
         Output("estimate", lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate),
@@ -34,11 +42,21 @@ class NavApp(App):
         self.P = np.eye(6)
         self.t_est = 0.0
         self.nis: float | None = None
+        self.cmd_period = 1.0 / sc.rates.low_hz
+        self._cmd: tuple[float, np.ndarray] = (0.0, np.zeros(3))  # (start s, LVLH accel m/s²)
         self._meas: RelNavMeasurement | None = None
-        self._models: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        self._models: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def on_relnav(self, msg: RelNavMeasurement) -> None:
         self._meas = msg
+
+    def on_guidance(self, msg: GuidanceStatus) -> None:
+        self._cmd = (msg.t_sim, np.array(msg.accel_lvlh_mps2))
+
+    def _accel(self, t: float) -> np.ndarray:
+        """The commanded acceleration acting from time t (zero outside its hold period)."""
+        t0, u = self._cmd
+        return u if t0 - 1e-9 <= t < t0 + self.cmd_period - 1e-9 else np.zeros(3)
 
     def step(self, t: float) -> None:
         meas, self._meas = self._meas, None
@@ -61,15 +79,18 @@ class NavApp(App):
         dt = round(t - self.t_est, 9)
         if dt <= 0.0 or self.x is None:
             return
-        Ad, Qd = self._model(dt)
-        self.x, self.P = kalman.predict(self.x, self.P, Ad, Qd)
+        Ad, Bd, Qd = self._model(dt)
+        u = self._accel(self.t_est)
+        q_thrust = (THRUST_ERROR_FRAC * float(np.linalg.norm(u)))**2
+        self.x, self.P = kalman.predict(self.x, self.P, Ad, Qd * (1.0 + q_thrust / self.q), Bd, u)
         self.t_est = t
 
-    def _model(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        """(Φ, Qd) for step dt, cached: the rate group makes dt constant."""
+    def _model(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(Φ, Γ, Qd) for step dt (Qd for the base noise density), cached: the rate group makes
+        dt constant."""
         m = self._models.get(dt)
         if m is None:
-            m = (hcw.hcw_stm(self.n, dt), hcw.process_noise(self.n, dt, self.q))
+            m = (*hcw.discretize(self.n, dt), hcw.process_noise(self.n, dt, self.q))
             self._models[dt] = m
         return m
 

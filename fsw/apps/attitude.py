@@ -1,0 +1,205 @@
+"""Attitude app: attitude determination and pointing control (paper Sec. II.B).
+
+Rate group high (ω_high).  Inputs: the attitude sensors (gyro every tick, star tracker when it
+has a fix), the nav state estimate (own position) and the camera's pointing target (until a
+camera app publishes one: the target's centre, the LVLH origin).  Outputs: the reaction-wheel
+torque command every tick and the attitude estimate/status at ω_mid.
+
+Each cycle: the MEKF (``fsw.lib.mekf``) propagates with the gyro and updates with the star
+tracker; the desired attitude puts the camera boresight on the line of sight to the pointing
+target (LVLH, carried into ECI by the onboard LVLH model ``fsw.lib.frames``) by the shortest
+rotation from the previous desired attitude (``fsw.lib.attitude.repoint``: roll-free pointing,
+no singular line of sight).  An error larger than ``attitude.slew_threshold_deg`` starts a slew
+planned by SCP with the rate limit (``scp_slew``; slerp if SCP fails); otherwise the nonlinear
+tracking law (``fsw.lib.attitude_control``) follows the pointing attitude directly.  Before the
+estimator has its first star-tracker fix the app damps the body rate with the gyro.
+
+The wheel momentum is not measured; the app integrates its own commands (h' = −τ) from the
+initial zero momentum, which the gyroscopic compensation uses.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from fsw.lib import hcw, mekf
+from fsw.lib.attitude import repoint, scp_slew, slerp_plan
+from fsw.lib.attitude_control import gains_for, tracking_torque
+from fsw.lib.frames import lvlh_to_eci
+from interfaces import topics
+from interfaces.app import App, AppContext, Input, Output
+from interfaces.messages import (
+    AttitudeEstimate,
+    AttitudeMeasurement,
+    PointingTarget,
+    StateEstimate,
+    WheelCommand,
+)
+
+DESIRED_RATE_STEP_S = 1.0
+"""Finite-difference step for the desired angular velocity, s."""
+
+
+class AttitudeApp(App):
+    NAME = "attitude"
+    RATE = "high"
+    INPUTS = (
+        Input(lambda c: topics.attitude_sensors(c.mission, c.spacecraft or 0), AttitudeMeasurement,
+              "on_sensors"),
+        Input(lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate,
+              "on_estimate"),
+        Input(lambda c: topics.key(c.mission, c.node, "camera", "pointing"), PointingTarget,
+              "on_target"),
+    )
+    OUTPUTS = (
+        Output("wheels", lambda c: topics.actuator(c.mission, c.spacecraft or 0, "wheels"),
+               WheelCommand),
+        Output("estimate", lambda c: topics.key(c.mission, c.node, "attitude", "estimate"),
+               AttitudeEstimate),
+    )
+
+    def __init__(self, ctx: AppContext) -> None:
+        super().__init__(ctx)
+        sc = ctx.scenario
+        self.sc_id = ctx.spacecraft or 0
+        self.n = hcw.mean_motion(sc.orbit.altitude_km * 1e3)
+        self.incl = math.radians(sc.orbit.inclination_deg)
+        self.dt = sc.rates.dt_s
+        self.mid_every = sc.rates.ticks_per("mid")
+        self.J = np.diag(sc.observers.inertia_kg_m2)
+        self.cfg = sc.attitude
+        self.boresight = np.array(sc.attitude.boresight_body, dtype=float)
+        self.st_axis = int(np.argmax(np.abs(self.boresight)))  # star tracker co-aligned
+        self.w_max = math.radians(sc.attitude.slew_rate_max_dps)
+        self.gains = gains_for(sc.attitude.settling_time_s, w_max_radps=self.w_max)
+        self.tau_max = sc.actuators.wheel_max_torque_nm
+        s = sc.sensors
+        self.sigma_v, self.sigma_u = s.gyro_arw_rad_rts, s.gyro_bias_rw_rad_s15
+        self.bias_sigma0 = s.gyro_bias_sigma_radps
+        self.q: np.ndarray | None = None     # MEKF attitude R_eci_body (scalar last)
+        self.b = np.zeros(3)
+        self.P = np.zeros((6, 6))
+        self.nis: float | None = None
+        self.h_wheels = np.zeros(3)
+        self.tau = np.zeros(3)
+        self.w_est = np.zeros(3)
+        self.target = np.zeros(3)
+        self.slew = None
+        self.slew_t0 = 0.0
+        self.slew_end = 0.0
+        self.r_point: Rotation | None = None  # last desired attitude while tracking
+        self.mode = "init"
+        self.cycles = 0
+        self._meas: AttitudeMeasurement | None = None
+        self._est: StateEstimate | None = None
+
+    def on_sensors(self, msg: AttitudeMeasurement) -> None:
+        self._meas = msg
+
+    def on_estimate(self, msg: StateEstimate) -> None:
+        self._est = msg
+
+    def on_target(self, msg: PointingTarget) -> None:
+        self.target = np.array(msg.target_lvlh_m)
+
+    # --- cycle ---------------------------------------------------------------------------------
+
+    def step(self, t: float) -> None:
+        meas, self._meas = self._meas, None
+        if meas is not None:
+            self._determine(meas)
+        if self.q is None or self._est is None:
+            w = np.array(meas.gyro_radps) if meas is not None else np.zeros(3)
+            self.tau = _saturate(-self.J @ (self.gains.kd * w), self.tau_max)  # rate damping
+        else:
+            self.tau = self._control(t)
+        self.h_wheels -= self.tau * self.dt
+        self.publish("wheels", WheelCommand(sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id,
+                                            torque_body_nm=self.tau.tolist()))
+        if self.cycles % self.mid_every == 0 and self.q is not None:
+            self._report(t)
+        self.cycles += 1
+
+    def _determine(self, meas: AttitudeMeasurement) -> None:
+        """MEKF: propagate with the gyro, update with the star tracker (initialise on its first
+        fix)."""
+        w_meas = np.array(meas.gyro_radps)
+        if self.q is not None:
+            self.q, self.b, self.P = mekf.mekf_propagate(self.q, self.b, self.P, w_meas, self.dt,
+                                                         self.sigma_v, self.sigma_u)
+        if meas.star_tracker is not None:
+            R = np.diag(np.full(3, meas.st_sigma_cross_rad**2))
+            R[self.st_axis, self.st_axis] = meas.st_sigma_roll_rad**2
+            if self.q is None:
+                self.q, self.b, self.P = mekf.mekf_init(np.array(meas.star_tracker), R,
+                                                        self.bias_sigma0)
+            else:
+                self.q, self.b, self.P, self.nis = mekf.mekf_update(
+                    self.q, self.b, self.P, np.array(meas.star_tracker), R)
+        self.w_est = w_meas - self.b
+
+    def _los_eci(self, t: float) -> np.ndarray:
+        """Line of sight to the pointing target at time t, ECI axes (m), from the nav estimate
+        extrapolated with its velocity."""
+        assert self._est is not None
+        x = np.array(self._est.x)
+        r = x[:3] + x[3:] * (t - self._est.t_sim)
+        los: np.ndarray = lvlh_to_eci(t, self.n, self.incl).apply(self.target - r)
+        return los
+
+    def _control(self, t: float) -> np.ndarray:
+        assert self.q is not None
+        r_est = Rotation.from_quat(self.q)
+        if self.mode == "slew" and self.slew is not None and t - self.slew_t0 <= self.slew_end:
+            r_des, w_des, wdot_des = self.slew.at(t - self.slew_t0)
+        else:
+            r_des = repoint(self.r_point or r_est, self._los_eci(t), self.boresight)
+            h = DESIRED_RATE_STEP_S
+            r_next = repoint(r_des, self._los_eci(t + h), self.boresight)
+            w_des, wdot_des = (r_des.inv() * r_next).as_rotvec() / h, np.zeros(3)
+            angle = (r_des.inv() * r_est).magnitude()
+            if angle > math.radians(self.cfg.slew_threshold_deg):
+                self._plan_slew(t, r_est, angle)
+                self.r_point = None
+                r_des, w_des, wdot_des = self.slew.at(0.0)
+            else:
+                self.mode, self.r_point = "track", r_des
+        tau, _ = tracking_torque(r_est, self.w_est, r_des, w_des, wdot_des, self.J,
+                                              self.h_wheels, self.gains, self.tau_max)
+        return tau
+
+    def _plan_slew(self, t: float, r_est: Rotation, angle: float) -> None:
+        duration = max(10.0, 1.5 * angle / self.w_max + self.cfg.settling_time_s)
+        r_end = repoint(r_est, self._los_eci(t + duration), self.boresight)
+        nodes = max(8, int(math.ceil(duration / 5.0)))
+        plan = scp_slew(r_est, r_end, duration, nodes, self.w_max, w0=self.w_est)
+        if not plan.converged:
+            self.log.warning("slew SCP %s; using slerp", plan.status)
+            plan = slerp_plan(r_est, r_end, 0.0, duration)
+        self.slew, self.slew_t0, self.slew_end, self.mode = plan, t, duration, "slew"
+        self.log.info("slew of %.1f° planned over %.0f s", math.degrees(angle), duration)
+
+    def _report(self, t: float) -> None:
+        assert self.q is not None
+        r = Rotation.from_quat(self.q)
+        q_lvlh = (lvlh_to_eci(t, self.n, self.incl).inv() * r).as_quat()
+        error = 0.0
+        if self._est is not None:
+            los = self._los_eci(t)
+            cos = float(r.apply(self.boresight) @ los) / max(1e-12, float(np.linalg.norm(los)))
+            error = math.acos(min(1.0, max(-1.0, cos)))
+        self.publish("estimate", AttitudeEstimate(
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, q_eci_body=self.q.tolist(),
+            q_lvlh_body=q_lvlh.tolist(), gyro_bias_radps=self.b.tolist(),
+            sigma_att_rad=float(math.sqrt(max(0.0, np.trace(self.P[:3, :3])))),
+            target_lvlh_m=self.target.tolist(), pointing_error_rad=error,
+            mode=self.mode, torque_body_nm=self.tau.tolist(), nis=self.nis))  # type: ignore[arg-type]
+
+
+def _saturate(tau: np.ndarray, tau_max: float) -> np.ndarray:
+    """Scale a torque so that no axis exceeds ``tau_max``, keeping its direction."""
+    m = float(np.abs(tau).max())
+    return tau if m <= tau_max else tau * (tau_max / m)

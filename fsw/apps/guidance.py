@@ -1,0 +1,220 @@
+"""Guidance app: PRO insertion, reconfiguration and station keeping (paper Sec. II.B, Fig. 7).
+
+Rate group low (ω_low).  Inputs: the ground's PRO assignments, the nav state estimate and the
+attitude estimate (to express thrust in body axes).  Outputs: the thrust command to the
+thrusters, the transfer plan when one is made, and the guidance status.
+
+A new assignment is kept pending (the current orbit is still held) until its departure time;
+then the app plans a fuel-optimal transfer to
+the assigned PRO's state at the arrival time — SCP with an L1 fuel cost, per-axis thrust limit and
+a keep-out sphere (``fsw.lib.scp``), the terminal state energy matched (``fsw.lib.pro``) — and
+tracks the plan, then the PRO, with the MPC (``fsw.lib.mpc``) every cycle.  The first MPC input is
+held for one cycle (ZOH), converted from LVLH to body axes with the attitude estimate.  With no
+assignment the spacecraft drifts (no thrust); without an attitude estimate, or while the
+attitude app is slewing, it does not fire (the MPC closes the gap on the next cycles).  The
+status reports the acceleration actually commanded, which nav uses as its known input.
+
+Thrust limits: body thrusters give |F_j| ≤ F_max per axis; any LVLH acceleration with
+|u|∞ ≤ F_max / (m √3) maps into body axes within that limit whatever the attitude, so that is the
+MPC's limit, and the plan uses ``guidance.plan_thrust_fraction`` of it to leave a margin.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from fsw.lib import hcw
+from fsw.lib.constants import R_EARTH_M
+from fsw.lib.mpc import MpcConfig, MpcTracker
+from fsw.lib.pro import Pro, energy_matched_state
+from fsw.lib.scp import TransferPlan, plan_transfer
+from interfaces import topics
+from interfaces.app import App, AppContext, Input, Output
+from interfaces.messages import (
+    AttitudeEstimate,
+    GuidanceStatus,
+    ProAssignment,
+    ProAssignments,
+    StateEstimate,
+    ThrustCommand,
+    TransferPlanMsg,
+)
+
+MIN_TRANSFER_S = 120.0
+"""Shortest transfer planned when an assignment arrives late, s."""
+
+
+class GuidanceApp(App):
+    NAME = "guidance"
+    RATE = "low"
+    INPUTS = (
+        Input(lambda c: topics.assignments(c.mission), ProAssignments, "on_assignments"),
+        Input(lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate,
+              "on_estimate"),
+        Input(lambda c: topics.key(c.mission, c.node, "attitude", "estimate"), AttitudeEstimate,
+              "on_attitude"),
+    )
+    OUTPUTS = (
+        Output("thrust", lambda c: topics.actuator(c.mission, c.spacecraft or 0, "thrust"),
+               ThrustCommand),
+        Output("plan", lambda c: topics.key(c.mission, c.node, "guidance", "plan"),
+               TransferPlanMsg),
+        Output("status", lambda c: topics.key(c.mission, c.node, "guidance", "status"),
+               GuidanceStatus),
+    )
+
+    def __init__(self, ctx: AppContext) -> None:
+        super().__init__(ctx)
+        sc = ctx.scenario
+        self.sc_id = ctx.spacecraft or 0
+        self.n = hcw.mean_motion(sc.orbit.altitude_km * 1e3)
+        self.chief_radius_m = R_EARTH_M + sc.orbit.altitude_km * 1e3
+        self.dt = 1.0 / sc.rates.low_hz
+        self.mass = sc.observers.mass_kg
+        self.u_max = sc.actuators.thruster_max_force_n / (self.mass * math.sqrt(3.0))
+        self.cfg = sc.guidance
+        self.mpc = MpcTracker(self.n, MpcConfig(dt_s=self.dt, horizon=self.cfg.mpc_horizon,
+                                                u_max_mps2=self.u_max))
+        self.assignment: ProAssignment | None = None  # the one being flown
+        self.pending: ProAssignment | None = None     # received, departure still ahead
+        self.pro: Pro | None = None
+        self.plan: TransferPlan | None = None
+        self.plan_t0 = 0.0
+        self.planned_id = 0
+        self.dv_commanded = 0.0
+        self._est: StateEstimate | None = None
+        self._att: AttitudeEstimate | None = None
+
+    # --- inputs ------------------------------------------------------------------------------
+
+    def on_assignments(self, msg: ProAssignments) -> None:
+        """Keep the newest assignment as pending until its departure time."""
+        mine = [a for a in msg.assignments if a.spacecraft == self.sc_id]
+        newest = max((a.assignment_id for a in (self.assignment, self.pending) if a), default=0)
+        if mine and mine[0].assignment_id > newest:
+            self.pending = mine[0]
+            self.log.info("assignment %d (%s) received: depart %.0f s, arrive %.0f s",
+                          mine[0].assignment_id, mine[0].phase, mine[0].t_depart_s,
+                          mine[0].t_arrive_s)
+
+    def on_estimate(self, msg: StateEstimate) -> None:
+        self._est = msg
+
+    def on_attitude(self, msg: AttitudeEstimate) -> None:
+        self._att = msg
+
+    # --- cycle ---------------------------------------------------------------------------------
+
+    def step(self, t: float) -> None:
+        if self.pending is not None and t >= self.pending.t_depart_s - 1e-9:
+            self.assignment, self.pending = self.pending, None
+            p = self.assignment.pro
+            self.pro = Pro(p.rho_x_m, p.alpha_x_rad, p.rho_y_m, p.rho_z_m, p.alpha_z_rad)
+        a = self.assignment
+        if self._est is None or a is None or self.pro is None:
+            self._status(t, "idle")
+            return
+        x = _propagate(self.n, np.array(self._est.x), t - self._est.t_sim)
+        if a.assignment_id != self.planned_id:
+            self._plan(t, x, a)
+        refs, u_ref = self._reference(t)
+        res = self.mpc.solve(x, refs, u_ref)
+        u = res.u0 if res.ok else np.zeros(3)
+        if not res.ok:
+            self.log.warning("MPC %s at t=%.0f s: no thrust this cycle", res.status, t)
+        u = self._command(t, u)
+        mode = "transfer" if self.plan is not None and t < self.plan_t0 + self.plan.t_s[-1] else "hold"
+        err = x - refs[0]
+        self._status(t, mode, err, u, res.status, 1e3 * res.solve_time_s)
+
+    def _plan(self, t: float, x: np.ndarray, a: ProAssignment) -> None:
+        """Plan the transfer to the assigned PRO (or go straight to holding it if already due)."""
+        self.planned_id = a.assignment_id
+        self.plan = None
+        self.mpc.reset()
+        duration = a.t_arrive_s - t
+        if duration <= 0.0:
+            return  # already due: hold the PRO from here (the MPC closes any gap)
+        duration = max(duration, MIN_TRANSFER_S)
+        d_min = min(self.cfg.keep_out_m, 0.9 * float(np.linalg.norm(x[:3])))
+        # Too short for the planning thrust: use the full limit, then take longer.
+        attempts = [(duration, self.cfg.plan_thrust_fraction * self.u_max)] + [
+            (duration * 1.5**k, self.u_max) for k in range(3)]
+        for duration, u_max in attempts:
+            plan = self._solve_transfer(t, x, duration, u_max, d_min)
+            if plan.status != "infeasible_thrust_limit":
+                break
+            self.log.warning("transfer %d infeasible in %.0f s at %.2g m/s²", a.assignment_id,
+                             duration, u_max)
+        self.log.info("transfer %d planned: %s, %.1f mm/s, %d iterations, %.0f ms",
+                      a.assignment_id, plan.status, 1e3 * plan.dv_mps, plan.iterations,
+                      1e3 * plan.solve_time_s)
+        self.publish("plan", TransferPlanMsg(
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, assignment_id=a.assignment_id,
+            t_s=(t + plan.t_s).tolist(), x=plan.x.tolist(), u_mps2=plan.u.tolist(),
+            dv_mps=plan.dv_mps, status=plan.status, iterations=plan.iterations,
+            min_range_m=max(0.0, plan.min_range_m), solve_ms=1e3 * plan.solve_time_s))
+        if plan.converged:
+            self.plan, self.plan_t0 = plan, t
+        else:
+            self.log.error("transfer %d: SCP %s; tracking the PRO directly", a.assignment_id,
+                           plan.status)
+
+    def _solve_transfer(self, t: float, x: np.ndarray, duration: float, u_max: float,
+                        d_min: float) -> TransferPlan:
+        """SCP transfer from ``x`` now to the assigned PRO's energy-matched state ``duration``
+        seconds later, with nodes every ``guidance.node_spacing_s``."""
+        assert self.pro is not None
+        intervals = max(4, int(math.ceil(duration / self.cfg.node_spacing_s)))
+        xf = energy_matched_state(self.pro.state(self.n, t + duration), self.chief_radius_m)
+        return plan_transfer(self.n, x, xf, duration, intervals, u_max, d_min)
+
+    def _reference(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Reference states at t + j·dt (j = 0..H) and feed-forward inputs (j = 0..H-1)."""
+        assert self.pro is not None
+        h = self.cfg.mpc_horizon
+        times = t + self.dt * np.arange(h + 1)
+        refs = self.pro.states(self.n, times)
+        u_ref = np.zeros((h, 3))
+        plan = self.plan
+        if plan is not None:
+            tau = times - self.plan_t0
+            inside = tau <= plan.t_s[-1]
+            for j in np.flatnonzero(inside):
+                refs[j] = plan.state_at(tau[j])
+                if j < h:
+                    u_ref[j] = plan.u[min(int(tau[j] // plan.t_s[1]), len(plan.u) - 1)]
+        return refs, u_ref
+
+    def _command(self, t: float, u_lvlh: np.ndarray) -> np.ndarray:
+        """Send the thrust for acceleration ``u_lvlh``; return the acceleration commanded (zero
+        when the thrusters cannot fire: no attitude estimate yet, or the spacecraft is slewing,
+        which would turn the body-fixed thrust during the burn)."""
+        if self._att is None or self._att.mode != "track" or not u_lvlh.any():
+            return np.zeros(3)
+        r_lvlh_body = Rotation.from_quat(self._att.q_lvlh_body)
+        force_body = self.mass * r_lvlh_body.inv().apply(u_lvlh)
+        self.dv_commanded += float(np.abs(u_lvlh).sum()) * self.dt
+        self.publish("thrust", ThrustCommand(
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id,
+            force_body_n=force_body.tolist(), duration_s=self.dt))
+        return u_lvlh
+
+    def _status(self, t: float, mode: str, err: np.ndarray | None = None,
+                u: np.ndarray | None = None, mpc_status: str = "", mpc_ms: float = 0.0) -> None:
+        a = self.assignment
+        self.publish("status", GuidanceStatus(
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, mode=mode,  # type: ignore[arg-type]
+            assignment_id=a.assignment_id if a else 0, phase=a.phase if a else "",
+            pos_error_m=float(np.linalg.norm(err[:3])) if err is not None else 0.0,
+            vel_error_mps=float(np.linalg.norm(err[3:])) if err is not None else 0.0,
+            accel_lvlh_mps2=(u if u is not None else np.zeros(3)).tolist(),
+            dv_commanded_mps=self.dv_commanded, mpc_status=mpc_status, mpc_ms=mpc_ms))
+
+
+def _propagate(n: float, x: np.ndarray, dt: float) -> np.ndarray:
+    """HCW propagation of an estimate to the cycle time (dt ≥ 0, usually 0)."""
+    return x if abs(dt) < 1e-9 else hcw.hcw_stm(n, dt) @ x

@@ -1,0 +1,109 @@
+"""The observers' GNC hardware in the sim: thrusters, reaction wheels, rigid-body attitude, gyro
+and star tracker, for all observers at once.
+
+Commands arrive from the flight software (``ThrustCommand``, ``WheelCommand``) and are held:
+a thrust command is realised once, when it arrives, over its whole duration — the thrusters
+fire it as pulse-width-modulated impulses, so the minimum impulse bit and the per-pulse noise
+apply to the command's impulse, not to each tick — and the resulting average force is applied
+until the duration ends; a wheel torque is held until the next command.  Every random draw comes
+from per-spacecraft, per-device generators of the scenario seed.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from interfaces.rng import stream
+from interfaces.scenario import Scenario
+from sim.actuators import ThrusterBank, WheelArray
+from sim.attitude import AttitudeTruth
+from sim.sensors import Gyro, StarTracker
+
+ARCSEC_RAD = math.pi / 180.0 / 3600.0
+
+
+def initial_attitudes(scenario: Scenario, r_eci_lvlh: Rotation) -> tuple[np.ndarray, np.ndarray]:
+    """Initial R_eci_body quaternions (N, 4) and body rates (N, 3, rad/s) of the observers:
+    uniformly random (seeded per spacecraft) or aligned with LVLH, plus a seeded tumble."""
+    obs = scenario.observers
+    q, w = [], []
+    for i in range(1, obs.count + 1):
+        rng = stream(scenario.seed, "attitude_init", i)
+        r = (Rotation.random(random_state=rng) if obs.initial_attitude == "random"
+             else r_eci_lvlh)
+        q.append(r.as_quat())
+        w.append(math.radians(obs.tumble_rate_dps) * rng.standard_normal(3))
+    return np.array(q), np.array(w)
+
+
+class ObserverHardware:
+    """Thrusters, wheels, attitude truth and attitude sensors of all observers."""
+
+    def __init__(self, scenario: Scenario, r_eci_lvlh: Rotation) -> None:
+        sc = scenario
+        n = sc.observers.count
+        ids = range(1, n + 1)
+        act, sen = sc.actuators, sc.sensors
+        self.n = n
+        self.mass_kg = sc.observers.mass_kg
+        q0, w0 = initial_attitudes(sc, r_eci_lvlh)
+        self.attitude = AttitudeTruth(q0, w0, np.diag(sc.observers.inertia_kg_m2), np.zeros((n, 3)))
+        self.thrusters = [ThrusterBank(act.thruster_max_force_n, act.thruster_min_impulse_ns,
+                                       act.thruster_noise_frac, [stream(sc.seed, "thruster", i)])
+                          for i in ids]
+        self.wheels = WheelArray(n, act.wheel_max_torque_nm, act.wheel_max_momentum_nms)
+        axis = int(np.argmax(np.abs(sc.attitude.boresight_body)))
+        self.gyro = Gyro([stream(sc.seed, "gyro", i) for i in ids], sen.gyro_arw_rad_rts,
+                         sen.gyro_bias_rw_rad_s15, sen.gyro_bias_sigma_radps)
+        self.star_tracker = StarTracker([stream(sc.seed, "star_tracker", i) for i in ids],
+                                        sen.star_tracker_cross_arcsec, sen.star_tracker_roll_arcsec,
+                                        boresight_axis=axis, rate_hz=sen.star_tracker_hz)
+        self.st_sigma_rad = (sen.star_tracker_cross_arcsec * ARCSEC_RAD,
+                             sen.star_tracker_roll_arcsec * ARCSEC_RAD)
+        self.force_body = np.zeros((n, 3))
+        self.force_until = np.zeros(n)
+        self.tau_cmd = np.zeros((n, 3))
+        self.dv_mps = np.zeros(n)
+
+    # --- commands -----------------------------------------------------------------------------
+
+    def command_thrust(self, index: int, force_body_n: list[float], duration_s: float,
+                       t_s: float) -> None:
+        """Realise a thrust command of observer ``index`` (0-based) from ``t_s`` for
+        ``duration_s``; it replaces any command still running."""
+        f = self.thrusters[index].fire(np.array([force_body_n]), duration_s)
+        self.force_body[index] = f[0]
+        self.force_until[index] = t_s + duration_s
+
+    def command_wheels(self, index: int, torque_body_nm: list[float]) -> None:
+        self.tau_cmd[index] = torque_body_nm
+
+    # --- one tick -----------------------------------------------------------------------------
+
+    def accel_lvlh(self, t_s: float, r_lvlh_eci: Rotation) -> np.ndarray:
+        """Thrust acceleration in LVLH over the tick starting at ``t_s`` (N, 3), m/s²."""
+        active = (t_s < self.force_until - 1e-9)[:, None]
+        f = np.where(active, self.force_body, 0.0)
+        return (r_lvlh_eci * self.attitude.r_eci_body()).apply(f) / self.mass_kg
+
+    def step(self, t_s: float, dt_s: float) -> None:
+        """Advance the attitude (wheel torques held) and the Δv bookkeeping by one tick."""
+        active = t_s < self.force_until - 1e-9
+        self.dv_mps += np.where(active, np.linalg.norm(self.force_body, axis=1), 0.0) \
+            * dt_s / self.mass_kg
+        tau = self.wheels.realise(self.tau_cmd, self.attitude.h, dt_s)
+        self.attitude.step(dt_s, tau)
+
+    def measure(self, t_s: float, dt_s: float) -> tuple[np.ndarray, np.ndarray | None]:
+        """Gyro rates (N, 3) averaged over the last tick and star-tracker quaternions (N, 4) when
+        a fix is due at ``t_s`` (else None)."""
+        gyro = self.gyro.measure(self.attitude.mean_rate, dt_s)
+        return gyro, self.star_tracker.measure(t_s, self.attitude.r_eci_body())
+
+    def q_lvlh_body(self, r_lvlh_eci: Rotation) -> np.ndarray:
+        """True attitudes with respect to LVLH (N, 4), scalar last."""
+        q: np.ndarray = (r_lvlh_eci * self.attitude.r_eci_body()).as_quat()
+        return q.reshape(self.n, 4)
