@@ -1,8 +1,11 @@
 """Evaluation of orbit and attitude control from a run's archive, against the sim's truth.
 
-* Δv per observer: delivered (sim truth, Σ|F|/m·dt), commanded (guidance, L1) and planned (SCP).
-* PRO holding: distance of the true position from the assigned PRO while guidance holds it.
-* Safety: the smallest true range to the target's centre over the run.
+* Δv per observer, all L1 (Σ over axes of |Δv_j|): delivered (sim truth, body axes), commanded
+  (guidance, LVLH) and planned (SCP transfers that were flown).
+* PRO holding: distance of the true position from the assigned PRO while guidance holds it, from
+  the assignment's arrival time on.
+* Safety: the smallest true range to the target's centre once flying (from the first departure;
+  a deployment starts inside the keep-out sphere by design).
 * Pointing: angle between the true camera boresight and the true line of sight to the commanded
   pointing target, and the attitude knowledge error (estimate against truth).
 """
@@ -55,12 +58,16 @@ def gnc_series(archive: RunArchive, scenario: Scenario, mission: str) -> dict[in
     bore = np.array(scenario.attitude.boresight_body, dtype=float)
     truth = _truth_by_time(archive, mission)
     out = {i: GncSeries() for i in range(1, scenario.observers.count + 1)}
+    t_flying = (scenario.phases[0].start_s if scenario.observers.start == "deploy"
+                and scenario.phases else 0.0)
     for ts in truth.values():
+        if ts.t_sim < t_flying:
+            continue
         for j, sc in enumerate(ts.spacecraft):
             s = out[sc]
             s.range_min_m = min(s.range_min_m, float(np.linalg.norm(ts.r_lvlh_m[j])))
     _delta_v(truth, out, scenario.rates.mid_hz)
-    assignments = {(a.spacecraft, a.assignment_id): a.pro
+    assignments = {(a.spacecraft, a.assignment_id): a
                    for m in archive.messages(topics.assignments(mission), ProAssignments)
                    for a in m.assignments}
     for st in archive.messages(topics.all_spacecraft(mission, "guidance", "status"), GuidanceStatus):
@@ -69,16 +76,18 @@ def gnc_series(archive: RunArchive, scenario: Scenario, mission: str) -> dict[in
         if s is None:
             continue
         s.dv_commanded_mps = max(s.dv_commanded_mps, st.dv_commanded_mps)
-        pro = assignments.get((st.spacecraft, st.assignment_id))
-        if st.mode != "hold" or pro is None or tr is None or st.spacecraft not in tr.spacecraft:
+        a = assignments.get((st.spacecraft, st.assignment_id))
+        if (st.mode != "hold" or a is None or st.t_sim < a.t_arrive_s or tr is None
+                or st.spacecraft not in tr.spacecraft):
             continue
+        pro = a.pro
         ref = hcw.pro_state(n, pro.rho_x_m, pro.alpha_x_rad, pro.rho_y_m, pro.rho_z_m,
                             pro.alpha_z_rad, st.t_sim)
         r = np.array(tr.r_lvlh_m[tr.spacecraft.index(st.spacecraft)])
         s.hold_t_s.append(st.t_sim)
         s.hold_error_m.append(float(np.linalg.norm(r - ref[:3])))
     for plan in archive.messages(topics.all_spacecraft(mission, "guidance", "plan"), TransferPlanMsg):
-        if plan.spacecraft in out:
+        if plan.spacecraft in out and plan.status == "solved":
             out[plan.spacecraft].dv_planned_mps += plan.dv_mps
             out[plan.spacecraft].transfers += 1
     for est in archive.messages(topics.all_spacecraft(mission, "attitude", "estimate"),
@@ -120,7 +129,7 @@ def gnc_summary(series: dict[int, GncSeries]) -> dict[str, dict[str, float | int
         ke = np.degrees(np.array(s.knowledge_error_rad)) * 3600.0
         he = np.array(s.hold_error_m)
         out[str(sc)] = {
-            "dv_delivered_mps": s.dv_mps[-1] if s.dv_mps else 0.0,
+            "dv_delivered_l1_mps": s.dv_mps[-1] if s.dv_mps else 0.0,
             "dv_commanded_l1_mps": s.dv_commanded_mps,
             "dv_planned_l1_mps": s.dv_planned_mps,
             "transfers": s.transfers,

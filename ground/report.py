@@ -109,7 +109,7 @@ def _gnc_section(out: Path, series: dict[int, GncSeries], summary: dict) -> list
         axes[1].semilogy(s.hold_t_s, np.maximum(s.hold_error_m, 1e-4), ".", ms=3, label=f"sc{sc}")
         axes[2].semilogy(s.point_t_s, np.maximum(np.degrees(s.pointing_error_rad), 1e-4), lw=0.8,
                          label=f"sc{sc}")
-    axes[0].set_ylabel("Δv delivered (mm/s)")
+    axes[0].set_ylabel("Δv delivered, L1 (mm/s)")
     axes[1].set_ylabel("|r − r_PRO| holding (m)")
     axes[2].set_ylabel("pointing error (deg)")
     axes[2].set_xlabel("sim time (s)")
@@ -124,12 +124,12 @@ def _gnc_section(out: Path, series: dict[int, GncSeries], summary: dict) -> list
     def f(v: float | None, fmt: str) -> str:
         return "–" if v is None else format(v, fmt)
 
-    rows = ["| sc | Δv delivered (mm/s) | Δv planned L1 (mm/s) | transfers | min range (m) | "
+    rows = ["| sc | Δv delivered L1 (mm/s) | Δv planned L1 (mm/s) | transfers | min range (m) | "
             "hold error RMS / max (m) | pointing error mean / p95 (deg, tracking) | "
             "attitude knowledge RMS (arcsec) |", "|---|---|---|---|---|---|---|---|"]
     for sc, g in summary.get("gnc", {}).items():
         rows.append(
-            f"| {sc} | {1e3 * g['dv_delivered_mps']:.1f} | {1e3 * g['dv_planned_l1_mps']:.1f} | "
+            f"| {sc} | {1e3 * g['dv_delivered_l1_mps']:.1f} | {1e3 * g['dv_planned_l1_mps']:.1f} | "
             f"{g['transfers']} | {f(g['min_range_m'], '.1f')} | "
             f"{f(g['hold_error_rms_m'], '.3f')} / {f(g['hold_error_max_m'], '.3f')} | "
             f"{f(g['pointing_error_mean_deg'], '.3f')} / {f(g['pointing_error_p95_deg'], '.3f')} | "

@@ -11,7 +11,7 @@ from ground.evaluation import nav_errors
 from ground.gnc_evaluation import gnc_series, gnc_summary
 from ground.reader import ArchiveError, RunArchive, load_run
 from interfaces import topics
-from interfaces.messages import ExecStats, LinkStats, TelemetryStatus, Tick
+from interfaces.messages import ExecStats, LinkStats, SimStatus, TelemetryStatus, Tick
 from interfaces.scenario import Scenario
 
 NAV_SETTLE_S = 10.0
@@ -24,6 +24,7 @@ def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict
     execs = {m.node: m for m in archive.messages(f"{topics.ROOT}/{mission}/**/exec/stats", ExecStats)}
     links = {m.node: m for m in archive.messages(f"{topics.ROOT}/{mission}/**/bus/link_stats", LinkStats)}
     tlm = archive.messages(topics.key(mission, topics.GROUND, "tlm", "status"), TelemetryStatus)
+    sim = archive.messages(topics.sim_status(mission), SimStatus)
     return {
         "ticks": len(ticks),
         "t_sim_final_s": ticks[-1].t_sim if ticks else 0.0,
@@ -38,6 +39,7 @@ def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict
                         "barrier_timeouts": m.barrier_timeouts}
                  for node, m in sorted(execs.items())},
         "telemetry": [e.model_dump() for e in tlm[-1].entries] if tlm else [],
+        "sim": {"rejected_commands": sim[-1].rejected_commands if sim else None},
     }
 
 

@@ -14,7 +14,9 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+import math
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec6 = Annotated[list[float], Field(min_length=6, max_length=6)]
@@ -67,6 +69,8 @@ class SimStatus(Message):
     state: Literal["waiting", "running", "finished", "aborted"]
     k: int = Field(default=0, ge=0)
     reason: str = ""
+    rejected_commands: int = Field(
+        default=0, ge=0, description="actuator commands refused (stale, future or wrong sender)")
 
 
 # --- sim truth and sensors -------------------------------------------------------------------
@@ -78,7 +82,8 @@ class TruthState(Message):
 
     ``q_lvlh_body``: true attitude, the rotation taking body vectors into LVLH; ``w_body_radps``:
     true inertial angular velocity in body axes; ``dv_mps``: velocity increment delivered by the
-    thrusters since the start (Σ|F|/m·dt, Euclidean), m/s.  Empty when the sim has no attitude.
+    thrusters since the start, L1 over the body axes (Σ_j |F_j|/m·dt, what the propellant pays
+    for), m/s.  Empty when the sim has no attitude.
     """
 
     spacecraft: list[int]
@@ -110,6 +115,15 @@ class AttitudeMeasurement(Message):
     star_tracker: Quat | None = None
     st_sigma_cross_rad: float = Field(default=0.0, ge=0.0)
     st_sigma_roll_rad: float = Field(default=0.0, ge=0.0)
+
+    @model_validator(mode="after")
+    def _fix_is_usable(self) -> AttitudeMeasurement:
+        if self.star_tracker is not None:
+            if abs(math.sqrt(sum(c * c for c in self.star_tracker)) - 1.0) > 1e-3:
+                raise ValueError("star_tracker must be a unit quaternion")
+            if self.st_sigma_cross_rad <= 0.0 or self.st_sigma_roll_rad <= 0.0:
+                raise ValueError("a star-tracker fix needs positive st_sigma_* (rad)")
+        return self
 
 
 # --- commands (flight software -> hardware) --------------------------------------------------
@@ -148,16 +162,22 @@ class StateEstimate(Message):
     nis: float | None = None
 
 
+MAX_PRO_SIZE_M = 1.0e5
+"""Largest PRO amplitude or offset a command may carry, m (far beyond the HCW model's range)."""
+MAX_TRANSFER_S = 86400.0
+"""Longest transfer a command may ask for, s."""
+
+
 class ProElements(BaseModel):
     """A passive relative orbit: x = ρx sin(nt+αx), y = ρy + 2ρx cos(nt+αx), z = ρz sin(nt+αz),
     t from the mission start (s); m and rad."""
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    rho_x_m: float = Field(ge=0.0)
-    alpha_x_rad: float
-    rho_y_m: float
-    rho_z_m: float = Field(ge=0.0)
-    alpha_z_rad: float
+    rho_x_m: float = Field(ge=0.0, le=MAX_PRO_SIZE_M)
+    alpha_x_rad: float = Field(ge=-100.0, le=100.0)
+    rho_y_m: float = Field(ge=-MAX_PRO_SIZE_M, le=MAX_PRO_SIZE_M)
+    rho_z_m: float = Field(ge=0.0, le=MAX_PRO_SIZE_M)
+    alpha_z_rad: float = Field(ge=-100.0, le=100.0)
 
 
 class ProAssignment(BaseModel):
@@ -171,6 +191,12 @@ class ProAssignment(BaseModel):
     pro: ProElements
     t_depart_s: float = Field(ge=0.0)
     t_arrive_s: float = Field(ge=0.0)
+
+    @model_validator(mode="after")
+    def _times(self) -> ProAssignment:
+        if not 0.0 <= self.t_arrive_s - self.t_depart_s <= MAX_TRANSFER_S:
+            raise ValueError(f"t_arrive_s must be within {MAX_TRANSFER_S:.0f} s after t_depart_s")
+        return self
 
 
 class ProAssignments(Message):

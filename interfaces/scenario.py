@@ -61,6 +61,9 @@ class Rates(_Section):
                 raise ValueError(f"rates.{name} = {hz} must divide rates.high_hz = {self.high_hz}")
         if self.low_hz > self.mid_hz:
             raise ValueError("rates.low_hz must not exceed rates.mid_hz")
+        ratio = self.mid_hz / self.low_hz
+        if abs(ratio - round(ratio)) > 1e-9:
+            raise ValueError(f"rates.low_hz = {self.low_hz} must divide rates.mid_hz = {self.mid_hz}")
         return self
 
     @property
@@ -218,6 +221,12 @@ class Attitude(_Section):
                                       description="errors above this are slewed on a plan")
     boresight_body: tuple[float, float, float] = (0.0, 0.0, 1.0)
 
+    @model_validator(mode="after")
+    def _boresight(self) -> Attitude:
+        if max(abs(c) for c in self.boresight_body) == 0.0:
+            raise ValueError("attitude.boresight_body must be a non-zero vector")
+        return self
+
 
 class Sensors(_Section):
     relnav_sigma_r_m: float = Field(default=0.1, gt=0.0, description="1σ position noise, m")
@@ -226,7 +235,7 @@ class Sensors(_Section):
                                     description="angle random walk σv, rad/√s (0.15°/√h)")
     gyro_bias_rw_rad_s15: float = Field(default=3e-7, ge=0.0,
                                         description="bias random walk σu, rad/s^1.5")
-    gyro_bias_sigma_radps: float = Field(default=1e-4, ge=0.0,
+    gyro_bias_sigma_radps: float = Field(default=1e-4, gt=0.0,
                                          description="1σ initial gyro bias, rad/s")
     star_tracker_hz: float = Field(default=1.0, gt=0.0)
     star_tracker_cross_arcsec: float = Field(default=10.0, gt=0.0, description="1σ")

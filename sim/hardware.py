@@ -5,7 +5,8 @@ Commands arrive from the flight software (``ThrustCommand``, ``WheelCommand``) a
 a thrust command is realised once, when it arrives, over its whole duration — the thrusters
 fire it as pulse-width-modulated impulses, so the minimum impulse bit and the per-pulse noise
 apply to the command's impulse, not to each tick — and the resulting average force is applied
-until the duration ends; a wheel torque is held until the next command.  Every random draw comes
+until the duration ends; a wheel torque is held until the next command, at most
+``WHEEL_COMMAND_TIMEOUT_S``.  Every random draw comes
 from per-spacecraft, per-device generators of the scenario seed.
 """
 
@@ -23,6 +24,9 @@ from sim.attitude import AttitudeTruth
 from sim.sensors import Gyro, StarTracker
 
 ARCSEC_RAD = math.pi / 180.0 / 3600.0
+WHEEL_COMMAND_TIMEOUT_S = 1.0
+"""A wheel torque not refreshed for this long is dropped to zero (a flight computer that stops
+commanding must not leave the wheels spinning the body up), s."""
 
 
 def initial_attitudes(scenario: Scenario, r_eci_lvlh: Rotation) -> tuple[np.ndarray, np.ndarray]:
@@ -66,6 +70,7 @@ class ObserverHardware:
         self.force_body = np.zeros((n, 3))
         self.force_until = np.zeros(n)
         self.tau_cmd = np.zeros((n, 3))
+        self.tau_until = np.zeros(n)
         self.dv_mps = np.zeros(n)
 
     # --- commands -----------------------------------------------------------------------------
@@ -78,8 +83,11 @@ class ObserverHardware:
         self.force_body[index] = f[0]
         self.force_until[index] = t_s + duration_s
 
-    def command_wheels(self, index: int, torque_body_nm: list[float]) -> None:
+    def command_wheels(self, index: int, torque_body_nm: list[float], t_s: float) -> None:
+        """Hold a wheel torque of observer ``index`` from ``t_s`` (until the next command or the
+        timeout)."""
         self.tau_cmd[index] = torque_body_nm
+        self.tau_until[index] = t_s + WHEEL_COMMAND_TIMEOUT_S
 
     # --- one tick -----------------------------------------------------------------------------
 
@@ -92,9 +100,10 @@ class ObserverHardware:
     def step(self, t_s: float, dt_s: float) -> None:
         """Advance the attitude (wheel torques held) and the Δv bookkeeping by one tick."""
         active = t_s < self.force_until - 1e-9
-        self.dv_mps += np.where(active, np.linalg.norm(self.force_body, axis=1), 0.0) \
+        self.dv_mps += np.where(active, np.abs(self.force_body).sum(axis=1), 0.0) \
             * dt_s / self.mass_kg
-        tau = self.wheels.realise(self.tau_cmd, self.attitude.h, dt_s)
+        held = np.where((t_s < self.tau_until - 1e-9)[:, None], self.tau_cmd, 0.0)
+        tau = self.wheels.realise(held, self.attitude.h, dt_s)
         self.attitude.step(dt_s, tau)
 
     def measure(self, t_s: float, dt_s: float) -> tuple[np.ndarray, np.ndarray | None]:

@@ -88,6 +88,9 @@ class SimNode:
         self._alive: set[str] = set()
         self._dead: set[str] = set()
         self.missed_answers = 0
+        self.rejected_commands = 0
+        self._t_now = 0.0
+        self._dt = sc.rates.dt_s
         for node in self.participants:
             self.bus.subscribe(topics.tick_done(m, node), TickDone, self._on_done, immediate=True)
         for index, i in enumerate(self.ids):
@@ -98,21 +101,30 @@ class SimNode:
 
     # --- commands to the hardware ---------------------------------------------------------
 
-    def _commanded_by_owner(self, index: int, msg: ThrustCommand | WheelCommand) -> bool:
-        """A command counts only if its body names the spacecraft whose key it came on."""
-        ok = msg.spacecraft == self.ids[index] and msg.sender == topics.sc_node(self.ids[index])
-        if not ok:
-            self.log.warning("command for sc%d from %s naming sc%d ignored", self.ids[index],
-                             msg.sender, msg.spacecraft)
-        return ok
+    def _accept(self, index: int, msg: ThrustCommand | WheelCommand) -> bool:
+        """A command is applied only if it is of the current tick (a replayed, stale or
+        future-dated one is refused) and names the spacecraft whose key it came on (the key
+        space itself is the publisher's, enforced by the Bus and access control).  Refusals are
+        counted and reported in SimStatus."""
+        sc = self.ids[index]
+        why = ("stale or future-dated" if abs(msg.t_sim - self._t_now) > 0.5 * self._dt
+               else "names another spacecraft" if msg.spacecraft != sc or
+               msg.sender != topics.sc_node(sc) else "")
+        if why:
+            self.rejected_commands += 1
+            if self.rejected_commands <= 5 or self.rejected_commands % 100 == 0:
+                self.log.warning("refused %s for sc%d at t=%.1f s (t_sim %.1f s): %s (#%d)",
+                                 type(msg).__name__, sc, self._t_now, msg.t_sim, why,
+                                 self.rejected_commands)
+        return not why
 
     def _on_thrust(self, index: int, msg: ThrustCommand) -> None:
-        if self._commanded_by_owner(index, msg):
+        if self._accept(index, msg):
             self.hw.command_thrust(index, msg.force_body_n, msg.duration_s, msg.t_sim)
 
     def _on_wheels(self, index: int, msg: WheelCommand) -> None:
-        if self._commanded_by_owner(index, msg):
-            self.hw.command_wheels(index, msg.torque_body_nm)
+        if self._accept(index, msg):
+            self.hw.command_wheels(index, msg.torque_body_nm, msg.t_sim)
 
     def _r_lvlh_eci(self) -> Rotation:
         """Rotation taking ECI vectors into the true LVLH frame of the target now."""
@@ -162,7 +174,7 @@ class SimNode:
             if self.stop.is_set():
                 self._status("aborted", k, "stopped by signal")
                 return False
-            t = k * dt
+            t = self._t_now = k * dt
             if self.realtime_speed:
                 _sleep_until(wall0 + t / self.realtime_speed)
             self._publish_hardware(k, t)
@@ -241,7 +253,8 @@ class SimNode:
     def _status(self, state: str, k: int, reason: str = "") -> None:
         t = k * self.scenario.rates.dt_s
         self.bus.publish(self._keys["status"], SimStatus(
-            sender=topics.SIM, t_sim=t, state=state, k=k, reason=reason), announce=False)  # type: ignore[arg-type]
+            sender=topics.SIM, t_sim=t, state=state, k=k, reason=reason,
+            rejected_commands=self.rejected_commands), announce=False)  # type: ignore[arg-type]
 
 
 def _sleep_until(wall: float) -> None:

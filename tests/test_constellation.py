@@ -47,7 +47,9 @@ def _comparable(path: Path) -> dict[str, list[dict]]:
 
 def test_same_seed_same_messages_on_zenoh_and_inproc(tmp_path: Path, free_port: int) -> None:
     sc = small_scenario("det", duration_s=30.0,
-                        comms={"range_m": 36.0, "packet_loss": 0.25, "burst": {"mean_length_packets": 3.0}})
+                        comms={"range_m": 36.0, "packet_loss": 0.25, "burst": {"mean_length_packets": 3.0}},
+                        phases=[{"name": "move", "start_s": 10.0, "transfer_s": 600.0,
+                                 "rho_x_m": 22.0, "rho_z_m": 20.0}])  # an SCP transfer + MPC
     path = write_scenario(tmp_path / "det.toml", sc)
     runs = {}
     for transport in ("zenoh", "inproc"):
@@ -63,6 +65,8 @@ def test_same_seed_same_messages_on_zenoh_and_inproc(tmp_path: Path, free_port: 
     # the channel really acted (range and loss) on the compared traffic
     links = [c for m in z[topics.key("det", "ground", "bus", "link_stats")][-1:] for c in m["links"]]
     assert sum(c["dropped_loss"] for c in links) > 0 and sum(c["delivered"] for c in links) > 0
+    # the transfer was planned (or refused) identically: compare the plans themselves
+    assert any(k.endswith("/guidance/plan") for k in z)
 
 
 def test_killed_fsw_process_fails_the_run_and_keeps_the_archive(tmp_path: Path, free_port: int) -> None:

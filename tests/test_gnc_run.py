@@ -15,6 +15,7 @@ from fsw.lib.hcw import mean_motion
 from fsw.lib.pro import Pro
 from ground.reader import load_run
 from interfaces.messages import AttitudeEstimate, GuidanceStatus, TransferPlanMsg, TruthState
+from interfaces import topics
 from interfaces.scenario import load_scenario
 
 SCENARIO = """
@@ -57,7 +58,7 @@ def test_reconfiguration_arrives_on_the_new_pro_and_holds_it(run: tuple[Path, di
     sc = load_scenario(out.parent / "gnc.toml")
     n = mean_motion(sc.orbit.altitude_km * 1e3)
     archive = load_run(out / "run.mcap")
-    truth = {round(m.t_sim, 6): m for m in archive.messages("insp/gnc/sim/truth/state", TruthState)}
+    truth = {round(m.t_sim, 6): m for m in archive.messages(topics.truth("gnc"), TruthState)}
     phase = sc.phases[0]
     t_arrive = phase.start_s + phase.transfer_s
     for i in (1, 2):
@@ -74,9 +75,18 @@ def test_reconfiguration_arrives_on_the_new_pro_and_holds_it(run: tuple[Path, di
         g = summary["gnc"][str(i)]
         assert g["transfers"] == 1 and g["hold_samples"] > 20
         assert g["min_range_m"] >= sc.guidance.keep_out_m
-        # Fuel: the delivered Δv (truth, Euclidean per burn) cannot beat the planned L1 optimum
-        # by more than the √3 between the norms, and tracking must not waste much on top.
-        assert g["dv_planned_l1_mps"] / np.sqrt(3) <= g["dv_delivered_mps"] <= 1.5 * g["dv_planned_l1_mps"] + 0.01
+        # Fuel: the delivered Δv (truth, L1 over body axes) against the planned L1 optimum (LVLH
+        # axes): the change of axes costs at most a factor √3 either way, and tracking must not
+        # waste much on top.
+        assert g["dv_planned_l1_mps"] / np.sqrt(3) <= g["dv_delivered_l1_mps"] \
+            <= np.sqrt(3) * g["dv_planned_l1_mps"] + 0.01
+
+
+def test_no_app_error_no_timeout_no_refused_command(run: tuple[Path, dict]) -> None:
+    _, summary = run
+    for node, e in summary["exec"].items():
+        assert e["app_errors"] == 0 and e["barrier_timeouts"] == 0, node
+    assert summary["sim"]["rejected_commands"] == 0
 
 
 def test_transfer_plan_is_published_and_respects_the_keep_out(run: tuple[Path, dict]) -> None:
@@ -87,7 +97,10 @@ def test_transfer_plan_is_published_and_respects_the_keep_out(run: tuple[Path, d
     for p in plans:
         assert p.status == "solved" and p.min_range_m >= 8.0 - 1e-6
         assert p.t_s[0] == pytest.approx(100.0) and p.t_s[-1] == pytest.approx(600.0)
-        assert np.abs(np.array(p.u_mps2)).max() <= 0.5 * 0.02 / (10.0 * np.sqrt(3)) * (1 + 1e-6)
+        sc = load_scenario(out.parent / "gnc.toml")
+        u_plan = (sc.guidance.plan_thrust_fraction * sc.actuators.thruster_max_force_n
+                  / (sc.observers.mass_kg * np.sqrt(3)))
+        assert np.abs(np.array(p.u_mps2)).max() <= u_plan * (1 + 1e-6)
     status = archive.messages("insp/gnc/sc/*/guidance/status", GuidanceStatus)
     assert {m.mode for m in status if m.t_sim > 0.0} == {"transfer", "hold"}  # idle before nav
 

@@ -25,10 +25,10 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import hcw, mekf
-from fsw.lib.attitude import repoint, scp_slew, slerp_plan
+from fsw.lib import hcw, mekf, quat
+from fsw.lib.attitude import AttitudePlan, repoint, scp_slew, slerp_plan
 from fsw.lib.attitude_control import gains_for, tracking_torque
-from fsw.lib.frames import lvlh_to_eci
+from fsw.lib.frames import lvlh_to_eci_quat
 from interfaces import topics
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import (
@@ -87,12 +87,11 @@ class AttitudeApp(App):
         self.tau = np.zeros(3)
         self.w_est = np.zeros(3)
         self.target = np.zeros(3)
-        self.slew = None
+        self.slew: AttitudePlan | None = None
         self.slew_t0 = 0.0
         self.slew_end = 0.0
-        self.r_point: Rotation | None = None  # last desired attitude while tracking
+        self.q_point: np.ndarray | None = None  # last desired attitude (quaternion) while tracking
         self.mode = "init"
-        self.cycles = 0
         self._meas: AttitudeMeasurement | None = None
         self._est: StateEstimate | None = None
 
@@ -109,19 +108,22 @@ class AttitudeApp(App):
 
     def step(self, t: float) -> None:
         meas, self._meas = self._meas, None
-        if meas is not None:
-            self._determine(meas)
-        if self.q is None or self._est is None:
-            w = np.array(meas.gyro_radps) if meas is not None else np.zeros(3)
-            self.tau = _saturate(-self.J @ (self.gains.kd * w), self.tau_max)  # rate damping
-        else:
-            self.tau = self._control(t)
-        self.h_wheels -= self.tau * self.dt
-        self.publish("wheels", WheelCommand(sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id,
-                                            torque_body_nm=self.tau.tolist()))
-        if self.cycles % self.mid_every == 0 and self.q is not None:
+        self.tau = np.zeros(3)
+        try:
+            if meas is not None:
+                self._determine(meas)
+            if self.q is None or self._est is None:
+                w = np.array(meas.gyro_radps) if meas is not None else np.zeros(3)
+                self.tau = _saturate(-self.J @ (self.gains.kd * w), self.tau_max)  # rate damping
+            else:
+                self.tau = self._control(t)
+        finally:  # safe mode on any failure: zero torque is still commanded, then the error
+            self.h_wheels -= self.tau * self.dt  # propagates to the executive's counter
+            self.publish("wheels", WheelCommand(sender=self.ctx.node, t_sim=t,
+                                                spacecraft=self.sc_id,
+                                                torque_body_nm=self.tau.tolist()))
+        if round(t / self.dt) % self.mid_every == 0 and self.q is not None:
             self._report(t)
-        self.cycles += 1
 
     def _determine(self, meas: AttitudeMeasurement) -> None:
         """MEKF: propagate with the gyro, update with the star tracker (initialise on its first
@@ -145,33 +147,37 @@ class AttitudeApp(App):
         """Line of sight to the pointing target at time t, ECI axes (m), from the nav estimate
         extrapolated with its velocity."""
         assert self._est is not None
-        x = np.array(self._est.x)
-        r = x[:3] + x[3:] * (t - self._est.t_sim)
-        los: np.ndarray = lvlh_to_eci(t, self.n, self.incl).apply(self.target - r)
-        return los
+        x = self._est.x
+        r = np.array(x[:3]) + np.array(x[3:]) * (t - self._est.t_sim)
+        return quat.rotate(lvlh_to_eci_quat(t, self.n, self.incl), self.target - r)
 
     def _control(self, t: float) -> np.ndarray:
+        """Wheel torque tracking the slew plan, or the pointing attitude (quaternions R_eci_body
+        on the hot path; the slew plan returns scipy Rotations)."""
         assert self.q is not None
-        r_est = Rotation.from_quat(self.q)
         if self.mode == "slew" and self.slew is not None and t - self.slew_t0 <= self.slew_end:
             r_des, w_des, wdot_des = self.slew.at(t - self.slew_t0)
         else:
-            r_des = repoint(self.r_point or r_est, self._los_eci(t), self.boresight)
+            q_des = repoint(self.q if self.q_point is None else self.q_point, self._los_eci(t),
+                            self.boresight)
             h = DESIRED_RATE_STEP_S
-            r_next = repoint(r_des, self._los_eci(t + h), self.boresight)
-            w_des, wdot_des = (r_des.inv() * r_next).as_rotvec() / h, np.zeros(3)
-            angle = (r_des.inv() * r_est).magnitude()
+            q_next = repoint(q_des, self._los_eci(t + h), self.boresight)
+            w_des, wdot_des = quat.log(quat.mul(quat.conj(q_des), q_next)) / h, np.zeros(3)
+            angle = float(np.linalg.norm(quat.log(quat.mul(quat.conj(q_des), self.q))))
             if angle > math.radians(self.cfg.slew_threshold_deg):
-                self._plan_slew(t, r_est, angle)
-                self.r_point = None
+                self._plan_slew(t, angle)
+                self.q_point = None
                 r_des, w_des, wdot_des = self.slew.at(0.0)
             else:
-                self.mode, self.r_point = "track", r_des
-        tau, _ = tracking_torque(r_est, self.w_est, r_des, w_des, wdot_des, self.J,
-                                              self.h_wheels, self.gains, self.tau_max)
+                self.mode, self.q_point, r_des = "track", q_des, q_des
+        tau, _ = tracking_torque(self.q, self.w_est, r_des, w_des, wdot_des, self.J,
+                                 self.h_wheels, self.gains, self.tau_max)
         return tau
 
-    def _plan_slew(self, t: float, r_est: Rotation, angle: float) -> None:
+    def _plan_slew(self, t: float, angle: float) -> None:
+        """Plan a rate-limited slew (SCP, slerp as fallback) onto the pointing attitude."""
+        assert self.q is not None
+        r_est = Rotation.from_quat(self.q)
         duration = max(10.0, 1.5 * angle / self.w_max + self.cfg.settling_time_s)
         r_end = repoint(r_est, self._los_eci(t + duration), self.boresight)
         nodes = max(8, int(math.ceil(duration / 5.0)))
@@ -184,13 +190,12 @@ class AttitudeApp(App):
 
     def _report(self, t: float) -> None:
         assert self.q is not None
-        r = Rotation.from_quat(self.q)
-        q_lvlh = (lvlh_to_eci(t, self.n, self.incl).inv() * r).as_quat()
+        q_lvlh = quat.mul(quat.conj(lvlh_to_eci_quat(t, self.n, self.incl)), self.q)
         error = 0.0
         if self._est is not None:
             los = self._los_eci(t)
-            cos = float(r.apply(self.boresight) @ los) / max(1e-12, float(np.linalg.norm(los)))
-            error = math.acos(min(1.0, max(-1.0, cos)))
+            b = quat.rotate(self.q, self.boresight)
+            error = math.acos(min(1.0, max(-1.0, float(b @ los) / max(1e-12, float(np.linalg.norm(los))))))
         self.publish("estimate", AttitudeEstimate(
             sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, q_eci_body=self.q.tolist(),
             q_lvlh_body=q_lvlh.tolist(), gyro_bias_radps=self.b.tolist(),

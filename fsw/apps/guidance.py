@@ -45,6 +45,8 @@ from interfaces.messages import (
 
 MIN_TRANSFER_S = 120.0
 """Shortest transfer planned when an assignment arrives late, s."""
+MAX_INTERVALS = 200
+"""Most SCP intervals per transfer; longer transfers get wider node spacing."""
 
 
 class GuidanceApp(App):
@@ -80,6 +82,8 @@ class GuidanceApp(App):
                                                 u_max_mps2=self.u_max))
         self.assignment: ProAssignment | None = None  # the one being flown
         self.pending: ProAssignment | None = None     # received, departure still ahead
+        self.previous: tuple[ProAssignment | None, Pro | None] = (None, None)
+        self.refused_id = 0
         self.pro: Pro | None = None
         self.plan: TransferPlan | None = None
         self.plan_t0 = 0.0
@@ -93,7 +97,8 @@ class GuidanceApp(App):
     def on_assignments(self, msg: ProAssignments) -> None:
         """Keep the newest assignment as pending until its departure time."""
         mine = [a for a in msg.assignments if a.spacecraft == self.sc_id]
-        newest = max((a.assignment_id for a in (self.assignment, self.pending) if a), default=0)
+        newest = max([a.assignment_id for a in (self.assignment, self.pending) if a]
+                     + [self.refused_id])
         if mine and mine[0].assignment_id > newest:
             self.pending = mine[0]
             self.log.info("assignment %d (%s) received: depart %.0f s, arrive %.0f s",
@@ -110,9 +115,8 @@ class GuidanceApp(App):
 
     def step(self, t: float) -> None:
         if self.pending is not None and t >= self.pending.t_depart_s - 1e-9:
-            self.assignment, self.pending = self.pending, None
-            p = self.assignment.pro
-            self.pro = Pro(p.rho_x_m, p.alpha_x_rad, p.rho_y_m, p.rho_z_m, p.alpha_z_rad)
+            self._activate(self.pending)
+            self.pending = None
         a = self.assignment
         if self._est is None or a is None or self.pro is None:
             self._status(t, "idle")
@@ -120,6 +124,9 @@ class GuidanceApp(App):
         x = _propagate(self.n, np.array(self._est.x), t - self._est.t_sim)
         if a.assignment_id != self.planned_id:
             self._plan(t, x, a)
+            if self.assignment is None or self.pro is None:  # refused, nothing to fall back on
+                self._status(t, "idle")
+                return
         refs, u_ref = self._reference(t)
         res = self.mpc.solve(x, refs, u_ref)
         u = res.u0 if res.ok else np.zeros(3)
@@ -130,21 +137,35 @@ class GuidanceApp(App):
         err = x - refs[0]
         self._status(t, mode, err, u, res.status, 1e3 * res.solve_time_s)
 
+    def _activate(self, a: ProAssignment) -> None:
+        """Fly assignment ``a`` from now (its transfer is planned in this cycle)."""
+        self.previous = (self.assignment, self.pro)
+        self.assignment = a
+        p = a.pro
+        self.pro = Pro(p.rho_x_m, p.alpha_x_rad, p.rho_y_m, p.rho_z_m, p.alpha_z_rad)
+
     def _plan(self, t: float, x: np.ndarray, a: ProAssignment) -> None:
-        """Plan the transfer to the assigned PRO (or go straight to holding it if already due)."""
+        """Plan the transfer to the assigned PRO.  If no safe plan exists, the assignment is
+        refused and the previous orbit kept (the MPC alone has no keep-out constraint); an
+        assignment already due with the spacecraft near its PRO is held directly."""
         self.planned_id = a.assignment_id
         self.plan = None
         self.mpc.reset()
         duration = a.t_arrive_s - t
-        if duration <= 0.0:
-            return  # already due: hold the PRO from here (the MPC closes any gap)
+        if duration <= 0.0 and a.t_depart_s >= a.t_arrive_s:
+            return  # a hold from the start (no transfer in the command)
         duration = max(duration, MIN_TRANSFER_S)
         d_min = min(self.cfg.keep_out_m, 0.9 * float(np.linalg.norm(x[:3])))
         # Too short for the planning thrust: use the full limit, then take longer.
         attempts = [(duration, self.cfg.plan_thrust_fraction * self.u_max)] + [
             (duration * 1.5**k, self.u_max) for k in range(3)]
         for duration, u_max in attempts:
-            plan = self._solve_transfer(t, x, duration, u_max, d_min)
+            try:
+                plan = self._solve_transfer(t, x, duration, u_max, d_min)
+            except ValueError as e:
+                self.log.error("assignment %d refused: %s", a.assignment_id, e)
+                self._revert()
+                return
             if plan.status != "infeasible_thrust_limit":
                 break
             self.log.warning("transfer %d infeasible in %.0f s at %.2g m/s²", a.assignment_id,
@@ -160,15 +181,25 @@ class GuidanceApp(App):
         if plan.converged:
             self.plan, self.plan_t0 = plan, t
         else:
-            self.log.error("transfer %d: SCP %s; tracking the PRO directly", a.assignment_id,
-                           plan.status)
+            self.log.error("transfer %d: SCP %s; assignment refused, keeping the previous orbit",
+                           a.assignment_id, plan.status)
+            self._revert()
+
+    def _revert(self) -> None:
+        """Refuse the current assignment for good and go back to the previous one (drift if
+        there was none)."""
+        assert self.assignment is not None
+        self.refused_id = self.assignment.assignment_id
+        self.assignment, self.pro = self.previous
+        self.planned_id = self.assignment.assignment_id if self.assignment else 0
+        self.plan = None
 
     def _solve_transfer(self, t: float, x: np.ndarray, duration: float, u_max: float,
                         d_min: float) -> TransferPlan:
         """SCP transfer from ``x`` now to the assigned PRO's energy-matched state ``duration``
         seconds later, with nodes every ``guidance.node_spacing_s``."""
         assert self.pro is not None
-        intervals = max(4, int(math.ceil(duration / self.cfg.node_spacing_s)))
+        intervals = min(MAX_INTERVALS, max(4, int(math.ceil(duration / self.cfg.node_spacing_s))))
         xf = energy_matched_state(self.pro.state(self.n, t + duration), self.chief_radius_m)
         return plan_transfer(self.n, x, xf, duration, intervals, u_max, d_min)
 

@@ -5,7 +5,9 @@ and the guidance status, whose commanded LVLH acceleration (held for one ω_low 
 the prediction as a known input.  Output: the state estimate [x y z vx vy vz] (m, m/s, LVLH)
 with its covariance and NIS.  The model is the flight model (HCW, exact ZOH discretization
 expm([[A, B], [0, 0]]·dt)), not the truth.  A commanded acceleration u adds process noise for its
-execution error, ``(THRUST_ERROR_FRAC·|u|)²`` m²/s³ (thruster noise and thrust direction error).
+execution error: one error of 1σ ``THRUST_ERROR_FRAC·|u|`` (m/s², thruster noise and thrust
+direction error) held over the command period T acts like white acceleration noise of density
+``(THRUST_ERROR_FRAC·|u|)²·T`` (m²/s³).
 """
 
 from __future__ import annotations
@@ -81,7 +83,7 @@ class NavApp(App):
             return
         Ad, Bd, Qd = self._model(dt)
         u = self._accel(self.t_est)
-        q_thrust = (THRUST_ERROR_FRAC * float(np.linalg.norm(u)))**2
+        q_thrust = (THRUST_ERROR_FRAC * float(np.linalg.norm(u)))**2 * self.cmd_period
         self.x, self.P = kalman.predict(self.x, self.P, Ad, Qd * (1.0 + q_thrust / self.q), Bd, u)
         self.t_est = t
 

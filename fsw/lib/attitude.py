@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -171,8 +171,8 @@ def pointing_rotation(
 # plans
 
 
-def repoint(r_prev: Rotation, los_ref: npt.ArrayLike,
-            boresight_body: npt.ArrayLike = (0.0, 0.0, 1.0)) -> Rotation:
+def repoint(r_prev: Rotation | npt.NDArray[np.float64], los_ref: npt.ArrayLike,
+            boresight_body: npt.ArrayLike = (0.0, 0.0, 1.0)) -> Any:
     """The attitude nearest to ``r_prev`` whose boresight lies on ``los_ref``.
 
     ``R = Rot(a → c) · r_prev`` with ``a = r_prev · boresight`` and ``c`` the unit line of sight:
@@ -184,14 +184,16 @@ def repoint(r_prev: Rotation, los_ref: npt.ArrayLike,
     most orthogonal to it (any perpendicular axis is shortest).
 
     Args:
-        r_prev: the previous attitude R_ref_body.
+        r_prev: the previous attitude R_ref_body, a Rotation or its quaternion (4,).
         los_ref: line of sight in the reference frame (any length > 0).
         boresight_body: boresight in body axes (any length > 0).
 
     Returns:
-        R_ref_body with ``R.apply(boresight) ∥ los_ref``.
+        R_ref_body with ``R.apply(boresight) ∥ los_ref``, of the same kind as ``r_prev``
+        (Rotation, or a unit quaternion array for the allocation-free hot path).
     """
-    q_prev = quat.normalize(_single_quat("r_prev", r_prev))
+    q_prev = quat.normalize(_single_quat("r_prev", r_prev) if isinstance(r_prev, Rotation)
+                            else finite_array("r_prev", r_prev, (4,)))
     c = _unit3("los_ref", los_ref)
     b = _unit3("boresight_body", boresight_body)
     a = quat.rotate(q_prev, b)
@@ -205,7 +207,8 @@ def repoint(r_prev: Rotation, los_ref: npt.ArrayLike,
         turn = axis * (math.pi / math.hypot(*axis.tolist()))
     else:
         turn = axis * (math.atan2(s, cos) / s)
-    return Rotation.from_quat(quat.mul(quat.exp(turn), q_prev))
+    q = quat.mul(quat.exp(turn), q_prev)
+    return Rotation.from_quat(q) if isinstance(r_prev, Rotation) else q
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,161 @@
+"""Bad or hostile input to the GNC chain: refused, counted, and never leaves an actuator running.
+
+Unit level (each piece on a real in-process Bus, messages fed to its handlers): the sim's
+command checks and wheel timeout, the attitude app's safe mode, guidance refusing an assignment
+it cannot fly safely, and the message models rejecting malformed commands."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+from pydantic import ValidationError
+
+from fsw.apps.attitude import AttitudeApp
+from fsw.apps.guidance import GuidanceApp
+from interfaces.app import AppContext
+from interfaces.bus import Bus
+from interfaces.messages import (
+    AttitudeEstimate,
+    AttitudeMeasurement,
+    PointingTarget,
+    ProAssignment,
+    ProAssignments,
+    ProElements,
+    StateEstimate,
+    ThrustCommand,
+    WheelCommand,
+)
+from interfaces.transport import InprocNetwork
+from sim.hardware import WHEEL_COMMAND_TIMEOUT_S
+from sim.node import SimNode
+from tests.conftest import small_scenario
+
+
+def _sim() -> SimNode:
+    sc = small_scenario("cmd", observers={"count": 2})
+    return SimNode(Bus("sim", "cmd", InprocNetwork().endpoint()), sc, participants=[])
+
+
+def test_sim_refuses_stale_future_and_forged_commands() -> None:
+    sim = _sim()
+    sim._t_now = 100.0
+    good = WheelCommand(sender="sc1", t_sim=100.0, spacecraft=1, torque_body_nm=[1e-3, 0, 0])
+    sim._on_wheels(0, good)
+    assert sim.hw.tau_cmd[0, 0] == 1e-3 and sim.rejected_commands == 0
+    for bad in (good.model_copy(update={"t_sim": 99.0, "torque_body_nm": [5e-3, 0, 0]}),  # stale
+                good.model_copy(update={"t_sim": 101.0, "torque_body_nm": [5e-3, 0, 0]}),  # future
+                good.model_copy(update={"spacecraft": 2, "torque_body_nm": [5e-3, 0, 0]}),
+                good.model_copy(update={"sender": "sc2", "torque_body_nm": [5e-3, 0, 0]})):
+        sim._on_wheels(0, bad)
+    assert sim.rejected_commands == 4 and sim.hw.tau_cmd[0, 0] == 1e-3
+    replay = ThrustCommand(sender="sc1", t_sim=0.0, spacecraft=1, force_body_n=[0.02, 0, 0],
+                           duration_s=3600.0)
+    sim._on_thrust(0, replay)
+    assert sim.rejected_commands == 5 and not sim.hw.force_until.any()
+
+
+def test_wheel_torque_times_out_when_the_flight_computer_stops_commanding() -> None:
+    sim = _sim()
+    hw, dt = sim.hw, 0.5
+    hw.command_wheels(0, [1e-3, 0.0, 0.0], 0.0)
+    t, h = 0.0, [hw.attitude.h[0, 0]]
+    while t < WHEEL_COMMAND_TIMEOUT_S + 2.0:
+        hw.step(t, dt)
+        t += dt
+        h.append(hw.attitude.h[0, 0])
+    dh = np.diff(h)
+    n_on = int(round(WHEEL_COMMAND_TIMEOUT_S / dt))
+    assert np.allclose(dh[:n_on], -1e-3 * dt) and np.all(dh[n_on:] == 0.0)
+
+
+def test_malformed_commands_are_invalid_messages() -> None:
+    with pytest.raises(ValidationError):
+        AttitudeMeasurement(sender="sim", t_sim=0.0, spacecraft=1, gyro_radps=[0, 0, 0],
+                            star_tracker=[0, 0, 0, 0], st_sigma_cross_rad=1e-5,
+                            st_sigma_roll_rad=1e-4)
+    with pytest.raises(ValidationError):
+        AttitudeMeasurement(sender="sim", t_sim=0.0, spacecraft=1, gyro_radps=[0, 0, 0],
+                            star_tracker=[0, 0, 0, 1])  # a fix without its noise
+    pro = ProElements(rho_x_m=10, alpha_x_rad=0, rho_y_m=0, rho_z_m=10, alpha_z_rad=0)
+    with pytest.raises(ValidationError):
+        ProAssignment(spacecraft=1, assignment_id=2, phase="x", pro=pro, t_depart_s=100.0,
+                      t_arrive_s=50.0)
+    with pytest.raises(ValidationError):
+        ProAssignment(spacecraft=1, assignment_id=2, phase="x", pro=pro, t_depart_s=0.0,
+                      t_arrive_s=1e9)
+    with pytest.raises(ValidationError):
+        ProElements(rho_x_m=1e9, alpha_x_rad=0, rho_y_m=0, rho_z_m=10, alpha_z_rad=0)
+
+
+def _ctx(app_node: str = "sc1") -> AppContext:
+    sc = small_scenario("apps", rates={"high_hz": 10.0, "mid_hz": 1.0, "low_hz": 0.1},
+                        observers={"count": 2})
+    bus = Bus(app_node, "apps", InprocNetwork().endpoint())
+    return AppContext(bus=bus, scenario=sc, node=app_node, spacecraft=1,
+                      rng=np.random.default_rng(0), log=logging.getLogger("test"))
+
+
+def _capture(app: AttitudeApp | GuidanceApp) -> list[tuple[str, object]]:
+    sent: list[tuple[str, object]] = []
+    app.publish = lambda name, msg: sent.append((name, msg))  # type: ignore[method-assign]
+    return sent
+
+
+def test_attitude_app_commands_zero_torque_when_its_step_fails() -> None:
+    """A pointing target on the spacecraft itself leaves no line of sight: the control law
+    fails, the app still commands zero torque for the tick (safe mode) and raises for the
+    executive to count; with a valid target the next tick controls again."""
+    app = AttitudeApp(_ctx())
+    sent = _capture(app)
+    fix = AttitudeMeasurement(sender="sim", t_sim=0.0, spacecraft=1, gyro_radps=[0.01, 0, 0],
+                              star_tracker=[0, 0, 0, 1], st_sigma_cross_rad=5e-5,
+                              st_sigma_roll_rad=3e-4)
+    app.on_sensors(fix)
+    app.on_estimate(StateEstimate(sender="sc1", t_sim=0.0, spacecraft=1,
+                                  x=[10.0, 0, 0, 0, 0, 0], P=np.eye(6).tolist()))
+    app.on_target(PointingTarget(sender="sc1", t_sim=0.0, spacecraft=1,
+                                 target_lvlh_m=[10.0, 0.0, 0.0]))
+    with pytest.raises(ValueError):
+        app.step(0.0)
+    name, msg = sent[-1]
+    assert name == "wheels" and msg.t_sim == 0.0 and not any(msg.torque_body_nm)  # type: ignore[attr-defined]
+    app.on_target(PointingTarget(sender="sc1", t_sim=0.1, spacecraft=1, target_lvlh_m=[0, 0, 0]))
+    app.on_sensors(fix.model_copy(update={"t_sim": 0.1, "star_tracker": None}))
+    app.step(0.1)
+    wheels = [m for name, m in sent if name == "wheels"]
+    assert wheels[-1].t_sim == 0.1 and np.any(wheels[-1].torque_body_nm)  # type: ignore[attr-defined]
+
+
+def _assignment(aid: int, rho: float, t_depart: float, t_arrive: float) -> ProAssignments:
+    pro = ProElements(rho_x_m=rho, alpha_x_rad=0.0, rho_y_m=0.0, rho_z_m=rho, alpha_z_rad=0.0)
+    return ProAssignments(sender="ground", t_sim=t_depart, assignments=[ProAssignment(
+        spacecraft=1, assignment_id=aid, phase=f"p{aid}", pro=pro, t_depart_s=t_depart,
+        t_arrive_s=t_arrive)])
+
+
+def test_guidance_refuses_an_assignment_it_cannot_fly_safely_and_keeps_its_orbit() -> None:
+    """A PRO inside the keep-out sphere has no safe transfer: guidance keeps holding the orbit
+    it has, once, without retrying the refused command the ground keeps repeating."""
+    app = GuidanceApp(_ctx())
+    sent = _capture(app)
+    from fsw.lib.hcw import mean_motion, pro_state
+    n = mean_motion(500e3)
+    app.on_estimate(StateEstimate(sender="sc1", t_sim=0.0, spacecraft=1,
+                                  x=pro_state(n, 20.0, 0.0, 0.0, 20.0, 0.0).tolist(),
+                                  P=(1e-4 * np.eye(6)).tolist()))
+    app.on_attitude(AttitudeEstimate(
+        sender="sc1", t_sim=0.0, spacecraft=1, q_eci_body=[0, 0, 0, 1], q_lvlh_body=[0, 0, 0, 1],
+        gyro_bias_radps=[0, 0, 0], sigma_att_rad=1e-4, target_lvlh_m=[0, 0, 0],
+        pointing_error_rad=0.0, mode="track", torque_body_nm=[0, 0, 0]))
+    app.on_assignments(_assignment(1, 20.0, 0.0, 0.0))
+    app.step(0.0)
+    assert app.assignment is not None and app.assignment.assignment_id == 1
+    app.on_assignments(_assignment(2, 2.0, 10.0, 600.0))  # a 2 m PRO: inside the 8 m keep-out
+    app.step(10.0)
+    assert app.assignment.assignment_id == 1 and app.refused_id == 2 and app.plan is None
+    app.on_assignments(_assignment(2, 2.0, 10.0, 600.0))  # repeated by the ground
+    assert app.pending is None
+    status = [m for name, m in sent if name == "status"]
+    assert status[-1].mode == "hold" and status[-1].assignment_id == 1  # type: ignore[attr-defined]
