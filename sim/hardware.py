@@ -17,6 +17,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from fsw.lib import quat
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
 from sim.actuators import ThrusterBank, WheelArray
@@ -91,11 +92,13 @@ class ObserverHardware:
 
     # --- one tick -----------------------------------------------------------------------------
 
-    def accel_lvlh(self, t_s: float, r_lvlh_eci: Rotation) -> np.ndarray:
-        """Thrust acceleration in LVLH over the tick starting at ``t_s`` (N, 3), m/s²."""
+    def accel_lvlh(self, t_s: float, q_lvlh_eci: np.ndarray) -> np.ndarray:
+        """Thrust acceleration in LVLH over the tick starting at ``t_s`` (N, 3), m/s², given the
+        true ECI -> LVLH rotation as a quaternion (4,)."""
         active = (t_s < self.force_until - 1e-9)[:, None]
         f = np.where(active, self.force_body, 0.0)
-        return (r_lvlh_eci * self.attitude.r_eci_body()).apply(f) / self.mass_kg
+        out: np.ndarray = quat.rotate(self.q_lvlh_body(q_lvlh_eci), f) / self.mass_kg
+        return out
 
     def step(self, t_s: float, dt_s: float) -> None:
         """Advance the attitude (wheel torques held) and the Δv bookkeeping by one tick."""
@@ -112,7 +115,7 @@ class ObserverHardware:
         gyro = self.gyro.measure(self.attitude.mean_rate, dt_s)
         return gyro, self.star_tracker.measure(t_s, self.attitude.r_eci_body())
 
-    def q_lvlh_body(self, r_lvlh_eci: Rotation) -> np.ndarray:
-        """True attitudes with respect to LVLH (N, 4), scalar last."""
-        q: np.ndarray = (r_lvlh_eci * self.attitude.r_eci_body()).as_quat()
-        return q.reshape(self.n, 4)
+    def q_lvlh_body(self, q_lvlh_eci: np.ndarray) -> np.ndarray:
+        """True attitudes with respect to LVLH (N, 4), scalar last, given the true ECI -> LVLH
+        rotation as a quaternion (4,)."""
+        return quat.mul(np.broadcast_to(q_lvlh_eci, (self.n, 4)), self.attitude.q)

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from fsw.lib import quat
 from fsw.lib.hcw import mean_motion, pro_state
 from interfaces import topics
 from interfaces.bus import Bus
@@ -68,7 +69,7 @@ class SimNode:
             chief, initial_states(sc), j2=sc.orbit.j2,
             energy_match=sc.observers.energy_match and sc.observers.start == "pro")
         self.ids = list(range(1, sc.observers.count + 1))
-        self.hw = ObserverHardware(sc, self._r_lvlh_eci().inv())
+        self.hw = ObserverHardware(sc, Rotation.from_quat(quat.conj(self._q_lvlh_eci())))
         self.sensors = [
             RelNavSensor(sc.sensors.relnav_sigma_r_m, sc.sensors.relnav_sigma_v_mps,
                          stream(sc.seed, "relnav", i)) for i in self.ids
@@ -126,9 +127,10 @@ class SimNode:
         if self._accept(index, msg):
             self.hw.command_wheels(index, msg.torque_body_nm, msg.t_sim)
 
-    def _r_lvlh_eci(self) -> Rotation:
-        """Rotation taking ECI vectors into the true LVLH frame of the target now."""
-        return Rotation.from_matrix(lvlh_basis(self.truth.chief_eci))
+    def _q_lvlh_eci(self) -> np.ndarray:
+        """Quaternion (scalar last) of the rotation taking ECI vectors into the true LVLH frame
+        of the target now."""
+        return quat.from_matrix(lvlh_basis(self.truth.chief_eci))
 
     # --- lockstep bookkeeping -------------------------------------------------------------
 
@@ -190,7 +192,7 @@ class SimNode:
             self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
             self.bus.dispatch(t, include_now=True)
             if k < n_ticks - 1:
-                accel = self.hw.accel_lvlh(t, self._r_lvlh_eci())
+                accel = self.hw.accel_lvlh(t, self._q_lvlh_eci())
                 self.truth.step(dt, accel, substeps=sc.sim.substeps)
                 self.hw.step(t, dt)
             if k % max(1, n_ticks // 10) == 0:
@@ -214,7 +216,7 @@ class SimNode:
         self.bus.publish(self._keys["truth"], TruthState(
             sender=topics.SIM, t_sim=t, spacecraft=self.ids,
             r_lvlh_m=rel[:, :3].tolist(), v_lvlh_mps=rel[:, 3:].tolist(),
-            q_lvlh_body=hw.q_lvlh_body(self._r_lvlh_eci()).tolist(),
+            q_lvlh_body=hw.q_lvlh_body(self._q_lvlh_eci()).tolist(),
             w_body_radps=hw.attitude.w.tolist(), dv_mps=hw.dv_mps.tolist()))
         gyro, st = hw.measure(t, self.scenario.rates.dt_s)
         for i, sc_id in enumerate(self.ids):

@@ -572,3 +572,15 @@ def test_repoint_is_the_shortest_rotation_onto_the_line_of_sight() -> None:
     flipped = repoint(r0, -r0.apply(bore), bore)
     assert np.allclose(flipped.apply(bore), -r0.apply(bore), atol=1e-12)
     assert (r0.inv() * flipped).magnitude() == pytest.approx(np.pi)
+
+
+def test_plans_give_the_same_attitude_as_quaternion_and_rotation() -> None:
+    """at_quat (the 10 Hz path) and at (scipy Rotation) describe the same plan."""
+    rng = np.random.default_rng(3)
+    r0, r1 = Rotation.random(random_state=rng), Rotation.random(random_state=rng)
+    for plan in (slerp_plan(r0, r1, 0.0, 50.0), scp_slew(r0, r1, 120.0, 25, 0.05)):
+        for t in (-1.0, 0.0, 7.3, 49.9, 50.0, 80.0, 130.0):
+            r, w, wd = plan.at(t)
+            q, wq, wdq = plan.at_quat(t)
+            assert np.allclose(q, r.as_quat(), atol=1e-15)
+            assert np.array_equal(w, wq) and np.array_equal(wd, wdq)

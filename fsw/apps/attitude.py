@@ -152,11 +152,11 @@ class AttitudeApp(App):
         return quat.rotate(lvlh_to_eci_quat(t, self.n, self.incl), self.target - r)
 
     def _control(self, t: float) -> np.ndarray:
-        """Wheel torque tracking the slew plan, or the pointing attitude (quaternions R_eci_body
-        on the hot path; the slew plan returns scipy Rotations)."""
+        """Wheel torque tracking the slew plan, or the pointing attitude (quaternions R_eci_body,
+        scalar last: no scipy Rotation on the 10 Hz path)."""
         assert self.q is not None
         if self.mode == "slew" and self.slew is not None and t - self.slew_t0 <= self.slew_end:
-            r_des, w_des, wdot_des = self.slew.at(t - self.slew_t0)
+            r_des, w_des, wdot_des = self.slew.at_quat(t - self.slew_t0)
         else:
             q_des = repoint(self.q if self.q_point is None else self.q_point, self._los_eci(t),
                             self.boresight)
@@ -167,7 +167,7 @@ class AttitudeApp(App):
             if angle > math.radians(self.cfg.slew_threshold_deg):
                 self._plan_slew(t, angle)
                 self.q_point = None
-                r_des, w_des, wdot_des = self.slew.at(0.0)
+                r_des, w_des, wdot_des = self.slew.at_quat(0.0)
             else:
                 self.mode, self.q_point, r_des = "track", q_des, q_des
         tau, _ = tracking_torque(self.q, self.w_est, r_des, w_des, wdot_des, self.J,

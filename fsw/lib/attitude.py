@@ -68,6 +68,10 @@ class AttitudePlan(Protocol):
         """
         ...
 
+    def at_quat(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """As :meth:`at`, the attitude as its quaternion (4,), scalar last."""
+        ...
+
 
 # ---------------------------------------------------------------------------
 # input checks
@@ -262,17 +266,19 @@ class _NodePath:
         t_k, t_next = float(t_nodes[k]), float(t_nodes[k + 1])
         return quat.mul(self.q[k], quat.exp(self.phi[k] * ((tc - t_k) / (t_next - t_k))))
 
-    def sample(self, rates: FloatArray, t: float) -> PlanSample:
+    def sample(self, rates: FloatArray, t: float, as_quat: bool = False) -> Any:
         """Attitude on the path and piecewise-constant body rate ``rates[k]`` (rad/s) at t (s).
 
         For the rate, interval k is ``[t_k, t_{k+1})``, the end time belonging to the last
         one.  Outside ``[t_s[0], t_s[-1]]`` the attitude is held at the first/last node
-        and the rate is zero; ω̇ is zero throughout.
+        and the rate is zero; ω̇ is zero throughout.  The attitude is a Rotation, or its
+        quaternion (4,) with ``as_quat`` (no Rotation built: the 10 Hz loop's path).
         """
         tt = _finite("t", t)
         t_nodes = self.t_s
         zero = np.zeros(3)
-        r_t = Rotation.from_quat(self.quat_at(tt))
+        q_t = self.quat_at(tt)
+        r_t = q_t if as_quat else Rotation.from_quat(q_t)
         if tt < t_nodes[0] or tt > t_nodes[-1]:
             return r_t, zero, zero.copy()
         k = int(np.searchsorted(t_nodes, tt, side="right")) - 1
@@ -327,6 +333,11 @@ class SlerpPlan:
         """
         return self._path.sample(self._rate, t)
 
+    def at_quat(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """As :meth:`at` with the attitude as a quaternion (4,), scalar last."""
+        out: tuple[FloatArray, FloatArray, FloatArray] = self._path.sample(self._rate, t, True)
+        return out
+
 
 def slerp_plan(r0: Rotation, r1: Rotation, t0_s: float, t1_s: float) -> SlerpPlan:
     """Constant-rate short-way geodesic plan from r0 at t0_s to r1 at t1_s (see SlerpPlan)."""
@@ -380,6 +391,11 @@ class SlewPlan:
     def at(self, t: float) -> PlanSample:
         """Desired ``(R_ref_body, ω_body rad/s, ω̇_body rad/s²)`` at time t (s)."""
         return self._path.sample(self.w, t)
+
+    def at_quat(self, t: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """As :meth:`at` with the attitude as a quaternion (4,), scalar last."""
+        out: tuple[FloatArray, FloatArray, FloatArray] = self._path.sample(self.w, t, True)
+        return out
 
 
 # ---------------------------------------------------------------------------
