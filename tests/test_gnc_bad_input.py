@@ -11,6 +11,7 @@ import logging
 import numpy as np
 import pytest
 from pydantic import ValidationError
+from scipy.spatial.transform import Rotation
 
 from fsw.apps.attitude import AttitudeApp
 from fsw.apps.guidance import GuidanceApp
@@ -159,3 +160,23 @@ def test_guidance_refuses_an_assignment_it_cannot_fly_safely_and_keeps_its_orbit
     assert app.pending is None
     status = [m for name, m in sent if name == "status"]
     assert status[-1].mode == "hold" and status[-1].assignment_id == 1  # type: ignore[attr-defined]
+
+
+def test_attitude_estimate_loses_no_rotation_over_a_lost_gyro_sample() -> None:
+    """The MEKF propagates to each sample's own time: with the sample of t = 0.2 s lost, the
+    attitude at 0.3 s still has turned by ω·0.3 s (constant rate, no bias)."""
+    app = AttitudeApp(_ctx())
+    _capture(app)
+    w = np.array([0.0, 0.02, 0.01])
+
+    def sample(t: float, fix: bool) -> AttitudeMeasurement:
+        return AttitudeMeasurement(
+            sender="sim", t_sim=t, spacecraft=1, gyro_radps=w.tolist(),
+            star_tracker=[0, 0, 0, 1] if fix else None,
+            st_sigma_cross_rad=5e-5 if fix else 0.0, st_sigma_roll_rad=3e-4 if fix else 0.0)
+
+    for t, fix in ((0.0, True), (0.1, False), (0.3, False)):
+        app.on_sensors(sample(t, fix))
+        app.step(t)
+    expected = Rotation.from_rotvec(w * 0.3)
+    assert (Rotation.from_quat(app.q).inv() * expected).magnitude() < 1e-9

@@ -92,11 +92,12 @@ class AttitudeApp(App):
         self.slew_end = 0.0
         self.q_point: np.ndarray | None = None  # last desired attitude (quaternion) while tracking
         self.mode = "init"
-        self._meas: AttitudeMeasurement | None = None
+        self._meas: list[AttitudeMeasurement] = []
+        self.t_att: float | None = None  # time of the MEKF state, s
         self._est: StateEstimate | None = None
 
     def on_sensors(self, msg: AttitudeMeasurement) -> None:
-        self._meas = msg
+        self._meas.append(msg)
 
     def on_estimate(self, msg: StateEstimate) -> None:
         self._est = msg
@@ -107,11 +108,12 @@ class AttitudeApp(App):
     # --- cycle ---------------------------------------------------------------------------------
 
     def step(self, t: float) -> None:
-        meas, self._meas = self._meas, None
+        pending, self._meas = sorted(self._meas, key=lambda m: m.t_sim), []
+        meas = pending[-1] if pending else None
         self.tau = np.zeros(3)
         try:
-            if meas is not None:
-                self._determine(meas)
+            for m in pending:
+                self._determine(m)
             if self.q is None or self._est is None:
                 w = np.array(meas.gyro_radps) if meas is not None else np.zeros(3)
                 self.tau = _saturate(-self.J @ (self.gains.kd * w), self.tau_max)  # rate damping
@@ -126,11 +128,13 @@ class AttitudeApp(App):
             self._report(t)
 
     def _determine(self, meas: AttitudeMeasurement) -> None:
-        """MEKF: propagate with the gyro, update with the star tracker (initialise on its first
-        fix)."""
+        """MEKF: propagate with the gyro to the sample's time, update with the star tracker
+        (initialise on its first fix).  The gyro sample is the mean rate over the tick before
+        it; after a lost sample that rate is used over the whole gap (no rotation is lost)."""
         w_meas = np.array(meas.gyro_radps)
-        if self.q is not None:
-            self.q, self.b, self.P = mekf.mekf_propagate(self.q, self.b, self.P, w_meas, self.dt,
+        dt = meas.t_sim - self.t_att if self.t_att is not None else 0.0
+        if self.q is not None and dt > 1e-9:
+            self.q, self.b, self.P = mekf.mekf_propagate(self.q, self.b, self.P, w_meas, dt,
                                                          self.sigma_v, self.sigma_u)
         if meas.star_tracker is not None:
             R = np.diag(np.full(3, meas.st_sigma_cross_rad**2))
@@ -141,6 +145,8 @@ class AttitudeApp(App):
             else:
                 self.q, self.b, self.P, self.nis = mekf.mekf_update(
                     self.q, self.b, self.P, np.array(meas.star_tracker), R)
+        if self.q is not None:
+            self.t_att = meas.t_sim
         self.w_est = w_meas - self.b
 
     def _los_eci(self, t: float) -> np.ndarray:
