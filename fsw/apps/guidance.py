@@ -77,6 +77,7 @@ class GuidanceApp(App):
         self.dt = 1.0 / sc.rates.low_hz
         self.mass = sc.observers.mass_kg
         self.u_max = sc.actuators.thruster_max_force_n / (self.mass * math.sqrt(3.0))
+        self.min_impulse = sc.actuators.thruster_min_impulse_ns
         self.cfg = sc.guidance
         self.mpc = MpcTracker(self.n, MpcConfig(dt_s=self.dt, horizon=self.cfg.mpc_horizon,
                                                 u_max_mps2=self.u_max))
@@ -223,11 +224,17 @@ class GuidanceApp(App):
     def _command(self, t: float, u_lvlh: np.ndarray) -> np.ndarray:
         """Send the thrust for acceleration ``u_lvlh``; return the acceleration commanded (zero
         when the thrusters cannot fire: no attitude estimate yet, or the spacecraft is slewing,
-        which would turn the body-fixed thrust during the burn)."""
+        which would turn the body-fixed thrust during the burn).  Body axes whose impulse over
+        the cycle is below the minimum impulse bit are not commanded (the thrusters would not
+        fire them), so nav and the Δv count see what is really flown."""
         if self._att is None or self._att.mode != "track" or not u_lvlh.any():
             return np.zeros(3)
         r_lvlh_body = Rotation.from_quat(self._att.q_lvlh_body)
         force_body = self.mass * r_lvlh_body.inv().apply(u_lvlh)
+        force_body[np.abs(force_body) * self.dt < self.min_impulse] = 0.0
+        if not force_body.any():
+            return np.zeros(3)
+        u_lvlh = r_lvlh_body.apply(force_body) / self.mass
         self.dv_commanded += float(np.abs(u_lvlh).sum()) * self.dt
         self.publish("thrust", ThrustCommand(
             sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id,
