@@ -5,7 +5,9 @@ from __future__ import annotations
 import logging
 
 from fsw.apps.attitude import AttitudeApp
+from fsw.apps.camera import CameraApp
 from fsw.apps.guidance import GuidanceApp
+from fsw.apps.infocost import InfoCostApp
 from fsw.apps.nav import NavApp
 from interfaces import topics
 from interfaces.app import App, AppContext
@@ -14,7 +16,7 @@ from interfaces.executive import Executive
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
 
-APPS: tuple[type[App], ...] = (AttitudeApp, NavApp, GuidanceApp)
+APPS: tuple[type[App], ...] = (AttitudeApp, NavApp, CameraApp, InfoCostApp, GuidanceApp)
 """The onboard apps, in execution order within a rate group."""
 
 

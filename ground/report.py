@@ -11,6 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ground.coverage import Coverage, coverage  # noqa: E402
 from ground.evaluation import NavErrors, nav_errors  # noqa: E402
 from ground.gnc_evaluation import GncSeries, gnc_series  # noqa: E402
 from ground.reader import ArchiveError, RunArchive, load_run  # noqa: E402
@@ -39,6 +40,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None) -> P
     lines += _trajectory_section(out, archive, mission)
     lines += _nav_section(out, nav_errors(archive, mission), summary)
     lines += _gnc_section(out, gnc_series(archive, scenario, mission), summary)
+    lines += _coverage_section(out, coverage(archive, scenario, mission), summary)
     lines += _links_section(summary) + _exec_section(summary)
     return _write(out, lines)
 
@@ -135,6 +137,29 @@ def _gnc_section(out: Path, series: dict[int, GncSeries], summary: dict) -> list
             f"{f(g['pointing_error_mean_deg'], '.3f')} / {f(g['pointing_error_p95_deg'], '.3f')} | "
             f"{f(g['knowledge_error_rms_arcsec'], '.1f')} |")
     return ["## Guidance and attitude", "", "![gnc](gnc.png)", "", *rows, ""]
+
+
+def _coverage_section(out: Path, c: Coverage, summary: dict) -> list[str]:
+    if not c.h:
+        return ["No camera images recorded.", ""]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    axes[0].plot(c.t_s, c.h, "k-", lw=1.2)
+    axes[0].set_ylabel("information cost H (all images fused)")
+    for sc, (ts, hs) in sorted(c.h_i.items()):
+        axes[1].plot(ts, hs, ".-", ms=3, lw=0.8, label=f"sc{sc}")
+    axes[1].set_ylabel("H_i reported (Eq. 8)")
+    axes[1].legend(fontsize=8)
+    for ax in axes:
+        ax.set_xlabel("sim time (s)")
+        ax.grid(True, alpha=0.3)
+    fig.suptitle("Inspection: information cost")
+    fig.tight_layout()
+    fig.savefig(out / "coverage.png", dpi=110)
+    plt.close(fig)
+    cov = summary.get("coverage", {})
+    return ["## Inspection", "", "![coverage](coverage.png)", "",
+            f"H from {cov.get('H_initial', float('nan')):.4f} to {cov.get('H_final', float('nan')):.4f}; "
+            f"{100 * cov.get('fraction_observed', 0):.1f}% of the POIs observed.", ""]
 
 
 def _links_section(summary: dict) -> list[str]:

@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from ground.coverage import coverage, coverage_summary
 from ground.evaluation import nav_errors
 from ground.gnc_evaluation import gnc_series, gnc_summary
 from ground.reader import ArchiveError, RunArchive, load_run
@@ -32,6 +33,7 @@ def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict
         "nav": {str(sc): e.stats(skip_s=NAV_SETTLE_S)
                 for sc, e in nav_errors(archive, mission).items()},
         "gnc": gnc_summary(gnc_series(archive, scenario, mission)),
+        "coverage": coverage_summary(coverage(archive, scenario, mission)),
         "links": [c.model_dump() for node in sorted(links) for c in links[node].links],
         "exec": {node: {"cycle_slips": {g: s.cycle_slips for g, s in m.groups.items()},
                         "max_exec_ms": {g: round(s.max_exec_ms, 3) for g, s in m.groups.items()},

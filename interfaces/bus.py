@@ -159,6 +159,7 @@ class Bus:
             return
         subs = self._groups.get(key_expr, [])
         decoded: dict[type[Message], Message] = {}
+        deferred: dict[int, tuple[Message, list[_Sub]]] = {}
         for sub in subs:
             msg = decoded.get(sub.msg_type)
             if msg is None:
@@ -175,7 +176,11 @@ class Bus:
             if sub.immediate:
                 self._call(sub, msg, key)
             else:
-                self._enqueue(_Envelope(msg, key, topics.node_of_key(key), False, [sub]))
+                deferred.setdefault(id(msg), (msg, []))[1].append(sub)
+        # One envelope per message, whatever the number of local subscribers: the channel
+        # decides once, so every app of the node sees the same messages.
+        for msg, group in deferred.values():
+            self._enqueue(_Envelope(msg, key, topics.node_of_key(key), False, group))
 
     def _enqueue(self, env: _Envelope) -> None:
         with self._cond:

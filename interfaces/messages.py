@@ -126,6 +126,25 @@ class AttitudeMeasurement(Message):
         return self
 
 
+class _PoiPrecisions(Message):
+    """POI indices (into the target's POI list) and the precision σ⁻¹ measured on each."""
+
+    spacecraft: int = Field(ge=1)
+    poi: list[Annotated[int, Field(ge=0)]] = Field(max_length=1_000_000)
+    precision: list[Annotated[float, Field(ge=0.0)]] = Field(max_length=1_000_000)
+
+    @model_validator(mode="after")
+    def _same_length(self) -> _PoiPrecisions:
+        if len(self.poi) != len(self.precision):
+            raise ValueError("poi and precision must have the same length")
+        return self
+
+
+class CameraImage(_PoiPrecisions):
+    """One inspection image of an observer (ω_mid): the POIs it saw (ascending) and the
+    precision of each measurement (Eq. 5: 1/(k·dist²), with the camera's noise and health)."""
+
+
 # --- commands (flight software -> hardware) --------------------------------------------------
 
 
@@ -243,6 +262,30 @@ class GuidanceStatus(Message):
     mpc_ms: float = Field(default=0.0, ge=0.0)
 
 
+class PoiObservations(_PoiPrecisions):
+    """The observations of one image of ``spacecraft`` (taken at ``image_t_s``) as shared with
+    the other observers and the ground.  Received only within range."""
+
+    image_t_s: float = Field(ge=0.0)
+
+
+class InfoCostTelemetry(Message):
+    """Information-cost telemetry of one observer at the FDI period (Eq. 8): its contribution
+    H_i, the information cost H and the prior term of its fused view (H = prior + Σ_j H_j),
+    the POIs it has seen, and the observers whose observations it has fused."""
+
+    spacecraft: int = Field(ge=1)
+    h_i: float = Field(ge=0.0)
+    h_local: float = Field(ge=0.0)
+    prior_term: float = Field(ge=0.0)
+    contributions: dict[str, float] = Field(default_factory=dict,
+                                            description="H_j by spacecraft id, as fused here")
+    pois_seen_own: int = Field(ge=0)
+    pois_seen_fused: int = Field(ge=0)
+    images: int = Field(ge=0)
+    shared_received: int = Field(ge=0)
+
+
 class PointingTarget(Message):
     """Where the camera wants the boresight: a point in LVLH (m) — from the camera app."""
 
@@ -346,6 +389,9 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     GuidanceStatus,
     PointingTarget,
     AttitudeEstimate,
+    CameraImage,
+    PoiObservations,
+    InfoCostTelemetry,
     Heartbeat,
     ExecStats,
     LinkStats,

@@ -40,9 +40,29 @@ class Orbit(_Section):
 
 
 class Target(_Section):
+    """The target spacecraft and its points of interest (POIs), spread uniformly on its surface;
+    each POI has prior variance ``prior_variance`` (w) and importance 1/``pois`` (φ)."""
+
     shape: Literal["sphere"] = "sphere"
     radius_m: float = Field(default=5.0, gt=0.0)
     pois: int = Field(default=5000, ge=1)
+    prior_variance: float = Field(default=1.0, gt=0.0, description="w, per POI")
+
+
+class CameraSettings(_Section):
+    """The observers' inspection cameras: σ = k·dist² (Eq. 5) within a conical field of view.
+    With the defaults (k = 1, the paper's Eq. 22 value, and w = 1) an image at 20 m adds
+    1/400 of the prior's information, so one image a second takes the cost down over an orbit
+    or two rather than in minutes."""
+
+    half_angle_deg: float = Field(default=20.0, gt=0.0, lt=90.0)
+    max_range_m: float = Field(default=200.0, gt=0.0)
+    k: float = Field(default=1.0, gt=0.0, description="variance per m² of distance")
+    noise_frac: float = Field(default=0.05, ge=0.0, lt=1.0, description="1σ, of each precision")
+    pointing: Literal["centre", "max_variance"] = Field(
+        default="centre",
+        description="camera app's pointing target: the target's centre, or the reachable POI of "
+                    "maximum variance (retargets in steps; see fsw/apps/camera.py)")
 
 
 class Rates(_Section):
@@ -284,6 +304,7 @@ class Scenario(_Section):
     duration_s: float = Field(gt=0.0)
     orbit: Orbit = Orbit()
     target: Target = Target()
+    camera: CameraSettings = CameraSettings()
     rates: Rates = Rates()
     comms: Comms = Comms()
     observers: Observers = Observers()

@@ -93,6 +93,10 @@ def attitude_sensors(mission: str, spacecraft: int) -> str:
     return key(mission, SIM, "sensors", f"sc{spacecraft}", "attitude")
 
 
+def camera_image(mission: str, spacecraft: int) -> str:
+    return key(mission, SIM, "sensors", f"sc{spacecraft}", "camera")
+
+
 def actuator(mission: str, spacecraft: int, device: str) -> str:
     """Command to the hardware of a spacecraft: ``sc/<id>/act/<device>`` (thrust, wheels)."""
     return key(mission, sc_node(spacecraft), "act", device)

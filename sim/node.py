@@ -18,12 +18,17 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+import math
+
 from fsw.lib import quat
 from fsw.lib.hcw import mean_motion, pro_state
+from fsw.lib.infocost import Camera
+from fsw.lib.poi import sphere_pois
 from interfaces import topics
 from interfaces.bus import Bus
 from interfaces.messages import (
     AttitudeMeasurement,
+    CameraImage,
     RelNavMeasurement,
     SimStatus,
     ThrustCommand,
@@ -34,6 +39,7 @@ from interfaces.messages import (
 )
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
+from sim.camera import TruthCameras
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
 from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
@@ -70,6 +76,12 @@ class SimNode:
             energy_match=sc.observers.energy_match and sc.observers.start == "pro")
         self.ids = list(range(1, sc.observers.count + 1))
         self.hw = ObserverHardware(sc, Rotation.from_quat(quat.conj(self._q_lvlh_eci())))
+        cam = sc.camera
+        self.cameras = TruthCameras(
+            *sphere_pois(sc.target.pois, sc.target.radius_m),
+            Camera(math.radians(cam.half_angle_deg), cam.max_range_m, cam.k),
+            np.array(sc.attitude.boresight_body), cam.noise_frac,
+            [stream(sc.seed, "camera", i) for i in self.ids])
         self.sensors = [
             RelNavSensor(sc.sensors.relnav_sigma_r_m, sc.sensors.relnav_sigma_v_mps,
                          stream(sc.seed, "relnav", i)) for i in self.ids
@@ -82,6 +94,7 @@ class SimNode:
             "tick": topics.tick(m), "status": topics.sim_status(m), "truth": topics.truth(m),
             "relnav": [topics.relnav(m, i) for i in self.ids],
             "attitude": [topics.attitude_sensors(m, i) for i in self.ids],
+            "camera": [topics.camera_image(m, i) for i in self.ids],
         }
         self._cond = threading.Condition()
         self._answers: dict[str, dict[str, int]] = {}
@@ -213,10 +226,11 @@ class SimNode:
     def _publish_hardware(self, k: int, t: float) -> None:
         rel = self.truth.rel_lvlh()
         hw = self.hw
+        q_lvlh_body = hw.q_lvlh_body(self._q_lvlh_eci())
         self.bus.publish(self._keys["truth"], TruthState(
             sender=topics.SIM, t_sim=t, spacecraft=self.ids,
             r_lvlh_m=rel[:, :3].tolist(), v_lvlh_mps=rel[:, 3:].tolist(),
-            q_lvlh_body=hw.q_lvlh_body(self._q_lvlh_eci()).tolist(),
+            q_lvlh_body=q_lvlh_body.tolist(),
             w_body_radps=hw.attitude.w.tolist(), dv_mps=hw.dv_mps.tolist()))
         gyro, st = hw.measure(t, self.scenario.rates.dt_s)
         for i, sc_id in enumerate(self.ids):
@@ -225,6 +239,10 @@ class SimNode:
                 star_tracker=None if st is None else st[i].tolist(),
                 st_sigma_cross_rad=hw.st_sigma_rad[0], st_sigma_roll_rad=hw.st_sigma_rad[1]))
         if k % self.scenario.rates.ticks_per("mid") == 0:
+            for i, img in enumerate(self.cameras.images(rel[:, :3], q_lvlh_body)):
+                self.bus.publish(self._keys["camera"][i], CameraImage(
+                    sender=topics.SIM, t_sim=t, spacecraft=self.ids[i], poi=img.poi.tolist(),
+                    precision=img.precision.tolist()))
             for i, sensor in enumerate(self.sensors):
                 r, v = sensor.measure(rel[i, :3], rel[i, 3:])
                 self.bus.publish(self._keys["relnav"][i], RelNavMeasurement(

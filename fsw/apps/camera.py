@@ -1,0 +1,97 @@
+"""Camera app: where to look, and what was seen (paper Sec. II.C-D).
+
+Rate group mid (ω_mid).  Inputs: the camera's images (from the sim), the observations of every
+observer (its own come back through the bus; a neighbour's arrive only within range) to keep
+the fused POI map, and the nav estimate.  Outputs: the observations of each image, shared with
+the other observers and the ground, and the pointing target for the attitude app.
+
+Pointing (``camera.pointing``): the target's centre (default), or, with ``"max_variance"``,
+every ``RETARGET_S`` the POI of maximum current variance (φ·H_POI) that is reachable: front-facing and in camera range from the estimated position, and within
+``RETARGET_MAX_DEG`` of the current line of sight (below the attitude app's slew threshold, so
+retargeting is tracked, not slewed).
+Until it has a position estimate it points at the target's centre.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from fsw.lib.poi import sphere_pois
+from fsw.lib.poi_map import PoiMap
+from interfaces import topics
+from interfaces.app import App, AppContext, Input, Output
+from interfaces.messages import CameraImage, PoiObservations, PointingTarget, StateEstimate
+
+RETARGET_S = 10.0
+"""Period of the pointing-target choice, s."""
+RETARGET_MAX_DEG = 8.0
+"""Largest change of line of sight allowed at a retarget, deg."""
+
+
+class CameraApp(App):
+    NAME = "camera"
+    RATE = "mid"
+    INPUTS = (
+        Input(lambda c: topics.camera_image(c.mission, c.spacecraft or 0), CameraImage, "on_image"),
+        Input(lambda c: topics.all_spacecraft(c.mission, "camera", "observations"),
+              PoiObservations, "on_observations"),
+        Input(lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate,
+              "on_estimate"),
+    )
+    OUTPUTS = (
+        Output("observations", lambda c: topics.key(c.mission, c.node, "camera", "observations"),
+               PoiObservations),
+        Output("pointing", lambda c: topics.key(c.mission, c.node, "camera", "pointing"),
+               PointingTarget),
+    )
+
+    def __init__(self, ctx: AppContext) -> None:
+        super().__init__(ctx)
+        sc = ctx.scenario
+        self.sc_id = ctx.spacecraft or 0
+        self.poi_pos, self.poi_normal = sphere_pois(sc.target.pois, sc.target.radius_m)
+        self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
+        self.max_range = sc.camera.max_range_m
+        self.max_variance = sc.camera.pointing == "max_variance"
+        self.target = np.zeros(3)
+        self.next_retarget = 0.0
+        self._images: list[CameraImage] = []
+        self._est: StateEstimate | None = None
+
+    def on_image(self, msg: CameraImage) -> None:
+        self._images.append(msg)
+
+    def on_observations(self, msg: PoiObservations) -> None:
+        self.map.add(msg.spacecraft, msg.poi, msg.precision)
+
+    def on_estimate(self, msg: StateEstimate) -> None:
+        self._est = msg
+
+    def step(self, t: float) -> None:
+        images, self._images = self._images, []
+        for img in images:
+            self.publish("observations", PoiObservations(
+                sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, image_t_s=img.t_sim,
+                poi=img.poi, precision=img.precision))
+        if self.max_variance and t >= self.next_retarget - 1e-9 and self._est is not None:
+            self.next_retarget = t + RETARGET_S
+            self.target = self._choose(np.array(self._est.x[:3]))
+        self.publish("pointing", PointingTarget(sender=self.ctx.node, t_sim=t,
+                                                spacecraft=self.sc_id,
+                                                target_lvlh_m=self.target.tolist()))
+
+    def _choose(self, r: np.ndarray) -> np.ndarray:
+        """The reachable POI of maximum φ·H_POI (the current target if none is reachable)."""
+        to_cam = r - self.poi_pos
+        dist = np.linalg.norm(to_cam, axis=1)
+        los_now = self.target - r
+        los = self.poi_pos - r
+        cos_turn = (los @ los_now) / (dist * max(1e-9, float(np.linalg.norm(los_now))))
+        ok = ((np.einsum("ij,ij->i", self.poi_normal, to_cam) > 0.0) & (dist <= self.max_range)
+              & (cos_turn >= math.cos(math.radians(RETARGET_MAX_DEG))))
+        if not ok.any():
+            return self.target
+        score = np.where(ok, self.map.phi * self.map.variance(), -np.inf)
+        return np.array(self.poi_pos[int(np.argmax(score))])

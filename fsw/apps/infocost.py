@@ -1,0 +1,56 @@
+"""Information-cost app: the spacecraft's share of the inspection (paper Eq. 8, Sec. III.A).
+
+Rate group mid (ω_mid).  Input: the observations of every observer (its own, and a neighbour's
+only while in communication range: the channel decides).  Output: at every FDI period
+(``rates.fdi_period_s``) the information-cost telemetry to the ground — its contribution H_i,
+the cost H and prior term of its fused view, every contribution H_j as fused here, and counts.
+"""
+
+from __future__ import annotations
+
+from fsw.lib.poi_map import PoiMap
+from interfaces import topics
+from interfaces.app import App, AppContext, Input, Output
+from interfaces.messages import InfoCostTelemetry, PoiObservations
+
+
+class InfoCostApp(App):
+    NAME = "infocost"
+    RATE = "mid"
+    INPUTS = (
+        Input(lambda c: topics.all_spacecraft(c.mission, "camera", "observations"),
+              PoiObservations, "on_observations"),
+    )
+    OUTPUTS = (
+        Output("telemetry", lambda c: topics.key(c.mission, c.node, "infocost", "telemetry"),
+               InfoCostTelemetry),
+    )
+
+    def __init__(self, ctx: AppContext) -> None:
+        super().__init__(ctx)
+        sc = ctx.scenario
+        self.sc_id = ctx.spacecraft or 0
+        self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
+        self.period = sc.rates.fdi_period_s
+        self.next_report = 0.0
+        self.images = 0
+        self.shared = 0
+
+    def on_observations(self, msg: PoiObservations) -> None:
+        self.map.add(msg.spacecraft, msg.poi, msg.precision)
+        if msg.spacecraft == self.sc_id:
+            self.images += 1
+        else:
+            self.shared += 1
+
+    def step(self, t: float) -> None:
+        if t < self.next_report - 1e-9:
+            return
+        self.next_report = t + self.period
+        h_j = self.map.contributions()
+        self.publish("telemetry", InfoCostTelemetry(
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, h_i=float(h_j[self.sc_id - 1]),
+            h_local=self.map.cost(), prior_term=self.map.prior_term(),
+            contributions={str(j + 1): float(h) for j, h in enumerate(h_j)},
+            pois_seen_own=self.map.seen(self.sc_id), pois_seen_fused=self.map.seen(),
+            images=self.images, shared_received=self.shared))

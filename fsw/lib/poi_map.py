@@ -1,0 +1,78 @@
+"""An observer's knowledge of the target's POIs: the accumulated precision of every observer
+whose observations it has received (its own and its neighbours'), and the information cost of
+that fused view (Eq. 4, 7, 8 through ``fsw.lib.infocost``).  No bus, no I/O."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from fsw.lib import infocost
+from fsw.lib.checks import finite_array
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(eq=False)
+class PoiMap:
+    """Fused POI precision of one observer.
+
+    Attributes:
+        phi: POI importance φ (M,).
+        w_inv: prior inverse variance w⁻¹ (M,), > 0.
+        n_agents: number of observers (rows of F; observer ids 1..n_agents).
+        F: accumulated precision per observer (n_agents, M): row j - 1 holds every observation
+            of observer j fused here.
+    """
+
+    phi: FloatArray
+    w_inv: FloatArray
+    n_agents: int
+    F: FloatArray = field(init=False)
+
+    def __post_init__(self) -> None:
+        m = len(self.phi)
+        self.phi = finite_array("phi", self.phi, (m,))
+        self.w_inv = finite_array("w_inv", self.w_inv, (m,))
+        if (self.phi < 0).any() or (self.w_inv <= 0).any():
+            raise ValueError("phi must be >= 0 and w_inv > 0")
+        self.F = np.zeros((self.n_agents, m))
+
+    @classmethod
+    def uniform(cls, pois: int, prior_variance: float, n_agents: int) -> PoiMap:
+        """Equal importance φ = 1/M (so H starts at w) and equal prior variance w."""
+        return cls(np.full(pois, 1.0 / pois), np.full(pois, 1.0 / prior_variance), n_agents)
+
+    def add(self, agent: int, poi: npt.ArrayLike, precision: npt.ArrayLike) -> None:
+        """Fuse the observations of observer ``agent`` (1-based): precision σ⁻¹ ≥ 0 on POIs
+        ``poi`` (indices; repeated indices add up)."""
+        idx = np.asarray(poi, dtype=np.int64)
+        prec = finite_array("precision", precision, (len(idx),))
+        if not 1 <= agent <= self.n_agents:
+            raise ValueError(f"agent {agent} outside 1..{self.n_agents}")
+        if len(idx) and (idx.min() < 0 or idx.max() >= len(self.phi) or (prec < 0).any()):
+            raise ValueError("POI index out of range or negative precision")
+        np.add.at(self.F[agent - 1], idx, prec)
+
+    def variance(self) -> FloatArray:
+        """Fused variance H_POI per POI (M,)."""
+        return infocost.h_poi(self.w_inv, self.F)
+
+    def cost(self) -> float:
+        """Information cost H of the fused view."""
+        return infocost.information_cost(self.phi, self.w_inv, self.F)
+
+    def contributions(self) -> FloatArray:
+        """H_j of every observer (n_agents,) (Eq. 8)."""
+        return infocost.agent_contributions(self.phi, self.w_inv, self.F)
+
+    def prior_term(self) -> float:
+        """Σ φψw⁻¹, so that prior_term + Σ H_j = H."""
+        return infocost.prior_term(self.phi, self.w_inv, self.F)
+
+    def seen(self, agent: int | None = None) -> int:
+        """POIs observed at least once (by ``agent``, or by anyone fused here)."""
+        f = self.F if agent is None else self.F[agent - 1:agent]
+        return int(np.count_nonzero(f.sum(axis=0)))
