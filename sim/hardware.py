@@ -113,6 +113,8 @@ class ObserverHardware:
         """Gyro rates (N, 3) averaged over the last tick and star-tracker quaternions (N, 4) when
         a fix is due at ``t_s`` (else None)."""
         gyro = self.gyro.measure(self.attitude.mean_rate, dt_s)
+        if not self.star_tracker.due(t_s):  # no Rotation built on the ticks without a fix
+            return gyro, None
         return gyro, self.star_tracker.measure(t_s, self.attitude.r_eci_body())
 
     def q_lvlh_body(self, q_lvlh_eci: np.ndarray) -> np.ndarray:

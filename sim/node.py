@@ -104,6 +104,7 @@ class SimNode:
         self.missed_answers = 0
         self.rejected_commands = 0
         self._t_now = 0.0
+        self._q_now = np.array([0.0, 0.0, 0.0, 1.0])  # ECI -> LVLH now (set each tick)
         self._dt = sc.rates.dt_s
         for node in self.participants:
             self.bus.subscribe(topics.tick_done(m, node), TickDone, self._on_done, immediate=True)
@@ -205,7 +206,7 @@ class SimNode:
             self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
             self.bus.dispatch(t, include_now=True)
             if k < n_ticks - 1:
-                accel = self.hw.accel_lvlh(t, self._q_lvlh_eci())
+                accel = self.hw.accel_lvlh(t, self._q_now)
                 self.truth.step(dt, accel, substeps=sc.sim.substeps)
                 self.hw.step(t, dt)
             if k % max(1, n_ticks // 10) == 0:
@@ -226,7 +227,8 @@ class SimNode:
     def _publish_hardware(self, k: int, t: float) -> None:
         rel = self.truth.rel_lvlh()
         hw = self.hw
-        q_lvlh_body = hw.q_lvlh_body(self._q_lvlh_eci())
+        self._q_now = self._q_lvlh_eci()  # reused for the thrust of this tick
+        q_lvlh_body = hw.q_lvlh_body(self._q_now)
         self.bus.publish(self._keys["truth"], TruthState(
             sender=topics.SIM, t_sim=t, spacecraft=self.ids,
             r_lvlh_m=rel[:, :3].tolist(), v_lvlh_mps=rel[:, 3:].tolist(),

@@ -211,12 +211,15 @@ class StarTracker:
         out: np.ndarray = q
         return out
 
-    def measure(self, t_s: float, r_eci_body: Rotation) -> np.ndarray | None:
-        """A sample (N, 4) if one is due at time ``t_s`` (s), else ``None``."""
+    def due(self, t_s: float) -> bool:
+        """Whether a sample is due at time ``t_s`` (s) (see the class docstring)."""
         if not math.isfinite(t_s):
             raise ValueError(f"t_s must be finite, got {t_s!r}")
-        index = math.floor(t_s / self.period_s + 1e-9)
-        if index < self._next_index:
+        return math.floor(t_s / self.period_s + 1e-9) >= self._next_index
+
+    def measure(self, t_s: float, r_eci_body: Rotation) -> np.ndarray | None:
+        """A sample (N, 4) if one is due at time ``t_s`` (s), else ``None``."""
+        if not self.due(t_s):
             return None
-        self._next_index = index + 1
+        self._next_index = math.floor(t_s / self.period_s + 1e-9) + 1
         return self.sample(r_eci_body)

@@ -64,7 +64,8 @@ class CameraApp(App):
         self._images.append(msg)
 
     def on_observations(self, msg: PoiObservations) -> None:
-        self.map.add(msg.spacecraft, msg.poi, msg.precision)
+        if self.max_variance:  # the map only serves the max-variance choice
+            self.map.add(msg.spacecraft, msg.poi, msg.precision)
 
     def on_estimate(self, msg: StateEstimate) -> None:
         self._est = msg
