@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 from fsw.lib.poi_map import PoiMap
 from ground.reader import RunArchive
 from interfaces import topics
-from interfaces.messages import CameraImage, InfoCostTelemetry
+from interfaces.messages import AssignmentDecision, CameraImage, InfoCostTelemetry
 from interfaces.scenario import Scenario
 
 
@@ -23,6 +23,7 @@ class Coverage:
     h_i: dict[int, tuple[list[float], list[float]]] = field(default_factory=dict)
     h_initial: float = 0.0
     fraction_observed: float = 0.0
+    decisions: list[AssignmentDecision] = field(default_factory=list)
 
 
 def coverage(archive: RunArchive, scenario: Scenario, mission: str,
@@ -48,17 +49,20 @@ def coverage(archive: RunArchive, scenario: Scenario, mission: str,
         ts, hs = out.h_i.setdefault(tm.spacecraft, ([], []))
         ts.append(tm.t_sim)
         hs.append(tm.h_i)
+    out.decisions = archive.messages(topics.assignment_decisions(mission), AssignmentDecision)
     return out
 
 
 def coverage_summary(c: Coverage) -> dict[str, float | dict[str, float]]:
-    """summary.json ``coverage``: H_initial, H_final, fraction of POIs observed, and each
-    observer's last reported H_i."""
+    """summary.json ``coverage``: H_initial, H_final, fraction of POIs observed, each
+    observer's last reported H_i, and the ground's information-driven orbit decisions."""
     return {
         "H_initial": c.h_initial,
         "H_final": c.h[-1] if c.h else c.h_initial,
         "fraction_observed": c.fraction_observed,
         "H_i_final": {str(sc): hs[-1] for sc, (_, hs) in sorted(c.h_i.items()) if hs},
         "H_reduction_fraction": float(1.0 - (c.h[-1] if c.h else c.h_initial) / c.h_initial),
+        "assignment_decisions": [d.model_dump(exclude={"sender", "seq", "t_wall"})
+                                 for d in c.decisions],
     }
 

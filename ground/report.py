@@ -152,6 +152,8 @@ def _coverage_section(out: Path, c: Coverage, summary: dict) -> list[str]:
     for ax in axes:
         ax.set_xlabel("sim time (s)")
         ax.grid(True, alpha=0.3)
+        for d in c.decisions:  # the ground's orbit choices: solid when flown
+            ax.axvline(d.t_sim, color="tab:blue", lw=0.8, ls="-" if d.switched else ":")
     fig.suptitle("Inspection: information cost")
     fig.tight_layout()
     fig.savefig(out / "coverage.png", dpi=110)
@@ -159,7 +161,25 @@ def _coverage_section(out: Path, c: Coverage, summary: dict) -> list[str]:
     cov = summary.get("coverage", {})
     return ["## Inspection", "", "![coverage](coverage.png)", "",
             f"H from {cov.get('H_initial', float('nan')):.4f} to {cov.get('H_final', float('nan')):.4f}; "
-            f"{100 * cov.get('fraction_observed', 0):.1f}% of the POIs observed.", ""]
+            f"{100 * cov.get('fraction_observed', 0):.1f}% of the POIs observed.", ""] \
+        + _decision_rows(c)
+
+
+def _decision_rows(c: Coverage) -> list[str]:
+    """The ground's information-driven orbit decisions (vertical lines in the plot)."""
+    if not c.decisions:
+        return []
+    rows = ["Orbit assignment decisions (blue lines; dotted: current set kept):", "",
+            "| t (s) | phase | reason | PROs (library index per observer) | expected gain | "
+            "bound ratio | current set's gain | measured gains | flown |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for d in c.decisions:
+        cur = "-" if d.current_gain is None else f"{d.current_gain:.3g}"
+        gains = ", ".join(f"{g:.3g}" for g in d.measured_gains) or "-"
+        rows.append(f"| {d.t_sim:.0f} | {d.phase} | {d.reason} | {d.library_indices} | "
+                    f"{d.expected_gain:.3g} | {d.ratio_bound:.3f} | {cur} | {gains} | "
+                    f"{'yes' if d.switched else 'no'} |")
+    return rows + [""]
 
 
 def _links_section(summary: dict) -> list[str]:

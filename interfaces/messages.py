@@ -225,6 +225,22 @@ class ProAssignments(Message):
     assignments: list[ProAssignment]
 
 
+class AssignmentDecision(Message):
+    """The ground's information-driven orbit choice (ground/mission_plan.py): the greedy set,
+    its expected information gain and online bound, the expected gain of keeping the current
+    PROs, the measured H decrease per check window that led to it, and whether it was flown."""
+
+    phase: str = Field(max_length=64)
+    reason: Literal["phase", "saturated"]
+    library_indices: list[int] = Field(description="candidate PRO of observer 1, 2, ...")
+    expected_gain: float = Field(ge=0.0)
+    upper_bound: float = Field(ge=0.0)
+    ratio_bound: float = Field(ge=0.0, le=1.0, description="expected_gain / upper_bound")
+    current_gain: float | None = Field(default=None, ge=0.0)
+    measured_gains: list[float]
+    switched: bool
+
+
 class TransferPlanMsg(Message):
     """A planned transfer (SCP, L1 fuel): node times (s, mission time), LVLH states (m, m/s) and
     ZOH accelerations (m/s², one per interval) — the nominal plan the ground's twin replays."""
@@ -287,10 +303,13 @@ class InfoCostTelemetry(Message):
 
 
 class PointingTarget(Message):
-    """Where the camera wants the boresight: a point in LVLH (m) — from the camera app."""
+    """Where the camera wants the boresight: a point in LVLH (m) at ``t_sim``, moving at
+    ``target_rate_lvlh_mps`` (m/s, LVLH) — from the camera app; the attitude app extrapolates
+    it and uses the motion as feed-forward."""
 
     spacecraft: int = Field(ge=1)
     target_lvlh_m: Vec3
+    target_rate_lvlh_mps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 class AttitudeEstimate(Message):
@@ -385,6 +404,7 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     WheelCommand,
     StateEstimate,
     ProAssignments,
+    AssignmentDecision,
     TransferPlanMsg,
     GuidanceStatus,
     PointingTarget,

@@ -204,11 +204,54 @@ class Observers(_ProFormation):
 
 class Phase(_ProFormation):
     """A phase of the mission plan (Fig. 7): at ``start_s`` every observer leaves its orbit for
-    the PRO of this phase, arriving ``transfer_s`` later (fuel-optimal SCP transfer, then held)."""
+    the PRO of this phase, arriving ``transfer_s`` later (fuel-optimal SCP transfer, then held).
+
+    ``assign = "scenario"``: the PROs are the ones given here.  ``assign = "information"``: the
+    ground chooses them from the candidate library of ``[assignment]`` by expected information
+    gain when the phase is uplinked, and reassigns whenever the gain of the set saturates, until
+    the next phase (the PRO fields of the phase are then unused)."""
 
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
     start_s: float = Field(ge=0.0)
     transfer_s: float = Field(default=900.0, gt=0.0)
+    assign: Literal["scenario", "information"] = "scenario"
+
+
+class AssignmentSettings(_Section):
+    """The central agent's information-driven orbit assignment (``ground/orbit_assignment.py``,
+    ``ground/mission_plan.py``), for phases with ``assign = "information"``.
+
+    Candidates: every combination of ``rho_x_m`` × ``rho_z_m`` × ``phases`` in-plane phases
+    (evenly spread) × ``cross_phase_offsets_deg``; those passing closer than the guidance
+    keep-out plus ``keep_out_margin_m`` to the target centre are excluded.  A set is chosen
+    greedily by the precision it is expected to add over ``window_s`` after arrival (``samples``
+    images, camera on the target centre), with chosen PROs at least ``min_separation_m`` apart.
+    Reassignment: every ``check_period_s`` after arrival the ground measures the decrease of H
+    of its fused view; when the last window's decrease falls below ``saturation_fraction`` of
+    the first, a new set is chosen (leaving one uplink lead later, ``transfer_s`` to arrive).
+    The new set is flown only if its expected gain beats the current set's by
+    ``min_improvement``; otherwise the current set is kept and measured afresh."""
+
+    rho_x_m: list[float] = Field(default=[10.0, 15.0, 20.0], min_length=1)
+    rho_z_m: list[float] = Field(default=[10.0, 20.0, 30.0], min_length=1)
+    phases: int = Field(default=6, ge=1, le=72)
+    cross_phase_offsets_deg: list[float] = Field(default=[0.0, 90.0], min_length=1)
+    window_s: float = Field(default=1200.0, gt=0.0, description="planning window, s")
+    samples: int = Field(default=24, ge=1, le=1000, description="images per planning window")
+    min_separation_m: float = Field(default=5.0, ge=0.0)
+    keep_out_margin_m: float = Field(default=2.0, ge=0.0)
+    check_period_s: float = Field(default=300.0, gt=0.0)
+    saturation_fraction: float = Field(default=0.5, gt=0.0, lt=1.0)
+    min_improvement: float = Field(default=0.1, ge=0.0,
+                                   description="relative expected-gain margin to switch sets")
+    transfer_s: float = Field(default=600.0, gt=0.0, description="reassignment transfer time, s")
+
+    @model_validator(mode="after")
+    def _amplitudes(self) -> AssignmentSettings:
+        for name in ("rho_x_m", "rho_z_m"):
+            if any(v < 0.0 or v > 1000.0 for v in getattr(self, name)):
+                raise ValueError(f"assignment.{name} values must be in [0, 1000] m")
+        return self
 
 
 class Actuators(_Section):
@@ -314,6 +357,7 @@ class Scenario(_Section):
     guidance: Guidance = Guidance()
     attitude: Attitude = Attitude()
     phases: list[Phase] = Field(default_factory=list)
+    assignment: AssignmentSettings = AssignmentSettings()
     sim: SimSettings = SimSettings()
     faults: list[Fault] = Field(default_factory=list)
 

@@ -107,6 +107,11 @@ def assignments(mission: str) -> str:
     return key(mission, GROUND, "planner", "assignments")
 
 
+def assignment_decisions(mission: str) -> str:
+    """The ground's information-driven orbit decisions (with their gains and bounds)."""
+    return key(mission, GROUND, "planner", "decisions")
+
+
 def tick_done(mission: str, node: str) -> str:
     return key(mission, node, "exec", "tick_done")
 

@@ -103,20 +103,16 @@ def test_malformed_messages_are_dropped_and_the_app_goes_on(tmp_path: Path, free
     _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
     hostile = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",), mode="client"))
     key = topics.relnav("bad", 1)  # what sc1's nav app subscribes to
-    stop = threading.Event()
-
-    def inject() -> None:
-        while not stop.wait(0.3):
+    running = threading.Semaphore(0)
+    try:
+        # inject only once sc1 is demonstrably subscribed and running (not on a timer: a loaded
+        # machine starts processes slowly)
+        hostile.subscribe(topics.key("bad", "sc1", "nav", "estimate"), lambda *_: running.release())
+        assert running.acquire(timeout=60), "the run never got going"
+        for _ in range(10):
             hostile.publish(key, "RelNavMeasurement", b'{"garbage": true}')
             hostile.publish(key, "RelNavMeasurement", b"\xff\xfe")
-
-    try:
-        time.sleep(2.0)
-        th = threading.Thread(target=inject)
-        th.start()
-        time.sleep(3.0)
-        stop.set()
-        th.join()
+            time.sleep(0.1)
     finally:
         hostile.close()
     stdout, stderr = p.communicate(timeout=60)

@@ -1,6 +1,7 @@
 """Closed-loop GNC in a real run (in-process transport; every app, the sim and the archive as in a
-multi-process run): hold a PRO, reconfigure to another by an SCP transfer tracked by the MPC, and
-point the camera at the target, all judged against the sim's truth."""
+multi-process run): hold a PRO, reconfigure to the PROs the ground chooses by expected
+information gain (an SCP transfer tracked by the MPC), and point the camera at the target, all
+judged against the sim's truth."""
 
 from __future__ import annotations
 
@@ -12,9 +13,17 @@ import pytest
 
 from deploy.run_constellation import main
 from fsw.lib.hcw import mean_motion
+from fsw.lib.poi import sphere_pois
 from fsw.lib.pro import Pro
+from ground.mission_plan import UPLINK_LEAD_S, MissionPlan
 from ground.reader import load_run
-from interfaces.messages import AttitudeEstimate, GuidanceStatus, TransferPlanMsg, TruthState
+from interfaces.messages import (
+    AssignmentDecision,
+    AttitudeEstimate,
+    GuidanceStatus,
+    TransferPlanMsg,
+    TruthState,
+)
 from interfaces import topics
 from interfaces.scenario import load_scenario
 
@@ -37,9 +46,7 @@ keep_out_m = 8.0
 name = "reconfigure"
 start_s = 100.0
 transfer_s = 500.0
-rho_x_m = 20.0
-rho_z_m = 12.0
-phase0_deg = 30.0
+assign = "information"
 """
 
 
@@ -61,8 +68,14 @@ def test_reconfiguration_arrives_on_the_new_pro_and_holds_it(run: tuple[Path, di
     truth = {round(m.t_sim, 6): m for m in archive.messages(topics.truth("gnc"), TruthState)}
     phase = sc.phases[0]
     t_arrive = phase.start_s + phase.transfer_s
+    # the ground's choice, as archived: decided at the uplink time, flown as decided
+    (decision,) = archive.messages(topics.assignment_decisions("gnc"), AssignmentDecision)
+    assert decision.reason == "phase" and decision.switched
+    assert decision.t_sim == phase.start_s - UPLINK_LEAD_S
+    assert 0.0 < decision.expected_gain <= decision.upper_bound
+    library = MissionPlan(sc, *sphere_pois(sc.target.pois, sc.target.radius_m)).library
     for i in (1, 2):
-        pro = Pro(*phase.pro_of(i, 2))
+        pro = library[decision.library_indices[i - 1]]
         # Truth against the assigned PRO from arrival to the end: within 0.5 m (nav noise ~3 cm,
         # MPC dead band ~1 cm, thrust noise); before departure the old PRO is held as well.
         errs = [np.linalg.norm(np.array(m.r_lvlh_m[i - 1]) - pro.state(n, t)[:3])

@@ -86,7 +86,9 @@ class AttitudeApp(App):
         self.h_wheels = np.zeros(3)
         self.tau = np.zeros(3)
         self.w_est = np.zeros(3)
-        self.target = np.zeros(3)
+        self.target = np.zeros(3)       # pointing target (LVLH, m) at self.target_t
+        self.target_rate = np.zeros(3)  # its motion (LVLH, m/s)
+        self.target_t = 0.0
         self.slew: AttitudePlan | None = None
         self.slew_t0 = 0.0
         self.slew_end = 0.0
@@ -104,6 +106,12 @@ class AttitudeApp(App):
 
     def on_target(self, msg: PointingTarget) -> None:
         self.target = np.array(msg.target_lvlh_m)
+        self.target_rate = np.array(msg.target_rate_lvlh_mps)
+        self.target_t = msg.t_sim
+
+    def _target_at(self, t: float) -> np.ndarray:
+        """The pointing target extrapolated to time t (LVLH, m)."""
+        return self.target + self.target_rate * (t - self.target_t)
 
     # --- cycle ---------------------------------------------------------------------------------
 
@@ -151,11 +159,11 @@ class AttitudeApp(App):
 
     def _los_eci(self, t: float) -> np.ndarray:
         """Line of sight to the pointing target at time t, ECI axes (m), from the nav estimate
-        extrapolated with its velocity."""
+        and the target, each extrapolated with its velocity."""
         assert self._est is not None
         x = self._est.x
         r = np.array(x[:3]) + np.array(x[3:]) * (t - self._est.t_sim)
-        return quat.rotate(lvlh_to_eci_quat(t, self.n, self.incl), self.target - r)
+        return quat.rotate(lvlh_to_eci_quat(t, self.n, self.incl), self._target_at(t) - r)
 
     def _control(self, t: float) -> np.ndarray:
         """Wheel torque tracking the slew plan, or the pointing attitude (quaternions R_eci_body,
@@ -206,7 +214,7 @@ class AttitudeApp(App):
             sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, q_eci_body=self.q.tolist(),
             q_lvlh_body=q_lvlh.tolist(), gyro_bias_radps=self.b.tolist(),
             sigma_att_rad=float(math.sqrt(max(0.0, np.trace(self.P[:3, :3])))),
-            target_lvlh_m=self.target.tolist(), pointing_error_rad=error,
+            target_lvlh_m=self._target_at(t).tolist(), pointing_error_rad=error,
             mode=self.mode, torque_body_nm=self.tau.tolist(), nis=self.nis))  # type: ignore[arg-type]
 
 

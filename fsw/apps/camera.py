@@ -6,10 +6,13 @@ the fused POI map, and the nav estimate.  Outputs: the observations of each imag
 the other observers and the ground, and the pointing target for the attitude app.
 
 Pointing (``camera.pointing``): the target's centre (default), or, with ``"max_variance"``,
-every ``RETARGET_S`` the POI of maximum current variance (φ·H_POI) that is reachable: front-facing and in camera range from the estimated position, and within
-``RETARGET_MAX_DEG`` of the current line of sight (below the attitude app's slew threshold, so
-retargeting is tracked, not slewed).
-Until it has a position estimate it points at the target's centre.
+every ``RETARGET_S`` the POI of maximum current variance (φ·H_POI) that is reachable:
+front-facing and in camera range from the estimated position, and within ``RETARGET_MAX_DEG``
+of the current line of sight.  The aim point does not jump to it: it moves there at constant
+velocity over the next ``RETARGET_S`` (at most 0.8°/s of line-of-sight turn, below the attitude
+app's rate limit), and the velocity is published with the target so the attitude app tracks it
+with feed-forward instead of chasing steps.  Until it has a position estimate it points at the
+target's centre.
 """
 
 from __future__ import annotations
@@ -55,7 +58,9 @@ class CameraApp(App):
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self.max_range = sc.camera.max_range_m
         self.max_variance = sc.camera.pointing == "max_variance"
-        self.target = np.zeros(3)
+        self.aim = np.zeros(3)       # aim point (LVLH, m) at self.aim_t...
+        self.aim_rate = np.zeros(3)  # ...moving at this rate (m/s) until self.aim_t + RETARGET_S
+        self.aim_t = 0.0
         self.next_retarget = 0.0
         self._images: list[CameraImage] = []
         self._est: StateEstimate | None = None
@@ -76,23 +81,33 @@ class CameraApp(App):
             self.publish("observations", PoiObservations(
                 sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, image_t_s=img.t_sim,
                 poi=img.poi, precision=img.precision))
+        aim, rate = self._aim_at(t)
         if self.max_variance and t >= self.next_retarget - 1e-9 and self._est is not None:
             self.next_retarget = t + RETARGET_S
-            self.target = self._choose(np.array(self._est.x[:3]))
+            goal = self._choose(np.array(self._est.x[:3]), aim)
+            self.aim, self.aim_t = aim, t
+            self.aim_rate = rate = (goal - aim) / RETARGET_S
         self.publish("pointing", PointingTarget(sender=self.ctx.node, t_sim=t,
-                                                spacecraft=self.sc_id,
-                                                target_lvlh_m=self.target.tolist()))
+                                                spacecraft=self.sc_id, target_lvlh_m=aim.tolist(),
+                                                target_rate_lvlh_mps=rate.tolist()))
 
-    def _choose(self, r: np.ndarray) -> np.ndarray:
-        """The reachable POI of maximum φ·H_POI (the current target if none is reachable)."""
+    def _aim_at(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Aim point (m) and its rate (m/s) at time t: it stops once it reaches the goal."""
+        elapsed = t - self.aim_t
+        if elapsed >= RETARGET_S - 1e-9:
+            return self.aim + self.aim_rate * RETARGET_S, np.zeros(3)
+        return self.aim + self.aim_rate * elapsed, self.aim_rate
+
+    def _choose(self, r: np.ndarray, aim: np.ndarray) -> np.ndarray:
+        """The reachable POI of maximum φ·H_POI (``aim`` if none is reachable)."""
         to_cam = r - self.poi_pos
         dist = np.linalg.norm(to_cam, axis=1)
-        los_now = self.target - r
+        los_now = aim - r
         los = self.poi_pos - r
         cos_turn = (los @ los_now) / (dist * max(1e-9, float(np.linalg.norm(los_now))))
         ok = ((np.einsum("ij,ij->i", self.poi_normal, to_cam) > 0.0) & (dist <= self.max_range)
               & (cos_turn >= math.cos(math.radians(RETARGET_MAX_DEG))))
         if not ok.any():
-            return self.target
+            return aim
         score = np.where(ok, self.map.phi * self.map.variance(), -np.inf)
         return np.array(self.poi_pos[int(np.argmax(score))])

@@ -1,76 +1,77 @@
-"""Mission planner: the central agent's PRO assignments (Fig. 7 phase sequence).
+"""Mission planner: the central agent's PRO assignments (Fig. 7 phases, Sec. II.C).
 
-Rate group low.  Output: ``ProAssignments`` (every observer's current assignment) on
-``ground/planner/assignments``.  The plan comes from the scenario: observers that start on a
-PRO are first told to hold it; each ``[[phases]]`` entry then moves every observer to its PRO of
-that phase (depart at ``start_s``, arrive ``transfer_s`` later).  An assignment is uplinked from
-``UPLINK_LEAD_S`` before its departure and repeated every cycle until the next one supersedes it,
-so a command lost on the range-limited, lossy link is simply received later (the spacecraft acts
-on a new ``assignment_id`` once).  Issue 4's information-driven assignment replaces the scenario
-schedule as the source of the PROs; the uplink stays the same.
+Rate group low.  Input: the observations of every observer (the ground is reached through the
+target, so it hears every observer in range of it), fused into the ground's POI map.  Outputs:
+``ProAssignments`` (every observer's current assignment) on ``ground/planner/assignments`` and
+each information-driven ``AssignmentDecision`` on ``ground/planner/decisions``.
+
+What to fly comes from :class:`ground.mission_plan.MissionPlan`: the scenario's phases, with
+``assign = "information"`` phases chosen by expected information gain and reassigned when the
+set's gain saturates.  An assignment is uplinked from ``UPLINK_LEAD_S`` before its departure
+and repeated every cycle until the next one supersedes it, so a command lost on the
+range-limited, lossy link is simply received later (a spacecraft acts on a new
+``assignment_id`` once).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from fsw.lib.poi import sphere_pois
+from fsw.lib.poi_map import PoiMap
+from ground.mission_plan import MissionPlan
 from interfaces import topics
-from interfaces.app import App, AppContext, Output
-from interfaces.messages import ProAssignment, ProAssignments, ProElements
-from interfaces.scenario import Scenario
-
-
-@dataclass(frozen=True)
-class PlannedAssignment:
-    """One entry of the schedule: assignment ``id`` of the phase ``phase``."""
-
-    id: int
-    phase: str
-    pros: dict[int, ProElements]
-    t_depart_s: float
-    t_arrive_s: float
-
-
-def schedule(scenario: Scenario) -> list[PlannedAssignment]:
-    """The assignments of a scenario in time order (ids 1, 2, ...)."""
-    count = scenario.observers.count
-
-    def elements(formation_pro: tuple[float, float, float, float, float]) -> ProElements:
-        rx, ax, ry, rz, az = formation_pro
-        return ProElements(rho_x_m=rx, alpha_x_rad=ax, rho_y_m=ry, rho_z_m=rz, alpha_z_rad=az)
-
-    out: list[PlannedAssignment] = []
-    if scenario.observers.start == "pro":
-        out.append(PlannedAssignment(
-            id=1, phase="initial", t_depart_s=0.0, t_arrive_s=0.0,
-            pros={i: elements(scenario.observers.pro(i)) for i in range(1, count + 1)}))
-    for phase in scenario.phases:
-        out.append(PlannedAssignment(
-            id=len(out) + 1, phase=phase.name, t_depart_s=phase.start_s,
-            t_arrive_s=phase.start_s + phase.transfer_s,
-            pros={i: elements(phase.pro_of(i, count)) for i in range(1, count + 1)}))
-    return out
+from interfaces.app import App, AppContext, Input, Output
+from interfaces.messages import (
+    AssignmentDecision,
+    PoiObservations,
+    ProAssignment,
+    ProAssignments,
+)
 
 
 class MissionPlanner(App):
     NAME = "planner"
     RATE = "low"
-    INPUTS = ()
+    INPUTS = (
+        Input(lambda c: topics.all_spacecraft(c.mission, "camera", "observations"),
+              PoiObservations, "on_observations"),
+    )
     OUTPUTS = (
         Output("assignments", lambda c: topics.assignments(c.mission), ProAssignments),
+        Output("decisions", lambda c: topics.assignment_decisions(c.mission),
+               AssignmentDecision),
     )
-    UPLINK_LEAD_S = 60.0
-    """Assignments are uplinked from this long before their departure time, s."""
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
-        self.schedule = schedule(ctx.scenario)
+        sc = ctx.scenario
+        pos, normal = sphere_pois(sc.target.pois, sc.target.radius_m)
+        self.plan = MissionPlan(sc, pos, normal)
+        self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
+        self._decisions_sent = 0
+
+    def on_observations(self, msg: PoiObservations) -> None:
+        if msg.spacecraft <= self.map.n_agents:
+            self.map.add(msg.spacecraft, msg.poi, msg.precision)
 
     def step(self, t: float) -> None:
-        current = [a for a in self.schedule if a.t_depart_s - self.UPLINK_LEAD_S <= t]
-        if not current:
+        self.plan.update(t, self.map)
+        for d in self.plan.decisions[self._decisions_sent:]:
+            self.log.info("%s at %.0f s (%s): PROs %s, expected gain %.4g (bound %.4g, "
+                          "current %s), %s", d.phase, d.t_s, d.reason, d.library_indices,
+                          d.expected_gain, d.upper_bound,
+                          "-" if d.current_gain is None else f"{d.current_gain:.4g}",
+                          "issued" if d.switched else "kept the current set")
+            self.publish("decisions", AssignmentDecision(
+                sender=self.ctx.node, t_sim=t, phase=d.phase, reason=d.reason,
+                library_indices=list(d.library_indices), expected_gain=d.expected_gain,
+                upper_bound=d.upper_bound,
+                ratio_bound=min(1.0, d.expected_gain / d.upper_bound) if d.upper_bound else 1.0,
+                current_gain=d.current_gain, measured_gains=list(d.measured_gains),
+                switched=d.switched))
+        self._decisions_sent = len(self.plan.decisions)
+        a = self.plan.current
+        if a is None:
             return
-        a = current[-1]
         self.publish("assignments", ProAssignments(sender=self.ctx.node, t_sim=t, assignments=[
             ProAssignment(spacecraft=sc, assignment_id=a.id, phase=a.phase, pro=pro,
                           t_depart_s=a.t_depart_s, t_arrive_s=a.t_arrive_s)

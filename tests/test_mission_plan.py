@@ -1,0 +1,159 @@
+"""Tests of ground.mission_plan: scenario phases issued as given, information phases chosen by
+the greedy of ground.orbit_assignment (checked against an independent call and brute-force
+matching), and reassignment when the measured gain saturates, closed on a fused map fed with
+what the issued orbits see."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+
+from fsw.lib.poi import sphere_pois
+from fsw.lib.poi_map import PoiMap
+from fsw.lib.pro import Pro
+from ground.mission_plan import UPLINK_LEAD_S, MissionPlan
+from ground.orbit_assignment import expected_precision, greedy_assignment
+from interfaces.scenario import Scenario
+
+POS, NOR = sphere_pois(400, 5.0)
+
+
+def _scenario(phases: list[dict], **assignment: object) -> Scenario:
+    return Scenario.model_validate({
+        "name": "plan", "duration_s": 20000.0, "target": {"pois": 400},
+        "observers": {"count": 3, "start": "pro", "rho_x_m": 30.0, "rho_z_m": 30.0},
+        "assignment": {"rho_x_m": [10.0, 20.0], "rho_z_m": [10.0, 25.0], "phases": 4,
+                       "samples": 8, **assignment},
+        "phases": phases})
+
+
+def _pro(e: object) -> Pro:
+    return Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)  # type: ignore[attr-defined]
+
+
+def _fly(plan: MissionPlan, fused: PoiMap, t0: float, t1: float, dt: float = 20.0) -> None:
+    """Advance the plan from t0 to t1 (s), feeding the map what the issued PROs see (after
+    arrival; one image per second, camera on the target centre)."""
+    t = t0
+    while t <= t1 + 1e-9:
+        plan.update(t, fused)
+        cur = plan.current
+        if cur is not None and t >= cur.t_arrive_s:
+            for i, e in cur.pros.items():
+                fused.add(i, np.arange(POS.shape[0]),
+                          expected_precision(_pro(e), plan.n, t, dt, int(dt), POS, NOR,
+                                             plan.camera))
+        t += dt
+
+
+def test_scenario_phases_are_issued_at_their_uplink_time() -> None:
+    sc = _scenario([{"name": "a", "start_s": 500.0, "transfer_s": 300.0, "rho_x_m": 12.0},
+                    {"name": "b", "start_s": 1500.0, "transfer_s": 400.0, "phase0_deg": 40.0}])
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    assert plan.current is not None and plan.current.phase == "initial"
+    plan.update(500.0 - UPLINK_LEAD_S - 10.0, fused)
+    assert plan.current.phase == "initial"
+    plan.update(500.0 - UPLINK_LEAD_S, fused)
+    a = plan.current
+    assert (a.id, a.phase, a.t_depart_s, a.t_arrive_s) == (2, "a", 500.0, 800.0)
+    plan.update(2000.0, fused)
+    b = plan.current
+    assert (b.id, b.phase, b.t_depart_s, b.t_arrive_s) == (3, "b", 1500.0, 1900.0)
+    for i in (1, 2, 3):
+        assert np.allclose([b.pros[i].rho_x_m, b.pros[i].alpha_x_rad, b.pros[i].rho_z_m],
+                           [sc.phases[1].rho_x_m, math.radians(40.0 + 120.0 * (i - 1)),
+                            sc.phases[1].rho_z_m])
+    assert plan.decisions == []
+
+
+def test_information_phase_takes_the_greedy_set_matched_to_the_observers() -> None:
+    sc = _scenario([{"name": "insp", "start_s": 600.0, "transfer_s": 500.0,
+                     "assign": "information"}])
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    rng = np.random.default_rng(3)
+    fused.add(1, np.arange(400), rng.uniform(0.0, 2.0, 400))  # an uneven fused view
+    plan.update(600.0 - UPLINK_LEAD_S, fused)
+    (d,) = plan.decisions
+    a = sc.assignment
+    ref = greedy_assignment(plan.library, 3, plan.n, 1100.0, a.window_s, a.samples, POS, NOR,
+                            fused.phi, fused.w_inv + fused.F.sum(axis=0), plan.camera,
+                            a.min_separation_m, sc.guidance.keep_out_m + a.keep_out_margin_m)
+    assert sorted(d.library_indices) == sorted(ref.indices)
+    assert math.isclose(d.expected_gain, ref.gain, rel_tol=1e-12)
+    assert d.reason == "phase" and d.switched and d.current_gain is None
+    issued = plan.current
+    assert (issued.phase, issued.t_depart_s, issued.t_arrive_s) == ("insp", 600.0, 1100.0)
+    # matching: no permutation brings the observers (on their initial PROs at departure)
+    # closer in total to their new slots
+    start = np.array([Pro(*sc.observers.pro(i)).state(plan.n, 600.0)[:3] for i in (1, 2, 3)])
+    slots = [plan.library[k].state(plan.n, 600.0)[:3] for k in d.library_indices]
+
+    def total(perm: tuple[int, ...]) -> float:
+        return sum(float(np.linalg.norm(start[i] - slots[j])) for i, j in enumerate(perm))
+
+    assert total((0, 1, 2)) <= min(total(p) for p in itertools.permutations(range(3))) + 1e-9
+    for i, k in enumerate(d.library_indices):
+        assert _pro(issued.pros[i + 1]) == plan.library[k]
+
+
+def test_reassigns_when_the_measured_gain_saturates() -> None:
+    sc = _scenario([{"name": "insp", "start_s": 300.0, "transfer_s": 300.0,
+                     "assign": "information"}], check_period_s=300.0, saturation_fraction=0.5)
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    _fly(plan, fused, 0.0, 6000.0)
+    saturated = [d for d in plan.decisions if d.reason == "saturated"]
+    assert saturated, "the gain of a fixed set diminishes: a reassignment must be considered"
+    f = sc.assignment.saturation_fraction
+    for d in saturated:
+        g = d.measured_gains
+        assert len(g) >= 2 and g[-1] < f * g[0]
+        assert all(x >= 0.0 for x in g)  # H never increases
+        assert d.current_gain is not None
+        assert d.switched == (d.expected_gain > (1.0 + sc.assignment.min_improvement)
+                              * d.current_gain)
+        assert d.expected_gain <= d.upper_bound + 1e-15
+    switched = [d for d in saturated if d.switched]
+    assert switched
+    ids = [a.id for a in plan.issued]
+    assert ids == list(range(1, len(ids) + 1))
+    for d in switched:  # issued one uplink lead after the decision, named after the phase
+        a = next(x for x in plan.issued if x.phase == d.phase)
+        assert a.t_depart_s == d.t_s + UPLINK_LEAD_S
+        assert a.t_arrive_s == a.t_depart_s + sc.assignment.transfer_s
+        assert a.phase.startswith("insp-r")
+    # no check before arrival: the first window starts once the set is flown
+    first = next(a for a in plan.issued if a.phase == "insp")
+    assert all(d.t_s >= first.t_arrive_s + 2 * sc.assignment.check_period_s - 1e-9
+               for d in saturated)
+
+
+def test_keeps_the_current_set_unless_the_new_one_is_better_by_the_margin() -> None:
+    sc = _scenario([{"name": "insp", "start_s": 300.0, "transfer_s": 300.0,
+                     "assign": "information"}], min_improvement=1e6)
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    _fly(plan, fused, 0.0, 4000.0)
+    saturated = [d for d in plan.decisions if d.reason == "saturated"]
+    assert saturated and not any(d.switched for d in saturated)
+    assert [a.phase for a in plan.issued] == ["initial", "insp"]
+    # each kept decision restarts the measurement: windows never span two decisions
+    later = saturated[1:]
+    assert all(len(d.measured_gains) >= 2 for d in later)
+
+
+def test_a_coming_phase_preempts_reassignment() -> None:
+    sc = _scenario([{"name": "insp", "start_s": 300.0, "transfer_s": 300.0,
+                     "assign": "information"},
+                    {"name": "end", "start_s": 2400.0, "transfer_s": 300.0}],
+                   check_period_s=200.0, saturation_fraction=0.9, transfer_s=2000.0)
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    _fly(plan, fused, 0.0, 2300.0)
+    # any reassignment would arrive after "end" starts, so none is decided
+    assert [d.reason for d in plan.decisions] == ["phase"]
+    assert plan.current.phase == "insp"
