@@ -304,12 +304,13 @@ class InfoCostTelemetry(Message):
 
 class PointingTarget(Message):
     """Where the camera wants the boresight: a point in LVLH (m) at ``t_sim``, moving at
-    ``target_rate_lvlh_mps`` (m/s, LVLH) — from the camera app; the attitude app extrapolates
-    it and uses the motion as feed-forward."""
+    ``target_rate_lvlh_mps`` (m/s) with ``target_accel_lvlh_mps2`` (m/s²) — from the camera app;
+    the attitude app extrapolates it and uses its motion as feed-forward."""
 
     spacecraft: int = Field(ge=1)
     target_lvlh_m: Vec3
     target_rate_lvlh_mps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    target_accel_lvlh_mps2: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 class AttitudeEstimate(Message):

@@ -87,7 +87,8 @@ class AttitudeApp(App):
         self.tau = np.zeros(3)
         self.w_est = np.zeros(3)
         self.target = np.zeros(3)       # pointing target (LVLH, m) at self.target_t
-        self.target_rate = np.zeros(3)  # its motion (LVLH, m/s)
+        self.target_rate = np.zeros(3)  # its motion (LVLH, m/s, m/s²)
+        self.target_accel = np.zeros(3)
         self.target_t = 0.0
         self.slew: AttitudePlan | None = None
         self.slew_t0 = 0.0
@@ -107,11 +108,13 @@ class AttitudeApp(App):
     def on_target(self, msg: PointingTarget) -> None:
         self.target = np.array(msg.target_lvlh_m)
         self.target_rate = np.array(msg.target_rate_lvlh_mps)
+        self.target_accel = np.array(msg.target_accel_lvlh_mps2)
         self.target_t = msg.t_sim
 
     def _target_at(self, t: float) -> np.ndarray:
-        """The pointing target extrapolated to time t (LVLH, m)."""
-        return self.target + self.target_rate * (t - self.target_t)
+        """The pointing target extrapolated to time t (LVLH, m), to second order."""
+        dt = t - self.target_t
+        return self.target + (self.target_rate + 0.5 * dt * self.target_accel) * dt
 
     # --- cycle ---------------------------------------------------------------------------------
 
@@ -174,9 +177,7 @@ class AttitudeApp(App):
         else:
             q_des = repoint(self.q if self.q_point is None else self.q_point, self._los_eci(t),
                             self.boresight)
-            h = DESIRED_RATE_STEP_S
-            q_next = repoint(q_des, self._los_eci(t + h), self.boresight)
-            w_des, wdot_des = quat.log(quat.mul(quat.conj(q_des), q_next)) / h, np.zeros(3)
+            w_des, wdot_des = self._desired_rates(t, q_des)
             angle = float(np.linalg.norm(quat.log(quat.mul(quat.conj(q_des), self.q))))
             if angle > math.radians(self.cfg.slew_threshold_deg):
                 self._plan_slew(t, angle)
@@ -187,6 +188,17 @@ class AttitudeApp(App):
         tau, _ = tracking_torque(self.q, self.w_est, r_des, w_des, wdot_des, self.J,
                                  self.h_wheels, self.gains, self.tau_max)
         return tau
+
+    def _desired_rates(self, t: float, q_des: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Desired body rate (rad/s) and its derivative (rad/s²) of the pointing attitude, by
+        central differences of the pointing attitudes h before and after t (target and own
+        position extrapolated): the feed-forward of the LOS motion, including a moving aim."""
+        h = DESIRED_RATE_STEP_S
+        q_prev = repoint(q_des, self._los_eci(t - h), self.boresight)
+        q_next = repoint(q_des, self._los_eci(t + h), self.boresight)
+        back = quat.log(quat.mul(quat.conj(q_prev), q_des))
+        ahead = quat.log(quat.mul(quat.conj(q_des), q_next))
+        return (back + ahead) / (2.0 * h), (ahead - back) / (h * h)
 
     def _plan_slew(self, t: float, angle: float) -> None:
         """Plan a rate-limited slew (SCP, slerp as fallback) onto the pointing attitude."""

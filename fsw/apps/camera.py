@@ -8,11 +8,12 @@ the other observers and the ground, and the pointing target for the attitude app
 Pointing (``camera.pointing``): the target's centre (default), or, with ``"max_variance"``,
 every ``RETARGET_S`` the POI of maximum current variance (φ·H_POI) that is reachable:
 front-facing and in camera range from the estimated position, and within ``RETARGET_MAX_DEG``
-of the current line of sight.  The aim point does not jump to it: it moves there at constant
-velocity over the next ``RETARGET_S`` (at most 0.8°/s of line-of-sight turn, below the attitude
-app's rate limit), and the velocity is published with the target so the attitude app tracks it
-with feed-forward instead of chasing steps.  Until it has a position estimate it points at the
-target's centre.
+of the current line of sight.  The aim point does not jump to it: it glides there over the
+next ``RETARGET_S`` on a smoothstep (rate zero at both ends, at most 1.2°/s of line-of-sight
+turn, below the attitude app's rate limit), and its rate is published with the target so the
+attitude app tracks it with feed-forward instead of chasing steps.  It retargets only while the attitude app is
+tracking (a target moving during a slew would end it off target).  Until it has a position
+estimate it points at the target's centre.
 """
 
 from __future__ import annotations
@@ -25,7 +26,13 @@ from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
 from interfaces import topics
 from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import CameraImage, PoiObservations, PointingTarget, StateEstimate
+from interfaces.messages import (
+    AttitudeEstimate,
+    CameraImage,
+    PoiObservations,
+    PointingTarget,
+    StateEstimate,
+)
 
 RETARGET_S = 10.0
 """Period of the pointing-target choice, s."""
@@ -42,6 +49,8 @@ class CameraApp(App):
               PoiObservations, "on_observations"),
         Input(lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate,
               "on_estimate"),
+        Input(lambda c: topics.key(c.mission, c.node, "attitude", "estimate"), AttitudeEstimate,
+              "on_attitude"),
     )
     OUTPUTS = (
         Output("observations", lambda c: topics.key(c.mission, c.node, "camera", "observations"),
@@ -58,12 +67,13 @@ class CameraApp(App):
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self.max_range = sc.camera.max_range_m
         self.max_variance = sc.camera.pointing == "max_variance"
-        self.aim = np.zeros(3)       # aim point (LVLH, m) at self.aim_t...
-        self.aim_rate = np.zeros(3)  # ...moving at this rate (m/s) until self.aim_t + RETARGET_S
+        self.aim_start = np.zeros(3)  # glide of the aim point (LVLH, m) from here at aim_t...
+        self.aim_goal = np.zeros(3)   # ...to here at aim_t + RETARGET_S
         self.aim_t = 0.0
         self.next_retarget = 0.0
         self._images: list[CameraImage] = []
         self._est: StateEstimate | None = None
+        self._tracking = False  # the attitude app tracks the aim (not slewing, initialised)
 
     def on_image(self, msg: CameraImage) -> None:
         self._images.append(msg)
@@ -75,28 +85,38 @@ class CameraApp(App):
     def on_estimate(self, msg: StateEstimate) -> None:
         self._est = msg
 
+    def on_attitude(self, msg: AttitudeEstimate) -> None:
+        self._tracking = msg.mode == "track"
+
     def step(self, t: float) -> None:
         images, self._images = self._images, []
         for img in images:
             self.publish("observations", PoiObservations(
                 sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, image_t_s=img.t_sim,
                 poi=img.poi, precision=img.precision))
-        aim, rate = self._aim_at(t)
-        if self.max_variance and t >= self.next_retarget - 1e-9 and self._est is not None:
+        if self.max_variance and t >= self.next_retarget - 1e-9 and self._est is not None \
+                and self._tracking:
             self.next_retarget = t + RETARGET_S
-            goal = self._choose(np.array(self._est.x[:3]), aim)
-            self.aim, self.aim_t = aim, t
-            self.aim_rate = rate = (goal - aim) / RETARGET_S
-        self.publish("pointing", PointingTarget(sender=self.ctx.node, t_sim=t,
-                                                spacecraft=self.sc_id, target_lvlh_m=aim.tolist(),
-                                                target_rate_lvlh_mps=rate.tolist()))
+            self.aim_start, self.aim_t = self._aim_at(t)[0], t
+            self.aim_goal = self._choose(np.array(self._est.x[:3]), self.aim_start)
+        aim, rate, accel = self._aim_at(t)
+        self.publish("pointing", PointingTarget(
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, target_lvlh_m=aim.tolist(),
+            target_rate_lvlh_mps=rate.tolist(), target_accel_lvlh_mps2=accel.tolist()))
 
-    def _aim_at(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """Aim point (m) and its rate (m/s) at time t: it stops once it reaches the goal."""
-        elapsed = t - self.aim_t
-        if elapsed >= RETARGET_S - 1e-9:
-            return self.aim + self.aim_rate * RETARGET_S, np.zeros(3)
-        return self.aim + self.aim_rate * elapsed, self.aim_rate
+    def _aim_at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Aim point (m), rate (m/s) and acceleration (m/s²) at time t on the glide from
+        ``aim_start`` to ``aim_goal``: a smoothstep 3τ² − 2τ³ over ``RETARGET_S``
+        (τ = elapsed/RETARGET_S), so the rate starts and ends at zero; the peak rate is 1.5× the
+        mean."""
+        tau = (t - self.aim_t) / RETARGET_S
+        if tau >= 1.0 - 1e-12:
+            return self.aim_goal.copy(), np.zeros(3), np.zeros(3)
+        tau = max(0.0, tau)
+        delta = self.aim_goal - self.aim_start
+        return (self.aim_start + delta * (tau * tau * (3.0 - 2.0 * tau)),
+                delta * (6.0 * tau * (1.0 - tau) / RETARGET_S),
+                delta * (6.0 * (1.0 - 2.0 * tau) / RETARGET_S**2))
 
     def _choose(self, r: np.ndarray, aim: np.ndarray) -> np.ndarray:
         """The reachable POI of maximum φ·H_POI (``aim`` if none is reachable)."""
