@@ -2,12 +2,24 @@
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import signal
 import subprocess
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
+
+
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:
+    """In the child before exec (Linux): get SIGTERM when the launcher dies, however it dies
+    (even SIGKILL), so no orphan keeps a port or a key space busy."""
+    libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+    libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 @dataclass
@@ -26,6 +38,7 @@ class Child:
         self.proc = subprocess.Popen(
             [sys.executable, *self.argv], cwd=cwd, stdout=self._log, stderr=subprocess.STDOUT,
             start_new_session=True,  # a Ctrl-C at the launcher does not hit children directly
+            preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
         )
 
     @property

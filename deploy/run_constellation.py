@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import sys
 import threading
 import time
@@ -54,6 +55,12 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return p.parse_args(argv)
 
 
+def _interrupt(signum: int, _frame: object) -> None:
+    """SIGTERM (e.g. a job scheduler or ``kill``) stops the run like Ctrl-C: the children are
+    stopped and the archive and summary are written."""
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     logging.basicConfig(level=getattr(logging, args.log_level.upper(), logging.INFO),
@@ -71,7 +78,13 @@ def main(argv: list[str] | None = None) -> int:
     if args.transport == "inproc":
         status, error = _run_inproc(scenario, mission, out, scenario_text, args)
     else:
-        status, error = _run_zenoh(scenario, mission, out, args)
+        main_thread = threading.current_thread() is threading.main_thread()
+        previous = signal.signal(signal.SIGTERM, _interrupt) if main_thread else None
+        try:
+            status, error = _run_zenoh(scenario, mission, out, args)
+        finally:
+            if main_thread:
+                signal.signal(signal.SIGTERM, previous)
     wall_s = time.monotonic() - wall0
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
                             status=status, error=error)

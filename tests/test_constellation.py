@@ -158,6 +158,47 @@ def test_range_limited_link_cuts_and_restores_with_distance() -> None:
         assert "DRD" in runs or "RDR" in runs, f"sc{sc_id} link never cut and restored: {runs}"
 
 
+def _pids_with(argument: str) -> list[int]:
+    """PIDs of the processes with ``argument`` in their command line."""
+    out = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            cmd = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        if argument.encode() in cmd:
+            out.append(int(pid))
+    return out
+
+
+def test_terminated_launcher_stops_every_process(tmp_path: Path, free_port: int) -> None:
+    """SIGTERM to the launcher (a scheduler, ``kill``) stops the whole constellation and still
+    writes the archive and a failed summary; nothing is left holding the port."""
+    sc = small_scenario("term", duration_s=400.0)
+    path = write_scenario(tmp_path / "term.toml", sc)
+    out = tmp_path / "out"
+    p = _launch(path, out, free_port, "--realtime", "20")
+    _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
+    watcher = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",), mode="client"))
+    seen = threading.Semaphore(0)
+    try:
+        watcher.subscribe(topics.key("term", "sc1", "nav", "estimate"), lambda *_: seen.release())
+        assert seen.acquire(timeout=60), "the run never got going"
+    finally:
+        watcher.close()
+    assert len(_pids_with(str(path))) >= 5  # sim, 3 observers, ground, recorder
+    p.send_signal(signal.SIGTERM)
+    _, stderr = p.communicate(timeout=60)
+    assert p.returncode != 0 and "interrupted" in stderr
+    deadline = time.monotonic() + 10.0
+    while _pids_with(str(path)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert _pids_with(str(path)) == []
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed"
+    assert not load_run(out / "run.mcap").truncated
+
+
 def _wait_pid(argv_parts: list[str], timeout_s: float) -> int:
     """PID of the process whose command line contains ``argv_parts`` consecutively."""
     deadline = time.monotonic() + timeout_s
