@@ -178,16 +178,20 @@ def test_terminated_launcher_stops_every_process(tmp_path: Path, free_port: int)
     path = write_scenario(tmp_path / "term.toml", sc)
     out = tmp_path / "out"
     p = _launch(path, out, free_port, "--realtime", "20")
-    _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
-    watcher = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",), mode="client"))
-    seen = threading.Semaphore(0)
     try:
-        watcher.subscribe(topics.key("term", "sc1", "nav", "estimate"), lambda *_: seen.release())
-        assert seen.acquire(timeout=60), "the run never got going"
+        _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
+        watcher = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",),
+                                               mode="client"))
+        seen = threading.Semaphore(0)
+        try:
+            watcher.subscribe(topics.key("term", "sc1", "nav", "estimate"),
+                              lambda *_: seen.release())
+            assert seen.acquire(timeout=60), "the run never got going"
+        finally:
+            watcher.close()
+        assert len(_pids_with(str(path))) >= 5  # sim, 3 observers, ground, recorder
     finally:
-        watcher.close()
-    assert len(_pids_with(str(path))) >= 5  # sim, 3 observers, ground, recorder
-    p.send_signal(signal.SIGTERM)
+        p.send_signal(signal.SIGTERM)  # also the clean-up if anything above failed
     _, stderr = p.communicate(timeout=60)
     assert p.returncode != 0 and "interrupted" in stderr
     deadline = time.monotonic() + 10.0
