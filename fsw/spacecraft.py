@@ -9,6 +9,7 @@ from fsw.apps.camera import CameraApp
 from fsw.apps.guidance import GuidanceApp
 from fsw.apps.infocost import InfoCostApp
 from fsw.apps.nav import NavApp
+from fsw.faults import reported_h_factor
 from interfaces import topics
 from interfaces.app import App, AppContext
 from interfaces.bus import Bus
@@ -26,5 +27,9 @@ def spacecraft_executive(bus: Bus, scenario: Scenario, spacecraft: int) -> Execu
     log = logging.getLogger(f"insp.{node}")
     ctx = AppContext(bus=bus, scenario=scenario, node=node, spacecraft=spacecraft,
                      rng=stream(scenario.seed, "fsw", spacecraft), log=log)
-    return Executive(bus, scenario, [a(ctx) for a in APPS], log=log,
+    apps = [a(ctx) for a in APPS]
+    for app in apps:
+        if isinstance(app, InfoCostApp):  # software fault injection (faulty_data), if any
+            app.report_factor = reported_h_factor(scenario, spacecraft)
+    return Executive(bus, scenario, apps, log=log,
                      barrier_timeout_s=scenario.sim.lockstep_timeout_s)

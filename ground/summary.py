@@ -12,7 +12,14 @@ from ground.evaluation import nav_errors
 from ground.gnc_evaluation import gnc_series, gnc_summary
 from ground.reader import ArchiveError, RunArchive, load_run
 from interfaces import topics
-from interfaces.messages import ExecStats, LinkStats, SimStatus, TelemetryStatus, Tick
+from interfaces.messages import (
+    ExecStats,
+    FaultEvent,
+    LinkStats,
+    SimStatus,
+    TelemetryStatus,
+    Tick,
+)
 from interfaces.scenario import Scenario
 
 NAV_SETTLE_S = 10.0
@@ -42,6 +49,8 @@ def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict
                  for node, m in sorted(execs.items())},
         "telemetry": [e.model_dump() for e in tlm[-1].entries] if tlm else [],
         "sim": {"rejected_commands": sim[-1].rejected_commands if sim else None},
+        "fault_events": [e.model_dump(exclude={"sender", "seq", "t_wall"})
+                         for e in archive.messages(topics.fault_events(mission), FaultEvent)],
     }
 
 

@@ -225,6 +225,20 @@ class ProAssignments(Message):
     assignments: list[ProAssignment]
 
 
+class FaultEvent(Message):
+    """Truth of an injected fault (sim): ``kind`` on ``spacecraft`` switched on or off at
+    ``t_sim``, with the scenario's ``magnitude`` and the realised parameters (``detail``:
+    directions, torques, rotations; see sim/faults.py)."""
+
+    spacecraft: int = Field(ge=1)
+    kind: str = Field(max_length=64)
+    active: bool
+    magnitude: float | None = None
+    start_s: float = Field(ge=0.0)
+    end_s: float | None = None
+    detail: dict[str, list[float] | float] = Field(default_factory=dict)
+
+
 class AssignmentDecision(Message):
     """The ground's information-driven orbit choice (ground/mission_plan.py): the greedy set,
     its expected information gain and online bound, the expected gain of keeping the current
@@ -406,6 +420,7 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     StateEstimate,
     ProAssignments,
     AssignmentDecision,
+    FaultEvent,
     TransferPlanMsg,
     GuidanceStatus,
     PointingTarget,

@@ -85,6 +85,11 @@ def truth(mission: str) -> str:
     return key(mission, SIM, "truth", "state")
 
 
+def fault_events(mission: str) -> str:
+    """Truth of the injected faults (on/off switches)."""
+    return key(mission, SIM, "truth", "faults")
+
+
 def relnav(mission: str, spacecraft: int) -> str:
     return key(mission, SIM, "sensors", f"sc{spacecraft}", "relnav")
 

@@ -70,6 +70,8 @@ class ObserverHardware:
                              sen.star_tracker_roll_arcsec * ARCSEC_RAD)
         self.force_body = np.zeros((n, 3))
         self.force_until = np.zeros(n)
+        self.force_bias_body = np.zeros((n, 3))
+        """Continuous force in body axes, N (fault hook: ``thruster_bias``, a leaking valve)."""
         self.tau_cmd = np.zeros((n, 3))
         self.tau_until = np.zeros(n)
         self.dv_mps = np.zeros(n)
@@ -96,15 +98,17 @@ class ObserverHardware:
         """Thrust acceleration in LVLH over the tick starting at ``t_s`` (N, 3), m/s², given the
         true ECI -> LVLH rotation as a quaternion (4,)."""
         active = (t_s < self.force_until - 1e-9)[:, None]
-        f = np.where(active, self.force_body, 0.0)
+        f = np.where(active, self.force_body, 0.0) + self.force_bias_body
         out: np.ndarray = quat.rotate(self.q_lvlh_body(q_lvlh_eci), f) / self.mass_kg
         return out
 
     def step(self, t_s: float, dt_s: float) -> None:
         """Advance the attitude (wheel torques held) and the Δv bookkeeping by one tick."""
-        active = t_s < self.force_until - 1e-9
-        self.dv_mps += np.where(active, np.abs(self.force_body).sum(axis=1), 0.0) \
-            * dt_s / self.mass_kg
+        # Propellant proxy: commanded and leaked force are spent separately (a leak on one
+        # thruster of an axis is not refunded by firing the opposite one).
+        active = (t_s < self.force_until - 1e-9)[:, None]
+        spent = np.abs(np.where(active, self.force_body, 0.0)) + np.abs(self.force_bias_body)
+        self.dv_mps += spent.sum(axis=1) * dt_s / self.mass_kg
         held = np.where((t_s < self.tau_until - 1e-9)[:, None], self.tau_cmd, 0.0)
         tau = self.wheels.realise(held, self.attitude.h, dt_s)
         self.attitude.step(dt_s, tau)

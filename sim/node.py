@@ -29,6 +29,7 @@ from interfaces.bus import Bus
 from interfaces.messages import (
     AttitudeMeasurement,
     CameraImage,
+    FaultEvent,
     RelNavMeasurement,
     SimStatus,
     ThrustCommand,
@@ -41,6 +42,7 @@ from interfaces.rng import stream
 from interfaces.scenario import Scenario
 from sim.camera import TruthCameras
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
+from sim.faults import FaultInjector
 from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
 
@@ -86,12 +88,11 @@ class SimNode:
             RelNavSensor(sc.sensors.relnav_sigma_r_m, sc.sensors.relnav_sigma_v_mps,
                          stream(sc.seed, "relnav", i)) for i in self.ids
         ]
-        if sc.faults:
-            self.log.warning("%d fault(s) in the scenario are NOT injected: fault injection is "
-                             "not implemented yet (issue 5)", len(sc.faults))
+        self.faults = FaultInjector(sc, self.hw, self.cameras, self.sensors)
         m = self.bus.mission
         self._keys = {
             "tick": topics.tick(m), "status": topics.sim_status(m), "truth": topics.truth(m),
+            "faults": topics.fault_events(m),
             "relnav": [topics.relnav(m, i) for i in self.ids],
             "attitude": [topics.attitude_sensors(m, i) for i in self.ids],
             "camera": [topics.camera_image(m, i) for i in self.ids],
@@ -225,6 +226,14 @@ class SimNode:
                 self._cond.wait(0.1)
 
     def _publish_hardware(self, k: int, t: float) -> None:
+        for s in self.faults.update(t):
+            f = s.fault
+            self.log.warning("fault %s on sc%d %s at t=%.1f s (magnitude %s)", f.kind,
+                             f.spacecraft, "ON" if s.active else "off", t, f.magnitude)
+            self.bus.publish(self._keys["faults"], FaultEvent(
+                sender=topics.SIM, t_sim=t, spacecraft=f.spacecraft, kind=f.kind,
+                active=s.active, magnitude=f.magnitude, start_s=f.start_s, end_s=f.end_s,
+                detail=s.detail))
         rel = self.truth.rel_lvlh()
         hw = self.hw
         self._q_now = self._q_lvlh_eci()  # reused for the thrust of this tick

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -25,11 +25,14 @@ class RelNavSensor:
     sigma_r_m: float
     sigma_v_mps: float
     rng: np.random.Generator
+    bias_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    """Position bias, LVLH, m (fault hook: ``nav_sensor_bias``)."""
 
     def measure(self, r_true_m: np.ndarray, v_true_mps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Noisy (position m, velocity m/s) of a true relative state."""
+        """Noisy (position m, velocity m/s) of a true relative state, plus the bias."""
         noise = self.rng.standard_normal(6)
-        return (r_true_m + self.sigma_r_m * noise[:3], v_true_mps + self.sigma_v_mps * noise[3:])
+        return (r_true_m + self.bias_m + self.sigma_r_m * noise[:3],
+                v_true_mps + self.sigma_v_mps * noise[3:])
 
 
 # --------------------------------------------------------------------------

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from interfaces.channel import ChannelModel, Verdict, applies, gilbert_elliott_rates
-from interfaces.scenario import Burst, Comms, LinkCut
+from interfaces.scenario import Burst, Comms, Fault, LinkCut
 
 
 def _channel(**comms: object) -> ChannelModel:
@@ -100,3 +100,24 @@ def test_same_seed_same_losses_other_seed_other_losses() -> None:
 def test_which_messages_cross_a_link() -> None:
     assert applies("sc1", "sc2") and applies("sc3", "ground") and applies("ground", "sc1")
     assert not applies("sim", "sc1") and not applies("sc1", "sc1") and not applies(None, "sc1")
+
+
+def test_link_faults_cut_and_add_loss_only_on_the_faulty_spacecraft() -> None:
+    faults = [Fault(spacecraft=1, kind="link_loss", start_s=10.0, end_s=20.0),
+              Fault(spacecraft=3, kind="packet_loss", start_s=0.0, magnitude=0.5)]
+    ch = ChannelModel("sc2", Comms(), seed=7, faults=faults)
+    for t in (0.0, 10.0, 20.0):
+        ch.observe_truth(t, [1, 2, 3], [[0, 0, 0], [1, 0, 0], [2, 0, 0]])
+    assert [ch.decide("sc1", t) for t in (0.0, 10.0, 19.9, 20.0)] == [
+        Verdict.DELIVER, Verdict.CUT, Verdict.CUT, Verdict.DELIVER]
+    lost = np.array([ch.decide("sc3", 0.0) is Verdict.LOSS for _ in range(4000)])
+    assert abs(lost.mean() - 0.5) < 4 * math.sqrt(0.25 / 4000)
+    assert all(ch.decide("sc1", 20.0) is Verdict.DELIVER for _ in range(200))  # sc1 unaffected
+    # the nominal loss stream is untouched by a fault on another spacecraft
+    a = ChannelModel("sc2", Comms(packet_loss=0.3), seed=7)
+    b = ChannelModel("sc2", Comms(packet_loss=0.3), seed=7, faults=faults[1:])
+    for ch_ in (a, b):
+        ch_.observe_truth(0.0, [1, 2, 3], [[0, 0, 0], [1, 0, 0], [2, 0, 0]])
+        for _ in range(50):
+            ch_.decide("sc3", 0.0)
+    assert [a.decide("sc1", 0.0) for _ in range(300)] == [b.decide("sc1", 0.0) for _ in range(300)]

@@ -8,6 +8,8 @@ the cost H and prior term of its fused view, every contribution H_j as fused her
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from fsw.lib.poi_map import PoiMap
 from interfaces import topics
 from interfaces.app import App, AppContext, Input, Output
@@ -35,6 +37,9 @@ class InfoCostApp(App):
         self.next_report = 0.0
         self.images = 0
         self.shared = 0
+        self.report_factor: Callable[[float], float] = lambda t: 1.0
+        """Factor on the reported H_i at time t: 1 unless the harness injects ``faulty_data``
+        (fsw/faults.py)."""
 
     def on_observations(self, msg: PoiObservations) -> None:
         self.map.add(msg.spacecraft, msg.poi, msg.precision)
@@ -49,7 +54,7 @@ class InfoCostApp(App):
         self.next_report = t + self.period
         h_j = self.map.contributions()
         self.publish("telemetry", InfoCostTelemetry(
-            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, h_i=float(h_j[self.sc_id - 1]),
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, h_i=float(h_j[self.sc_id - 1]) * self.report_factor(t),
             h_local=self.map.cost(), prior_term=self.map.prior_term(),
             contributions={str(j + 1): float(h) for j, h in enumerate(h_j)},
             pois_seen_own=self.map.seen(self.sc_id), pois_seen_fused=self.map.seen(),

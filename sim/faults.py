@@ -1,0 +1,154 @@
+"""Fault injection into the hardware stand-in: the scenario's ``[[faults]]`` switched on at
+``start_s`` and off at ``end_s`` (DESIGN.md, "Scenario TOML": kinds and magnitudes).
+
+The sim's kinds act on the truth, as a failing unit would:
+
+* ``thruster_bias``: a continuous force of ``magnitude`` × the maximum thrust per axis, in a
+  body direction drawn from the seed (a leaking or stuck-open valve: it acts whether or not the
+  thrusters fire, and it is counted in the Δv spent).
+* ``pointing_actuator``: a wheel torque bias perpendicular to the boresight, sized so that the
+  nominal attitude loop settles ``magnitude`` degrees off its target: with the small-error
+  closed loop ``J δθ̈ + J kd δθ̇ + J (kp/2) δθ = τ_bias`` (``fsw.lib.attitude_control``),
+  ``τ_bias = J kp θ / 2`` per axis.  The attitude estimate sees the error; the loop cannot
+  remove it.
+* ``camera_degradation``: every precision scaled by β = ``magnitude`` (Eq. 21).
+* ``camera_misalignment``: the camera boresight rotated by ``magnitude`` degrees about a body
+  axis perpendicular to it, drawn from the seed; the attitude loop does not know.
+* ``nav_sensor_bias``: the relative-navigation position measurement offset by ``magnitude`` m in
+  an LVLH direction drawn from the seed.
+
+The link kinds (``link_loss``, ``packet_loss``) act in every node's channel model
+(``interfaces.channel``) and ``faulty_data`` in the faulty spacecraft's software
+(``fsw.faults``); they are listed here too so that the truth of every fault is archived.
+
+Every switch is returned as a :class:`FaultSwitch` (for the ``FaultEvent`` truth message).
+Random directions come from ``interfaces.rng.stream(seed, "fault", k)`` for the k-th fault.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fsw.lib.attitude_control import gains_for
+from interfaces.rng import stream
+from interfaces.scenario import Fault, Scenario
+from sim.camera import TruthCameras
+from sim.hardware import ObserverHardware
+from sim.sensors import RelNavSensor
+
+SIM_KINDS = frozenset({"thruster_bias", "pointing_actuator", "camera_degradation",
+                       "camera_misalignment", "nav_sensor_bias"})
+
+
+@dataclass(frozen=True)
+class FaultSwitch:
+    """A fault turned on or off at ``t_s`` (s); ``detail`` holds the realised parameters
+    (directions, torques) for the archive."""
+
+    index: int
+    fault: Fault
+    active: bool
+    t_s: float
+    detail: dict[str, list[float] | float]
+
+
+def _unit_perpendicular(rng: np.random.Generator, axis: np.ndarray) -> np.ndarray:
+    """A random unit vector perpendicular to ``axis`` (unit)."""
+    while True:
+        v = rng.standard_normal(3)
+        v -= (v @ axis) * axis
+        norm = float(np.linalg.norm(v))
+        if norm > 1e-6:
+            return v / norm
+
+
+def _unit(rng: np.random.Generator) -> np.ndarray:
+    while True:
+        v = rng.standard_normal(3)
+        norm = float(np.linalg.norm(v))
+        if norm > 1e-6:
+            return v / norm
+
+
+def _axis_angle_quat(axis: np.ndarray, angle_rad: float) -> np.ndarray:
+    """Quaternion (scalar last) of a rotation by ``angle_rad`` about unit ``axis``."""
+    return np.concatenate([axis * math.sin(angle_rad / 2.0), [math.cos(angle_rad / 2.0)]])
+
+
+@dataclass
+class FaultInjector:
+    """Switches the scenario's faults on the sim's hardware, cameras and relnav sensors.
+
+    Attributes:
+        scenario: the mission (faults, actuator limits, attitude settling time, inertia).
+        hardware, cameras, relnav: the units the faults act on.
+        detail: per fault, the realised parameters (drawn once, at construction).
+    """
+
+    scenario: Scenario
+    hardware: ObserverHardware
+    cameras: TruthCameras
+    relnav: list[RelNavSensor]
+    detail: list[dict[str, list[float] | float]] = field(init=False)
+
+    def __post_init__(self) -> None:
+        self._active = [False] * len(self.scenario.faults)
+        self.detail = [self._realise(k, f) for k, f in enumerate(self.scenario.faults)]
+
+    def _realise(self, k: int, f: Fault) -> dict[str, list[float] | float]:
+        """The concrete parameters of fault k (directions drawn from its own stream)."""
+        sc = self.scenario
+        rng = stream(sc.seed, "fault", k)
+        boresight = np.array(sc.attitude.boresight_body, dtype=float)
+        boresight /= np.linalg.norm(boresight)
+        mag = float(f.magnitude or 0.0)
+        if f.kind == "thruster_bias":
+            d = _unit(rng)
+            return {"direction_body": d.tolist(),
+                    "force_body_n": (mag * sc.actuators.thruster_max_force_n * d).tolist()}
+        if f.kind == "pointing_actuator":
+            axis = _unit_perpendicular(rng, boresight)
+            kp = gains_for(sc.attitude.settling_time_s).kp
+            torque = np.array(sc.observers.inertia_kg_m2) * axis * kp * math.radians(mag) / 2.0
+            return {"axis_body": axis.tolist(), "torque_bias_nm": torque.tolist()}
+        if f.kind == "camera_misalignment":
+            axis = _unit_perpendicular(rng, boresight)
+            return {"axis_body": axis.tolist(),
+                    "rotation_xyzw": _axis_angle_quat(axis, math.radians(mag)).tolist()}
+        if f.kind == "nav_sensor_bias":
+            d = _unit(rng)
+            return {"direction_lvlh": d.tolist(), "bias_lvlh_m": (mag * d).tolist()}
+        return {"magnitude": mag} if f.magnitude is not None else {}
+
+    def update(self, t_s: float) -> list[FaultSwitch]:
+        """Apply every fault whose state changes at ``t_s`` (on at start_s ≤ t, off at end_s ≤ t);
+        returns the switches."""
+        out = []
+        for k, f in enumerate(self.scenario.faults):
+            on = f.start_s <= t_s + 1e-9 and (f.end_s is None or t_s < f.end_s - 1e-9)
+            if on != self._active[k]:
+                self._active[k] = on
+                if f.kind in SIM_KINDS:
+                    self._apply(k, f, on)
+                out.append(FaultSwitch(k, f, on, t_s, self.detail[k]))
+        return out
+
+    def _apply(self, k: int, f: Fault, on: bool) -> None:
+        i = f.spacecraft - 1
+        d = self.detail[k]
+        if f.kind == "thruster_bias":
+            self.hardware.force_bias_body[i] = np.array(d["force_body_n"]) if on else 0.0
+        elif f.kind == "pointing_actuator":
+            bias = self.hardware.wheels.torque_bias_nm
+            bias[i] = np.array(d["torque_bias_nm"]) if on else 0.0
+            self.hardware.wheels.torque_bias_nm = bias
+        elif f.kind == "camera_degradation":
+            self.cameras.beta[i] = float(f.magnitude or 1.0) if on else 1.0
+        elif f.kind == "camera_misalignment":
+            self.cameras.misalignment[i] = np.array(d["rotation_xyzw"]) if on \
+                else np.array([0.0, 0.0, 0.0, 1.0])
+        elif f.kind == "nav_sensor_bias":
+            self.relnav[i].bias_m = np.array(d["bias_lvlh_m"]) if on else np.zeros(3)
