@@ -99,7 +99,8 @@ class MissionPlan:
 
     Attributes:
         scenario: the mission.
-        poi_pos, poi_normal: the target model (M, 3), m; what the planner's camera model sees.
+        poi_pos, poi_normal: the target model (M, 3), m; the planner's camera model sees every
+            ``assignment.poi_stride``-th of them (expected gains are scaled accordingly).
         issued: every assignment issued so far, in order (the last one is current).
         decisions: every information-driven decision, in order.
     """
@@ -117,6 +118,9 @@ class MissionPlan:
         self.count = sc.observers.count
         self.camera = Camera(math.radians(sc.camera.half_angle_deg), sc.camera.max_range_m,
                              sc.camera.k)
+        self._stride = a.poi_stride
+        self._plan_pos = self.poi_pos[::a.poi_stride]
+        self._plan_normal = self.poi_normal[::a.poi_stride]
         self.library = pro_library(
             a.rho_x_m, a.rho_z_m, np.linspace(0.0, 2.0 * math.pi, a.phases, endpoint=False),
             cross_phase_offsets_rad=[math.radians(d) for d in a.cross_phase_offsets_deg])
@@ -193,17 +197,19 @@ class MissionPlan:
         the current set by the margin."""
         a = self.scenario.assignment
         t_arrive = t_depart + transfer_s
-        w_now = fused.w_inv + fused.F.sum(axis=0)
+        k = self._stride  # planning subsample: every k-th POI standing for k of them
+        w_now = (fused.w_inv + fused.F.sum(axis=0))[::k]
+        phi = fused.phi[::k] * k
         keep_out = self.scenario.guidance.keep_out_m + a.keep_out_margin_m
         choice = greedy_assignment(self.library, self.count, self.n, t_arrive, a.window_s,
-                                   a.samples, self.poi_pos, self.poi_normal, fused.phi, w_now,
+                                   a.samples, self._plan_pos, self._plan_normal, phi, w_now,
                                    self.camera, a.min_separation_m, keep_out)
         current_gain = None
         if self._current_indices is not None:
             prec = np.array([expected_precision(self.library[i], self.n, t_arrive, a.window_s,
-                                                a.samples, self.poi_pos, self.poi_normal,
+                                                a.samples, self._plan_pos, self._plan_normal,
                                                 self.camera) for i in self._current_indices])
-            current_gain = set_gain(prec, fused.phi, w_now)
+            current_gain = set_gain(prec, phi, w_now)
         switch = force or current_gain is None or \
             choice.gain > (1.0 + a.min_improvement) * current_gain
         states = self._states_at(t_depart)

@@ -238,6 +238,10 @@ class AssignmentSettings(_Section):
     cross_phase_offsets_deg: list[float] = Field(default=[0.0, 90.0], min_length=1)
     window_s: float = Field(default=1200.0, gt=0.0, description="planning window, s")
     samples: int = Field(default=24, ge=1, le=1000, description="images per planning window")
+    poi_stride: int = Field(
+        default=4, ge=1,
+        description="the planner evaluates every k-th POI (φ scaled by k): a uniform subsample "
+                    "of the Fibonacci sphere, k times cheaper, for ranking orbits")
     min_separation_m: float = Field(default=5.0, ge=0.0)
     keep_out_margin_m: float = Field(default=2.0, ge=0.0)
     check_period_s: float = Field(default=300.0, gt=0.0)

@@ -5,7 +5,9 @@ An image of observer i sees the POIs visible from its true position along its tr
 (``fsw.lib.infocost.visibility``: inside the field-of-view cone, within range, front-facing on
 the convex target) and measures each with precision σ⁻¹ = 1/(k d²) (Eq. 5), scaled by the
 camera's health β and perturbed by multiplicative noise: σ⁻¹_meas = β σ⁻¹ max(0, 1 + ν ε),
-ε ~ N(0, 1) from the observer's own generator.  Fault hooks (issue 5): ``beta`` (camera
+ε ~ N(0, 1) from the observer's own generator, and quantised to ``SIGNIFICANT_DIGITS``
+significant digits (far below the noise; it halves the images' JSON on the bus and in the
+archive, where 17-digit floats dominated).  Fault hooks (issue 5): ``beta`` (camera
 degradation, information scaled by β ∈ (0, 1]) and ``misalignment`` (a rotation of the
 boresight in body axes: other POIs, or none, are seen).
 """
@@ -24,6 +26,22 @@ from fsw.lib.infocost import Camera, precision
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
+
+SIGNIFICANT_DIGITS = 6
+"""Precision of a measured σ⁻¹ (the camera noise is 5% by default)."""
+
+
+def quantise(values: FloatArray, digits: int = SIGNIFICANT_DIGITS) -> FloatArray:
+    """Round positive ``values`` to ``digits`` significant digits, as the nearest doubles of the
+    rounded decimals (n / 10^k with an exact power of ten), so their shortest decimal form has
+    at most ``digits`` digits.  Zeros stay zero."""
+    out = np.zeros_like(values)
+    pos = values > 0.0
+    k = digits - 1 - np.floor(np.log10(values[pos]))
+    scale = 10.0 ** np.abs(k)
+    v = values[pos]
+    out[pos] = np.where(k >= 0, np.round(v * scale) / scale, np.round(v / scale) * scale)
+    return out
 
 
 @dataclass(frozen=True)
@@ -88,5 +106,5 @@ class TruthCameras:
         for i in range(n):
             seen = np.flatnonzero(prec[i]).astype(np.int64)
             noise = np.maximum(0.0, 1.0 + self.noise_frac * self.rngs[i].standard_normal(len(seen)))
-            out.append(Image(seen, self.beta[i] * prec[i, seen] * noise))
+            out.append(Image(seen, quantise(self.beta[i] * prec[i, seen] * noise)))
         return out
