@@ -1,0 +1,81 @@
+"""The adaptive fault threshold (paper Eq. 11-12), its calibrated floor, and the persistence
+rule (DESIGN.md: a fault is declared when H_m,i > τ_i for a configurable number of windows, as
+cFS Limit Checker's fails-before-action).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ground.fdir.metric import metric
+
+
+def adaptive_threshold(dh_samples: Sequence[float], dh_pred: float, h_prev: float = 0.0,
+                       floor: float = 0.0) -> float | None:
+    """τ_i (Eq. 11-12) from the changes ΔH_i^(k) of K sampled near-nominal pointings (the
+    ε-neighbourhood of the max-variance POI): Eq. 11 picks the sample set S' whose cost is the
+    closest to the prediction without equalling it, so τ_i is the smallest non-zero metric
+    ``|1 − ΔH^(k)/ΔH^pred|`` over the samples; then ``max(τ_i, floor)``.
+
+    Returns None when the prediction is degenerate (no threshold, no decision).  When every
+    sample equals the prediction the floor alone is returned.
+    """
+    values = [metric(dh, dh_pred, h_prev) for dh in dh_samples]
+    if any(v is None for v in values) or metric(dh_pred, dh_pred, h_prev) is None:
+        return None
+    nonzero = [v for v in values if v is not None and v > 0.0]
+    tau = min(nonzero) if nonzero else 0.0
+    return max(tau, floor)
+
+
+def calibrate_floor(nominal_metrics: Sequence[float], false_alarm_rate: float,
+                    persistence: int) -> float:
+    """The threshold floor for a target false-alarm probability per FDI window.
+
+    With a fault declared after ``persistence`` = N consecutive exceedances, and windows treated
+    as independent, a per-window exceedance probability q gives false alarms at rate ≈ q^N; so
+    q = rate^(1/N) and the floor is the (1 − q) empirical quantile of the nominal metrics
+    (linear interpolation).  Nominal windows are rarely independent (slow geometry), so the
+    achieved rate is measured on nominal runs, not promised by this formula.
+
+    Raises:
+        ValueError: no finite samples, a rate outside (0, 1), or persistence < 1.
+    """
+    if not 0.0 < false_alarm_rate < 1.0:
+        raise ValueError(f"false_alarm_rate must be in (0, 1), got {false_alarm_rate!r}")
+    if persistence < 1:
+        raise ValueError(f"persistence must be >= 1, got {persistence!r}")
+    m = np.asarray([v for v in nominal_metrics if v is not None and math.isfinite(v)])
+    if m.size == 0:
+        raise ValueError("no finite nominal metric samples to calibrate from")
+    q = false_alarm_rate ** (1.0 / persistence)
+    return float(np.quantile(m, 1.0 - q))
+
+
+@dataclass
+class Persistence:
+    """Consecutive-exceedance counter per spacecraft: ``update`` returns True on the window that
+    completes ``count`` exceedances in a row (once per episode); a window without a decision
+    (None: missing or degenerate) neither counts nor resets."""
+
+    count: int = 3
+    _run: dict[int, int] = field(default_factory=dict)
+    _declared: set[int] = field(default_factory=set)
+
+    def update(self, spacecraft: int, exceeded: bool | None) -> bool:
+        if exceeded is None:
+            return False
+        if not exceeded:
+            self._run[spacecraft] = 0
+            self._declared.discard(spacecraft)
+            return False
+        run = self._run.get(spacecraft, 0) + 1
+        self._run[spacecraft] = run
+        if run >= self.count and spacecraft not in self._declared:
+            self._declared.add(spacecraft)
+            return True
+        return False
