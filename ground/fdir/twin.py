@@ -1,0 +1,116 @@
+"""The ground's nominal twin of one observer: where the plan puts it, where its camera points,
+and the information its images should bring (DESIGN.md: H_i^pred over [t − Δt, t] from the
+plan and the fused state at t − Δt).
+
+Information change with ψ held at the window start.  With F the fused precision and
+ψ = H_POI(t − Δt)² (Eq. 8) frozen over the window, agent i's contribution changes by::
+
+    ΔH_i = Σ_s φ(s) ψ(s) ΔF_i(s),
+
+linear in its own new precision ΔF_i — the linearisation under which the paper's ratios are
+exact (r_i = β for a camera fault, Eq. 21) and faults isolate to one agent (Sec. III.F: with ψ
+recomputed, one agent's loss also rescales the others' contributions).  The twin compares
+like with like: the prediction covers exactly the images whose observations reached the ground,
+so a lost packet removes an image from both sides and never reads as zero information gain.
+
+Pure functions and frozen dataclasses; the FDIR app holds the state.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from fsw.lib.infocost import Camera, precision
+from fsw.lib.pro import Pro
+from fsw.lib.scp import zoh_matrices
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Transfer:
+    """A planned transfer as published by the spacecraft (``TransferPlanMsg``): node times
+    (s, mission time), node states (N+1, 6) and ZOH accelerations (N, 3), LVLH."""
+
+    t_s: FloatArray
+    x: FloatArray
+    u: FloatArray
+
+
+@dataclass(frozen=True)
+class FlightPlan:
+    """What an observer is expected to fly from ``t_from_s``: the PRO ``pro`` (from the ground's
+    assignment), preceded by ``transfer`` where one is planned."""
+
+    t_from_s: float
+    pro: Pro
+    transfer: Transfer | None = None
+
+    def positions(self, n: float, t: npt.ArrayLike) -> FloatArray:
+        """Planned LVLH positions (K, 3), m, at absolute times ``t`` (K,): on the transfer
+        between its first and last node (exact ZOH propagation from the preceding node), on the
+        PRO otherwise."""
+        tt = np.atleast_1d(np.asarray(t, dtype=float))
+        out = self.pro.states(n, tt)[:, :3]
+        tr = self.transfer
+        if tr is None:
+            return out
+        inside = (tt >= tr.t_s[0]) & (tt < tr.t_s[-1])
+        if inside.any():
+            k = np.clip(np.searchsorted(tr.t_s, tt[inside], side="right") - 1, 0,
+                        len(tr.u) - 1)
+            phi, gam = zoh_matrices(n, tt[inside] - tr.t_s[k])
+            x = np.einsum("tij,tj->ti", phi, tr.x[k]) + np.einsum("tij,tj->ti", gam, tr.u[k])
+            out[inside] = x[:, :3]
+        return out
+
+
+def centre_boresights(positions: npt.ArrayLike) -> FloatArray:
+    """Unit boresights (K, 3) from each position to the target centre (the default pointing)."""
+    p = np.asarray(positions, dtype=float)
+    norm = np.linalg.norm(p, axis=1, keepdims=True)
+    if np.any(norm <= 0.0):
+        raise ValueError("a planned position is at the target centre: no boresight")
+    return -p / norm
+
+
+def delta_h(psi: npt.ArrayLike, phi: npt.ArrayLike, new_precision: npt.ArrayLike) -> float:
+    """ΔH_i = Σ_s φ ψ ΔF_i with ψ held at the window start; ``new_precision`` (K, M) or (M,):
+    the precision of the window's images (summed over images)."""
+    p = np.asarray(new_precision, dtype=float)
+    total = p.sum(axis=0) if p.ndim == 2 else p
+    return float(total @ (np.asarray(phi, dtype=float) * np.asarray(psi, dtype=float)))
+
+
+def predicted_delta_h(positions: npt.ArrayLike, boresights: npt.ArrayLike,
+                      poi_pos: npt.ArrayLike, poi_normal: npt.ArrayLike | None, camera: Camera,
+                      psi: npt.ArrayLike, phi: npt.ArrayLike) -> float:
+    """ΔH_i^pred of images taken at ``positions`` (K, 3) along ``boresights`` (K, 3) with the
+    nominal camera (β = 1, no noise)."""
+    if np.shape(positions)[0] == 0:
+        return 0.0
+    prec = precision(positions, boresights, poi_pos, poi_normal, camera)
+    return delta_h(psi, phi, prec)
+
+
+def perturbed_boresights(boresight: npt.ArrayLike, eps_rad: float, count: int,
+                         rng: np.random.Generator) -> FloatArray:
+    """``count`` unit directions drawn uniformly (in solid angle) within ``eps_rad`` of
+    ``boresight``: the ε-neighbourhood pointings of the adaptive threshold (Eq. 11)."""
+    b = np.asarray(boresight, dtype=float)
+    b = b / np.linalg.norm(b)
+    if not (math.isfinite(eps_rad) and 0.0 < eps_rad < math.pi / 2):
+        raise ValueError(f"eps_rad must be in (0, pi/2), got {eps_rad!r}")
+    cos_t = 1.0 - rng.random(count) * (1.0 - math.cos(eps_rad))
+    sin_t = np.sqrt(1.0 - cos_t**2)
+    az = rng.random(count) * 2.0 * math.pi
+    helper = np.array([1.0, 0.0, 0.0]) if abs(b[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = np.cross(b, helper)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(b, e1)
+    return (cos_t[:, None] * b + sin_t[:, None] * (np.cos(az)[:, None] * e1
+                                                  + np.sin(az)[:, None] * e2))

@@ -1,0 +1,78 @@
+"""The ground's nominal twin (ground/fdir/twin.py) against independent truth: the SCP plan's own
+propagation, the PRO closed form, the Eq. 8 decomposition with ψ held, uniform cone sampling."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fsw.lib import infocost as ic
+from fsw.lib.hcw import mean_motion
+from fsw.lib.poi import sphere_pois
+from fsw.lib.pro import Pro
+from fsw.lib.scp import plan_transfer
+from ground.fdir.twin import (
+    FlightPlan,
+    Transfer,
+    centre_boresights,
+    delta_h,
+    perturbed_boresights,
+    predicted_delta_h,
+)
+
+N = mean_motion(500e3)
+
+
+def test_planned_positions_follow_the_transfer_then_the_pro() -> None:
+    old, new = Pro(20.0, 0.0, 0.0, 25.0, 0.0), Pro(12.0, 1.0, 0.0, 15.0, 2.0)
+    t0, duration = 300.0, 600.0
+    x0 = old.state(N, t0)
+    xf = new.state(N, t0 + duration)
+    plan = plan_transfer(N, x0, xf, duration, 30, 1e-3, 8.0)
+    assert plan.converged
+    tr = Transfer(plan.t_s + t0, plan.x, plan.u)
+    fp = FlightPlan(t0, new, tr)
+    t = np.array([t0, t0 + 7.3, t0 + 299.9, t0 + 599.0])
+    np.testing.assert_allclose(fp.positions(N, t), plan.states_at(t - t0)[:, :3], atol=1e-9)
+    after = np.array([t0 + duration, t0 + 1000.0])
+    np.testing.assert_allclose(fp.positions(N, after), new.states(N, after)[:, :3], atol=1e-12)
+    before = np.array([t0 - 50.0])
+    np.testing.assert_allclose(FlightPlan(0.0, new).positions(N, before),
+                               new.states(N, before)[:, :3], atol=1e-12)
+
+
+def test_delta_h_is_the_change_of_the_contribution_with_psi_held() -> None:
+    rng = np.random.default_rng(2)
+    pos, nor = sphere_pois(300, 5.0)
+    phi, w_inv = np.full(300, 1 / 300), np.full(300, 1.0)
+    f0 = rng.uniform(0.0, 0.5, (3, 300))
+    cams = np.array([[0.0, 0.0, -20.0], [15.0, 0.0, 5.0], [0.0, -18.0, 0.0]])
+    prec = ic.precision(cams, centre_boresights(cams), pos, nor, ic.Camera())
+    psi = ic.h_poi(w_inv, f0) ** 2
+    f1 = f0.copy()
+    f1[1] += prec[1]
+    direct = (ic.agent_contributions(phi, w_inv, f1, psi=psi)
+              - ic.agent_contributions(phi, w_inv, f0, psi=psi))
+    assert delta_h(psi, phi, prec[1]) == pytest.approx(direct[1], rel=1e-12)
+    assert np.allclose(np.delete(direct, 1), 0.0)  # isolation: nobody else moves
+    assert predicted_delta_h(cams[1:2], centre_boresights(cams[1:2]), pos, nor, ic.Camera(),
+                             psi, phi) == pytest.approx(direct[1], rel=1e-12)
+    assert predicted_delta_h(np.zeros((0, 3)), np.zeros((0, 3)), pos, nor, ic.Camera(), psi,
+                             phi) == 0.0
+
+
+def test_perturbed_boresights_are_uniform_in_the_cone() -> None:
+    b = np.array([0.3, -0.2, 0.9])
+    b /= np.linalg.norm(b)
+    eps = math.radians(5.0)
+    d = perturbed_boresights(b, eps, 20000, np.random.default_rng(0))
+    assert np.allclose(np.linalg.norm(d, axis=1), 1.0)
+    ang = np.arccos(np.clip(d @ b, -1.0, 1.0))
+    assert ang.max() <= eps + 1e-12
+    # uniform in solid angle: P(angle ≤ eps/2) = (1 − cos(eps/2)) / (1 − cos eps) ≈ 0.25
+    expect = (1 - math.cos(eps / 2)) / (1 - math.cos(eps))
+    assert np.mean(ang <= eps / 2) == pytest.approx(expect, abs=0.015)
+    with pytest.raises(ValueError):
+        perturbed_boresights(b, 0.0, 3, np.random.default_rng(0))
