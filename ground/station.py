@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 
+from ground.apps.fdir import FdirApp
 from ground.apps.planner import MissionPlanner
 from ground.apps.telemetry import TelemetryMonitor
 from interfaces import topics
@@ -13,7 +14,7 @@ from interfaces.executive import Executive
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
 
-APPS: tuple[type[App], ...] = (MissionPlanner, TelemetryMonitor)
+APPS: tuple[type[App], ...] = (MissionPlanner, TelemetryMonitor, FdirApp)
 
 
 def ground_executive(bus: Bus, scenario: Scenario) -> Executive:

@@ -239,6 +239,37 @@ class FaultEvent(Message):
     detail: dict[str, list[float] | float] = Field(default_factory=dict)
 
 
+class FdirWindow(Message):
+    """The FDIR's verdict on one observer over one FDI window [t_start_s, t_end_s): the
+    information gained by the images that reached the ground (ΔH_i, ψ held at the window start)
+    against the nominal twin's prediction for the same images, the metric H_m,i (Eq. 9), the
+    adaptive threshold τ_i (Eq. 11-12), the direction (Table 3) and whether it was exceeded
+    (None: no decision — no images, no plan, or a degenerate prediction)."""
+
+    spacecraft: int = Field(ge=1)
+    t_start_s: float
+    t_end_s: float
+    images: int = Field(ge=0)
+    dh: float | None = None
+    dh_pred: float | None = None
+    metric: float | None = None
+    threshold: float | None = None
+    direction: Literal["improved", "degraded"] | None = None
+    exceeded: bool | None = None
+
+
+class FaultReport(Message):
+    """A fault declared by the ground FDIR: the observer, its identified class (None until
+    identified), the direction, and the metric and threshold of the window that declared it."""
+
+    spacecraft: int = Field(ge=1)
+    fault_class: Literal["actuator", "camera", "state_sensor", "link", "data_integrity"] | None
+    direction: Literal["improved", "degraded"] | None = None
+    metric: float | None = None
+    threshold: float | None = None
+    window_end_s: float
+
+
 class AssignmentDecision(Message):
     """The ground's information-driven orbit choice (ground/mission_plan.py): the greedy set,
     its expected information gain and online bound, the expected gain of keeping the current
@@ -421,6 +452,8 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     ProAssignments,
     AssignmentDecision,
     FaultEvent,
+    FdirWindow,
+    FaultReport,
     TransferPlanMsg,
     GuidanceStatus,
     PointingTarget,

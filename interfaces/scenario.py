@@ -315,6 +315,23 @@ class Nav(_Section):
     )
 
 
+class FdirSettings(_Section):
+    """The ground FDIR (ground/apps/fdir.py, DESIGN.md "Information cost and FDIR"): every
+    FDI window (``rates.fdi_period_s``) each observer's information gain is compared with the
+    nominal twin's prediction (Eq. 9) against the adaptive threshold (Eq. 11-12) from
+    ``samples`` pointings within ``eps_deg`` of the planned one, floored at ``floor``; a fault
+    is declared after ``persistence`` windows in a row over the threshold, and an observer
+    whose observations stay missing for ``silent_windows`` windows is reported as a link fault.
+    A window is evaluated ``latency_s`` after it closes (its last images must have arrived)."""
+
+    samples: int = Field(default=10, ge=1, le=1000)
+    eps_deg: float = Field(default=1.0, gt=0.0, lt=45.0)
+    floor: float = Field(default=0.05, ge=0.0)
+    persistence: int = Field(default=2, ge=1)
+    silent_windows: int = Field(default=2, ge=1)
+    latency_s: float = Field(default=3.0, ge=0.0)
+
+
 class SimSettings(_Section):
     lockstep_timeout_s: float = Field(default=5.0, gt=0.0, description="per-tick answer timeout")
     startup_timeout_s: float = Field(default=60.0, gt=0.0)
@@ -362,6 +379,7 @@ class Scenario(_Section):
     attitude: Attitude = Attitude()
     phases: list[Phase] = Field(default_factory=list)
     assignment: AssignmentSettings = AssignmentSettings()
+    fdir: FdirSettings = FdirSettings()
     sim: SimSettings = SimSettings()
     faults: list[Fault] = Field(default_factory=list)
 

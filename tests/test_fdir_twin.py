@@ -76,3 +76,11 @@ def test_perturbed_boresights_are_uniform_in_the_cone() -> None:
     assert np.mean(ang <= eps / 2) == pytest.approx(expect, abs=0.015)
     with pytest.raises(ValueError):
         perturbed_boresights(b, 0.0, 3, np.random.default_rng(0))
+
+
+def test_perturbed_boresights_one_per_row() -> None:
+    rows = centre_boresights(np.array([[0.0, 0.0, -20.0], [10.0, 5.0, 0.0], [0.0, -7.0, 1.0]]))
+    d = perturbed_boresights(rows, math.radians(2.0), 3, np.random.default_rng(1))
+    assert np.all(np.arccos(np.clip(np.sum(d * rows, axis=1), -1, 1)) <= math.radians(2.0) + 1e-12)
+    with pytest.raises(ValueError):
+        perturbed_boresights(rows, 0.1, 2, np.random.default_rng(1))

@@ -99,18 +99,23 @@ def predicted_delta_h(positions: npt.ArrayLike, boresights: npt.ArrayLike,
 
 def perturbed_boresights(boresight: npt.ArrayLike, eps_rad: float, count: int,
                          rng: np.random.Generator) -> FloatArray:
-    """``count`` unit directions drawn uniformly (in solid angle) within ``eps_rad`` of
-    ``boresight``: the ε-neighbourhood pointings of the adaptive threshold (Eq. 11)."""
-    b = np.asarray(boresight, dtype=float)
-    b = b / np.linalg.norm(b)
+    """Unit directions drawn uniformly (in solid angle) within ``eps_rad`` of a boresight: the
+    ε-neighbourhood pointings of the adaptive threshold (Eq. 11).  ``boresight`` (3,) gives
+    ``count`` draws about it; (K, 3) gives one draw about each row (``count`` must be K)."""
+    b = np.atleast_2d(np.asarray(boresight, dtype=float))
+    b = b / np.linalg.norm(b, axis=1, keepdims=True)
+    if b.shape[0] == 1:
+        b = np.repeat(b, count, axis=0)
+    elif b.shape[0] != count:
+        raise ValueError(f"{b.shape[0]} boresights for {count} draws")
     if not (math.isfinite(eps_rad) and 0.0 < eps_rad < math.pi / 2):
         raise ValueError(f"eps_rad must be in (0, pi/2), got {eps_rad!r}")
     cos_t = 1.0 - rng.random(count) * (1.0 - math.cos(eps_rad))
     sin_t = np.sqrt(1.0 - cos_t**2)
     az = rng.random(count) * 2.0 * math.pi
-    helper = np.array([1.0, 0.0, 0.0]) if abs(b[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    helper = np.where((np.abs(b[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     e1 = np.cross(b, helper)
-    e1 /= np.linalg.norm(e1)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
     e2 = np.cross(b, e1)
     return (cos_t[:, None] * b + sin_t[:, None] * (np.cos(az)[:, None] * e1
                                                   + np.sin(az)[:, None] * e2))

@@ -1,0 +1,59 @@
+"""The ground FDIR in a real (in-process) run: a degraded camera is detected and isolated with
+the metric at 1 − β (Eq. 21), the healthy observers stay far below the threshold, and a
+spacecraft whose link is cut is reported as a link fault, not as a performance fault."""
+
+from __future__ import annotations
+
+import pytest
+
+from deploy.inproc import run_inproc
+from interfaces.messages import FaultReport, FdirWindow
+from tests.conftest import small_scenario
+
+
+@pytest.fixture(scope="module")
+def fdir_run() -> tuple[list[FdirWindow], list[FaultReport]]:
+    sc = small_scenario(
+        "fd", duration_s=400.0, target={"pois": 1000},
+        rates={"high_hz": 5.0, "fdi_period_s": 50.0},
+        observers={"count": 3, "initial_attitude": "lvlh"},
+        faults=[{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0,
+                 "magnitude": 0.5},
+                {"spacecraft": 3, "kind": "link_loss", "start_s": 200.0, "end_s": 300.0}])
+    windows: list[FdirWindow] = []
+    reports: list[FaultReport] = []
+
+    def tap(key: str, type_name: str, payload: bytes) -> None:
+        if type_name == "FdirWindow":
+            windows.append(FdirWindow.model_validate_json(payload))
+        elif type_name == "FaultReport":
+            reports.append(FaultReport.model_validate_json(payload))
+
+    run_inproc(sc, tap=tap)
+    return windows, reports
+
+
+def test_camera_fault_detected_and_isolated(fdir_run: tuple[list[FdirWindow],
+                                                            list[FaultReport]]) -> None:
+    windows, reports = fdir_run
+    judged = [w for w in windows if w.metric is not None]
+    faulty = [w for w in judged if w.spacecraft == 2 and w.images >= 40]
+    assert len(faulty) >= 3
+    assert all(w.metric == pytest.approx(0.5, abs=0.01) and w.direction == "degraded"
+               and w.exceeded for w in faulty)
+    healthy = [w for w in judged if w.spacecraft != 2]
+    assert healthy and all(not w.exceeded for w in healthy)
+    assert max(w.metric for w in healthy if w.metric is not None) < 0.01
+    perf = [r for r in reports if r.fault_class != "link"]
+    assert [r.spacecraft for r in perf] == [2]  # declared once, on the faulty one only
+
+
+def test_silent_spacecraft_is_a_link_fault(fdir_run: tuple[list[FdirWindow],
+                                                           list[FaultReport]]) -> None:
+    windows, reports = fdir_run
+    cut = [w for w in windows if w.spacecraft == 3 and 200.0 <= w.t_start_s < 300.0]
+    assert cut and all(w.images == 0 and w.metric is None and w.exceeded is None for w in cut)
+    link = [r for r in reports if r.fault_class == "link"]
+    assert [(r.spacecraft, r.t_sim) for r in link] == [(3, 300.0)]
+    after = [w for w in windows if w.spacecraft == 3 and w.t_start_s >= 300.0]
+    assert after and all(w.images > 0 and not w.exceeded for w in after)  # back, healthy
