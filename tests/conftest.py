@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import socket
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 
+from interfaces.messages import Message
 from interfaces.scenario import Scenario, parse_scenario
 
 REPO = Path(__file__).resolve().parent.parent
@@ -59,3 +62,18 @@ def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
+
+
+def collector(*types: type[Message], key_prefix: dict[str, str] | None = None,
+              ) -> tuple[Callable[[str, str, bytes], None], dict[str, list[Any]]]:
+    """A raw tap (for ``run_inproc``) that validates the messages of ``types`` into lists by
+    type name; ``key_prefix`` restricts a type to keys starting with the given prefix."""
+    by_name = {t.__name__: t for t in types}
+    out: dict[str, list[Any]] = {name: [] for name in by_name}
+
+    def tap(key: str, type_name: str, payload: bytes) -> None:
+        t = by_name.get(type_name)
+        if t is not None and key.startswith((key_prefix or {}).get(type_name, "")):
+            out[type_name].append(t.model_validate_json(payload))
+
+    return tap, out

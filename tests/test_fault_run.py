@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from deploy.inproc import run_inproc
 from interfaces.messages import FaultEvent, InfoCostTelemetry, LinkStats, TruthState
-from tests.conftest import small_scenario
+from tests.conftest import collector, small_scenario
 
 
 def test_faults_act_and_their_truth_is_published() -> None:
@@ -17,22 +17,11 @@ def test_faults_act_and_their_truth_is_published() -> None:
                                  "magnitude": 2.0},
                                 {"spacecraft": 3, "kind": "link_loss", "start_s": 100.0,
                                  "end_s": 150.0}])
-    events: list[FaultEvent] = []
-    telemetry: list[InfoCostTelemetry] = []
-    truth: list[TruthState] = []
-    ground_links: list[LinkStats] = []
-
-    def tap(key: str, type_name: str, payload: bytes) -> None:
-        if type_name == "FaultEvent":
-            events.append(FaultEvent.model_validate_json(payload))
-        elif type_name == "InfoCostTelemetry":
-            telemetry.append(InfoCostTelemetry.model_validate_json(payload))
-        elif type_name == "TruthState":
-            truth.append(TruthState.model_validate_json(payload))
-        elif type_name == "LinkStats" and key.startswith("insp/flt/ground/"):
-            ground_links.append(LinkStats.model_validate_json(payload))
-
+    tap, got = collector(FaultEvent, InfoCostTelemetry, TruthState, LinkStats,
+                         key_prefix={"LinkStats": "insp/flt/ground/"})
     run_inproc(sc, tap=tap)
+    events, telemetry = got["FaultEvent"], got["InfoCostTelemetry"]
+    truth, ground_links = got["TruthState"], got["LinkStats"]
     assert [(e.spacecraft, e.kind, e.active, e.t_sim) for e in events] == [
         (2, "faulty_data", True, 0.0), (1, "thruster_bias", True, 50.0),
         (3, "link_loss", True, 100.0), (3, "link_loss", False, 150.0)]

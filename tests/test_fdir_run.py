@@ -8,7 +8,7 @@ import pytest
 
 from deploy.inproc import run_inproc
 from interfaces.messages import FaultReport, FdirWindow
-from tests.conftest import small_scenario
+from tests.conftest import collector, small_scenario
 
 
 @pytest.fixture(scope="module")
@@ -20,17 +20,9 @@ def fdir_run() -> tuple[list[FdirWindow], list[FaultReport]]:
         faults=[{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0,
                  "magnitude": 0.5},
                 {"spacecraft": 3, "kind": "link_loss", "start_s": 200.0, "end_s": 300.0}])
-    windows: list[FdirWindow] = []
-    reports: list[FaultReport] = []
-
-    def tap(key: str, type_name: str, payload: bytes) -> None:
-        if type_name == "FdirWindow":
-            windows.append(FdirWindow.model_validate_json(payload))
-        elif type_name == "FaultReport":
-            reports.append(FaultReport.model_validate_json(payload))
-
+    tap, got = collector(FdirWindow, FaultReport)
     run_inproc(sc, tap=tap)
-    return windows, reports
+    return got["FdirWindow"], got["FaultReport"]
 
 
 def test_camera_fault_detected_and_isolated(fdir_run: tuple[list[FdirWindow],
