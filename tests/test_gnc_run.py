@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from deploy.run_constellation import main
+from fsw.apps.guidance import KEEP_OUT_MARGIN_M
 from fsw.lib.hcw import mean_motion
 from fsw.lib.poi import sphere_pois
 from fsw.lib.pro import Pro
@@ -108,7 +109,7 @@ def test_transfer_plan_is_published_and_respects_the_keep_out(run: tuple[Path, d
     plans = archive.messages("insp/gnc/sc/*/guidance/plan", TransferPlanMsg)
     assert sorted(p.spacecraft for p in plans) == [1, 2]
     for p in plans:
-        assert p.status == "solved" and p.min_range_m >= 8.0 - 1e-6
+        assert p.status == "solved" and p.min_range_m >= 8.0 + KEEP_OUT_MARGIN_M - 1e-6
         assert p.t_s[0] == pytest.approx(100.0) and p.t_s[-1] == pytest.approx(600.0)
         sc = load_scenario(out.parent / "gnc.toml")
         u_plan = (sc.guidance.plan_thrust_fraction * sc.actuators.thruster_max_force_n
