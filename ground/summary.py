@@ -9,12 +9,15 @@ from typing import Any
 
 from ground.coverage import coverage, coverage_summary
 from ground.evaluation import nav_errors
+from ground.fdir.scoring import Alarm, Judged, score
 from ground.gnc_evaluation import gnc_series, gnc_summary
 from ground.reader import ArchiveError, RunArchive, load_run
 from interfaces import topics
 from interfaces.messages import (
     ExecStats,
     FaultEvent,
+    FaultReport,
+    FdirWindow,
     LinkStats,
     SimStatus,
     TelemetryStatus,
@@ -51,6 +54,23 @@ def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict
         "sim": {"rejected_commands": sim[-1].rejected_commands if sim else None},
         "fault_events": [e.model_dump(exclude={"sender", "seq", "t_wall"})
                          for e in archive.messages(topics.fault_events(mission), FaultEvent)],
+        **fdir_summary(archive, scenario, mission),
+    }
+
+
+def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[str, Any]:
+    """``detections`` (the ground FDIR's fault reports) and ``scores`` against the injected
+    faults (ground/fdir/scoring.py; grace of one FDI window)."""
+    reports = archive.messages(topics.key(mission, topics.GROUND, "fdir", "report"), FaultReport)
+    windows = archive.messages(topics.key(mission, topics.GROUND, "fdir", "window"), FdirWindow)
+    alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class) for r in reports]
+    judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
+              if w.exceeded is not None]
+    return {
+        "detections": [{"spacecraft": r.spacecraft, "time_s": r.t_sim, "class": r.fault_class,
+                        "direction": r.direction, "metric": r.metric, "threshold": r.threshold}
+                       for r in reports],
+        "scores": score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
     }
 
 

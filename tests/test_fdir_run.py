@@ -4,15 +4,21 @@ spacecraft whose link is cut is reported as a link fault, not as a performance f
 
 from __future__ import annotations
 
+from typing import Any
+
 import pytest
 
 from deploy.inproc import run_inproc
+from ground.reader import load_run
+from ground.recorder import McapRecorder
+from ground.summary import build_summary
 from interfaces.messages import FaultReport, FdirWindow
 from tests.conftest import collector, small_scenario
 
 
 @pytest.fixture(scope="module")
-def fdir_run() -> tuple[list[FdirWindow], list[FaultReport]]:
+def fdir_run(tmp_path_factory: pytest.TempPathFactory
+             ) -> tuple[list[FdirWindow], list[FaultReport], dict[str, Any]]:
     sc = small_scenario(
         "fd", duration_s=400.0, target={"pois": 1000},
         rates={"high_hz": 5.0, "fdi_period_s": 50.0},
@@ -21,13 +27,22 @@ def fdir_run() -> tuple[list[FdirWindow], list[FaultReport]]:
                  "magnitude": 0.5},
                 {"spacecraft": 3, "kind": "link_loss", "start_s": 200.0, "end_s": 300.0}])
     tap, got = collector(FdirWindow, FaultReport)
-    run_inproc(sc, tap=tap)
-    return got["FdirWindow"], got["FaultReport"]
+    path = tmp_path_factory.mktemp("fdir") / "run.mcap"
+    with McapRecorder(path, {}) as rec:
+        def both(key: str, type_name: str, payload: bytes) -> None:
+            tap(key, type_name, payload)
+            rec.record(key, type_name, payload)
+
+        run_inproc(sc, tap=both)
+    summary = build_summary(load_run(path), sc, sc.name)
+    return got["FdirWindow"], got["FaultReport"], summary
 
 
-def test_camera_fault_detected_and_isolated(fdir_run: tuple[list[FdirWindow],
-                                                            list[FaultReport]]) -> None:
-    windows, reports = fdir_run
+Run = tuple[list[FdirWindow], list[FaultReport], dict[str, Any]]
+
+
+def test_camera_fault_detected_and_isolated(fdir_run: Run) -> None:
+    windows, reports, _ = fdir_run
     judged = [w for w in windows if w.metric is not None]
     faulty = [w for w in judged if w.spacecraft == 2 and w.images >= 40]
     assert len(faulty) >= 3
@@ -40,12 +55,22 @@ def test_camera_fault_detected_and_isolated(fdir_run: tuple[list[FdirWindow],
     assert [r.spacecraft for r in perf] == [2]  # declared once, on the faulty one only
 
 
-def test_silent_spacecraft_is_a_link_fault(fdir_run: tuple[list[FdirWindow],
-                                                           list[FaultReport]]) -> None:
-    windows, reports = fdir_run
+def test_silent_spacecraft_is_a_link_fault(fdir_run: Run) -> None:
+    windows, reports, _ = fdir_run
     cut = [w for w in windows if w.spacecraft == 3 and 200.0 <= w.t_start_s < 300.0]
     assert cut and all(w.images == 0 and w.metric is None and w.exceeded is None for w in cut)
     link = [r for r in reports if r.fault_class == "link"]
     assert [(r.spacecraft, r.t_sim) for r in link] == [(3, 300.0)]
     after = [w for w in windows if w.spacecraft == 3 and w.t_start_s >= 300.0]
     assert after and all(w.images > 0 and not w.exceeded for w in after)  # back, healthy
+
+
+def test_summary_scores_the_run(fdir_run: Run) -> None:
+    _, reports, summary = fdir_run
+    assert len(summary["detections"]) == len(reports)
+    cam, link = summary["scores"]["per_fault"]
+    assert cam["detected"] and cam["isolated"] and cam["spacecraft"] == 2
+    assert cam["latency_s"] == min(r.t_sim for r in reports if r.spacecraft == 2)
+    assert link["isolated"] and link["identified_class"] == "link" and link["identified_correctly"]
+    assert link["latency_s"] == 100.0  # two silent 50 s windows
+    assert summary["scores"]["false_alarms"] == 0 and summary["scores"]["nominal_cycles"] >= 8
