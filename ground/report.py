@@ -16,7 +16,7 @@ from ground.evaluation import NavErrors, nav_errors  # noqa: E402
 from ground.gnc_evaluation import GncSeries, gnc_series  # noqa: E402
 from ground.reader import ArchiveError, RunArchive, load_run  # noqa: E402
 from interfaces import topics  # noqa: E402
-from interfaces.messages import TruthState  # noqa: E402
+from interfaces.messages import FdirWindow, TruthState  # noqa: E402
 from interfaces.scenario import Scenario  # noqa: E402
 
 
@@ -41,6 +41,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None) -> P
     lines += _nav_section(out, nav_errors(archive, mission), summary)
     lines += _gnc_section(out, gnc_series(archive, scenario, mission), summary)
     lines += _coverage_section(out, coverage(archive, scenario, mission), summary)
+    lines += _fdir_section(out, archive, mission, summary)
     lines += _links_section(summary) + _exec_section(summary)
     return _write(out, lines)
 
@@ -180,6 +181,52 @@ def _decision_rows(c: Coverage) -> list[str]:
                     f"{d.expected_gain:.3g} | {d.ratio_bound:.3f} | {cur} | {gains} | "
                     f"{'yes' if d.switched else 'no'} |")
     return rows + [""]
+
+
+def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -> list[str]:
+    """Per observer: log10 of the metric H_m,i against log10 of the threshold τ_i (as the
+    paper's Fig. 23-26, right), fault onsets (red) and declared faults (black)."""
+    windows = archive.messages(topics.key(mission, topics.GROUND, "fdir", "window"), FdirWindow)
+    judged = [w for w in windows if w.metric is not None and w.threshold is not None]
+    if not judged:
+        return ["No FDIR decision recorded.", ""]
+    ids = sorted({w.spacecraft for w in windows})
+    fig, axes = plt.subplots(len(ids), 1, figsize=(10, 1.8 * len(ids) + 1), sharex=True,
+                             squeeze=False)
+    floor = 1e-6  # log of a zero metric
+    for ax, sc in zip(axes[:, 0], ids):
+        mine = [w for w in judged if w.spacecraft == sc]
+        t = [w.t_end_s for w in mine]
+        ax.plot(t, np.log10([max(w.metric, floor) for w in mine]), "o-", ms=3, lw=1.0,
+                label="log H_m")
+        ax.plot(t, np.log10([max(w.threshold, floor) for w in mine]), "--", lw=1.0,
+                label="log τ")
+        for f in summary.get("injected_faults", []):
+            if f["spacecraft"] == sc:
+                ax.axvline(f["start_s"], color="tab:red", lw=1.0)
+        for d in summary.get("detections", []):
+            if d["spacecraft"] == sc:
+                ax.axvline(d["time_s"], color="k", lw=1.0, ls=":")
+        ax.set_ylabel(f"sc{sc}")
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(fontsize=8, loc="upper right")
+    axes[-1, 0].set_xlabel("sim time (s)  (red: fault onset, dotted: fault declared)")
+    fig.suptitle("FDIR: metric against adaptive threshold (Eq. 9, 12)")
+    fig.tight_layout()
+    fig.savefig(out / "fdir.png", dpi=110)
+    plt.close(fig)
+    rows = ["## FDIR", "", "![fdir](fdir.png)", "",
+            "| fault | spacecraft | onset (s) | detected | isolated | latency (s) | class |",
+            "|---|---|---|---|---|---|---|"]
+    scores = summary.get("scores", {})
+    for f in scores.get("per_fault", []):
+        lat = "-" if f["latency_s"] is None else f"{f['latency_s']:.0f}"
+        rows.append(f"| {f['kind']} | {f['spacecraft']} | {f['start_s']:.0f} | "
+                    f"{'yes' if f['detected'] else 'no'} | {'yes' if f['isolated'] else 'no'} | "
+                    f"{lat} | {f['identified_class'] or '-'} (expected {f['expected_class']}) |")
+    rows += ["", f"False alarms: {scores.get('false_alarms', 0)} in "
+                 f"{scores.get('nominal_cycles', 0)} nominal FDI cycles.", ""]
+    return rows
 
 
 def _links_section(summary: dict) -> list[str]:

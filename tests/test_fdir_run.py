@@ -9,9 +9,9 @@ from typing import Any
 import pytest
 
 from deploy.inproc import run_inproc
-from ground.reader import load_run
 from ground.recorder import McapRecorder
-from ground.summary import build_summary
+from ground.report import write_report
+from ground.summary import write_summary
 from interfaces.messages import FaultReport, FdirWindow
 from tests.conftest import collector, small_scenario
 
@@ -34,7 +34,8 @@ def fdir_run(tmp_path_factory: pytest.TempPathFactory
             rec.record(key, type_name, payload)
 
         run_inproc(sc, tap=both)
-    summary = build_summary(load_run(path), sc, sc.name)
+    summary = write_summary(path.parent, sc, "inproc", 1.0, "completed")
+    write_report(path.parent, sc)
     return got["FdirWindow"], got["FaultReport"], summary
 
 
@@ -74,3 +75,13 @@ def test_summary_scores_the_run(fdir_run: Run) -> None:
     assert link["isolated"] and link["identified_class"] == "link" and link["identified_correctly"]
     assert link["latency_s"] == 100.0  # two silent 50 s windows
     assert summary["scores"]["false_alarms"] == 0 and summary["scores"]["nominal_cycles"] >= 8
+
+
+def test_report_plots_metric_against_threshold(fdir_run: Run,
+                                               tmp_path_factory: pytest.TempPathFactory) -> None:
+    _, _, summary = fdir_run
+    out = next(tmp_path_factory.getbasetemp().glob("fdir*"))
+    report = (out / "report.md").read_text()
+    assert "## FDIR" in report and (out / "fdir.png").stat().st_size > 10_000
+    assert "| camera_degradation | 2 | 0 | yes | yes |" in report
+    assert f"False alarms: 0 in {summary['scores']['nominal_cycles']} nominal" in report
