@@ -322,6 +322,8 @@ class FdirSettings(_Section):
     ``samples`` pointings within ``eps_deg`` of the planned one, floored at ``floor``; a fault
     is declared after ``persistence`` windows in a row over the threshold, and an observer
     whose observations stay missing for ``silent_windows`` windows is reported as a link fault.
+    A reported H_i off the ground's recomputation from the observer's own observations by more
+    than ``integrity_tol`` (relative) for ``persistence`` windows is a data-integrity fault.
     A window is evaluated ``latency_s`` after it closes (its last images must have arrived)."""
 
     samples: int = Field(default=10, ge=1, le=1000)
@@ -330,6 +332,10 @@ class FdirSettings(_Section):
     persistence: int = Field(default=2, ge=1)
     silent_windows: int = Field(default=2, ge=1)
     latency_s: float = Field(default=3.0, ge=0.0)
+    integrity_tol: float = Field(
+        default=0.2, gt=0.0,
+        description="relative difference between a reported H_i and the ground's recomputation "
+                    "beyond which the report is inconsistent (data integrity)")
 
 
 class SimSettings(_Section):

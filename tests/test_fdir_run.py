@@ -1,6 +1,7 @@
 """The ground FDIR in a real (in-process) run: a degraded camera is detected and isolated with
-the metric at 1 − β (Eq. 21), the healthy observers stay far below the threshold, and a
-spacecraft whose link is cut is reported as a link fault, not as a performance fault."""
+the metric at 1 − β (Eq. 21), the healthy observers stay far below the threshold, a
+spacecraft whose link is cut is reported as a link fault, not as a performance fault, and one
+that reports a corrupted H_i as a data-integrity fault."""
 
 from __future__ import annotations
 
@@ -25,7 +26,8 @@ def fdir_run(tmp_path_factory: pytest.TempPathFactory
         observers={"count": 3, "initial_attitude": "lvlh"},
         faults=[{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0,
                  "magnitude": 0.5},
-                {"spacecraft": 3, "kind": "link_loss", "start_s": 200.0, "end_s": 300.0}])
+                {"spacecraft": 3, "kind": "link_loss", "start_s": 200.0, "end_s": 300.0},
+                {"spacecraft": 1, "kind": "faulty_data", "start_s": 150.0, "magnitude": 2.0}])
     tap, got = collector(FdirWindow, FaultReport)
     path = tmp_path_factory.mktemp("fdir") / "run.mcap"
     with McapRecorder(path, {}) as rec:
@@ -52,7 +54,7 @@ def test_camera_fault_detected_and_isolated(fdir_run: Run) -> None:
     healthy = [w for w in judged if w.spacecraft != 2]
     assert healthy and all(not w.exceeded for w in healthy)
     assert max(w.metric for w in healthy if w.metric is not None) < 0.01
-    perf = [r for r in reports if r.fault_class != "link"]
+    perf = [r for r in reports if r.fault_class not in ("link", "data_integrity")]
     assert [r.spacecraft for r in perf] == [2]  # declared once, on the faulty one only
 
 
@@ -69,12 +71,14 @@ def test_silent_spacecraft_is_a_link_fault(fdir_run: Run) -> None:
 def test_summary_scores_the_run(fdir_run: Run) -> None:
     _, reports, summary = fdir_run
     assert len(summary["detections"]) == len(reports)
-    cam, link = summary["scores"]["per_fault"]
+    cam, link, data = summary["scores"]["per_fault"]
     assert cam["detected"] and cam["isolated"] and cam["spacecraft"] == 2
     assert cam["latency_s"] == min(r.t_sim for r in reports if r.spacecraft == 2)
     assert link["isolated"] and link["identified_class"] == "link" and link["identified_correctly"]
     assert link["latency_s"] == 100.0  # two silent 50 s windows
-    assert summary["scores"]["false_alarms"] == 0 and summary["scores"]["nominal_cycles"] >= 8
+    assert data["isolated"] and data["identified_class"] == "data_integrity"
+    assert data["latency_s"] == 50.0  # reports at 150 and 200 s inconsistent: persistence 2
+    assert summary["scores"]["false_alarms"] == 0 and summary["scores"]["nominal_cycles"] >= 4
 
 
 def test_report_plots_metric_against_threshold(fdir_run: Run,

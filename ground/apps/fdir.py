@@ -18,7 +18,10 @@ closes.  For observer i, with ψ the squared fused variance of the ground's map 
   ones (Eq. 11-12) with the floor ``fdir.floor``, direction by Table 3;
 * a fault is declared after ``fdir.persistence`` exceedances in a row (``Persistence``); an
   observer with a plan whose images stay missing for ``fdir.silent_windows`` windows is
-  declared a link fault — missing data is never read as zero information gain.
+  declared a link fault — missing data is never read as zero information gain;
+* the H_i an observer reports (``InfoCostTelemetry``) is checked against the ground's
+  recomputation from its observations: inconsistent for ``fdir.persistence`` windows, a
+  data-integrity fault.
 
 Only lost images are missing from both sides of the comparison; images taken while the
 observer reports a slew (its attitude plan, not a pointing) are left out of both; a window
@@ -55,6 +58,7 @@ from interfaces.messages import (
     AttitudeEstimate,
     FaultReport,
     FdirWindow,
+    InfoCostTelemetry,
     PoiObservations,
     ProAssignments,
     TransferPlanMsg,
@@ -96,6 +100,8 @@ class FdirApp(App):
         Input(lambda c: topics.assignments(c.mission), ProAssignments, "on_assignments"),
         Input(lambda c: topics.all_spacecraft(c.mission, "attitude", "estimate"),
               AttitudeEstimate, "on_attitude"),
+        Input(lambda c: topics.all_spacecraft(c.mission, "infocost", "telemetry"),
+              InfoCostTelemetry, "on_telemetry"),
     )
     OUTPUTS = (
         Output("window", lambda c: topics.key(c.mission, c.node, "fdir", "window"), FdirWindow),
@@ -116,6 +122,8 @@ class FdirApp(App):
         self.pending: list[PoiObservations] = []
         self.observers = {i: _Observer() for i in range(1, sc.observers.count + 1)}
         self.persistence = Persistence(self.cfg.persistence)
+        self.integrity = Persistence(self.cfg.persistence)
+        self._reported: dict[tuple[int, float], float] = {}  # (observer, t) -> reported H_i
         self.window_start = 0.0
         self._transfers: dict[tuple[int, int], Transfer] = {}
 
@@ -134,6 +142,10 @@ class FdirApp(App):
         plan = obs.plans.get(msg.assignment_id)
         if plan is not None:
             obs.plans[msg.assignment_id] = FlightPlan(plan.t_from_s, plan.pro, tr)
+
+    def on_telemetry(self, msg: InfoCostTelemetry) -> None:
+        if msg.spacecraft in self.observers and msg.t_sim >= self.window_start:
+            self._reported[(msg.spacecraft, round(msg.t_sim, 6))] = msg.h_i
 
     def on_attitude(self, msg: AttitudeEstimate) -> None:
         obs = self.observers.get(msg.spacecraft)
@@ -168,6 +180,27 @@ class FdirApp(App):
         for m in inside:
             self.settled.add(m.spacecraft, m.poi, m.precision)
         self.pending = [m for m in self.pending if m.image_t_s >= b]
+        self._check_reports(b)
+
+    def _check_reports(self, b: float) -> None:
+        """Data integrity: each observer's H_i reported at b against the contribution the
+        ground computes from the observations it received (its map now holds every image
+        before b).  The two views differ only by what each has fused (range-limited sharing),
+        so a relative difference above ``fdir.integrity_tol`` is an inconsistent report."""
+        ground = self.settled.contributions()
+        for sc in self.observers:
+            reported = self._reported.pop((sc, round(b, 6)), None)
+            mine = float(ground[sc - 1])
+            if reported is None or mine <= 0.0:
+                continue
+            deviation = abs(reported / mine - 1.0)
+            if self.integrity.update(sc, deviation > self.cfg.integrity_tol):
+                self.log.warning("FDIR: sc%d reports H_i %.4g, observations give %.4g: "
+                                 "data integrity", sc, reported, mine)
+                self.publish("report", FaultReport(
+                    sender=self.ctx.node, t_sim=b, spacecraft=sc, fault_class="data_integrity",
+                    metric=deviation, threshold=self.cfg.integrity_tol, window_end_s=b))
+        self._reported = {k: v for k, v in self._reported.items() if k[1] > b}
 
     def _judge(self, sc: int, obs: _Observer, images: list[PoiObservations], a: float,
                b: float, psi: np.ndarray, phi: np.ndarray) -> None:
