@@ -215,7 +215,8 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -
     fig.tight_layout()
     fig.savefig(out / "fdir.png", dpi=110)
     plt.close(fig)
-    rows = ["## FDIR", "", "![fdir](fdir.png)", "",
+    _gain_plot(out, judged, ids)
+    rows = ["## FDIR", "", "![fdir](fdir.png)", "", "![fdir gain](fdir_gain.png)", "",
             "| fault | spacecraft | onset (s) | detected | isolated | latency (s) | class |",
             "|---|---|---|---|---|---|---|"]
     scores = summary.get("scores", {})
@@ -227,6 +228,30 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -
     rows += ["", f"False alarms: {scores.get('false_alarms', 0)} in "
                  f"{scores.get('nominal_cycles', 0)} nominal FDI cycles.", ""]
     return rows
+
+
+def _gain_plot(out: Path, judged: list[FdirWindow], ids: list[int]) -> None:
+    """Per observer, the information it actually brought (Σ ΔH_i over the judged windows)
+    against what its nominal twin predicted for the same images (Σ ΔH_i^pred), as the paper's
+    Fig. 23-26, left."""
+    fig, ax = plt.subplots(figsize=(10, 4))
+    for k, sc in enumerate(ids):
+        mine = [w for w in judged if w.spacecraft == sc and w.dh is not None
+                and w.dh_pred is not None]
+        if not mine:
+            continue
+        t = [w.t_end_s for w in mine]
+        color = f"C{k % 10}"
+        ax.plot(t, np.cumsum([w.dh for w in mine]), "-", color=color, lw=1.2, label=f"sc{sc}")
+        ax.plot(t, np.cumsum([w.dh_pred for w in mine]), "--", color=color, lw=1.0)
+    ax.set_xlabel("sim time (s)")
+    ax.set_ylabel("Σ ΔH_i (solid) and Σ ΔH_i^pred (dashed)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.suptitle("Information brought by each observer against its nominal twin")
+    fig.tight_layout()
+    fig.savefig(out / "fdir_gain.png", dpi=110)
+    plt.close(fig)
 
 
 def _links_section(summary: dict) -> list[str]:

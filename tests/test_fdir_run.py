@@ -87,5 +87,6 @@ def test_report_plots_metric_against_threshold(fdir_run: Run,
     out = next(tmp_path_factory.getbasetemp().glob("fdir*"))
     report = (out / "report.md").read_text()
     assert "## FDIR" in report and (out / "fdir.png").stat().st_size > 10_000
+    assert "fdir_gain.png" in report and (out / "fdir_gain.png").stat().st_size > 10_000
     assert "| camera_degradation | 2 | 0 | yes | yes |" in report
     assert f"False alarms: 0 in {summary['scores']['nominal_cycles']} nominal" in report
