@@ -6,8 +6,9 @@ own ``numpy.random.Generator`` (``rngs[i]`` for spacecraft i), and each generato
 same number of times every tick whatever the command, so one spacecraft's noise never depends on
 the others' or on its own command history.
 
-Fault hooks (written by fault injection, read every tick): ``ThrusterBank.bias_n`` and
-``WheelArray.torque_scale`` / ``WheelArray.torque_bias_nm``.
+Fault hooks (written by fault injection, read every tick): ``WheelArray.torque_scale`` /
+``WheelArray.torque_bias_nm``.  A thruster leak acts whether or not the thrusters fire, so it
+lives in ``sim.hardware.ObserverHardware.force_bias_body``, not here.
 """
 
 from __future__ import annotations
@@ -66,13 +67,10 @@ class ThrusterBank:
        ``mib_rounding="nearest"`` -- ``I < MIB/2`` is not fired, ``MIB/2 <= I < MIB`` fires one
        MIB (``|F| = MIB/dt``, capped at f_max), ``I >= MIB`` as commanded;
     3. multiplicative noise on each fired axis: ``F *= max(0, 1 + noise_frac * e)``,
-       e ~ N(0, 1) (three draws per spacecraft per tick, fired or not);
-    4. additive bias (fault hook, body axes, N, not clipped): ``F += bias_n``.
+       e ~ N(0, 1) (three draws per spacecraft per tick, fired or not).
 
     Accounting per spacecraft: ``impulse_ns`` += sum over axes of ``|F_realised| dt`` (the
-    propellant-relevant total impulse, bias included: a leaking valve spends propellant) and
-    ``pulses`` += number of axes fired by command in the tick (the bias does not count as a
-    pulse).
+    propellant-relevant total impulse) and ``pulses`` += number of axes fired in the tick.
     """
 
     def __init__(
@@ -104,7 +102,6 @@ class ThrusterBank:
         self._rounding = mib_rounding
         self._rngs = as_generators(rngs)
         n = len(self._rngs)
-        self._bias: FloatArray = np.zeros((n, 3))
         self._impulse: FloatArray = np.zeros(n)
         self._pulses: IntArray = np.zeros(n, dtype=np.int64)
 
@@ -128,28 +125,6 @@ class ThrusterBank:
         """Number of commanded axis firings so far per spacecraft (N,)."""
         return self._pulses.copy()
 
-    @property
-    def bias_n(self) -> FloatArray:
-        """Additive force bias per spacecraft, body axes (N, 3), N (fault hook; a copy)."""
-        return self._bias.copy()
-
-    @bias_n.setter
-    def bias_n(self, value: npt.ArrayLike) -> None:
-        self._bias = _rows("bias_n", value, self.n)
-
-    def set_bias_fraction(self, index: int, fraction: float, direction_body: npt.ArrayLike) -> None:
-        """Set spacecraft ``index``'s bias to ``fraction`` of the maximum thrust along a direction.
-
-        The bias is ``fraction * f_max * u`` (element-wise per axis) with ``u`` the unit vector of
-        ``direction_body`` -- the scenario's ``thruster_bias`` magnitude.  ``fraction = 0``
-        clears it.
-        """
-        d = np.array(direction_body, dtype=float)
-        norm = float(np.linalg.norm(d)) if d.shape == (3,) else 0.0
-        if not (math.isfinite(fraction) and math.isfinite(norm) and norm > 0.0):
-            raise ValueError("need a finite fraction and a non-zero finite (3,) direction")
-        self._bias[index] = fraction * self._f_max * d / norm
-
     def fire(self, force_cmd_body: npt.ArrayLike, dt: float) -> FloatArray:
         """Realise one tick of commanded body forces.
 
@@ -171,7 +146,7 @@ class ThrusterBank:
             fired = impulse >= self._mib
         fired &= f != 0.0
         e = np.stack([g.standard_normal(3) for g in self._rngs])
-        f = np.where(fired, f * np.maximum(0.0, 1.0 + self._noise * e), 0.0) + self._bias
+        f = np.where(fired, f * np.maximum(0.0, 1.0 + self._noise * e), 0.0)
         self._impulse += np.abs(f).sum(axis=1) * dt
         self._pulses += fired.sum(axis=1)
         return f

@@ -55,19 +55,14 @@ class FaultSwitch:
     detail: dict[str, list[float] | float]
 
 
-def _unit_perpendicular(rng: np.random.Generator, axis: np.ndarray) -> np.ndarray:
-    """A random unit vector perpendicular to ``axis`` (unit)."""
+def _random_unit(rng: np.random.Generator, perpendicular_to: np.ndarray | None = None
+                 ) -> np.ndarray:
+    """A random unit vector (uniform on the sphere, or on the circle perpendicular to the unit
+    vector ``perpendicular_to``)."""
     while True:
         v = rng.standard_normal(3)
-        v -= (v @ axis) * axis
-        norm = float(np.linalg.norm(v))
-        if norm > 1e-6:
-            return v / norm
-
-
-def _unit(rng: np.random.Generator) -> np.ndarray:
-    while True:
-        v = rng.standard_normal(3)
+        if perpendicular_to is not None:
+            v -= (v @ perpendicular_to) * perpendicular_to
         norm = float(np.linalg.norm(v))
         if norm > 1e-6:
             return v / norm
@@ -106,20 +101,20 @@ class FaultInjector:
         boresight /= np.linalg.norm(boresight)
         mag = float(f.magnitude or 0.0)
         if f.kind == "thruster_bias":
-            d = _unit(rng)
+            d = _random_unit(rng)
             return {"direction_body": d.tolist(),
                     "force_body_n": (mag * sc.actuators.thruster_max_force_n * d).tolist()}
         if f.kind == "pointing_actuator":
-            axis = _unit_perpendicular(rng, boresight)
+            axis = _random_unit(rng, boresight)
             kp = gains_for(sc.attitude.settling_time_s).kp
             torque = np.array(sc.observers.inertia_kg_m2) * axis * kp * math.radians(mag) / 2.0
             return {"axis_body": axis.tolist(), "torque_bias_nm": torque.tolist()}
         if f.kind == "camera_misalignment":
-            axis = _unit_perpendicular(rng, boresight)
+            axis = _random_unit(rng, boresight)
             return {"axis_body": axis.tolist(),
                     "rotation_xyzw": _axis_angle_quat(axis, math.radians(mag)).tolist()}
         if f.kind == "nav_sensor_bias":
-            d = _unit(rng)
+            d = _random_unit(rng)
             return {"direction_lvlh": d.tolist(), "bias_lvlh_m": (mag * d).tolist()}
         return {"magnitude": mag} if f.magnitude is not None else {}
 

@@ -66,20 +66,6 @@ def test_thruster_noise_statistics_and_per_spacecraft_streams() -> None:
         np.testing.assert_array_equal(alone.fire(cmd[:1], DT)[0], crowd.fire(other, DT)[0])
 
 
-def test_thruster_bias_hook() -> None:
-    f_max = np.array([1.0, 2.0, 1.0])
-    bank = ThrusterBank(f_max_n=f_max, min_impulse_ns=1e-3, noise_frac=0.0, rngs=_rngs(3))
-    bank.set_bias_fraction(1, 0.1, [1.0, 1.0, 0.0])
-    expected = 0.1 * f_max * np.array([1.0, 1.0, 0.0]) / math.sqrt(2.0)
-    f = bank.fire(np.zeros((3, 3)), DT)
-    np.testing.assert_allclose(f[1], expected, rtol=1e-15)
-    np.testing.assert_array_equal(f[[0, 2]], 0.0)
-    np.testing.assert_allclose(bank.impulse_ns, [0.0, np.abs(expected).sum() * DT, 0.0], rtol=1e-15)
-    np.testing.assert_array_equal(bank.pulses, [0, 0, 0])  # a leak is not a commanded pulse
-    bank.bias_n = np.zeros(3)
-    np.testing.assert_array_equal(bank.fire(np.zeros((3, 3)), DT), 0.0)
-
-
 def test_accel_lvlh_closed_form_rotations() -> None:
     # Body x along LVLH y (90° about z), body x along LVLH -z (90° about y).
     rot = Rotation.from_rotvec([[0.0, 0.0, math.pi / 2], [0.0, math.pi / 2, 0.0]])

@@ -75,6 +75,11 @@ class _Observer:
     silent: int = 0
     link_declared: bool = False
 
+    def forget_modes_before(self, t: float) -> None:
+        """Drop mode changes no later window needs (keep the one in force at t)."""
+        i = bisect.bisect_right(self.modes, (t, "~")) - 1
+        del self.modes[:max(i, 0)]
+
     def tracking_at(self, t: float) -> bool:
         """Whether the last reported attitude mode at or before t is ``track``."""
         i = bisect.bisect_right(self.modes, (t, "~")) - 1
@@ -130,8 +135,12 @@ class FdirApp(App):
     # --- inputs ---------------------------------------------------------------------------
 
     def on_observations(self, msg: PoiObservations) -> None:
-        if msg.spacecraft in self.observers and msg.image_t_s >= self.window_start:
+        if msg.spacecraft not in self.observers:
+            return
+        if msg.image_t_s >= self.window_start:
             self.pending.append(msg)
+        else:  # too late for its window's verdict, not for the ground's map
+            self.settled.add(msg.spacecraft, msg.poi, msg.precision)
 
     def on_transfer(self, msg: TransferPlanMsg) -> None:
         if msg.spacecraft not in self.observers or len(msg.t_s) < 2:
@@ -176,7 +185,7 @@ class FdirApp(App):
         for sc, obs in self.observers.items():
             mine = sorted((m for m in inside if m.spacecraft == sc), key=lambda m: m.image_t_s)
             self._judge(sc, obs, mine, a, b, psi, phi)
-            obs.modes = obs.modes[-1:] if obs.modes and obs.modes[-1][0] < b else obs.modes
+            obs.forget_modes_before(b)
         for m in inside:
             self.settled.add(m.spacecraft, m.poi, m.precision)
         self.pending = [m for m in self.pending if m.image_t_s >= b]
