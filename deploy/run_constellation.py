@@ -3,10 +3,14 @@ recorder as separate OS processes over Zenoh (default), or all in one process (-
 
     python deploy/run_constellation.py [--scenario deploy/scenarios/default.toml] --out runs/x
         [--transport zenoh|inproc] [--seed N] [--duration S] [--realtime SPEED]
+        [--compare-recovery]
 
 Writes <out>/run.mcap (every bus message, JSON schemas; opens in Foxglove), <out>/summary.json,
 <out>/report.md with PNG plots, and <out>/logs/ (one log per process).  While it runs, any Zenoh
 client can connect to the endpoint (default tcp/127.0.0.1:7447) and subscribe to insp/**.
+With --compare-recovery the same scenario and seed is run a second time, in-process, with the
+ground's fault recovery switched the other way ([fdir] recovery), into <out>/counterfactual/,
+and summary.json's ``recovery`` section compares the final H of the two.
 Exits 0 on success; non-zero, with the reason, if a process dies or the run cannot start.
 """
 
@@ -28,7 +32,7 @@ from deploy.processes import Child, Supervisor  # noqa: E402
 from ground.record import run_metadata  # noqa: E402
 from ground.recorder import McapRecorder  # noqa: E402
 from ground.report import write_report  # noqa: E402
-from ground.summary import write_summary  # noqa: E402
+from ground.summary import add_recovery_comparison, write_summary  # noqa: E402
 from interfaces import topics  # noqa: E402
 from interfaces.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
@@ -51,6 +55,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help=f"Zenoh endpoint the constellation listens on (default {DEFAULT_ENDPOINT})")
     p.add_argument("--mission", help="key-space name (default: scenario name)")
     p.add_argument("--no-report", action="store_true", help="skip report.md and plots")
+    p.add_argument("--compare-recovery", action="store_true",
+                   help="also run the scenario with [fdir] recovery flipped (in-process) and "
+                        "compare final H in summary.json")
     p.add_argument("--log-level", default="INFO")
     return p.parse_args(argv)
 
@@ -88,6 +95,8 @@ def main(argv: list[str] | None = None) -> int:
     wall_s = time.monotonic() - wall0
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
                             status=status, error=error)
+    if args.compare_recovery and status == "completed":
+        summary = _compare_recovery(scenario, mission, out, scenario_text, args, summary)
     if not args.no_report:
         write_report(out, scenario)
     rtf = summary.get("real_time_factor")
@@ -108,6 +117,21 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
     with McapRecorder(out / "run.mcap", run_metadata(scenario, "inproc", scenario_text)) as rec:
         run_inproc(scenario, mission, tap=rec.record)
     return "completed", None
+
+
+def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text: str,
+                      args: argparse.Namespace, summary: dict) -> dict:
+    """Run the counterfactual (recovery flipped) in-process and add the comparison."""
+    flipped = scenario.model_copy(update={"fdir": scenario.fdir.model_copy(
+        update={"recovery": not scenario.fdir.recovery})})
+    other = out / "counterfactual"
+    other.mkdir(exist_ok=True)
+    log.info("counterfactual run: recovery %s", "on" if flipped.fdir.recovery else "off")
+    wall0 = time.monotonic()
+    status, error = _run_inproc(flipped, mission, other, scenario_text, args)
+    counter = write_summary(other, flipped, transport="inproc", wall_s=time.monotonic() - wall0,
+                            status=status, error=error)
+    return add_recovery_comparison(out, summary, counter, scenario.fdir.recovery)
 
 
 def _run_zenoh(scenario: Scenario, mission: str, out: Path,

@@ -12,6 +12,15 @@ if its expected gain beats keeping the current one by ``min_improvement`` (a tra
 fuel and time).  Every decision is kept with its figures (expected gain, online bound) for the
 archive.
 
+Recovery (:meth:`MissionPlan.recover`, on a fault the FDIR has identified): an observer whose
+camera failed is dropped from the inspection task -- it stays on its PRO, untasked -- and the
+healthy ones are reassigned by expected gain around it (its PRO kept clear by the separation
+rule, the coverage it still brings counted); an observer with an actuator fault gets a PRO it
+can still hold: one whose minimum distance from the target leaves room for the deviation the
+FDIR measured (twice it, beyond the keep-out), or, for a pointing fault of θ, keeps the whole
+target in a camera of half-angle α (distance ≥ R / sin(α − θ); the farthest candidate when none
+does).
+
 Pure logic: no bus, no I/O; the planner app feeds it time and the fused POI map.
 Units: s, m, rad; gains in information-cost units (H decrease).
 """
@@ -27,7 +36,7 @@ import numpy.typing as npt
 from fsw.lib.hcw import mean_motion
 from fsw.lib.infocost import Camera
 from fsw.lib.poi_map import PoiMap
-from fsw.lib.pro import Pro
+from fsw.lib.pro import Pro, min_distance_between, min_distance_to_origin
 from ground.orbit_assignment import (
     expected_precision,
     gain_saturated,
@@ -130,6 +139,8 @@ class MissionPlan:
         self._last_check: tuple[float, float] | None = None  # (time s, H) of the last check
         self._info_phase = ""
         self._reassignments = 0
+        self.dropped: set[int] = set()  # observers untasked (failed camera)
+        self.impaired: dict[int, float] = {}  # observer -> keep-out it needs (actuator), m
         if sc.observers.start == "pro":
             self._issue("initial", {i: elements(Pro(*sc.observers.pro(i)))
                                     for i in range(1, self.count + 1)}, 0.0, 0.0)
@@ -225,6 +236,85 @@ class MissionPlan:
                     t_depart, t_arrive)
         self._current_indices = per_observer
 
+    def recover(self, t: float, spacecraft: int, fault_class: str | None,
+                evidence: dict[str, float], fused: PoiMap) -> bool:
+        """Replan after a fault identified on ``spacecraft`` (module docstring).  ``evidence``:
+        the FDIR's (``nav_vs_plan_m``, ``pointing_error_deg``).  Returns whether a new
+        assignment was issued (once per observer and class; link, state-sensor and
+        data-integrity faults are not replanned)."""
+        if self.current is None or not 1 <= spacecraft <= self.count:
+            return False
+        if fault_class == "camera" and spacecraft not in self.dropped:
+            self.dropped.add(spacecraft)
+        elif fault_class == "actuator" and spacecraft not in self.impaired:
+            self.impaired[spacecraft] = self._holdable_keep_out(evidence)
+        else:
+            return False
+        if len(self.dropped) >= self.count:
+            return False
+        a = self.scenario.assignment
+        t_depart = t + UPLINK_LEAD_S
+        t_arrive = t_depart + a.transfer_s
+        k = self._stride
+        w_now = (fused.w_inv + fused.F.sum(axis=0))[::k]
+        phi = fused.phi[::k] * k
+        cur = self.current.pros
+        fixed = {i: cur[i] for i in sorted(self.dropped)}
+        chosen: dict[int, int] = {}  # observer -> library index
+        gain = bound = 0.0
+        groups = [[i for i in sorted(self.impaired) if i not in self.dropped],
+                  [i for i in range(1, self.count + 1)
+                   if i not in self.dropped and i not in self.impaired]]
+        for group in groups:
+            if not group:
+                continue
+            keep_out = max([self.scenario.guidance.keep_out_m + a.keep_out_margin_m]
+                           + [self.impaired.get(i, 0.0) for i in group])
+            around = [_pro(e) for e in fixed.values()] + [self.library[j] for j in chosen.values()]
+            picks, g, ub = self._greedy_around(len(group), around, keep_out, t_arrive, w_now, phi)
+            states = self._states_at(t_depart)[[i - 1 for i in group]]
+            order = match_to_observers(states, [self.library[j] for j in picks], self.n, t_depart)
+            chosen.update({sc: picks[j] for sc, j in zip(group, order)})
+            gain, bound = gain + g, bound + ub
+        pros = {**fixed, **{i: elements(self.library[j]) for i, j in chosen.items()}}
+        name = f"recovery-{len(self.dropped) + len(self.impaired)}"
+        self.decisions.append(Decision(
+            t, name, "recovery", tuple(chosen.get(i, -1) for i in range(1, self.count + 1)),
+            gain, max(bound, gain), None, tuple(self._gains), True))
+        self._issue(name, dict(sorted(pros.items())), t_depart, t_arrive)
+        self._current_indices = None  # a recovery set is not re-optimised as a whole
+        return True
+
+    def _holdable_keep_out(self, evidence: dict[str, float]) -> float:
+        """The keep-out an actuator-impaired observer needs, m (``recover``)."""
+        sc = self.scenario
+        base = sc.guidance.keep_out_m + sc.assignment.keep_out_margin_m
+        need = base + 2.0 * evidence.get("nav_vs_plan_m", 0.0)
+        theta = math.radians(evidence.get("pointing_error_deg", 0.0))
+        half = math.radians(sc.camera.half_angle_deg)
+        if theta > math.radians(sc.fdir.pointing_tol_deg):
+            fit = sc.target.radius_m / math.sin(half - theta) if half > theta else math.inf
+            need = max(need, fit)
+        farthest = max(min_distance_to_origin(p, self.n)[0] for p in self.library)
+        return min(need, farthest)
+
+    def _greedy_around(self, count: int, around: list[Pro], keep_out: float, t_arrive: float,
+                       w_now: npt.NDArray[np.float64], phi: npt.NDArray[np.float64]
+                       ) -> tuple[list[int], float, float]:
+        """Greedy set of ``count`` library PROs clear of the PROs ``around`` (separation) and
+        of ``keep_out``, counting the coverage those bring: (library indices, gain, bound)."""
+        a = self.scenario.assignment
+        free = [i for i, p in enumerate(self.library)
+                if all(min_distance_between(p, q, self.n)[0] >= a.min_separation_m
+                       for q in around)]
+        w = w_now + sum((expected_precision(q, self.n, t_arrive, a.window_s, a.samples,
+                                            self._plan_pos, self._plan_normal, self.camera)
+                         for q in around), np.zeros_like(w_now))
+        choice = greedy_assignment([self.library[i] for i in free], count, self.n, t_arrive,
+                                   a.window_s, a.samples, self._plan_pos, self._plan_normal,
+                                   phi, w, self.camera, a.min_separation_m, keep_out)
+        return [free[j] for j in choice.indices], choice.gain, choice.upper_bound
+
     def _states_at(self, t: float) -> npt.NDArray[np.float64]:
         """Where the plan has each observer at ``t``: on its current PRO (the target centre
         before any assignment, i.e. right after deployment)."""
@@ -235,6 +325,9 @@ class MissionPlan:
         for i in range(self.count):
             e = cur.pros.get(i + 1)
             if e is not None:
-                out[i] = Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m,
-                             e.alpha_z_rad).state(self.n, t)
+                out[i] = _pro(e).state(self.n, t)
         return out
+
+
+def _pro(e: ProElements) -> Pro:
+    return Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 
+from ground.apps.baselines import BaselinesApp
 from ground.apps.fdir import FdirApp
 from ground.apps.planner import MissionPlanner
 from ground.apps.telemetry import TelemetryMonitor
@@ -14,7 +15,7 @@ from interfaces.executive import Executive
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
 
-APPS: tuple[type[App], ...] = (MissionPlanner, TelemetryMonitor, FdirApp)
+APPS: tuple[type[App], ...] = (MissionPlanner, TelemetryMonitor, FdirApp, BaselinesApp)
 
 
 def ground_executive(bus: Bus, scenario: Scenario) -> Executive:

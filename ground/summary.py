@@ -14,6 +14,7 @@ from ground.gnc_evaluation import gnc_series, gnc_summary
 from ground.reader import ArchiveError, RunArchive, load_run
 from interfaces import topics
 from interfaces.messages import (
+    BaselineVerdict,
     ExecStats,
     FaultEvent,
     FaultReport,
@@ -68,10 +69,28 @@ def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[
               if w.exceeded is not None]
     return {
         "detections": [{"spacecraft": r.spacecraft, "time_s": r.t_sim, "class": r.fault_class,
-                        "direction": r.direction, "metric": r.metric, "threshold": r.threshold}
+                        "direction": r.direction, "metric": r.metric, "threshold": r.threshold,
+                        "evidence": r.evidence}
                        for r in reports],
         "scores": score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
+        "baselines": baseline_scores(archive, scenario, mission),
     }
+
+
+def baseline_scores(archive: RunArchive, scenario: Scenario, mission: str
+                    ) -> dict[str, dict[str, Any]]:
+    """``baselines``: each baseline detector (ground/apps/baselines.py) scored like the main
+    one, from its per-window verdicts."""
+    verdicts = archive.messages(topics.key(mission, topics.GROUND, "fdir", "baseline"),
+                                BaselineVerdict)
+    out = {}
+    for name in sorted({v.detector for v in verdicts}):
+        mine = [v for v in verdicts if v.detector == name]
+        alarms = [Alarm(v.spacecraft, v.t_end_s, None) for v in mine if v.alarm]
+        judged = [Judged(v.spacecraft, v.t_start_s, v.t_end_s) for v in mine
+                  if v.exceeded is not None]
+        out[name] = score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s)
+    return out
 
 
 def _by_type(archive: RunArchive) -> dict[str, int]:
@@ -103,6 +122,33 @@ def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, 
         summary["real_time_factor"] = round(t_final / wall_s, 2) if wall_s > 0 else None
     except (ArchiveError, OSError) as e:
         summary["archive_error"] = str(e)
+    return _write_json(out, summary)
+
+
+def add_recovery_comparison(out: Path, summary: dict[str, Any], counter: dict[str, Any],
+                            recovery: bool) -> dict[str, Any]:
+    """Add ``recovery`` to ``<out>/summary.json``: the recovery actions of the run that had
+    recovery on, and the final H with and without recovery for the same scenario and seed
+    (``counter``: the summary of the same scenario with recovery flipped)."""
+    with_r, without = (summary, counter) if recovery else (counter, summary)
+
+    def final_h(s: dict[str, Any]) -> float | None:
+        return s.get("coverage", {}).get("H_final")
+
+    h_with, h_without = final_h(with_r), final_h(without)
+    summary["recovery"] = {
+        "enabled": recovery,
+        "actions": [d for d in with_r.get("coverage", {}).get("assignment_decisions", [])
+                    if d.get("reason") == "recovery"],
+        "H_final_with_recovery": h_with,
+        "H_final_without_recovery": h_without,
+        "H_final_ratio": h_with / h_without if h_with is not None and h_without else None,
+        "counterfactual": "counterfactual/summary.json",
+    }
+    return _write_json(out, summary)
+
+
+def _write_json(out: Path, summary: dict[str, Any]) -> dict[str, Any]:
     summary = _finite(summary)
     (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
     return summary

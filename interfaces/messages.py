@@ -172,8 +172,8 @@ class WheelCommand(Message):
 
 class StateEstimate(Message):
     """Navigation filter output: relative state [x, y, z, vx, vy, vz] (m, m/s, LVLH) and its 6x6
-    covariance; ``nis`` is the normalized innovation squared of the last update (chi-square, 6 dof).
-    """
+    covariance; ``nis`` is the normalized innovation squared of this step's measurement update
+    (chi-square, 6 dof), None when the step had none."""
 
     spacecraft: int = Field(ge=1)
     x: Vec6
@@ -244,23 +244,28 @@ class FdirWindow(Message):
     information gained by the images that reached the ground (ΔH_i, ψ held at the window start)
     against the nominal twin's prediction for the same images, the metric H_m,i (Eq. 9), the
     adaptive threshold τ_i (Eq. 11-12), the direction (Table 3) and whether it was exceeded
-    (None: no decision — no images, no plan, or a degenerate prediction)."""
+    (None: no decision — no images, no plan, or a degenerate prediction), with the
+    identification evidence (ground/fdir/identify.py ``Evidence``) and the observations lost
+    (sequence gaps)."""
 
     spacecraft: int = Field(ge=1)
     t_start_s: float
     t_end_s: float
     images: int = Field(ge=0)
+    lost: int = Field(default=0, ge=0, description="observations missing by sequence number")
     dh: float | None = None
     dh_pred: float | None = None
     metric: float | None = None
     threshold: float | None = None
     direction: Literal["improved", "degraded"] | None = None
     exceeded: bool | None = None
+    evidence: dict[str, float] = Field(default_factory=dict, max_length=32)
 
 
 class FaultReport(Message):
-    """A fault declared by the ground FDIR: the observer, its identified class (None until
-    identified), the direction, and the metric and threshold of the window that declared it."""
+    """A fault declared by the ground FDIR: the observer, its identified class (None: not
+    identified), the direction, the metric and threshold of the window that declared it, and
+    the evidence behind the class."""
 
     spacecraft: int = Field(ge=1)
     fault_class: Literal["actuator", "camera", "state_sensor", "link", "data_integrity"] | None
@@ -268,6 +273,22 @@ class FaultReport(Message):
     metric: float | None = None
     threshold: float | None = None
     window_end_s: float
+    evidence: dict[str, float] = Field(default_factory=dict, max_length=32)
+
+
+class BaselineVerdict(Message):
+    """A baseline detector's verdict on one observer over one FDI window [t_start_s, t_end_s)
+    (ground/fdir/baselines.py): its statistic against its threshold, whether that was exceeded
+    (None: no decision) and whether this window declared a fault (``alarm``)."""
+
+    detector: Literal["chi2_nis", "cusum", "fixed_threshold"]
+    spacecraft: int = Field(ge=1)
+    t_start_s: float
+    t_end_s: float
+    statistic: float | None = None
+    threshold: float | None = None
+    exceeded: bool | None = None
+    alarm: bool = False
 
 
 class AssignmentDecision(Message):
@@ -276,8 +297,9 @@ class AssignmentDecision(Message):
     PROs, the measured H decrease per check window that led to it, and whether it was flown."""
 
     phase: str = Field(max_length=64)
-    reason: Literal["phase", "saturated"]
-    library_indices: list[int] = Field(description="candidate PRO of observer 1, 2, ...")
+    reason: Literal["phase", "saturated", "recovery"]
+    library_indices: list[int] = Field(
+        description="candidate PRO of observer 1, 2, ... (-1: kept its PRO, dropped from the task)")
     expected_gain: float = Field(ge=0.0)
     upper_bound: float = Field(ge=0.0)
     ratio_bound: float = Field(ge=0.0, le=1.0, description="expected_gain / upper_bound")
@@ -454,6 +476,7 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     FaultEvent,
     FdirWindow,
     FaultReport,
+    BaselineVerdict,
     TransferPlanMsg,
     GuidanceStatus,
     PointingTarget,

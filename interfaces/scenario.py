@@ -323,8 +323,14 @@ class FdirSettings(_Section):
     is declared after ``persistence`` windows in a row over the threshold, and an observer
     whose observations stay missing for ``silent_windows`` windows is reported as a link fault.
     A reported H_i off the ground's recomputation from the observer's own observations by more
-    than ``integrity_tol`` (relative) for ``persistence`` windows is a data-integrity fault.
-    A window is evaluated ``latency_s`` after it closes (its last images must have arrived)."""
+    than ``integrity_tol`` (relative) for ``persistence`` windows is a data-integrity fault,
+    and more than ``loss_tol`` of its observations lost (sequence gaps) for ``persistence``
+    windows a link fault.  A window is evaluated ``latency_s`` after it closes (its last images
+    must have arrived).  A declared performance fault is identified (ground/fdir/identify.py)
+    against the nominal bounds ``beta_tol`` (camera health located from the images),
+    ``position_tol_m`` (camera from the images vs nav, nav vs plan), ``pointing_tol_deg``
+    (reported pointing error), ``overlap_tol`` (seen vs expected POIs) and ``explained_min``
+    (share of the ΔH gap the reported pose must explain)."""
 
     samples: int = Field(default=10, ge=1, le=1000)
     eps_deg: float = Field(default=1.0, gt=0.0, lt=45.0)
@@ -332,10 +338,28 @@ class FdirSettings(_Section):
     persistence: int = Field(default=2, ge=1)
     silent_windows: int = Field(default=2, ge=1)
     latency_s: float = Field(default=3.0, ge=0.0)
+    settle_s: float = Field(default=30.0, ge=0.0,
+                            description="images this soon after a slew are not judged")
+    recovery: bool = Field(default=True, description="replan on an identified camera or "
+                                                     "actuator fault (ground/mission_plan.py)")
     integrity_tol: float = Field(
         default=0.2, gt=0.0,
         description="relative difference between a reported H_i and the ground's recomputation "
                     "beyond which the report is inconsistent (data integrity)")
+    loss_tol: float = Field(default=0.2, gt=0.0, le=1.0,
+                            description="fraction of observations lost in a window")
+    beta_tol: float = Field(default=0.1, gt=0.0, lt=1.0)
+    position_tol_m: float = Field(default=0.5, gt=0.0)
+    pointing_tol_deg: float = Field(default=1.0, gt=0.0)
+    overlap_tol: float = Field(default=0.8, gt=0.0, le=1.0)
+    explained_min: float = Field(default=0.5, gt=0.0, le=1.0)
+    nis_alpha: float = Field(default=1e-3, gt=0.0, lt=1.0,
+                             description="baseline chi2_nis: false-alarm probability per window")
+    cusum_drift: float = Field(default=0.02, ge=0.0,
+                               description="baseline cusum: allowed |1 - ΔH_i/ΔH_i^pred| per window")
+    cusum_threshold: float = Field(default=0.15, gt=0.0, description="baseline cusum: alarm level")
+    fixed_threshold: float = Field(default=0.1, gt=0.0,
+                                   description="baseline fixed_threshold: H_m,i alarm level")
 
 
 class SimSettings(_Section):

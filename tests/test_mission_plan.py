@@ -12,7 +12,7 @@ import numpy as np
 
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
-from fsw.lib.pro import Pro
+from fsw.lib.pro import Pro, min_distance_between, min_distance_to_origin
 from ground.mission_plan import UPLINK_LEAD_S, MissionPlan
 from ground.orbit_assignment import expected_precision, greedy_assignment
 from interfaces.scenario import Scenario
@@ -180,3 +180,49 @@ def test_poi_subsample_evaluates_every_kth_poi_with_scaled_importance() -> None:
     full.update(600.0 - UPLINK_LEAD_S, fused)
     # the subsample estimates the full expected gain (uniform Fibonacci subsample)
     assert math.isclose(d.expected_gain, full.decisions[0].expected_gain, rel_tol=0.1)
+
+
+def test_recovery_drops_a_failed_camera_and_reassigns_around_it() -> None:
+    sc = _scenario([])
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    _fly(plan, fused, 0.0, 400.0)
+    before = plan.current
+    assert before is not None
+    assert plan.recover(400.0, 2, "camera", {"beta_hat": 0.5}, fused)
+    after = plan.current
+    assert after is not None and after.id == before.id + 1
+    assert after.t_depart_s == 400.0 + UPLINK_LEAD_S
+    assert after.pros[2] == before.pros[2]  # untasked, stays on its PRO
+    sep = sc.assignment.min_separation_m
+    for i in (1, 3):
+        p = _pro(after.pros[i])
+        assert p in plan.library
+        assert min_distance_between(p, _pro(after.pros[2]), plan.n)[0] >= sep
+    assert min_distance_between(_pro(after.pros[1]), _pro(after.pros[3]), plan.n)[0] >= sep
+    d = plan.decisions[-1]
+    assert d.reason == "recovery" and d.library_indices[1] == -1 and d.switched
+    assert not plan.recover(500.0, 2, "camera", {}, fused)  # once per observer and class
+    assert not plan.recover(500.0, 1, "state_sensor", {}, fused)  # not replanned
+    assert not plan.recover(500.0, 1, "link", {}, fused)
+
+
+def test_recovery_gives_an_actuator_fault_a_pro_it_can_hold() -> None:
+    """A 5° pointing fault with a 20° camera: the whole 5 m target stays in view from
+    R / sin(15°) = 19.3 m; a thruster leak that pushed the observer 3 m off needs the keep-out
+    plus twice that.  Every other observer keeps the normal keep-out."""
+    sc = _scenario([])
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    assert plan.recover(100.0, 1, "actuator", {"pointing_error_deg": 5.0}, fused)
+    need = 5.0 / math.sin(math.radians(15.0))
+    assert plan.impaired[1] == need
+    assert min_distance_to_origin(_pro(plan.current.pros[1]), plan.n)[0] >= need  # type: ignore[union-attr]
+    assert plan.recover(200.0, 3, "actuator", {"nav_vs_plan_m": 3.0}, fused)
+    keep = sc.guidance.keep_out_m + sc.assignment.keep_out_margin_m
+    assert plan.impaired[3] == keep + 6.0
+    cur = plan.current
+    assert cur is not None
+    assert min_distance_to_origin(_pro(cur.pros[3]), plan.n)[0] >= keep + 6.0
+    assert min_distance_to_origin(_pro(cur.pros[1]), plan.n)[0] >= need
+    assert min_distance_to_origin(_pro(cur.pros[2]), plan.n)[0] >= keep

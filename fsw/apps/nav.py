@@ -69,6 +69,7 @@ class NavApp(App):
             self.x, self.P, self.t_est = np.array(meas.r_m + meas.v_mps), _R(meas), meas.t_sim
         else:
             self._propagate_to(meas.t_sim if meas is not None else t)
+            self.nis = None  # only this step's update has one
             if meas is not None:
                 self.x, self.P, self.nis = kalman.update(
                     self.x, self.P, np.array(meas.r_m + meas.v_mps), np.eye(6), _R(meas))

@@ -19,12 +19,19 @@ closes.  For observer i, with ψ the squared fused variance of the ground's map 
 * a fault is declared after ``fdir.persistence`` exceedances in a row (``Persistence``); an
   observer with a plan whose images stay missing for ``fdir.silent_windows`` windows is
   declared a link fault — missing data is never read as zero information gain;
+* a declared performance fault is identified (``ground/fdir/identify.py``): the camera's
+  position and health located from the images themselves, the nav estimate and the reported
+  attitude against the plan, the twin re-run at the reported pose (the gradient test) and the
+  seen POIs against those that pose would see;
 * the H_i an observer reports (``InfoCostTelemetry``) is checked against the ground's
   recomputation from its observations: inconsistent for ``fdir.persistence`` windows, a
-  data-integrity fault.
+  data-integrity fault;
+* more than ``fdir.loss_tol`` of an observer's observations missing by sequence number for
+  ``fdir.persistence`` windows: a link fault (packet loss), as is silence.
 
 Only lost images are missing from both sides of the comparison; images taken while the
-observer reports a slew (its attitude plan, not a pointing) are left out of both; a window
+observer reports a slew (its attitude plan, not a pointing), or within ``fdir.settle_s`` of the
+end of one (the loop's transient), are left out of both; a window
 without any image or any plan gives no decision.  The twin models centre pointing (the
 default camera policy).
 """
@@ -37,11 +44,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fsw.lib import quat
 from fsw.lib.hcw import mean_motion
-from fsw.lib.infocost import Camera
+from fsw.lib.infocost import Camera, visibility
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
 from fsw.lib.pro import Pro
+from ground.fdir.identify import (
+    Evidence,
+    Tolerances,
+    classify,
+    explained_fraction,
+    locate_camera,
+    seen_overlap,
+)
 from ground.fdir.metric import direction, metric
 from ground.fdir.threshold import Persistence, adaptive_threshold
 from ground.fdir.twin import (
@@ -61,8 +77,35 @@ from interfaces.messages import (
     InfoCostTelemetry,
     PoiObservations,
     ProAssignments,
+    StateEstimate,
     TransferPlanMsg,
 )
+
+
+class _Series:
+    """A time series of vectors reported by an observer (nav position, attitude), sampled at
+    any time by linear interpolation (held at the ends)."""
+
+    def __init__(self) -> None:
+        self.t: list[float] = []
+        self.v: list[np.ndarray] = []
+
+    def add(self, t: float, value: np.ndarray) -> None:
+        i = bisect.bisect_right(self.t, t)
+        self.t.insert(i, t)
+        self.v.insert(i, value)
+
+    def at(self, times: np.ndarray) -> np.ndarray | None:
+        """Values (K, d) at ``times`` (K,), or None when nothing was reported."""
+        if not self.t:
+            return None
+        v = np.array(self.v)
+        return np.stack([np.interp(times, self.t, v[:, j]) for j in range(v.shape[1])], axis=1)
+
+    def forget_before(self, t: float) -> None:
+        """Drop samples no later window needs (keep the last one before t)."""
+        i = max(bisect.bisect_left(self.t, t) - 1, 0)
+        del self.t[:i], self.v[:i]
 
 
 @dataclass
@@ -72,18 +115,31 @@ class _Observer:
 
     plans: dict[int, FlightPlan] = field(default_factory=dict)
     modes: list[tuple[float, str]] = field(default_factory=list)
+    nav: _Series = field(default_factory=_Series)
+    """reported position (nav estimate), LVLH m"""
+    attitude: _Series = field(default_factory=_Series)
+    """reported camera boresight (LVLH, 3) and pointing error (rad)"""
     silent: int = 0
     link_declared: bool = False
+    last_seq: int | None = None
+    received: int = 0
+    lost: int = 0
+    """observations received and missing (sequence gaps) since the start"""
+
+    def lost_fraction(self) -> float:
+        total = self.received + self.lost
+        return self.lost / total if total else 0.0
 
     def forget_modes_before(self, t: float) -> None:
         """Drop mode changes no later window needs (keep the one in force at t)."""
         i = bisect.bisect_right(self.modes, (t, "~")) - 1
         del self.modes[:max(i, 0)]
 
-    def tracking_at(self, t: float) -> bool:
-        """Whether the last reported attitude mode at or before t is ``track``."""
+    def tracking_at(self, t: float, settle_s: float) -> bool:
+        """Whether the last reported attitude mode at or before t is ``track``, entered at
+        least ``settle_s`` before t (the loop's transient after a slew is not predicted)."""
         i = bisect.bisect_right(self.modes, (t, "~")) - 1
-        return i >= 0 and self.modes[i][1] == "track"
+        return i >= 0 and self.modes[i][1] == "track" and self.modes[i][0] <= t - settle_s
 
     def plan_at(self, t: float) -> FlightPlan | None:
         valid = [p for p in self.plans.values() if p.t_from_s <= t]
@@ -107,6 +163,8 @@ class FdirApp(App):
               AttitudeEstimate, "on_attitude"),
         Input(lambda c: topics.all_spacecraft(c.mission, "infocost", "telemetry"),
               InfoCostTelemetry, "on_telemetry"),
+        Input(lambda c: topics.all_spacecraft(c.mission, "nav", "estimate"), StateEstimate,
+              "on_nav"),
     )
     OUTPUTS = (
         Output("window", lambda c: topics.key(c.mission, c.node, "fdir", "window"), FdirWindow),
@@ -128,6 +186,12 @@ class FdirApp(App):
         self.observers = {i: _Observer() for i in range(1, sc.observers.count + 1)}
         self.persistence = Persistence(self.cfg.persistence)
         self.integrity = Persistence(self.cfg.persistence)
+        self.loss = Persistence(self.cfg.persistence)
+        self.boresight_body = np.array(sc.attitude.boresight_body, dtype=float)
+        self.boresight_body /= np.linalg.norm(self.boresight_body)
+        self.tol = Tolerances(self.cfg.beta_tol, self.cfg.position_tol_m,
+                              self.cfg.pointing_tol_deg, self.cfg.overlap_tol,
+                              self.cfg.explained_min)
         self._reported: dict[tuple[int, float], float] = {}  # (observer, t) -> reported H_i
         self.window_start = 0.0
         self._transfers: dict[tuple[int, int], Transfer] = {}
@@ -158,8 +222,18 @@ class FdirApp(App):
 
     def on_attitude(self, msg: AttitudeEstimate) -> None:
         obs = self.observers.get(msg.spacecraft)
-        if obs is not None and (not obs.modes or obs.modes[-1][1] != msg.mode):
+        if obs is None:
+            return
+        if not obs.modes or obs.modes[-1][1] != msg.mode:
             bisect.insort(obs.modes, (msg.t_sim, msg.mode))
+        if msg.t_sim >= self.window_start:
+            bore = quat.rotate(np.array(msg.q_lvlh_body), self.boresight_body)
+            obs.attitude.add(msg.t_sim, np.append(bore, msg.pointing_error_rad))
+
+    def on_nav(self, msg: StateEstimate) -> None:
+        obs = self.observers.get(msg.spacecraft)
+        if obs is not None and msg.t_sim >= self.window_start:
+            obs.nav.add(msg.t_sim, np.array(msg.x[:3]))
 
     def on_assignments(self, msg: ProAssignments) -> None:
         for a in msg.assignments:
@@ -184,8 +258,11 @@ class FdirApp(App):
         phi = self.settled.phi
         for sc, obs in self.observers.items():
             mine = sorted((m for m in inside if m.spacecraft == sc), key=lambda m: m.image_t_s)
-            self._judge(sc, obs, mine, a, b, psi, phi)
+            lost = self._check_loss(sc, obs, mine, b)
+            self._judge(sc, obs, mine, a, b, psi, phi, lost)
             obs.forget_modes_before(b)
+            obs.nav.forget_before(b)
+            obs.attitude.forget_before(b)
         for m in inside:
             self.settled.add(m.spacecraft, m.poi, m.precision)
         self.pending = [m for m in self.pending if m.image_t_s >= b]
@@ -194,13 +271,17 @@ class FdirApp(App):
     def _check_reports(self, b: float) -> None:
         """Data integrity: each observer's H_i reported at b against the contribution the
         ground computes from the observations it received (its map now holds every image
-        before b).  The two views differ only by what each has fused (range-limited sharing),
-        so a relative difference above ``fdir.integrity_tol`` is an inconsistent report."""
+        before b), scaled up by the share of its observations lost on the way (sequence gaps;
+        the observer's H_i holds all of its images).  The two views then differ only by what
+        each has fused (range-limited sharing), so a relative difference above
+        ``fdir.integrity_tol`` is an inconsistent report.  While more than ``fdir.loss_tol``
+        of an observer's observations are missing, its report cannot be judged."""
         ground = self.settled.contributions()
-        for sc in self.observers:
+        for sc, obs in self.observers.items():
             reported = self._reported.pop((sc, round(b, 6)), None)
-            mine = float(ground[sc - 1])
-            if reported is None or mine <= 0.0:
+            lost = obs.lost_fraction()
+            mine = float(ground[sc - 1]) / (1.0 - lost)
+            if reported is None or mine <= 0.0 or lost > self.cfg.loss_tol:
                 continue
             deviation = abs(reported / mine - 1.0)
             if self.integrity.update(sc, deviation > self.cfg.integrity_tol):
@@ -211,18 +292,40 @@ class FdirApp(App):
                     metric=deviation, threshold=self.cfg.integrity_tol, window_end_s=b))
         self._reported = {k: v for k, v in self._reported.items() if k[1] > b}
 
+    def _check_loss(self, sc: int, obs: _Observer, images: list[PoiObservations],
+                    b: float) -> int:
+        """Observations of the window missing by sequence number (the observer numbers every
+        message it publishes on its key); more than ``fdir.loss_tol`` of them for
+        ``fdir.persistence`` windows is a link fault.  Returns the count lost."""
+        if not images:
+            return 0
+        seqs = sorted(m.seq for m in images)
+        first = seqs[0] if obs.last_seq is None else obs.last_seq + 1
+        lost = max(seqs[-1] - first + 1 - len(seqs), 0)
+        obs.last_seq = max(seqs[-1], obs.last_seq or 0)
+        obs.received += len(seqs)
+        obs.lost += lost
+        fraction = lost / (lost + len(seqs))
+        if self.loss.update(sc, fraction > self.cfg.loss_tol):
+            self.log.warning("FDIR: sc%d lost %.0f%% of its observations: link fault", sc,
+                             100.0 * fraction)
+            self.publish("report", FaultReport(
+                sender=self.ctx.node, t_sim=b, spacecraft=sc, fault_class="link",
+                metric=fraction, threshold=self.cfg.loss_tol, window_end_s=b))
+        return lost
+
     def _judge(self, sc: int, obs: _Observer, images: list[PoiObservations], a: float,
-               b: float, psi: np.ndarray, phi: np.ndarray) -> None:
+               b: float, psi: np.ndarray, phi: np.ndarray, lost: int) -> None:
         plan = obs.plan_at(a)
         window = FdirWindow(sender=self.ctx.node, t_sim=b, spacecraft=sc, t_start_s=a,
-                            t_end_s=b, images=len(images))
+                            t_end_s=b, images=len(images), lost=lost)
         if plan is not None and not images:
             self._silence(sc, obs, b)
         if plan is None or not images:
             self.publish("window", window)
             return
         obs.silent, obs.link_declared = 0, False
-        images = [m for m in images if obs.tracking_at(m.image_t_s)]  # slews are not predicted
+        images = [m for m in images if obs.tracking_at(m.image_t_s, self.cfg.settle_s)]
         window = window.model_copy(update={"images": len(images)})
         if not images:
             self.publish("window", window)
@@ -238,15 +341,52 @@ class FdirApp(App):
         tau = self._threshold(sc, a, pos, bore, psi, phi, h_prev)
         exceeded = None if m_val is None or tau is None else m_val > tau
         dirn = direction(dh, dh_pred, h_prev)
+        ev = self._evidence(obs, images, times, pos, psi, phi,
+                            (dh, dh_pred) if exceeded else None)
         self.publish("window", window.model_copy(update={
             "dh": dh, "dh_pred": dh_pred, "metric": m_val, "threshold": tau,
-            "direction": dirn, "exceeded": exceeded}))
+            "direction": dirn, "exceeded": exceeded, "evidence": ev.as_dict()}))
         if self.persistence.update(sc, exceeded):
-            self.log.warning("FDIR: fault declared on sc%d at %.0f s (H_m %.3g > τ %.3g, %s)",
-                             sc, b, m_val, tau, dirn)
-            self.publish("report", FaultReport(sender=self.ctx.node, t_sim=b, spacecraft=sc,
-                                               fault_class=None, direction=dirn, metric=m_val,
-                                               threshold=tau, window_end_s=b))
+            cls = classify(ev, self.tol)
+            self.log.warning("FDIR: fault declared on sc%d at %.0f s (H_m %.3g > τ %.3g, %s): "
+                             "%s", sc, b, m_val, tau, dirn, cls or "unidentified")
+            self.publish("report", FaultReport(
+                sender=self.ctx.node, t_sim=b, spacecraft=sc, fault_class=cls, direction=dirn,
+                metric=m_val, threshold=tau, window_end_s=b, evidence=ev.as_dict()))
+
+    def _evidence(self, obs: _Observer, images: list[PoiObservations], times: np.ndarray,
+                  planned: np.ndarray, psi: np.ndarray, phi: np.ndarray,
+                  gap: tuple[float, float] | None) -> Evidence:
+        """Identification evidence of one window (``identify.Evidence``).  The cheap parts
+        (camera fixes, nav and attitude against the plan) every window, so their nominal spread
+        is in the archive; the twin at the reported pose and the seen-set overlap only when the
+        window exceeded its threshold (``gap`` = (ΔH_i, ΔH_i^pred))."""
+        sc_cfg = self.ctx.scenario
+        fixes = [locate_camera(self.poi_pos[m.poi], np.array(m.precision), self.camera.k,
+                               sc_cfg.target.radius_m) for m in images]
+        nav = obs.nav.at(times)
+        att = obs.attitude.at(times)
+        located = [(i, f) for i, f in enumerate(fixes) if f is not None]
+        beta = float(np.median([f.beta for _, f in located])) if located else None
+        cam_nav = nav_plan = point = explained = overlap = None
+        if nav is not None:
+            nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
+            if located:
+                d = np.array([f.position_m - nav[i] for i, f in located])
+                cam_nav = float(np.linalg.norm(np.median(d, axis=0)))
+        if att is not None:
+            point = math.degrees(float(np.median(att[:, 3])))
+        if gap is not None and nav is not None and att is not None:
+            bore = att[:, :3] / np.linalg.norm(att[:, :3], axis=1, keepdims=True)
+            dh_rep = predicted_delta_h(nav, bore, self.poi_pos, self.poi_normal, self.camera,
+                                       psi, phi)
+            explained = explained_fraction(gap[0], gap[1], dh_rep)
+            k = max(1, math.ceil(len(images) / THRESHOLD_IMAGES))
+            vis = visibility(nav[::k], bore[::k], self.poi_pos, self.poi_normal, self.camera)
+            ratios = [seen_overlap(m.poi, np.flatnonzero(v)) for m, v in zip(images[::k], vis)]
+            valid = [r for r in ratios if r is not None]
+            overlap = float(np.median(valid)) if valid else None
+        return Evidence(beta, cam_nav, nav_plan, point, overlap, explained)
 
     def _threshold(self, sc: int, a: float, pos: np.ndarray, bore: np.ndarray, psi: np.ndarray,
                    phi: np.ndarray, h_prev: float) -> float | None:

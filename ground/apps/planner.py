@@ -7,7 +7,8 @@ each information-driven ``AssignmentDecision`` on ``ground/planner/decisions``.
 
 What to fly comes from :class:`ground.mission_plan.MissionPlan`: the scenario's phases, with
 ``assign = "information"`` phases chosen by expected information gain and reassigned when the
-set's gain saturates.  An assignment is uplinked from ``UPLINK_LEAD_S`` before its departure
+set's gain saturates, and -- with ``fdir.recovery`` -- a recovery assignment when the FDIR
+reports an identified camera or actuator fault (input ``ground/fdir/report``).  An assignment is uplinked from ``UPLINK_LEAD_S`` before its departure
 and repeated every cycle until the next one supersedes it, so a command lost on the
 range-limited, lossy link is simply received later (a spacecraft acts on a new
 ``assignment_id`` once).
@@ -22,6 +23,7 @@ from interfaces import topics
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import (
     AssignmentDecision,
+    FaultReport,
     PoiObservations,
     ProAssignment,
     ProAssignments,
@@ -34,6 +36,8 @@ class MissionPlanner(App):
     INPUTS = (
         Input(lambda c: topics.all_spacecraft(c.mission, "camera", "observations"),
               PoiObservations, "on_observations"),
+        Input(lambda c: topics.key(c.mission, topics.GROUND, "fdir", "report"), FaultReport,
+              "on_fault"),
     )
     OUTPUTS = (
         Output("assignments", lambda c: topics.assignments(c.mission), ProAssignments),
@@ -48,13 +52,23 @@ class MissionPlanner(App):
         self.plan = MissionPlan(sc, pos, normal)
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self._decisions_sent = 0
+        self._faults: list[FaultReport] = []
 
     def on_observations(self, msg: PoiObservations) -> None:
         if msg.spacecraft <= self.map.n_agents:
             self.map.add(msg.spacecraft, msg.poi, msg.precision)
 
+    def on_fault(self, msg: FaultReport) -> None:
+        if self.ctx.scenario.fdir.recovery:
+            self._faults.append(msg)
+
     def step(self, t: float) -> None:
         self.plan.update(t, self.map)
+        for f in self._faults:
+            if self.plan.recover(t, f.spacecraft, f.fault_class, f.evidence, self.map):
+                self.log.warning("recovery: %s fault on sc%d, replanned", f.fault_class,
+                                 f.spacecraft)
+        self._faults = []
         for d in self.plan.decisions[self._decisions_sent:]:
             self.log.info("%s at %.0f s (%s): PROs %s, expected gain %.4g (bound %.4g, "
                           "current %s), %s", d.phase, d.t_s, d.reason, d.library_indices,

@@ -1,0 +1,91 @@
+"""Baseline detectors beside the ground FDIR, on the same windows (ground/fdir/baselines.py).
+
+Rate group mid.  Inputs: the FDIR's per-window verdicts (``FdirWindow``: ΔH_i, ΔH_i^pred,
+H_m,i) and every observer's nav estimate (its NIS).  Output: one ``BaselineVerdict`` per
+detector, observer and FDI window on ``ground/fdir/baseline``; ``alarm`` marks the window that
+declares a fault (``chi2_nis`` and ``fixed_threshold`` after ``fdir.persistence`` exceedances
+in a row for the first, at once for the second, as a plain limit check; ``cusum`` when its sum
+crosses ``fdir.cusum_threshold``).  summary.json scores each like the main detector.
+"""
+
+from __future__ import annotations
+
+from ground.fdir.baselines import Cusum, nis_window_test
+from ground.fdir.threshold import Persistence
+from interfaces import topics
+from interfaces.app import App, AppContext, Input, Output
+from interfaces.messages import BaselineVerdict, FdirWindow, StateEstimate
+
+
+class BaselinesApp(App):
+    NAME = "baselines"
+    RATE = "mid"
+    INPUTS = (
+        Input(lambda c: topics.key(c.mission, topics.GROUND, "fdir", "window"), FdirWindow,
+              "on_window"),
+        Input(lambda c: topics.all_spacecraft(c.mission, "nav", "estimate"), StateEstimate,
+              "on_nav"),
+    )
+    OUTPUTS = (
+        Output("verdict", lambda c: topics.key(c.mission, c.node, "fdir", "baseline"),
+               BaselineVerdict),
+    )
+
+    def __init__(self, ctx: AppContext) -> None:
+        super().__init__(ctx)
+        self.cfg = ctx.scenario.fdir
+        self.count = ctx.scenario.observers.count
+        self.nis: dict[int, list[tuple[float, float]]] = {}
+        self.windows: list[FdirWindow] = []
+        self.cusum = Cusum(self.cfg.cusum_drift, self.cfg.cusum_threshold)
+        self.chi2_persistence = Persistence(self.cfg.persistence)
+        self.fixed_persistence = Persistence(1)
+
+    def on_nav(self, msg: StateEstimate) -> None:
+        if msg.nis is not None and 1 <= msg.spacecraft <= self.count:
+            self.nis.setdefault(msg.spacecraft, []).append((msg.t_sim, msg.nis))
+
+    def on_window(self, msg: FdirWindow) -> None:
+        self.windows.append(msg)
+
+    def step(self, t: float) -> None:
+        windows, self.windows = self.windows, []
+        for w in sorted(windows, key=lambda w: (w.t_end_s, w.spacecraft)):
+            self._chi2(w)
+            self._information(w)
+
+    def _verdict(self, detector: str, w: FdirWindow, statistic: float | None,
+                 threshold: float | None, exceeded: bool | None, alarm: bool) -> None:
+        if alarm:
+            self.log.warning("baseline %s: fault declared on sc%d at %.0f s", detector,
+                             w.spacecraft, w.t_end_s)
+        self.publish("verdict", BaselineVerdict(
+            sender=self.ctx.node, t_sim=w.t_end_s, detector=detector,  # type: ignore[arg-type]
+            spacecraft=w.spacecraft, t_start_s=w.t_start_s, t_end_s=w.t_end_s,
+            statistic=statistic, threshold=threshold, exceeded=exceeded, alarm=alarm))
+
+    def _chi2(self, w: FdirWindow) -> None:
+        """Σ NIS of the window's nav updates against its χ² quantile."""
+        mine = self.nis.get(w.spacecraft, [])
+        inside = [v for t, v in mine if w.t_start_s <= t < w.t_end_s]
+        self.nis[w.spacecraft] = [(t, v) for t, v in mine if t >= w.t_end_s]
+        test = nis_window_test(inside, self.cfg.nis_alpha)
+        if test is None:
+            self._verdict("chi2_nis", w, None, None, None, False)
+            return
+        exceeded = test[0] > test[1]
+        alarm = self.chi2_persistence.update(w.spacecraft, exceeded)
+        self._verdict("chi2_nis", w, test[0], test[1], exceeded, alarm)
+
+    def _information(self, w: FdirWindow) -> None:
+        """CUSUM on r = 1 − ΔH_i/ΔH_i^pred and the fixed H_m,i level, on the FDIR's windows
+        with a decision."""
+        if w.metric is None or w.dh is None or not w.dh_pred:
+            self._verdict("cusum", w, None, None, None, False)
+            self._verdict("fixed_threshold", w, None, None, None, False)
+            return
+        stat, alarm = self.cusum.update(w.spacecraft, 1.0 - w.dh / w.dh_pred)
+        self._verdict("cusum", w, stat, self.cfg.cusum_threshold, alarm, alarm)
+        exceeded = w.metric > self.cfg.fixed_threshold
+        alarm = self.fixed_persistence.update(w.spacecraft, exceeded)
+        self._verdict("fixed_threshold", w, w.metric, self.cfg.fixed_threshold, exceeded, alarm)

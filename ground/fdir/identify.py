@@ -1,0 +1,162 @@
+"""Fault identification: which part of a faulty observer failed (DESIGN.md, "Information cost
+and FDIR": identification beyond the paper's 1-DOF example, Eq. 17-21).
+
+Once H_m,i has isolated observer i, the ground weighs four pieces of evidence from one FDI
+window, all from telemetry it already receives:
+
+* **Where the camera really was.**  Each image measures every visible POI with precision
+  σ⁻¹ = β / (k d²) (Eq. 5 with the camera health β of Eq. 21), so q = 1/(k σ⁻¹) = d²/β.  On a
+  spherical target of radius R, d² = |c|² + R² − 2 c·s is affine in the POI position s, so a
+  least-squares fit q ≈ a + g·s gives g = −2c/β and a = (|c|² + R²)/β, hence
+  β²|g|²/4 − aβ + R² = 0: two roots, one camera outside the sphere (the answer) and its
+  inverse point inside it (:func:`locate_camera`).  The camera's position and β come out of
+  the image itself, independent of the observer's navigation.
+* **Where the observer says it was**: its nav estimate and its attitude estimate (reported
+  boresight and pointing error), against the plan.
+* **The gradient test**: ∂H_i/∂p_i times the pose deviation predicts the change of H_i that
+  motion alone explains.  The twin carries this to all orders: it re-evaluates ΔH_i at the
+  reported pose, and :func:`explained_fraction` says how much of the gap ΔH_i − ΔH_i^pred that
+  pose accounts for.
+* **The seen set**: the POIs an image saw against those the reported pose would see.
+
+:func:`classify` turns the evidence into a class:
+
+=======================================================  ================
+evidence                                                 class
+=======================================================  ================
+β̂ off 1 (information short by a uniform factor)          ``camera``
+reported pose off plan, and it explains the ΔH gap       ``actuator``
+camera (from the images) not where nav says it is        ``state_sensor``
+seen set not what the reported pose would see            ``camera``
+=======================================================  ================
+
+(``link`` and ``data_integrity`` are decided by the FDIR app from missing telemetry and from
+the reported H_i.)  Pure functions; the app gathers the inputs.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+
+MIN_POIS = 12
+"""Fewer POIs in an image than this give no camera fix (4 unknowns, noisy precisions)."""
+
+
+@dataclass(frozen=True)
+class CameraFix:
+    """A camera position (LVLH, m) and health β located from one image."""
+
+    position_m: FloatArray
+    beta: float
+
+
+def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
+                  radius_m: float) -> CameraFix | None:
+    """Trilaterate the camera from one image of a spherical target (module docstring).
+
+    Args:
+        poi_pos: positions (n, 3) of the POIs the image saw, target frame (LVLH), m, on the
+            sphere of radius ``radius_m`` about the origin.
+        precision: their measured σ⁻¹ (n,), > 0.
+        k: the camera's variance coefficient (σ = k d², Eq. 5), m⁻².
+        radius_m: the target's radius R, m.
+
+    Returns:
+        The fix, or None when the image saw fewer than ``MIN_POIS`` POIs or the fit is
+        degenerate (no root outside the sphere).
+    """
+    s = np.asarray(poi_pos, dtype=float)
+    p = np.asarray(precision, dtype=float)
+    good = p > 0.0
+    if good.sum() < MIN_POIS:
+        return None
+    s, q = s[good], 1.0 / (k * p[good])
+    coef, *_ = np.linalg.lstsq(np.c_[np.ones(len(q)), s], q, rcond=None)
+    a, g = float(coef[0]), coef[1:]
+    gg = float(g @ g)
+    if not (gg > 0.0 and a > 0.0):
+        return None
+    root = math.sqrt(max(a * a - gg * radius_m**2, 0.0))
+    beta = 2.0 * (a + root) / gg  # the larger root: |c| = β|g|/2 > R (the other is inside)
+    c = -0.5 * beta * g
+    if not (np.linalg.norm(c) > radius_m and math.isfinite(beta)):
+        return None
+    return CameraFix(c, beta)
+
+
+def explained_fraction(dh: float, dh_pred: float, dh_alt: float) -> float | None:
+    """How much of the gap ΔH_i − ΔH_i^pred an alternative pose's ΔH_alt accounts for:
+    1 − |ΔH_i − ΔH_alt| / |ΔH_i − ΔH_i^pred| (1: all of it, ≤ 0: none).  None without a gap."""
+    gap = abs(dh - dh_pred)
+    if not gap > 0.0:
+        return None
+    return 1.0 - abs(dh - dh_alt) / gap
+
+
+def seen_overlap(seen: npt.ArrayLike, expected: npt.ArrayLike) -> float | None:
+    """Jaccard overlap |A ∩ B| / |A ∪ B| of two POI index sets; None when both are empty."""
+    a, b = set(np.asarray(seen).tolist()), set(np.asarray(expected).tolist())
+    union = len(a | b)
+    return len(a & b) / union if union else None
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """One FDI window's identification evidence for one observer (medians over its images;
+    None where not available).
+
+    Attributes:
+        beta_hat: camera health from the images (1 nominal).
+        camera_vs_nav_m: distance between the median camera position from the images and the
+            nav estimate's (median of the per-image vector differences), m.
+        nav_vs_plan_m: median distance of the nav estimate from the plan, m.
+        pointing_error_deg: median pointing error the attitude estimate reports, deg.
+        seen_overlap: median Jaccard overlap of the seen POIs with those the reported pose
+            (nav position, reported boresight) would see.
+        explained_reported: :func:`explained_fraction` of the twin at the reported pose.
+    """
+
+    beta_hat: float | None = None
+    camera_vs_nav_m: float | None = None
+    nav_vs_plan_m: float | None = None
+    pointing_error_deg: float | None = None
+    seen_overlap: float | None = None
+    explained_reported: float | None = None
+
+    def as_dict(self) -> dict[str, float]:
+        return {k: v for k, v in asdict(self).items() if v is not None}
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Nominal bounds of the evidence (see ``FdirSettings``)."""
+
+    beta: float = 0.1
+    position_m: float = 0.5
+    pointing_deg: float = 1.0
+    overlap: float = 0.8
+    explained: float = 0.5
+
+
+def classify(ev: Evidence, tol: Tolerances) -> str | None:
+    """The fault class the evidence points to (module docstring table), or None when nothing
+    stands out."""
+    if ev.beta_hat is not None and abs(ev.beta_hat - 1.0) > tol.beta:
+        return "camera"
+    off_plan = ((ev.nav_vs_plan_m or 0.0) > tol.position_m
+                or (ev.pointing_error_deg or 0.0) > tol.pointing_deg)
+    if off_plan and (ev.explained_reported is None or ev.explained_reported >= tol.explained):
+        return "actuator"
+    if (ev.camera_vs_nav_m or 0.0) > tol.position_m:
+        return "state_sensor"
+    if ev.seen_overlap is not None and ev.seen_overlap < tol.overlap:
+        return "camera"
+    if off_plan:
+        return "actuator"
+    return None

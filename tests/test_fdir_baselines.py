@@ -1,0 +1,39 @@
+"""Baseline detectors on constructed cases: the windowed NIS test against the χ² law it
+assumes, and CUSUM's accumulation of small residuals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from ground.fdir.baselines import NIS_DOF, Cusum, nis_window_test
+
+
+def test_nis_window_false_alarm_rate_matches_alpha() -> None:
+    """Consistent filter: NIS ~ χ²(6) per update; windows of 100 updates exceed their quantile
+    at the rate α."""
+    rng = np.random.default_rng(11)
+    alpha = 0.05
+    trials = 4000
+    hits = 0
+    for _ in range(trials):
+        stat, thr = nis_window_test(list(rng.chisquare(NIS_DOF, 100)), alpha)  # type: ignore[misc]
+        hits += stat > thr
+    assert hits / trials == pytest.approx(alpha, abs=0.01)
+
+
+def test_nis_window_threshold_and_empty() -> None:
+    stat, thr = nis_window_test([6.0, 6.0, 6.0], 1e-3)  # type: ignore[misc]
+    assert stat == 18.0 and thr == pytest.approx(chi2.ppf(0.999, 18))
+    assert nis_window_test([], 1e-3) is None
+
+
+def test_cusum_accumulates_a_small_bias_and_ignores_noise_within_the_drift() -> None:
+    c = Cusum(drift=0.02, threshold=0.16)
+    assert not any(c.update(1, r)[1] for r in [0.015, -0.015] * 50)  # within the drift
+    alarms = [c.update(2, 0.05)[1] for _ in range(10)]  # 0.03 net per window
+    assert alarms.index(True) == 5  # 6 × 0.03 = 0.18 > 0.16 > 5 × 0.03
+    stat, alarm = c.update(3, -0.5)  # one large window, either sign
+    assert alarm and stat == pytest.approx(0.48)
+    assert c.update(3, 0.0) == (0.0, False)  # restarted after the alarm
