@@ -108,6 +108,11 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     ({"camera_vs_nav_m": 3.0, "explained_reported": -0.2, "seen_overlap": 0.9},
      "state_sensor"),  # nav bias: flies the plan by its nav, the images say elsewhere
     ({"nav_vs_plan_m": 3.0, "explained_reported": 0.1}, "actuator"),  # off plan, unexplained
+    ({"nav_vs_plan_m": 6.3, "camera_vs_nav_m": 1.5, "explained_reported": 0.04,
+      "explained_located": 0.9}, "actuator"),  # strong leak: nav off plan, lagging the truth
+    ({"nav_vs_plan_m": 0.8, "camera_vs_nav_m": 3.0}, "state_sensor"),  # nav bias settling
+    ({"pointing_error_deg": 5.0, "explained_reported": 0.1, "explained_located": 0.2},
+     None),  # reported off target, but that does not explain the loss
     ({}, None),  # nothing stands out
 ])
 def test_classify_table(change: dict[str, float], expected: str | None) -> None:

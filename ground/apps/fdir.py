@@ -368,7 +368,7 @@ class FdirApp(App):
         att = obs.attitude.at(times)
         located = [(i, f) for i, f in enumerate(fixes) if f is not None]
         beta = float(np.median([f.beta for _, f in located])) if located else None
-        cam_nav = nav_plan = point = explained = overlap = None
+        cam_nav = nav_plan = point = explained = explained_loc = overlap = None
         if nav is not None:
             nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
             if located:
@@ -381,12 +381,18 @@ class FdirApp(App):
             dh_rep = predicted_delta_h(nav, bore, self.poi_pos, self.poi_normal, self.camera,
                                        psi, phi)
             explained = explained_fraction(gap[0], gap[1], dh_rep)
+            where = nav.copy()
+            for i, f in located:
+                where[i] = f.position_m
+            dh_loc = predicted_delta_h(where, bore, self.poi_pos, self.poi_normal, self.camera,
+                                       psi, phi)
+            explained_loc = explained_fraction(gap[0], gap[1], dh_loc)
             k = max(1, math.ceil(len(images) / THRESHOLD_IMAGES))
             vis = visibility(nav[::k], bore[::k], self.poi_pos, self.poi_normal, self.camera)
             ratios = [seen_overlap(m.poi, np.flatnonzero(v)) for m, v in zip(images[::k], vis)]
             valid = [r for r in ratios if r is not None]
             overlap = float(np.median(valid)) if valid else None
-        return Evidence(beta, cam_nav, nav_plan, point, overlap, explained)
+        return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc)
 
     def _threshold(self, sc: int, a: float, pos: np.ndarray, bore: np.ndarray, psi: np.ndarray,
                    phi: np.ndarray, h_prev: float) -> float | None:

@@ -15,20 +15,27 @@ window, all from telemetry it already receives:
   boresight and pointing error), against the plan.
 * **The gradient test**: ∂H_i/∂p_i times the pose deviation predicts the change of H_i that
   motion alone explains.  The twin carries this to all orders: it re-evaluates ΔH_i at the
-  reported pose, and :func:`explained_fraction` says how much of the gap ΔH_i − ΔH_i^pred that
-  pose accounts for.
+  reported pose, and at the located camera positions, and :func:`explained_fraction` says how
+  much of the gap ΔH_i − ΔH_i^pred each pose accounts for.
 * **The seen set**: the POIs an image saw against those the reported pose would see.
 
 :func:`classify` turns the evidence into a class:
 
-=======================================================  ================
-evidence                                                 class
-=======================================================  ================
-β̂ off 1 (information short by a uniform factor)          ``camera``
-reported pose off plan, and it explains the ΔH gap       ``actuator``
-camera (from the images) not where nav says it is        ``state_sensor``
-seen set not what the reported pose would see            ``camera``
-=======================================================  ================
+==========================================================  ================
+evidence (in this order)                                    class
+==========================================================  ================
+β̂ off 1 (information short by a uniform factor)             ``camera``
+pointing error reported, and the pose explains the ΔH gap   ``actuator``
+camera not where nav says, by more than nav is off plan     ``state_sensor``
+nav off plan (the observer knows it is not on its orbit)    ``actuator``
+seen set not what the reported pose would see               ``camera``
+==========================================================  ================
+
+The comparison of the two distances separates a biased nav sensor (the observer flies its
+plan by its nav, so nav stays on plan and the camera is off by the bias) from an orbit
+actuator fault (nav follows the deviation off plan, lagging it by what the unmodelled force
+does in the filter).  In the first window of a strong thruster fault the nav lag can still
+dominate; the persistence count lets the evidence settle before a class is named.
 
 (``link`` and ``data_integrity`` are decided by the FDIR app from missing telemetry and from
 the reported H_i.)  Pure functions; the app gathers the inputs.
@@ -120,6 +127,7 @@ class Evidence:
         seen_overlap: median Jaccard overlap of the seen POIs with those the reported pose
             (nav position, reported boresight) would see.
         explained_reported: :func:`explained_fraction` of the twin at the reported pose.
+        explained_located: the same at the located camera positions (reported boresight).
     """
 
     beta_hat: float | None = None
@@ -128,6 +136,7 @@ class Evidence:
     pointing_error_deg: float | None = None
     seen_overlap: float | None = None
     explained_reported: float | None = None
+    explained_located: float | None = None
 
     def as_dict(self) -> dict[str, float]:
         return {k: v for k, v in asdict(self).items() if v is not None}
@@ -149,14 +158,15 @@ def classify(ev: Evidence, tol: Tolerances) -> str | None:
     stands out."""
     if ev.beta_hat is not None and abs(ev.beta_hat - 1.0) > tol.beta:
         return "camera"
-    off_plan = ((ev.nav_vs_plan_m or 0.0) > tol.position_m
-                or (ev.pointing_error_deg or 0.0) > tol.pointing_deg)
-    if off_plan and (ev.explained_reported is None or ev.explained_reported >= tol.explained):
+    explained = [e for e in (ev.explained_reported, ev.explained_located) if e is not None]
+    pose_explains = not explained or max(explained) >= tol.explained
+    if (ev.pointing_error_deg or 0.0) > tol.pointing_deg and pose_explains:
         return "actuator"
-    if (ev.camera_vs_nav_m or 0.0) > tol.position_m:
+    camera_nav, nav_plan = ev.camera_vs_nav_m or 0.0, ev.nav_vs_plan_m or 0.0
+    if camera_nav > tol.position_m and camera_nav > nav_plan:
         return "state_sensor"
+    if nav_plan > tol.position_m:
+        return "actuator"
     if ev.seen_overlap is not None and ev.seen_overlap < tol.overlap:
         return "camera"
-    if off_plan:
-        return "actuator"
     return None

@@ -1,0 +1,66 @@
+"""The FDIR app's handling of late and missing telemetry, driven message by message: a late
+observation is fused into the ground's map (not judged, not dropped), a window without images
+is no decision (never zero information gain), and observations missing by sequence number
+make a link fault once the lost share stays above ``fdir.loss_tol``."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+
+from ground.apps.fdir import FdirApp
+from interfaces.app import AppContext
+from interfaces.bus import Bus
+from interfaces.transport import InprocNetwork
+from interfaces.messages import FaultReport, FdirWindow, Message, PoiObservations
+from tests.conftest import small_scenario
+
+
+def _app() -> tuple[FdirApp, list[Message]]:
+    sc = small_scenario("fa", target={"pois": 200}, rates={"fdi_period_s": 10.0},
+                        observers={"count": 2}, fdir={"persistence": 2, "latency_s": 0.0})
+    bus = Bus("ground", "fa", InprocNetwork().endpoint())
+    app = FdirApp(AppContext(bus=bus, scenario=sc, node="ground", spacecraft=None,
+                             rng=np.random.default_rng(0), log=logging.getLogger("t")))
+    sent: list[Message] = []
+    app.publish = lambda name, msg: sent.append(msg)  # type: ignore[method-assign]
+    return app, sent
+
+
+def _obs(sc: int, t: float, seq: int, poi: list[int]) -> PoiObservations:
+    return PoiObservations(sender=f"sc{sc}", t_sim=t, seq=seq, spacecraft=sc, image_t_s=t,
+                           poi=poi, precision=[0.01] * len(poi))
+
+
+def test_late_observation_is_fused_not_judged() -> None:
+    app, sent = _app()
+    app.step(10.0)  # window [0, 10) judged: nothing received
+    assert app.window_start == 10.0
+    before = app.settled.F.copy()
+    app.on_observations(_obs(1, 5.0, 0, [3, 4]))  # image of the judged window, arriving late
+    assert not app.pending
+    assert app.settled.F[0, 3] == pytest.approx(before[0, 3] + 0.01)
+    assert app.settled.F[1, 3] == before[1, 3]
+    windows = [m for m in sent if isinstance(m, FdirWindow)]
+    assert len(windows) == 2 and all(w.metric is None and w.exceeded is None for w in windows)
+
+
+def test_observations_missing_by_sequence_make_a_link_fault() -> None:
+    app, sent = _app()
+    seq = 0
+    for k in range(4):  # four windows of 10 images each, 6 of them lost in windows 2 and 3
+        for i in range(10):
+            if k >= 1 and i < 6:
+                seq += 1
+                continue
+            app.on_observations(_obs(2, 10.0 * k + i, seq, [1]))
+            seq += 1
+        app.step(10.0 * (k + 1))
+    windows = [m for m in sent if isinstance(m, FdirWindow) and m.spacecraft == 2]
+    assert [w.lost for w in windows] == [0, 6, 6, 6]
+    reports = [m for m in sent if isinstance(m, FaultReport)]
+    assert [(r.spacecraft, r.fault_class, r.t_sim) for r in reports] == [(2, "link", 30.0)]
+    assert reports[0].metric == pytest.approx(0.6)
+    assert app.observers[2].lost_fraction() == pytest.approx(18 / 40)
