@@ -10,6 +10,7 @@ from typing import Any
 import pytest
 
 from deploy.inproc import run_inproc
+from ground.fdir.calibrate import main as calibrate_main
 from ground.recorder import McapRecorder
 from ground.report import write_report
 from ground.summary import write_summary
@@ -90,3 +91,24 @@ def test_report_plots_metric_against_threshold(fdir_run: Run,
     assert "fdir_gain.png" in report and (out / "fdir_gain.png").stat().st_size > 10_000
     assert "| camera_degradation | 2 | 0 | yes | yes |" in report
     assert f"False alarms: 0 in {summary['scores']['nominal_cycles']} nominal" in report
+    assert "| camera_degradation, faulty_data, link_loss | H_m,i > 0, i = 1, 2, 3 |" in report
+    assert "| chi2_nis |" in report and "| cusum |" in report and "| fixed_threshold |" in report
+    assert "| camera |" in report and "beta_hat 0.5" in report  # the class and its evidence
+
+
+def test_camera_fault_identified(fdir_run: Run) -> None:
+    _, reports, _ = fdir_run
+    cam = [r for r in reports if r.spacecraft == 2]
+    assert cam[0].fault_class == "camera"
+    assert cam[0].evidence["beta_hat"] == pytest.approx(0.5, abs=0.03)
+
+
+def test_floor_calibrated_from_the_run(tmp_path_factory: pytest.TempPathFactory,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
+    """The calibration command reads the archived windows and prints the floor; a missing run
+    is a clear error (exit 2)."""
+    out = next(tmp_path_factory.getbasetemp().glob("fdir*"))
+    assert calibrate_main([str(out), "--rate", "0.01", "--skip-s", "100"]) == 0
+    text = capsys.readouterr().out
+    assert "nominal windows" in text and "floor for 0.01 false alarms" in text
+    assert calibrate_main([str(out / "nothing")]) == 2

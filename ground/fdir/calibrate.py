@@ -1,0 +1,67 @@
+"""Calibrate the FDIR threshold floor from nominal runs (DESIGN.md: "a floor calibrated from
+nominal runs for a chosen false-alarm rate").
+
+    python -m ground.fdir.calibrate runs/nominal [runs/nominal-seed2 ...] [--rate 1e-3]
+        [--persistence 2] [--skip-s 0]
+
+Reads every ``ground/fdir/window`` verdict of the given run directories (``run.mcap``), prints
+the distribution of the nominal metric H_m,i and the floor that gives the chosen false-alarm
+probability per FDI window under the persistence rule (:func:`threshold.calibrate_floor`), and
+the margin of each run's configured floor.  Only runs without injected faults should be given.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ground.fdir.threshold import calibrate_floor
+from ground.reader import ArchiveError, load_run
+from interfaces.messages import FdirWindow
+
+
+def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[float]:
+    """Every judged H_m,i of a run's FDIR windows ending after ``skip_s``."""
+    archive = load_run(run_dir / "run.mcap")
+    keys = [k for k, (t, _) in archive.topics().items()
+            if k.endswith("/ground/fdir/window") and t == "FdirWindow"]
+    return [w.metric for k in keys for w in archive.messages(k, FdirWindow)
+            if w.metric is not None and w.t_end_s > skip_s]
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m ground.fdir.calibrate", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("runs", type=Path, nargs="+", help="run directories of nominal runs")
+    p.add_argument("--rate", type=float, default=1e-3,
+                   help="false-alarm probability per FDI window (default 1e-3)")
+    p.add_argument("--persistence", type=int, default=2, help="windows in a row (default 2)")
+    p.add_argument("--skip-s", type=float, default=0.0, help="ignore windows ending before")
+    args = p.parse_args(argv)
+    values: list[float] = []
+    for run in args.runs:
+        try:
+            values += nominal_metrics(run, args.skip_s)
+        except (ArchiveError, OSError) as e:
+            print(f"error: {run}: {e}", file=sys.stderr)
+            return 2
+    if not values:
+        print("error: no judged FDIR window in these runs", file=sys.stderr)
+        return 2
+    m = np.array(values)
+    floor = calibrate_floor(values, args.rate, args.persistence)
+    print(f"{m.size} nominal windows: H_m median {np.median(m):.4g}, p90 "
+          f"{np.quantile(m, 0.9):.4g}, p99 {np.quantile(m, 0.99):.4g}, max {m.max():.4g}")
+    print(f"floor for {args.rate:g} false alarms per window with persistence "
+          f"{args.persistence}: {floor:.4g}")
+    if m.size * args.rate ** (1.0 / args.persistence) < 1.0:
+        print(f"note: {m.size} windows are too few to resolve that quantile; the floor is near "
+              "the sample maximum: add nominal runs (other seeds)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
