@@ -23,6 +23,7 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # run as a script from a checkout
@@ -120,7 +121,7 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
 
 
 def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text: str,
-                      args: argparse.Namespace, summary: dict) -> dict:
+                      args: argparse.Namespace, summary: dict[str, Any]) -> dict[str, Any]:
     """Run the counterfactual (recovery flipped) in-process and add the comparison."""
     flipped = scenario.model_copy(update={"fdir": scenario.fdir.model_copy(
         update={"recovery": not scenario.fdir.recovery})})
@@ -128,7 +129,12 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
     other.mkdir(exist_ok=True)
     log.info("counterfactual run: recovery %s", "on" if flipped.fdir.recovery else "off")
     wall0 = time.monotonic()
-    status, error = _run_inproc(flipped, mission, other, scenario_text, args)
+    note = f"\n# counterfactual run: [fdir] recovery = {str(flipped.fdir.recovery).lower()}\n"
+    try:
+        status, error = _run_inproc(flipped, mission, other, scenario_text + note, args)
+    except Exception as e:  # noqa: BLE001 - the primary run's results must still be written
+        log.exception("counterfactual run failed")
+        status, error = "failed", f"{type(e).__name__}: {e}"
     counter = write_summary(other, flipped, transport="inproc", wall_s=time.monotonic() - wall0,
                             status=status, error=error)
     return add_recovery_comparison(out, summary, counter, scenario.fdir.recovery)

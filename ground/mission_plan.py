@@ -27,7 +27,9 @@ Units: s, m, rad; gains in information-cost units (H decrease).
 
 from __future__ import annotations
 
+import logging
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -47,6 +49,8 @@ from ground.orbit_assignment import (
 )
 from interfaces.messages import ProElements
 from interfaces.scenario import Phase, Scenario
+
+log = logging.getLogger(__name__)
 
 UPLINK_LEAD_S = 60.0
 """Assignments are uplinked from this long before their departure time, s."""
@@ -139,6 +143,7 @@ class MissionPlan:
         self._last_check: tuple[float, float] | None = None  # (time s, H) of the last check
         self._info_phase = ""
         self._reassignments = 0
+        self._recoveries = 0
         self.dropped: set[int] = set()  # observers untasked (failed camera)
         self.impaired: dict[int, float] = {}  # observer -> keep-out it needs (actuator), m
         if sc.observers.start == "pro":
@@ -208,85 +213,67 @@ class MissionPlan:
         the current set by the margin."""
         a = self.scenario.assignment
         t_arrive = t_depart + transfer_s
-        k = self._stride  # planning subsample: every k-th POI standing for k of them
-        w_now = (fused.w_inv + fused.F.sum(axis=0))[::k]
-        phi = fused.phi[::k] * k
-        keep_out = self.scenario.guidance.keep_out_m + a.keep_out_margin_m
-        choice = greedy_assignment(self.library, self.count, self.n, t_arrive, a.window_s,
-                                   a.samples, self._plan_pos, self._plan_normal, phi, w_now,
-                                   self.camera, a.min_separation_m, keep_out)
+        pros, per_observer, gain, bound = self._plan_set(t_depart, t_arrive, fused,
+                                                         self.dropped, self.impaired)
         current_gain = None
         if self._current_indices is not None:
-            prec = np.array([expected_precision(self.library[i], self.n, t_arrive, a.window_s,
-                                                a.samples, self._plan_pos, self._plan_normal,
-                                                self.camera) for i in self._current_indices])
-            current_gain = set_gain(prec, phi, w_now)
-        switch = force or current_gain is None or \
-            choice.gain > (1.0 + a.min_improvement) * current_gain
-        states = self._states_at(t_depart)
-        order = match_to_observers(states, choice.pros, self.n, t_depart)
-        per_observer = tuple(choice.indices[j] for j in order)
-        self.decisions.append(Decision(t, phase, reason, per_observer, choice.gain,
-                                       choice.upper_bound, current_gain, tuple(self._gains),
-                                       switch))
+            w, phi = self._weights(t_arrive, fused, self.dropped)
+            prec = np.array([self._expected(self.library[i], t_arrive)
+                             for i in self._current_indices if i >= 0])
+            current_gain = set_gain(prec, phi, w)
+        switch = force or current_gain is None or gain > (1.0 + a.min_improvement) * current_gain
+        self.decisions.append(Decision(t, phase, reason, per_observer, gain, bound, current_gain,
+                                       tuple(self._gains), switch))
         if not switch:
             self._gains, self._last_check = [], (t, fused.cost())
             return
-        self._issue(phase, {i + 1: elements(self.library[k]) for i, k in enumerate(per_observer)},
-                    t_depart, t_arrive)
+        self._issue(phase, pros, t_depart, t_arrive)
         self._current_indices = per_observer
 
-    def recover(self, t: float, spacecraft: int, fault_class: str | None,
-                evidence: dict[str, float], fused: PoiMap) -> bool:
-        """Replan after a fault identified on ``spacecraft`` (module docstring).  ``evidence``:
-        the FDIR's (``nav_vs_plan_m``, ``pointing_error_deg``).  Returns whether a new
-        assignment was issued (once per observer and class; link, state-sensor and
-        data-integrity faults are not replanned)."""
-        if self.current is None or not 1 <= spacecraft <= self.count:
+    def recover(self, t: float, faults: Sequence[tuple[int, str | None, dict[str, float]]],
+                fused: PoiMap) -> bool:
+        """Replan after faults the FDIR identified (module docstring): ``faults`` holds
+        (observer, class, evidence) -- the evidence's ``nav_vs_plan_m`` and
+        ``pointing_error_deg`` size what an impaired observer can hold.  One assignment for
+        all of them; returns whether one was issued (an observer is replanned once per class;
+        link, state-sensor, data-integrity and unidentified faults are not replanned).
+
+        Raises:
+            ValueError: no set clears the keep-out and separation rules even at the nominal
+                keep-out (the plan is left as it was).
+        """
+        if self.current is None:
             return False
-        if fault_class == "camera" and spacecraft not in self.dropped:
-            self.dropped.add(spacecraft)
-        elif fault_class == "actuator" and spacecraft not in self.impaired:
-            self.impaired[spacecraft] = self._holdable_keep_out(evidence)
-        else:
-            return False
-        if len(self.dropped) >= self.count:
+        dropped, impaired = set(self.dropped), dict(self.impaired)
+        for sc, fault_class, evidence in faults:
+            if not 1 <= sc <= self.count:
+                continue
+            if fault_class == "camera":
+                dropped.add(sc)
+            elif fault_class == "actuator" and sc not in impaired:
+                impaired[sc] = self._holdable_keep_out(evidence)
+        if (dropped, impaired) == (self.dropped, self.impaired) or len(dropped) >= self.count:
             return False
         a = self.scenario.assignment
         t_depart = t + UPLINK_LEAD_S
         t_arrive = t_depart + a.transfer_s
-        k = self._stride
-        w_now = (fused.w_inv + fused.F.sum(axis=0))[::k]
-        phi = fused.phi[::k] * k
-        cur = self.current.pros
-        fixed = {i: cur[i] for i in sorted(self.dropped)}
-        chosen: dict[int, int] = {}  # observer -> library index
-        gain = bound = 0.0
-        groups = [[i for i in sorted(self.impaired) if i not in self.dropped],
-                  [i for i in range(1, self.count + 1)
-                   if i not in self.dropped and i not in self.impaired]]
-        for group in groups:
-            if not group:
-                continue
-            keep_out = max([self.scenario.guidance.keep_out_m + a.keep_out_margin_m]
-                           + [self.impaired.get(i, 0.0) for i in group])
-            around = [_pro(e) for e in fixed.values()] + [self.library[j] for j in chosen.values()]
-            picks, g, ub = self._greedy_around(len(group), around, keep_out, t_arrive, w_now, phi)
-            states = self._states_at(t_depart)[[i - 1 for i in group]]
-            order = match_to_observers(states, [self.library[j] for j in picks], self.n, t_depart)
-            chosen.update({sc: picks[j] for sc, j in zip(group, order)})
-            gain, bound = gain + g, bound + ub
-        pros = {**fixed, **{i: elements(self.library[j]) for i, j in chosen.items()}}
-        name = f"recovery-{len(self.dropped) + len(self.impaired)}"
-        self.decisions.append(Decision(
-            t, name, "recovery", tuple(chosen.get(i, -1) for i in range(1, self.count + 1)),
-            gain, max(bound, gain), None, tuple(self._gains), True))
-        self._issue(name, dict(sorted(pros.items())), t_depart, t_arrive)
-        self._current_indices = None  # a recovery set is not re-optimised as a whole
+        pros, per_observer, gain, bound = self._plan_set(t_depart, t_arrive, fused, dropped,
+                                                         impaired)
+        self.dropped, self.impaired = dropped, impaired
+        self._recoveries += 1
+        name = f"recovery-{self._recoveries}"
+        self.decisions.append(Decision(t, name, "recovery", per_observer, gain, bound, None,
+                                       tuple(self._gains), True))
+        info_phase = self._current_indices is not None
+        self._issue(name, pros, t_depart, t_arrive)
+        # an information phase goes on re-optimising around the faulty; a scenario one holds
+        self._current_indices = per_observer if info_phase else None
         return True
 
     def _holdable_keep_out(self, evidence: dict[str, float]) -> float:
-        """The keep-out an actuator-impaired observer needs, m (``recover``)."""
+        """The keep-out an actuator-impaired observer needs, m (``recover``): the nominal one
+        plus twice the deviation the FDIR measured; for a pointing fault of θ at least
+        R / sin(α − θ), capped at the farthest candidate the library has."""
         sc = self.scenario
         base = sc.guidance.keep_out_m + sc.assignment.keep_out_margin_m
         need = base + 2.0 * evidence.get("nav_vs_plan_m", 0.0)
@@ -296,20 +283,82 @@ class MissionPlan:
             fit = sc.target.radius_m / math.sin(half - theta) if half > theta else math.inf
             need = max(need, fit)
         farthest = max(min_distance_to_origin(p, self.n)[0] for p in self.library)
+        if need > farthest:
+            log.warning("an impaired observer needs %.1f m from the target; the farthest "
+                        "candidate PRO keeps %.1f m", need, farthest)
         return min(need, farthest)
 
+    def _expected(self, pro: Pro, t_arrive: float) -> npt.NDArray[np.float64]:
+        a = self.scenario.assignment
+        return expected_precision(pro, self.n, t_arrive, a.window_s, a.samples, self._plan_pos,
+                                  self._plan_normal, self.camera)
+
+    def _weights(self, t_arrive: float, fused: PoiMap, dropped: set[int]
+                 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(w⁻¹, φ) of the planning subsample (every ``poi_stride``-th POI standing for that
+        many): the fused precision now plus what the untasked (``dropped``) observers still
+        bring from their PROs over the planning window."""
+        k = self._stride
+        w = (fused.w_inv + fused.F.sum(axis=0))[::k]
+        cur = self.current
+        for i in sorted(dropped):
+            if cur is not None and i in cur.pros:
+                w = w + self._expected(pro_of(cur.pros[i]), t_arrive)
+        return w, fused.phi[::k] * k
+
+    def _plan_set(self, t_depart: float, t_arrive: float, fused: PoiMap, dropped: set[int],
+                  impaired: dict[int, float]
+                  ) -> tuple[dict[int, ProElements], tuple[int, ...], float, float]:
+        """Every observer's PRO for an assignment arriving at ``t_arrive``: the ``dropped``
+        ones keep theirs (untasked); the ``impaired`` ones, then the healthy ones, get the
+        greedy set of library PROs (``greedy_assignment``) clear of the keep-out they need and
+        separated from the PROs already fixed, matched to the observers by
+        ``match_to_observers``.  Returns (PROs by observer, library index per observer or -1,
+        expected gain, online bound).  An impaired group with no feasible set falls back to the
+        nominal keep-out (logged)."""
+        a = self.scenario.assignment
+        nominal = self.scenario.guidance.keep_out_m + a.keep_out_margin_m
+        cur = self.current
+        fixed = {i: cur.pros[i] for i in sorted(dropped) if cur is not None and i in cur.pros}
+        w, phi = self._weights(t_arrive, fused, dropped)
+        chosen: dict[int, int] = {}
+        gain = bound = 0.0
+        tasked = [i for i in range(1, self.count + 1) if i not in fixed]
+        groups = ([i for i in tasked if i in impaired], [i for i in tasked if i not in impaired])
+        for group in groups:
+            if not group:
+                continue
+            keep_out = max([nominal] + [impaired.get(i, 0.0) for i in group])
+            around = ([pro_of(e) for e in fixed.values()]
+                      + [self.library[j] for j in chosen.values()])
+            try:
+                picks, g, ub = self._greedy_around(len(group), around, keep_out, t_arrive, w, phi)
+            except ValueError:
+                if keep_out <= nominal:
+                    raise
+                log.warning("no PRO set clears %.1f m for observers %s: nominal keep-out", keep_out,
+                            group)
+                picks, g, ub = self._greedy_around(len(group), around, nominal, t_arrive, w, phi)
+            for j in picks:
+                w = w + self._expected(self.library[j], t_arrive)
+            states = self._states_at(t_depart)[[i - 1 for i in group]]
+            order = match_to_observers(states, [self.library[j] for j in picks], self.n, t_depart)
+            chosen.update({sc: picks[j] for sc, j in zip(group, order)})
+            gain, bound = gain + g, bound + ub
+        pros = {**fixed, **{i: elements(self.library[j]) for i, j in chosen.items()}}
+        per_observer = tuple(chosen.get(i, -1) for i in range(1, self.count + 1))
+        return dict(sorted(pros.items())), per_observer, gain, max(bound, gain)
+
     def _greedy_around(self, count: int, around: list[Pro], keep_out: float, t_arrive: float,
-                       w_now: npt.NDArray[np.float64], phi: npt.NDArray[np.float64]
+                       w: npt.NDArray[np.float64], phi: npt.NDArray[np.float64]
                        ) -> tuple[list[int], float, float]:
-        """Greedy set of ``count`` library PROs clear of the PROs ``around`` (separation) and
-        of ``keep_out``, counting the coverage those bring: (library indices, gain, bound)."""
+        """Greedy set of ``count`` library PROs clear of ``keep_out`` and separated from the
+        PROs ``around`` (whose coverage ``w`` already counts): (library indices, gain,
+        bound)."""
         a = self.scenario.assignment
         free = [i for i, p in enumerate(self.library)
                 if all(min_distance_between(p, q, self.n)[0] >= a.min_separation_m
                        for q in around)]
-        w = w_now + sum((expected_precision(q, self.n, t_arrive, a.window_s, a.samples,
-                                            self._plan_pos, self._plan_normal, self.camera)
-                         for q in around), np.zeros_like(w_now))
         choice = greedy_assignment([self.library[i] for i in free], count, self.n, t_arrive,
                                    a.window_s, a.samples, self._plan_pos, self._plan_normal,
                                    phi, w, self.camera, a.min_separation_m, keep_out)
@@ -325,9 +374,10 @@ class MissionPlan:
         for i in range(self.count):
             e = cur.pros.get(i + 1)
             if e is not None:
-                out[i] = _pro(e).state(self.n, t)
+                out[i] = pro_of(e).state(self.n, t)
         return out
 
 
-def _pro(e: ProElements) -> Pro:
+def pro_of(e: ProElements) -> Pro:
+    """The PRO of an uplinked assignment (the inverse of :func:`elements`)."""
     return Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)

@@ -225,6 +225,8 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -
         rows.append(f"| {f['kind']} | {f['spacecraft']} | {f['start_s']:.0f} | "
                     f"{'yes' if f['detected'] else 'no'} | {'yes' if f['isolated'] else 'no'} | "
                     f"{lat} | {f['identified_class'] or '-'} (expected {f['expected_class']}) |")
+    if not scores.get("per_fault"):
+        rows[-2:] = ["No fault injected."]
     rows += ["", f"False alarms: {scores.get('false_alarms', 0)} in "
                  f"{scores.get('nominal_cycles', 0)} nominal FDI cycles.", ""]
     return (rows + _identification_rows(summary) + _table4_rows(summary)
@@ -233,7 +235,8 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -
 
 def _identification_rows(summary: dict) -> list[str]:
     """Each declared fault with the evidence its class rests on (ground/fdir/identify.py)."""
-    rows = ["| declared (s) | spacecraft | class | H_m | τ | evidence |", "|---|---|---|---|---|---|"]
+    rows = ["| declared (s) | spacecraft | class | H_m | τ | evidence |",
+            "|---|---|---|---|---|---|"]
     for d in summary.get("detections", []):
         ev = ", ".join(f"{k} {v:.3g}" for k, v in d.get("evidence", {}).items()) or "-"
         m = "-" if d.get("metric") is None else f"{d['metric']:.3g}"
@@ -251,10 +254,14 @@ def _recovery_rows(summary: dict) -> list[str]:
     rows = [f"Recovery: {len(acts)} replan(s)"
             + "".join(f"; {d['phase']} at {d['t_sim']:.0f} s (PROs {d['library_indices']})"
                       for d in acts) + "."]
-    if rec and rec.get("H_final_with_recovery") is not None:
+    if rec and None not in (rec.get("H_final_with_recovery"),
+                            rec.get("H_final_without_recovery")):
         rows.append(f"Final H with recovery {rec['H_final_with_recovery']:.5g}, without "
                     f"{rec['H_final_without_recovery']:.5g} (same scenario and seed; "
                     f"{rec['counterfactual']}).")
+    elif rec:
+        rows.append(f"The counterfactual run ({rec['counterfactual']}) did not complete: "
+                    f"{rec.get('counterfactual_status')}.")
     return rows + [""]
 
 

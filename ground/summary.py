@@ -144,6 +144,7 @@ def add_recovery_comparison(out: Path, summary: dict[str, Any], counter: dict[st
         "H_final_without_recovery": h_without,
         "H_final_ratio": h_with / h_without if h_with is not None and h_without else None,
         "counterfactual": "counterfactual/summary.json",
+        "counterfactual_status": counter.get("status"),
     }
     return _write_json(out, summary)
 

@@ -324,9 +324,10 @@ class FdirSettings(_Section):
     whose observations stay missing for ``silent_windows`` windows is reported as a link fault.
     A reported H_i off the ground's recomputation from the observer's own observations by more
     than ``integrity_tol`` (relative) for ``persistence`` windows is a data-integrity fault,
-    and more than ``loss_tol`` of its observations lost (sequence gaps) for ``persistence``
-    windows a link fault.  A window is evaluated ``latency_s`` after it closes (its last images
-    must have arrived).  A declared performance fault is identified (ground/fdir/identify.py)
+    and more of its observations lost (sequence gaps) than the links' nominal
+    ``comms.packet_loss`` plus ``loss_tol`` (and the window's sampling spread) for
+    ``persistence`` windows a link fault.  A window is evaluated ``latency_s`` after it closes
+    (its last images must have arrived).  A declared performance fault is identified (ground/fdir/identify.py)
     against the nominal bounds ``beta_tol`` (camera health located from the images),
     ``position_tol_m`` (camera from the images vs nav, nav vs plan), ``pointing_tol_deg``
     (reported pointing error), ``overlap_tol`` (seen vs expected POIs) and ``explained_min``
@@ -347,7 +348,8 @@ class FdirSettings(_Section):
         description="relative difference between a reported H_i and the ground's recomputation "
                     "beyond which the report is inconsistent (data integrity)")
     loss_tol: float = Field(default=0.2, gt=0.0, le=1.0,
-                            description="fraction of observations lost in a window")
+                            description="share of a window's observations lost beyond the "
+                                        "nominal comms.packet_loss")
     beta_tol: float = Field(default=0.1, gt=0.0, lt=1.0)
     position_tol_m: float = Field(default=0.5, gt=0.0)
     pointing_tol_deg: float = Field(default=1.0, gt=0.0)
@@ -356,7 +358,8 @@ class FdirSettings(_Section):
     nis_alpha: float = Field(default=1e-3, gt=0.0, lt=1.0,
                              description="baseline chi2_nis: false-alarm probability per window")
     cusum_drift: float = Field(default=0.02, ge=0.0,
-                               description="baseline cusum: allowed |1 - ΔH_i/ΔH_i^pred| per window")
+                               description="baseline cusum: allowed |1 - ΔH_i/ΔH_i^pred| "
+                                           "per window")
     cusum_threshold: float = Field(default=0.15, gt=0.0, description="baseline cusum: alarm level")
     fixed_threshold: float = Field(default=0.1, gt=0.0,
                                    description="baseline fixed_threshold: H_m,i alarm level")

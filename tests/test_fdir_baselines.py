@@ -32,8 +32,12 @@ def test_nis_window_threshold_and_empty() -> None:
 def test_cusum_accumulates_a_small_bias_and_ignores_noise_within_the_drift() -> None:
     c = Cusum(drift=0.02, threshold=0.16)
     assert not any(c.update(1, r)[1] for r in [0.015, -0.015] * 50)  # within the drift
-    alarms = [c.update(2, 0.05)[1] for _ in range(10)]  # 0.03 net per window
-    assert alarms.index(True) == 5  # 6 × 0.03 = 0.18 > 0.16 > 5 × 0.03
-    stat, alarm = c.update(3, -0.5)  # one large window, either sign
-    assert alarm and stat == pytest.approx(0.48)
-    assert c.update(3, 0.0) == (0.0, False)  # restarted after the alarm
+    alarms = [c.update(2, 0.05)[2] for _ in range(10)]  # 0.03 net per window
+    assert alarms == [False] * 5 + [True] + [False] * 4  # 6 × 0.03 > 0.16 > 5 × 0.03; once
+    stat, above, alarm = c.update(3, -0.5)  # one large window, either sign
+    assert above and alarm and stat == pytest.approx(0.48)
+    assert c.update(3, -0.5)[1:] == (True, False)  # the same episode
+    for _ in range(60):  # the fault ends: the sum drains below the level, re-armed
+        stat, above, alarm = c.update(3, 0.0)
+    assert stat == 0.0 and not above
+    assert c.update(3, 0.5)[1:] == (True, True)  # a new episode alarms again

@@ -19,6 +19,7 @@ from ground.fdir.identify import (
     locate_camera,
     seen_overlap,
 )
+from interfaces.scenario import FdirSettings
 
 R = 5.0
 POS, NORMAL = sphere_pois(5000, R)
@@ -95,7 +96,7 @@ def test_seen_overlap() -> None:
     assert seen_overlap([], []) is None
 
 
-TOL = Tolerances()
+TOL = Tolerances.of(FdirSettings())
 NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_error_deg=0.05,
                seen_overlap=0.99, explained_reported=0.0)
 

@@ -9,6 +9,7 @@ import itertools
 import math
 
 import numpy as np
+import pytest
 
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
@@ -189,7 +190,7 @@ def test_recovery_drops_a_failed_camera_and_reassigns_around_it() -> None:
     _fly(plan, fused, 0.0, 400.0)
     before = plan.current
     assert before is not None
-    assert plan.recover(400.0, 2, "camera", {"beta_hat": 0.5}, fused)
+    assert plan.recover(400.0, [(2, "camera", {"beta_hat": 0.5})], fused)
     after = plan.current
     assert after is not None and after.id == before.id + 1
     assert after.t_depart_s == 400.0 + UPLINK_LEAD_S
@@ -202,27 +203,63 @@ def test_recovery_drops_a_failed_camera_and_reassigns_around_it() -> None:
     assert min_distance_between(_pro(after.pros[1]), _pro(after.pros[3]), plan.n)[0] >= sep
     d = plan.decisions[-1]
     assert d.reason == "recovery" and d.library_indices[1] == -1 and d.switched
-    assert not plan.recover(500.0, 2, "camera", {}, fused)  # once per observer and class
-    assert not plan.recover(500.0, 1, "state_sensor", {}, fused)  # not replanned
-    assert not plan.recover(500.0, 1, "link", {}, fused)
+    assert not plan.recover(500.0, [(2, "camera", {})], fused)  # once per observer and class
+    assert not plan.recover(500.0, [(1, "state_sensor", {}), (1, "link", {}), (3, None, {})],
+                            fused)  # not replanned
 
 
 def test_recovery_gives_an_actuator_fault_a_pro_it_can_hold() -> None:
     """A 5° pointing fault with a 20° camera: the whole 5 m target stays in view from
     R / sin(15°) = 19.3 m; a thruster leak that pushed the observer 3 m off needs the keep-out
-    plus twice that.  Every other observer keeps the normal keep-out."""
+    plus twice that.  Faults of one FDIR cycle make one assignment; the others keep the
+    nominal keep-out."""
     sc = _scenario([])
     plan = MissionPlan(sc, POS, NOR)
     fused = PoiMap.uniform(400, 1.0, 3)
-    assert plan.recover(100.0, 1, "actuator", {"pointing_error_deg": 5.0}, fused)
+    issued = len(plan.issued)
+    assert plan.recover(100.0, [(1, "actuator", {"pointing_error_deg": 5.0}),
+                                (3, "actuator", {"nav_vs_plan_m": 3.0})], fused)
+    assert len(plan.issued) == issued + 1
     need = 5.0 / math.sin(math.radians(15.0))
-    assert plan.impaired[1] == need
-    assert min_distance_to_origin(_pro(plan.current.pros[1]), plan.n)[0] >= need  # type: ignore[union-attr]
-    assert plan.recover(200.0, 3, "actuator", {"nav_vs_plan_m": 3.0}, fused)
     keep = sc.guidance.keep_out_m + sc.assignment.keep_out_margin_m
-    assert plan.impaired[3] == keep + 6.0
+    assert plan.impaired == {1: pytest.approx(need), 3: pytest.approx(keep + 6.0)}
     cur = plan.current
     assert cur is not None
-    assert min_distance_to_origin(_pro(cur.pros[3]), plan.n)[0] >= keep + 6.0
     assert min_distance_to_origin(_pro(cur.pros[1]), plan.n)[0] >= need
+    assert min_distance_to_origin(_pro(cur.pros[3]), plan.n)[0] >= keep + 6.0
     assert min_distance_to_origin(_pro(cur.pros[2]), plan.n)[0] >= keep
+
+
+def test_later_information_phases_keep_the_recovery() -> None:
+    """After a recovery, an information phase and its saturation reassignments still leave
+    the failed camera's observer untasked and give the impaired one a PRO it can hold."""
+    sc = _scenario([{"name": "insp", "start_s": 1000.0, "transfer_s": 300.0,
+                     "assign": "information"}], check_period_s=200.0)
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    _fly(plan, fused, 0.0, 300.0)
+    assert plan.recover(300.0, [(2, "camera", {}), (3, "actuator", {"nav_vs_plan_m": 3.0})],
+                        fused)
+    dropped_pro = plan.current.pros[2]  # type: ignore[union-attr]
+    _fly(plan, fused, 320.0, 8000.0)
+    later = [a for a in plan.issued if a.t_depart_s >= 1000.0]
+    assert len(later) >= 2  # the phase and at least one saturation reassignment
+    need = plan.impaired[3]
+    for a in later:
+        assert a.pros[2] == dropped_pro
+        assert min_distance_to_origin(_pro(a.pros[3]), plan.n)[0] >= need - 1e-9
+    assert all(d.library_indices[1] == -1 for d in plan.decisions if d.t_s >= 300.0)
+
+
+def test_an_impossible_keep_out_falls_back_and_an_impossible_set_changes_nothing() -> None:
+    sc = _scenario([])
+    plan = MissionPlan(sc, POS, NOR)
+    fused = PoiMap.uniform(400, 1.0, 3)
+    # no library PRO keeps 1 km: the impaired one falls back to the nominal keep-out
+    plan._holdable_keep_out = lambda ev: 1000.0  # type: ignore[method-assign]
+    assert plan.recover(100.0, [(1, "actuator", {})], fused)
+    # three observers, every one dropped: nothing left to task, the plan stays
+    issued = len(plan.issued)
+    assert not plan.recover(200.0, [(1, "camera", {}), (2, "camera", {}), (3, "camera", {})],
+                            fused)
+    assert len(plan.issued) == issued and plan.dropped == set()

@@ -5,16 +5,20 @@ H_m,i) and every observer's nav estimate (its NIS).  Output: one ``BaselineVerdi
 detector, observer and FDI window on ``ground/fdir/baseline``; ``alarm`` marks the window that
 declares a fault (``chi2_nis`` and ``fixed_threshold`` after ``fdir.persistence`` exceedances
 in a row for the first, at once for the second, as a plain limit check; ``cusum`` when its sum
-crosses ``fdir.cusum_threshold``).  summary.json scores each like the main detector.
+first crosses ``fdir.cusum_threshold``, once per episode).  summary.json scores each like the main detector.
 """
 
 from __future__ import annotations
+
+from typing import Literal
 
 from ground.fdir.baselines import Cusum, nis_window_test
 from ground.fdir.threshold import Persistence
 from interfaces import topics
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import BaselineVerdict, FdirWindow, StateEstimate
+
+Detector = Literal["chi2_nis", "cusum", "fixed_threshold"]
 
 
 class BaselinesApp(App):
@@ -54,13 +58,13 @@ class BaselinesApp(App):
             self._chi2(w)
             self._information(w)
 
-    def _verdict(self, detector: str, w: FdirWindow, statistic: float | None,
+    def _verdict(self, detector: Detector, w: FdirWindow, statistic: float | None,
                  threshold: float | None, exceeded: bool | None, alarm: bool) -> None:
         if alarm:
             self.log.warning("baseline %s: fault declared on sc%d at %.0f s", detector,
                              w.spacecraft, w.t_end_s)
         self.publish("verdict", BaselineVerdict(
-            sender=self.ctx.node, t_sim=w.t_end_s, detector=detector,  # type: ignore[arg-type]
+            sender=self.ctx.node, t_sim=w.t_end_s, detector=detector,
             spacecraft=w.spacecraft, t_start_s=w.t_start_s, t_end_s=w.t_end_s,
             statistic=statistic, threshold=threshold, exceeded=exceeded, alarm=alarm))
 
@@ -84,8 +88,8 @@ class BaselinesApp(App):
             self._verdict("cusum", w, None, None, None, False)
             self._verdict("fixed_threshold", w, None, None, None, False)
             return
-        stat, alarm = self.cusum.update(w.spacecraft, 1.0 - w.dh / w.dh_pred)
-        self._verdict("cusum", w, stat, self.cfg.cusum_threshold, alarm, alarm)
+        stat, above, alarm = self.cusum.update(w.spacecraft, 1.0 - w.dh / w.dh_pred)
+        self._verdict("cusum", w, stat, self.cfg.cusum_threshold, above, alarm)
         exceeded = w.metric > self.cfg.fixed_threshold
         alarm = self.fixed_persistence.update(w.spacecraft, exceeded)
         self._verdict("fixed_threshold", w, w.metric, self.cfg.fixed_threshold, exceeded, alarm)

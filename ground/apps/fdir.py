@@ -26,8 +26,9 @@ closes.  For observer i, with ψ the squared fused variance of the ground's map 
 * the H_i an observer reports (``InfoCostTelemetry``) is checked against the ground's
   recomputation from its observations: inconsistent for ``fdir.persistence`` windows, a
   data-integrity fault;
-* more than ``fdir.loss_tol`` of an observer's observations missing by sequence number for
-  ``fdir.persistence`` windows: a link fault (packet loss), as is silence.
+* more of an observer's observations missing by sequence number than the link's nominal loss
+  (``comms.packet_loss``) plus ``fdir.loss_tol``, for ``fdir.persistence`` windows: a link
+  fault (packet loss), as is silence.
 
 Only lost images are missing from both sides of the comparison; images taken while the
 observer reports a slew (its attitude plan, not a pointing), or within ``fdir.settle_s`` of the
@@ -46,11 +47,11 @@ import numpy as np
 
 from fsw.lib import quat
 from fsw.lib.hcw import mean_motion
-from fsw.lib.infocost import Camera, visibility
+from fsw.lib.infocost import Camera, agent_contributions, visibility
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
-from fsw.lib.pro import Pro
 from ground.fdir.identify import (
+    MIN_FIXES,
     Evidence,
     Tolerances,
     classify,
@@ -59,6 +60,7 @@ from ground.fdir.identify import (
     seen_overlap,
 )
 from ground.fdir.metric import direction, metric
+from ground.mission_plan import pro_of
 from ground.fdir.threshold import Persistence, adaptive_threshold
 from ground.fdir.twin import (
     FlightPlan,
@@ -84,7 +86,10 @@ from interfaces.messages import (
 
 class _Series:
     """A time series of vectors reported by an observer (nav position, attitude), sampled at
-    any time by linear interpolation (held at the ends)."""
+    any time by linear interpolation (held at the ends for at most ``MAX_GAP_S``)."""
+
+    MAX_GAP_S = 5.0
+    """A time farther than this from every sample has no value (stale telemetry), s."""
 
     def __init__(self) -> None:
         self.t: list[float] = []
@@ -96,11 +101,18 @@ class _Series:
         self.v.insert(i, value)
 
     def at(self, times: np.ndarray) -> np.ndarray | None:
-        """Values (K, d) at ``times`` (K,), or None when nothing was reported."""
+        """Values (K, d) at ``times`` (K,), or None unless every time is within ``MAX_GAP_S``
+        of a sample."""
         if not self.t:
             return None
+        t = np.array(self.t)
+        j = np.searchsorted(t, times)
+        before = np.abs(times - t[np.clip(j - 1, 0, len(t) - 1)])
+        after = np.abs(t[np.clip(j, 0, len(t) - 1)] - times)
+        if np.any(np.minimum(before, after) > self.MAX_GAP_S):
+            return None
         v = np.array(self.v)
-        return np.stack([np.interp(times, self.t, v[:, j]) for j in range(v.shape[1])], axis=1)
+        return np.stack([np.interp(times, t, v[:, j]) for j in range(v.shape[1])], axis=1)
 
     def forget_before(self, t: float) -> None:
         """Drop samples no later window needs (keep the last one before t)."""
@@ -121,12 +133,14 @@ class _Observer:
     """reported camera boresight (LVLH, 3) and pointing error (rad)"""
     silent: int = 0
     link_declared: bool = False
-    last_seq: int | None = None
+    last_seq: int = 0
+    """last observation sequence number judged (the Bus numbers from 1)"""
     received: int = 0
     lost: int = 0
     """observations received and missing (sequence gaps) since the start"""
 
     def lost_fraction(self) -> float:
+        """Share of its observations that never reached the ground, since the start."""
         total = self.received + self.lost
         return self.lost / total if total else 0.0
 
@@ -148,6 +162,14 @@ class _Observer:
 
 THRESHOLD_IMAGES = 20
 """The threshold's pointing samples use at most this many of a window's images (cost)."""
+
+def _sample_stride(images: int) -> int:
+    """Every k-th image, so that at most ``THRESHOLD_IMAGES`` of them are sampled."""
+    return max(1, math.ceil(images / THRESHOLD_IMAGES))
+
+
+MAX_JUDGED_LOSS = 0.9
+"""An observer with a larger share of its observations lost has no data-integrity verdict."""
 
 
 class FdirApp(App):
@@ -189,17 +211,22 @@ class FdirApp(App):
         self.loss = Persistence(self.cfg.persistence)
         self.boresight_body = np.array(sc.attitude.boresight_body, dtype=float)
         self.boresight_body /= np.linalg.norm(self.boresight_body)
-        self.tol = Tolerances(self.cfg.beta_tol, self.cfg.position_tol_m,
-                              self.cfg.pointing_tol_deg, self.cfg.overlap_tol,
-                              self.cfg.explained_min)
+        self.tol = Tolerances.of(self.cfg)
         self._reported: dict[tuple[int, float], float] = {}  # (observer, t) -> reported H_i
         self.window_start = 0.0
+        self.rejected = 0
         self._transfers: dict[tuple[int, int], Transfer] = {}
 
     # --- inputs ---------------------------------------------------------------------------
 
     def on_observations(self, msg: PoiObservations) -> None:
         if msg.spacecraft not in self.observers:
+            return
+        if msg.poi and (min(msg.poi) < 0 or max(msg.poi) >= len(self.poi_pos)):
+            self.rejected += 1
+            self.log.error("FDIR: dropped observations of sc%d with POI indices outside the "
+                           "%d of the target (%d dropped)", msg.spacecraft, len(self.poi_pos),
+                           self.rejected)
             return
         if msg.image_t_s >= self.window_start:
             self.pending.append(msg)
@@ -240,17 +267,16 @@ class FdirApp(App):
             obs = self.observers.get(a.spacecraft)
             if obs is None or a.assignment_id in obs.plans:
                 continue
-            e = a.pro
             obs.plans[a.assignment_id] = FlightPlan(
-                a.t_depart_s, Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad),
-                self._transfers.get((a.spacecraft, a.assignment_id)))
+                a.t_depart_s, pro_of(a.pro), self._transfers.get((a.spacecraft, a.assignment_id)))
 
     # --- cycle ----------------------------------------------------------------------------
 
     def step(self, t: float) -> None:
         while t >= self.window_start + self.period + self.cfg.latency_s - 1e-9:
-            self._evaluate(self.window_start, self.window_start + self.period)
-            self.window_start += self.period
+            a = self.window_start
+            self.window_start += self.period  # first: a failing window is not retried forever
+            self._evaluate(a, a + self.period)
 
     def _evaluate(self, a: float, b: float) -> None:
         inside = [m for m in self.pending if a <= m.image_t_s < b]
@@ -271,17 +297,19 @@ class FdirApp(App):
     def _check_reports(self, b: float) -> None:
         """Data integrity: each observer's H_i reported at b against the contribution the
         ground computes from the observations it received (its map now holds every image
-        before b), scaled up by the share of its observations lost on the way (sequence gaps;
-        the observer's H_i holds all of its images).  The two views then differ only by what
-        each has fused (range-limited sharing), so a relative difference above
-        ``fdir.integrity_tol`` is an inconsistent report.  While more than ``fdir.loss_tol``
-        of an observer's observations are missing, its report cannot be judged."""
-        ground = self.settled.contributions()
-        for sc, obs in self.observers.items():
+        before b), with every observer's precision scaled up by the share of its observations
+        lost on the way (sequence gaps), so ψ is as consistent as the ground can make it: the
+        observer's H_i holds all of its images.  The two views then differ only by what each
+        has fused (range-limited sharing), so a relative difference above
+        ``fdir.integrity_tol`` is an inconsistent report.  An observer with more than
+        ``MAX_JUDGED_LOSS`` of its observations missing cannot be judged."""
+        lost = np.array([o.lost_fraction() for o in self.observers.values()])
+        scaled = self.settled.F / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS))[:, None]
+        ground = agent_contributions(self.settled.phi, self.settled.w_inv, scaled)
+        for sc in self.observers:
             reported = self._reported.pop((sc, round(b, 6)), None)
-            lost = obs.lost_fraction()
-            mine = float(ground[sc - 1]) / (1.0 - lost)
-            if reported is None or mine <= 0.0 or lost > self.cfg.loss_tol:
+            mine = float(ground[sc - 1])
+            if reported is None or mine <= 0.0 or lost[sc - 1] > MAX_JUDGED_LOSS:
                 continue
             deviation = abs(reported / mine - 1.0)
             if self.integrity.update(sc, deviation > self.cfg.integrity_tol):
@@ -292,26 +320,40 @@ class FdirApp(App):
                     metric=deviation, threshold=self.cfg.integrity_tol, window_end_s=b))
         self._reported = {k: v for k, v in self._reported.items() if k[1] > b}
 
+    def _loss_limit(self, sent: int) -> float:
+        """Lost share of a window's ``sent`` observations beyond which the link is faulty: the
+        nominal loss p (``comms.packet_loss``) plus ``fdir.loss_tol`` plus two standard
+        deviations of the window's loss share, √(p(1−p)(2L−1)/n) for Gilbert-Elliott bursts of
+        mean length L (2L − 1: the variance inflation of a two-state Markov loss process with
+        rare bursts; L = 1 is Bernoulli)."""
+        comms = self.ctx.scenario.comms
+        p = comms.packet_loss
+        burst = comms.burst.mean_length_packets if comms.burst else 1.0
+        spread = math.sqrt(p * (1.0 - p) * (2.0 * burst - 1.0) / max(sent, 1))
+        return min(1.0, p + self.cfg.loss_tol + 2.0 * spread)
+
     def _check_loss(self, sc: int, obs: _Observer, images: list[PoiObservations],
                     b: float) -> int:
         """Observations of the window missing by sequence number (the observer numbers every
-        message it publishes on its key); more than ``fdir.loss_tol`` of them for
+        message it publishes on its key); more than ``_loss_limit`` of them for
         ``fdir.persistence`` windows is a link fault.  Returns the count lost."""
         if not images:
             return 0
         seqs = sorted(m.seq for m in images)
-        first = seqs[0] if obs.last_seq is None else obs.last_seq + 1
-        lost = max(seqs[-1] - first + 1 - len(seqs), 0)
-        obs.last_seq = max(seqs[-1], obs.last_seq or 0)
+        lost = max(seqs[-1] - obs.last_seq - len(seqs), 0)
+        obs.last_seq = max(seqs[-1], obs.last_seq)
         obs.received += len(seqs)
         obs.lost += lost
+        if obs.silent:  # the gap is the silence already judged (a link fault), not loss
+            return 0
         fraction = lost / (lost + len(seqs))
-        if self.loss.update(sc, fraction > self.cfg.loss_tol):
+        if self.loss.update(sc, fraction > self._loss_limit(lost + len(seqs))):
             self.log.warning("FDIR: sc%d lost %.0f%% of its observations: link fault", sc,
                              100.0 * fraction)
             self.publish("report", FaultReport(
                 sender=self.ctx.node, t_sim=b, spacecraft=sc, fault_class="link",
-                metric=fraction, threshold=self.cfg.loss_tol, window_end_s=b))
+                metric=fraction, threshold=self._loss_limit(lost + len(seqs)),
+                window_end_s=b))
         return lost
 
     def _judge(self, sc: int, obs: _Observer, images: list[PoiObservations], a: float,
@@ -367,6 +409,8 @@ class FdirApp(App):
         nav = obs.nav.at(times)
         att = obs.attitude.at(times)
         located = [(i, f) for i, f in enumerate(fixes) if f is not None]
+        if len(located) < MIN_FIXES:
+            located = []
         beta = float(np.median([f.beta for _, f in located])) if located else None
         cam_nav = nav_plan = point = explained = explained_loc = overlap = None
         if nav is not None:
@@ -387,7 +431,7 @@ class FdirApp(App):
             dh_loc = predicted_delta_h(where, bore, self.poi_pos, self.poi_normal, self.camera,
                                        psi, phi)
             explained_loc = explained_fraction(gap[0], gap[1], dh_loc)
-            k = max(1, math.ceil(len(images) / THRESHOLD_IMAGES))
+            k = _sample_stride(len(images))
             vis = visibility(nav[::k], bore[::k], self.poi_pos, self.poi_normal, self.camera)
             ratios = [seen_overlap(m.poi, np.flatnonzero(v)) for m, v in zip(images[::k], vis)]
             valid = [r for r in ratios if r is not None]
@@ -399,7 +443,7 @@ class FdirApp(App):
         """τ_i (Eq. 11-12) from ``fdir.samples`` ε-cone pointings of (at most
         ``THRESHOLD_IMAGES``, evenly spread) planned images, each compared with the prediction
         for the same images; floored at ``fdir.floor``.  Seeded by (seed, observer, window)."""
-        k = max(1, math.ceil(len(pos) / THRESHOLD_IMAGES))
+        k = _sample_stride(len(pos))
         pos, bore = pos[::k], bore[::k]
         ref = predicted_delta_h(pos, bore, self.poi_pos, self.poi_normal, self.camera, psi, phi)
         rng = np.random.default_rng([self.ctx.scenario.seed, sc, int(round(a))])
@@ -407,7 +451,8 @@ class FdirApp(App):
         samples = [predicted_delta_h(pos, perturbed_boresights(bore, eps, len(bore), rng),
                                      self.poi_pos, self.poi_normal, self.camera, psi, phi)
                    for _ in range(self.cfg.samples)]
-        return adaptive_threshold(samples, ref, h_prev / k, self.cfg.floor)  # subset: ~1/k of the gain
+        # the subset holds about 1/k of the window's gain
+        return adaptive_threshold(samples, ref, h_prev / k, self.cfg.floor)
 
     def _silence(self, sc: int, obs: _Observer, b: float) -> None:
         """An observer with a plan sent no image this window: after ``silent_windows`` in a

@@ -8,8 +8,8 @@ each information-driven ``AssignmentDecision`` on ``ground/planner/decisions``.
 What to fly comes from :class:`ground.mission_plan.MissionPlan`: the scenario's phases, with
 ``assign = "information"`` phases chosen by expected information gain and reassigned when the
 set's gain saturates, and -- with ``fdir.recovery`` -- a recovery assignment when the FDIR
-reports an identified camera or actuator fault (input ``ground/fdir/report``).  An assignment is uplinked from ``UPLINK_LEAD_S`` before its departure
-and repeated every cycle until the next one supersedes it, so a command lost on the
+reports an identified camera or actuator fault (input ``ground/fdir/report``).  An
+assignment is uplinked from ``UPLINK_LEAD_S`` before its departure and repeated every cycle until the next one supersedes it, so a command lost on the
 range-limited, lossy link is simply received later (a spacecraft acts on a new
 ``assignment_id`` once).
 """
@@ -64,11 +64,15 @@ class MissionPlanner(App):
 
     def step(self, t: float) -> None:
         self.plan.update(t, self.map)
-        for f in self._faults:
-            if self.plan.recover(t, f.spacecraft, f.fault_class, f.evidence, self.map):
-                self.log.warning("recovery: %s fault on sc%d, replanned", f.fault_class,
-                                 f.spacecraft)
-        self._faults = []
+        faults, self._faults = self._faults, []
+        if faults:
+            try:
+                if self.plan.recover(t, [(f.spacecraft, f.fault_class, f.evidence)
+                                         for f in faults], self.map):
+                    self.log.warning("recovery: replanned around %s", ", ".join(
+                        f"sc{f.spacecraft} ({f.fault_class})" for f in faults))
+            except ValueError as e:
+                self.log.error("recovery impossible, plan unchanged: %s", e)
         for d in self.plan.decisions[self._decisions_sent:]:
             self.log.info("%s at %.0f s (%s): PROs %s, expected gain %.4g (bound %.4g, "
                           "current %s), %s", d.phase, d.t_s, d.reason, d.library_indices,

@@ -39,18 +39,25 @@ def nis_window_test(nis: Sequence[float], alpha: float,
 @dataclass
 class Cusum:
     """Two-sided CUSUM per spacecraft on a residual with drift ``drift`` and alarm level
-    ``threshold``; restarts from zero after an alarm."""
+    ``threshold``.  It alarms once per episode, as the other detectors are scored: when the
+    statistic first crosses the level, re-armed when it falls back to or below it."""
 
     drift: float
     threshold: float
     _g: dict[int, tuple[float, float]] = field(default_factory=dict)
+    _above: set[int] = field(default_factory=set)
 
-    def update(self, spacecraft: int, residual: float) -> tuple[float, bool]:
-        """Add one window's residual; returns (max(g⁺, g⁻), alarm)."""
+    def update(self, spacecraft: int, residual: float) -> tuple[float, bool, bool]:
+        """Add one window's residual; returns (max(g⁺, g⁻), above the level, alarm)."""
         hi, lo = self._g.get(spacecraft, (0.0, 0.0))
         hi = max(0.0, hi + residual - self.drift)
         lo = max(0.0, lo - residual - self.drift)
+        self._g[spacecraft] = (hi, lo)
         stat = max(hi, lo)
-        alarm = stat > self.threshold
-        self._g[spacecraft] = (0.0, 0.0) if alarm else (hi, lo)
-        return stat, alarm
+        above = stat > self.threshold
+        alarm = above and spacecraft not in self._above
+        if above:
+            self._above.add(spacecraft)
+        else:
+            self._above.discard(spacecraft)
+        return stat, above, alarm

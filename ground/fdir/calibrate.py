@@ -4,15 +4,18 @@ nominal runs for a chosen false-alarm rate").
     python -m ground.fdir.calibrate runs/nominal [runs/nominal-seed2 ...] [--rate 1e-3]
         [--persistence 2] [--skip-s 0]
 
-Reads every ``ground/fdir/window`` verdict of the given run directories (``run.mcap``), prints
-the distribution of the nominal metric H_m,i and the floor that gives the chosen false-alarm
-probability per FDI window under the persistence rule (:func:`threshold.calibrate_floor`), and
-the margin of each run's configured floor.  Only runs without injected faults should be given.
+Reads every ``ground/fdir/window`` verdict of the given run directories (``run.mcap``; windows
+overlapping a fault of their spacecraft, as listed in the run's ``summary.json``, are left
+out), prints the distribution of the nominal metric H_m,i, the floor that gives the chosen
+false-alarm probability per FDI window under the persistence rule
+(:func:`threshold.calibrate_floor`), and how far the largest nominal metric is below each
+run's configured floor.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -23,13 +26,22 @@ from ground.reader import ArchiveError, load_run
 from interfaces.messages import FdirWindow
 
 
-def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[float]:
-    """Every judged H_m,i of a run's FDIR windows ending after ``skip_s``."""
+def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[FdirWindow]:
+    """The judged FDIR windows of a run that end after ``skip_s`` and overlap no fault of
+    their spacecraft (``summary.json`` ``injected_faults``, when the run has one)."""
     archive = load_run(run_dir / "run.mcap")
+    faults = []
+    if (run_dir / "summary.json").exists():
+        faults = json.loads((run_dir / "summary.json").read_text()).get("injected_faults", [])
+
+    def faulty(w: FdirWindow) -> bool:
+        return any(f["spacecraft"] == w.spacecraft and f["start_s"] < w.t_end_s
+                   and (f.get("end_s") is None or w.t_start_s < f["end_s"]) for f in faults)
+
     keys = [k for k, (t, _) in archive.topics().items()
             if k.endswith("/ground/fdir/window") and t == "FdirWindow"]
-    return [w.metric for k in keys for w in archive.messages(k, FdirWindow)
-            if w.metric is not None and w.t_end_s > skip_s]
+    return [w for k in keys for w in archive.messages(k, FdirWindow)
+            if w.metric is not None and w.t_end_s > skip_s and not faulty(w)]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -41,22 +53,31 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--persistence", type=int, default=2, help="windows in a row (default 2)")
     p.add_argument("--skip-s", type=float, default=0.0, help="ignore windows ending before")
     args = p.parse_args(argv)
-    values: list[float] = []
+    windows: list[FdirWindow] = []
     for run in args.runs:
         try:
-            values += nominal_metrics(run, args.skip_s)
-        except (ArchiveError, OSError) as e:
+            windows += nominal_metrics(run, args.skip_s)
+        except (ArchiveError, OSError, ValueError) as e:
             print(f"error: {run}: {e}", file=sys.stderr)
             return 2
+    values = [w.metric for w in windows if w.metric is not None]
     if not values:
-        print("error: no judged FDIR window in these runs", file=sys.stderr)
+        print("error: no judged nominal FDIR window in these runs", file=sys.stderr)
+        return 2
+    try:
+        floor = calibrate_floor(values, args.rate, args.persistence)
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
         return 2
     m = np.array(values)
-    floor = calibrate_floor(values, args.rate, args.persistence)
     print(f"{m.size} nominal windows: H_m median {np.median(m):.4g}, p90 "
           f"{np.quantile(m, 0.9):.4g}, p99 {np.quantile(m, 0.99):.4g}, max {m.max():.4g}")
     print(f"floor for {args.rate:g} false alarms per window with persistence "
           f"{args.persistence}: {floor:.4g}")
+    floors = sorted({w.threshold for w in windows if w.threshold is not None})
+    if floors:
+        print(f"margin: the smallest threshold these runs applied ({floors[0]:.4g}) is "
+              f"{floors[0] / m.max():.2g}x the largest nominal H_m")
     if m.size * args.rate ** (1.0 / args.persistence) < 1.0:
         print(f"note: {m.size} windows are too few to resolve that quantile; the floor is near "
               "the sample maximum: add nominal runs (other seeds)")

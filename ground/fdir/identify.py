@@ -49,10 +49,16 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import numpy.typing as npt
 
+from interfaces.scenario import FdirSettings
+
 FloatArray = npt.NDArray[np.float64]
 
 MIN_POIS = 12
 """Fewer POIs in an image than this give no camera fix (4 unknowns, noisy precisions)."""
+
+MIN_FIXES = 5
+"""Fewer located images than this in a window give no camera evidence (one fix is noisy:
+tenths of a metre and a few percent of β per image with a 12° camera at 20 m)."""
 
 
 @dataclass(frozen=True)
@@ -76,7 +82,7 @@ def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
 
     Returns:
         The fix, or None when the image saw fewer than ``MIN_POIS`` POIs or the fit is
-        degenerate (no root outside the sphere).
+        degenerate (POIs on a plane, no root outside the sphere).
     """
     s = np.asarray(poi_pos, dtype=float)
     p = np.asarray(precision, dtype=float)
@@ -84,7 +90,9 @@ def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
     if good.sum() < MIN_POIS:
         return None
     s, q = s[good], 1.0 / (k * p[good])
-    coef, *_ = np.linalg.lstsq(np.c_[np.ones(len(q)), s], q, rcond=None)
+    coef, _, rank, _ = np.linalg.lstsq(np.c_[np.ones(len(q)), s], q, rcond=None)
+    if rank < 4:
+        return None
     a, g = float(coef[0]), coef[1:]
     gg = float(g @ g)
     if not (gg > 0.0 and a > 0.0):
@@ -139,18 +147,25 @@ class Evidence:
     explained_located: float | None = None
 
     def as_dict(self) -> dict[str, float]:
+        """The evidence present, by name (for the bus and summary.json)."""
         return {k: v for k, v in asdict(self).items() if v is not None}
 
 
 @dataclass(frozen=True)
 class Tolerances:
-    """Nominal bounds of the evidence (see ``FdirSettings``)."""
+    """Nominal bounds of the evidence (``FdirSettings``: beta_tol, position_tol_m,
+    pointing_tol_deg, overlap_tol, explained_min)."""
 
-    beta: float = 0.1
-    position_m: float = 0.5
-    pointing_deg: float = 1.0
-    overlap: float = 0.8
-    explained: float = 0.5
+    beta: float
+    position_m: float
+    pointing_deg: float
+    overlap: float
+    explained: float
+
+    @classmethod
+    def of(cls, fdir: FdirSettings) -> Tolerances:
+        return cls(fdir.beta_tol, fdir.position_tol_m, fdir.pointing_tol_deg, fdir.overlap_tol,
+                   fdir.explained_min)
 
 
 def classify(ev: Evidence, tol: Tolerances) -> str | None:
