@@ -74,7 +74,24 @@ def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[
                        for r in reports],
         "scores": score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
         "baselines": baseline_scores(archive, scenario, mission),
+        "fdir_series": _series(windows, archive.messages(
+            topics.key(mission, topics.GROUND, "fdir", "baseline"), BaselineVerdict)),
     }
+
+
+def _series(windows: list[FdirWindow], verdicts: list[BaselineVerdict]
+            ) -> dict[str, list[list[float]]]:
+    """``fdir_series``: every decided window of each detector as [spacecraft, t_start_s,
+    t_end_s, statistic, threshold] -- what a campaign needs to re-score at other threshold
+    scales (ROC) without the archives."""
+    out: dict[str, list[list[float]]] = {"main": [
+        [w.spacecraft, w.t_start_s, w.t_end_s, w.metric, w.threshold] for w in windows
+        if w.metric is not None and w.threshold is not None]}
+    for v in verdicts:
+        if v.statistic is not None and v.threshold is not None:
+            out.setdefault(v.detector, []).append(
+                [v.spacecraft, v.t_start_s, v.t_end_s, v.statistic, v.threshold])
+    return out
 
 
 def baseline_scores(archive: RunArchive, scenario: Scenario, mission: str

@@ -1,0 +1,275 @@
+"""Campaign files: a base scenario plus dispersions, expanded into a deterministic list of runs
+(DESIGN.md "Campaigns"; issue 6).
+
+A campaign TOML names a base scenario and groups of runs::
+
+    name = "paper"
+    base = "../scenarios/nominal.toml"    # relative to this file
+    seeds = { first = 1, count = 10 }     # or a list: [1, 2, 3]
+    duration_s = 800.0                    # optional override of every run
+
+    [[groups]]
+    name = "fig23"
+    scenario = "../scenarios/paper_fig23.toml"   # optional, default: base
+    [[groups.faults]]                     # replaces the scenario's faults
+    spacecraft = [2, 4]                   # a list is a grid axis: one run per value
+    kind = "thruster_bias"
+    start_s = { min = 200.0, max = 600.0 }   # a range is drawn uniformly, per run
+    magnitude = [0.3, 0.5]
+
+    [[groups]]
+    name = "nominal"
+    nominal = true                        # no fault at all
+
+Each group expands to (its seeds) × (the Cartesian product of every list-valued fault field,
+in file order); every range is then drawn from a generator seeded by (campaign name, group,
+run index), so the list is the same on every machine and every restart.  A group may also
+override scenario sections (``[groups.overrides]``, e.g. ``fdir = { floor = 0.04 }``).
+Unknown fields, bad values and runs whose scenario does not validate are errors, raised by
+:func:`load_campaign` before any run starts.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import logging
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from interfaces.scenario import FaultKind, Scenario
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Range(_Strict):
+    """A value drawn uniformly in [min, max] for each run."""
+
+    min: float
+    max: float
+
+    @model_validator(mode="after")
+    def _order(self) -> Range:
+        if not self.max >= self.min:
+            raise ValueError(f"range max {self.max} is below min {self.min}")
+        return self
+
+
+class Seeds(_Strict):
+    """Seeds first, first + 1, ..., first + count - 1."""
+
+    first: int = Field(ge=0)
+    count: int = Field(ge=1, le=100_000)
+
+    def values(self) -> list[int]:
+        return list(range(self.first, self.first + self.count))
+
+
+Number = float | list[float] | Range
+
+
+class FaultSpec(_Strict):
+    """One injected fault per run, its fields fixed, gridded (lists) or drawn (ranges)."""
+
+    spacecraft: int | list[int]
+    kind: FaultKind | list[FaultKind]
+    start_s: Number
+    end_s: Number | None = None
+    magnitude: Number | None = None
+
+
+class Group(_Strict):
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=64)
+    scenario: str | None = None
+    seeds: list[int] | Seeds | None = None
+    nominal: bool = False
+    faults: list[FaultSpec] = Field(default_factory=list)
+    overrides: dict[str, dict[str, Any]] = Field(default_factory=dict)
+
+    @model_validator(mode="after")
+    def _nominal(self) -> Group:
+        if self.nominal and self.faults:
+            raise ValueError(f"group {self.name}: nominal = true with faults")
+        return self
+
+
+class Campaign(_Strict):
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=64)
+    base: str
+    seeds: list[int] | Seeds = Field(default_factory=lambda: [1])
+    duration_s: float | None = Field(default=None, gt=0.0)
+    groups: list[Group] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _unique(self) -> Campaign:
+        names = [g.name for g in self.groups]
+        if len(set(names)) != len(names):
+            raise ValueError(f"group names must be unique: {names}")
+        return self
+
+
+class CampaignError(ValueError):
+    """A campaign file that cannot be read, does not validate, or expands into an invalid run."""
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a campaign: its id (``<group>-<index>``, also its directory name), group,
+    seed, and the validated scenario it runs."""
+
+    id: str
+    group: str
+    seed: int
+    scenario: Scenario
+
+
+def _seeds(value: list[int] | Seeds) -> list[int]:
+    return value.values() if isinstance(value, Seeds) else list(value)
+
+
+def _axes(faults: list[FaultSpec]) -> list[tuple[int, str, list[Any]]]:
+    """(fault index, field, values) of every list-valued field, in file order."""
+    out = []
+    for i, f in enumerate(faults):
+        for name in FaultSpec.model_fields:
+            v = getattr(f, name)
+            if isinstance(v, list):
+                out.append((i, name, v))
+    return out
+
+
+def _rng(campaign: str, group: str, index: int) -> np.random.Generator:
+    digest = hashlib.sha256(f"{campaign}/{group}/{index}".encode()).digest()
+    return np.random.default_rng(int.from_bytes(digest[:8], "little"))
+
+
+def _fault(spec: FaultSpec, chosen: dict[str, Any], rng: np.random.Generator) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for name in FaultSpec.model_fields:
+        v = chosen.get(name, getattr(spec, name))
+        if isinstance(v, Range):
+            v = float(rng.uniform(v.min, v.max))
+        if v is not None:
+            out[name] = v
+    return out
+
+
+def _read_toml(path: Path) -> dict[str, Any]:
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as e:
+        raise CampaignError(f"cannot read {path}: {e.strerror}") from e
+    except tomllib.TOMLDecodeError as e:
+        raise CampaignError(f"{path}: not valid TOML: {e}") from e
+
+
+def _merge(data: dict[str, Any], overrides: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    out = dict(data)
+    for section, values in overrides.items():
+        out[section] = {**out.get(section, {}), **values}
+    return out
+
+
+def expand(campaign: Campaign, root: Path) -> list[RunSpec]:
+    """The campaign's runs, in a deterministic order (module docstring); ``root``: the
+    directory scenario paths are relative to."""
+    runs: list[RunSpec] = []
+    for group in campaign.groups:
+        base = _read_toml(root / (group.scenario or campaign.base))
+        seeds = _seeds(group.seeds if group.seeds is not None else campaign.seeds)
+        axes = _axes(group.faults)
+        combos = list(itertools.product(*(values for _, _, values in axes))) or [()]
+        index = 0
+        for seed in seeds:
+            for combo in combos:
+                chosen: dict[int, dict[str, Any]] = {}
+                for (i, name, _), value in zip(axes, combo):
+                    chosen.setdefault(i, {})[name] = value
+                rng = _rng(campaign.name, group.name, index)
+                data = _merge(base, group.overrides)
+                data["seed"] = seed
+                if campaign.duration_s is not None:
+                    data["duration_s"] = campaign.duration_s
+                if group.nominal:
+                    data["faults"] = []
+                elif group.faults:
+                    data["faults"] = [_fault(f, chosen.get(i, {}), rng)
+                                      for i, f in enumerate(group.faults)]
+                run_id = f"{group.name}-{index:04d}"
+                data["name"] = f"{campaign.name}-{run_id}"
+                try:
+                    scenario = Scenario.model_validate(data)
+                except ValidationError as e:
+                    raise CampaignError(f"run {run_id}: invalid scenario: "
+                                        + "; ".join(f"{'.'.join(map(str, err['loc']))}: "
+                                                    f"{err['msg']}" for err in e.errors())
+                                        ) from None
+                runs.append(RunSpec(run_id, group.name, seed, scenario))
+                index += 1
+    return runs
+
+
+def load_campaign(path: str | Path) -> tuple[Campaign, list[RunSpec]]:
+    """Read, validate and expand a campaign file; CampaignError names what is wrong."""
+    p = Path(path)
+    data = _read_toml(p)
+    try:
+        campaign = Campaign.model_validate(data)
+    except ValidationError as e:
+        lines = [f"{p}: invalid campaign:"]
+        for err in e.errors():
+            lines.append(f"  {'.'.join(map(str, err['loc'])) or '(top level)'}: {err['msg']}")
+        raise CampaignError("\n".join(lines)) from None
+    return campaign, expand(campaign, p.parent)
+
+
+def execute_run(spec: RunSpec, out_root: str) -> dict[str, Any]:
+    """Run one campaign run in-process into ``<out_root>/runs/<id>/`` (run.mcap, summary.json,
+    run.log) and return {id, status, error, wall_s}.  The run is written under
+    ``<id>.partial`` and renamed when complete, so a run directory exists only for a finished
+    run; a crash is caught and recorded as a failed run with its error.  A module-level
+    function, so a Dask worker can import it."""
+    import shutil
+    import time
+    import traceback
+
+    from deploy.inproc import run_inproc
+    from ground.record import run_metadata
+    from ground.recorder import McapRecorder
+    from ground.summary import write_summary
+
+    runs = Path(out_root) / "runs"
+    final, partial = runs / spec.id, runs / f"{spec.id}.partial"
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
+    handler = logging.FileHandler(partial / "run.log")
+    handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
+    root = logging.getLogger()
+    root.addHandler(handler)
+    t0 = time.monotonic()
+    status, error = "completed", None
+    try:
+        note = f"# campaign run {spec.id} (group {spec.group}, seed {spec.seed}): resolved_json\n"
+        with McapRecorder(partial / "run.mcap", run_metadata(spec.scenario, "inproc", note)) as rec:
+            run_inproc(spec.scenario, tap=rec.record)
+    except Exception as e:  # noqa: BLE001 - a crashed run is a result, not the campaign's end
+        status, error = "failed", f"{type(e).__name__}: {e}\n{traceback.format_exc()}"
+        logging.getLogger("insp.campaign").error("run %s failed: %s", spec.id, error)
+    finally:
+        root.removeHandler(handler)
+        handler.close()
+    wall = time.monotonic() - t0
+    summary = write_summary(partial, spec.scenario, "inproc", wall, status, error)
+    (partial / "campaign.json").write_text(json.dumps(
+        {"run": spec.id, "group": spec.group, "seed": spec.seed}, indent=2) + "\n")
+    shutil.rmtree(final, ignore_errors=True)
+    partial.rename(final)
+    return {"id": spec.id, "status": summary["status"], "error": error, "wall_s": wall}

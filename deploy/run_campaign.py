@@ -1,0 +1,163 @@
+"""Run a fault campaign: many scenarios (seeds, fault kinds, spacecraft, onsets, magnitudes)
+from one campaign file, on a local process pool or a Dask cluster, resumable.
+
+    python deploy/run_campaign.py --campaign deploy/campaigns/paper.toml --out runs/paper
+        [--workers N] [--limit N] [--cluster tcp://HOST:PORT] [--report-only]
+
+Each run goes in-process (deploy/inproc.py) into <out>/runs/<id>/ (run.mcap, summary.json,
+run.log); a run directory appears only when its run has finished (written as <id>.partial,
+then renamed), so a campaign started again with the same --out skips finished runs and redoes
+half-written ones.  A run that crashes is recorded as failed, with its error, and the campaign
+goes on.  SIGINT or SIGTERM stops the campaign: running runs are abandoned (redone next time)
+and the report is written over what has finished.  --cluster sends the runs to an existing
+Dask distributed scheduler (its workers must import this repository and see --out).
+At the end <out>/report.md, PNG plots and results.csv are written (ground/campaign_report.py);
+--report-only rewrites them from the run directories without running anything.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import os
+import shutil
+import signal
+import sys
+import time
+from collections.abc import Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Any
+
+REPO = Path(__file__).resolve().parent.parent
+if str(REPO) not in sys.path:  # run as a script from a checkout
+    sys.path.insert(0, str(REPO))
+
+from deploy.campaign import CampaignError, RunSpec, execute_run, load_campaign  # noqa: E402
+from ground.campaign_report import write_campaign_report  # noqa: E402
+
+log = logging.getLogger("insp.campaign")
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    p = argparse.ArgumentParser(description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--campaign", type=Path, required=True, help="campaign TOML")
+    p.add_argument("--out", type=Path, required=True, help="campaign directory")
+    p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                   help="local worker processes (default: one per core)")
+    p.add_argument("--limit", type=int, help="run only the first N runs of the list")
+    p.add_argument("--cluster", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786")
+    p.add_argument("--report-only", action="store_true",
+                   help="rewrite the report from the run directories, run nothing")
+    return p.parse_args(argv)
+
+
+class Progress:
+    """Runs done, failed and the estimated time left, on stderr."""
+
+    def __init__(self, total: int, skipped: int) -> None:
+        self.total, self.skipped = total, skipped
+        self.done = self.failed = 0
+        self.t0 = time.monotonic()
+
+    def update(self, result: dict[str, Any]) -> None:
+        self.done += 1
+        self.failed += result["status"] != "completed"
+        left = self.total - self.skipped - self.done
+        rate = self.done / max(time.monotonic() - self.t0, 1e-9)
+        eta = left / rate if rate > 0 else math.inf
+        bar = "#" * int(30 * (self.skipped + self.done) / max(self.total, 1))
+        tty = sys.stderr.isatty()
+        start = "\r" if tty else ""
+        print(f"{start}[{bar:<30}] {self.skipped + self.done}/{self.total} runs "
+              f"({self.failed} failed) ETA {eta / 60:5.1f} min  last {result['id']} "
+              f"{result['status']}", end="\n" if left == 0 or not tty else "", file=sys.stderr,
+              flush=True)
+
+
+def _interrupt(signum: int, _frame: object) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
+def _local(todo: list[RunSpec], out: Path, workers: int) -> Iterator[dict[str, Any]]:
+    pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"))
+    pending: set[Future[dict[str, Any]]] = set()
+    queue = list(reversed(todo))
+    try:
+        while queue or pending:
+            while queue and len(pending) < 2 * max(1, workers):
+                pending.add(pool.submit(execute_run, queue.pop(), str(out)))
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for f in finished:
+                yield f.result()
+    finally:
+        for proc in list(getattr(pool, "_processes", {}).values()):
+            proc.terminate()  # an interrupted run is abandoned: redone next time
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _dask(todo: list[RunSpec], out: Path, address: str) -> Iterator[dict[str, Any]]:
+    from distributed import Client, as_completed
+
+    with Client(address, timeout="30s") as client:
+        futures = [client.submit(execute_run, spec, str(out), key=f"run-{out.name}-{spec.id}",
+                                 pure=False) for spec in todo]
+        try:
+            for f in as_completed(futures):
+                yield f.result()
+        finally:
+            client.cancel([f for f in futures if not f.done()])
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s campaign %(levelname)s %(message)s",
+                        datefmt="%H:%M:%S")
+    try:
+        campaign, runs = load_campaign(args.campaign)
+    except CampaignError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    if args.limit is not None:
+        runs = runs[:max(args.limit, 0)]
+    args.out.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(args.campaign, args.out / "campaign.toml")
+    status = 0
+    if not args.report_only:
+        status = _run(runs, args)
+    write_campaign_report(args.out, campaign.name, [r.id for r in runs])
+    print(f"report: {args.out / 'report.md'}", file=sys.stderr)
+    return status
+
+
+def _run(runs: list[RunSpec], args: argparse.Namespace) -> int:
+    runs_dir = args.out / "runs"
+    runs_dir.mkdir(exist_ok=True)
+    for partial in runs_dir.glob("*.partial"):
+        shutil.rmtree(partial, ignore_errors=True)  # half-written by an interrupted campaign
+    todo = [r for r in runs if not (runs_dir / r.id / "summary.json").exists()]
+    log.info("%d runs, %d already finished, %d to run on %s", len(runs), len(runs) - len(todo),
+             len(todo), args.cluster or f"{args.workers} local workers")
+    progress = Progress(len(runs), len(runs) - len(todo))
+    main_thread = signal.getsignal(signal.SIGTERM)
+    signal.signal(signal.SIGTERM, _interrupt)
+    try:
+        results = _dask(todo, args.out, args.cluster) if args.cluster else \
+            _local(todo, args.out, args.workers)
+        for result in results:
+            progress.update(result)
+    except KeyboardInterrupt:
+        print("", file=sys.stderr)
+        log.warning("interrupted: %d runs finished this time; start again with the same --out "
+                    "to go on", progress.done)
+        return 130
+    finally:
+        signal.signal(signal.SIGTERM, main_thread)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

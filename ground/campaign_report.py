@@ -1,0 +1,258 @@
+"""Campaign report: detection, latency, false-alarm, isolation and identification figures over
+many runs, for the main detector and each baseline side by side (issue 6; DESIGN.md
+"Campaigns").
+
+Reads ``<out>/runs/<id>/summary.json`` of every run and writes ``<out>/results.csv`` (one row
+per injected fault and detector, plus one per nominal run and detector), ``<out>/report.md``
+and its plots: latency distributions, the confusion matrix of identified class against
+injected kind, and a ROC curve per detector from sweeping a scale on its threshold
+(re-scored from each run's ``fdir_series`` with the detector's persistence).
+
+Definitions as in ground/fdir/scoring.py: a fault is detected when any alarm falls in its
+active span (plus one FDI window), isolated when one names its spacecraft; a false alarm is
+an alarm on a spacecraft with no active fault; rates are per nominal FDI cycle and per hour.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from ground.fdir.scoring import EXPECTED_CLASS  # noqa: E402
+
+CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", None)
+PERSISTENCE = {"main": 2, "chi2_nis": 2, "cusum": 1, "fixed_threshold": 1}
+"""Windows in a row each detector needs (as configured by default; ROC re-scoring only)."""
+SCALES = np.geomspace(0.1, 10.0, 41)
+"""Threshold scales of the ROC sweep."""
+
+
+def _load(out: Path, ids: Sequence[str]) -> list[dict[str, Any]]:
+    runs = []
+    for rid in ids:
+        p = out / "runs" / rid / "summary.json"
+        if p.exists():
+            s = json.loads(p.read_text())
+            s["_id"] = rid
+            runs.append(s)
+    return runs
+
+
+def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """results.csv rows: per run, detector and fault (or one nominal row per detector)."""
+    rows = []
+    for s in runs:
+        detectors = {"main": s.get("scores", {}), **s.get("baselines", {})}
+        for name, sc in detectors.items():
+            common = {"run": s["_id"], "seed": s.get("seed"), "status": s.get("status"),
+                      "detector": name, "false_alarms": sc.get("false_alarms", 0),
+                      "nominal_cycles": sc.get("nominal_cycles", 0)}
+            faults = sc.get("per_fault", [])
+            if not faults:
+                rows.append({**common, "kind": "none"})
+            for i, f in enumerate(faults):
+                inj = s.get("injected_faults", [{}] * len(faults))[i]
+                rows.append({**common, "kind": f["kind"], "spacecraft": f["spacecraft"],
+                             "start_s": f["start_s"], "magnitude": inj.get("magnitude"),
+                             "detected": f["detected"], "isolated": f["isolated"],
+                             "latency_s": f["latency_s"],
+                             "identified_class": f["identified_class"] if name == "main" else None,
+                             "expected_class": f["expected_class"]})
+    return rows
+
+
+def _stats(rows: list[dict[str, Any]], hours: float) -> dict[str, Any]:
+    faults = [r for r in rows if r["kind"] != "none"]
+    lat = [r["latency_s"] for r in faults if r["isolated"] and r["latency_s"] is not None]
+    fa = sum(r["false_alarms"] for r in {(r["run"]): r for r in rows}.values())
+    cycles = sum(r["nominal_cycles"] for r in {(r["run"]): r for r in rows}.values())
+    return {
+        "faults": len(faults),
+        "detected": sum(r["detected"] for r in faults),
+        "isolated": sum(r["isolated"] for r in faults),
+        "identified": sum(r.get("identified_class") == r["expected_class"] for r in faults),
+        "latency_median": float(np.median(lat)) if lat else None,
+        "latency_p90": float(np.quantile(lat, 0.9)) if lat else None,
+        "latency_max": float(max(lat)) if lat else None,
+        "false_alarms": fa, "nominal_cycles": cycles,
+        "false_alarm_rate": fa / cycles if cycles else None,
+        "false_alarms_per_hour": fa / hours if hours > 0 else None,
+    }
+
+
+def _fmt(v: float | None, f: str = ".0f") -> str:
+    return "-" if v is None else format(v, f)
+
+
+def _pct(n: int, d: int) -> str:
+    return "-" if d == 0 else f"{100.0 * n / d:.0f}% ({n}/{d})"
+
+
+def _nominal_hours(runs: list[dict[str, Any]]) -> float:
+    """Spacecraft-hours judged without a fault, from the main detector's windows."""
+    total = 0.0
+    for s in runs:
+        faults = s.get("injected_faults", [])
+        for sc, t0, t1, _, _ in s.get("fdir_series", {}).get("main", []):
+            if not any(f["spacecraft"] == sc and f["start_s"] < t1
+                       and (f.get("end_s") is None or t0 < f["end_s"]) for f in faults):
+                total += t1 - t0
+    return total / 3600.0
+
+
+def _roc(runs: list[dict[str, Any]], detector: str) -> tuple[np.ndarray, np.ndarray]:
+    """(false alarms per nominal cycle, detection rate) at each threshold scale in SCALES,
+    re-scoring the detector's windows with its persistence."""
+    n = PERSISTENCE.get(detector, 1)
+    fa = np.zeros(len(SCALES))
+    det = np.zeros(len(SCALES))
+    cycles = faults = 0
+    for s in runs:
+        series = s.get("fdir_series", {}).get(detector, [])
+        injected = s.get("injected_faults", [])
+        faults += len(injected)
+        by_sc: dict[int, list[list[float]]] = {}
+        for w in series:
+            by_sc.setdefault(int(w[0]), []).append(w)
+        for sc, ws in by_sc.items():
+            ws.sort(key=lambda w: w[2])
+            mine = [f for f in injected if f["spacecraft"] == sc]
+            grace = ws[0][2] - ws[0][1] if ws else 0.0
+
+            def active(t: float) -> list[dict[str, Any]]:
+                return [f for f in mine if f["start_s"] <= t and
+                        (f.get("end_s") is None or t <= f["end_s"] + grace)]
+
+            cycles += sum(1 for w in ws if not any(
+                f["start_s"] < w[2] and (f.get("end_s") is None or w[1] < f["end_s"])
+                for f in mine))
+            for k, scale in enumerate(SCALES):
+                run, alarms = 0, []
+                for w in ws:
+                    run = run + 1 if w[3] > scale * w[4] else 0
+                    if run == n:
+                        alarms.append(w[2])
+                fa[k] += sum(1 for t in alarms if not active(t))
+                det[k] += sum(1 for f in mine if any(
+                    f["start_s"] <= t and (f.get("end_s") is None or t <= f["end_s"] + grace)
+                    for t in alarms))
+    return fa / max(cycles, 1), det / max(faults, 1)
+
+
+def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
+    """Write results.csv, report.md and plots for the runs ``ids`` of campaign ``name``."""
+    runs = _load(out, ids)
+    rows = _rows(runs)
+    fields = ["run", "seed", "status", "detector", "kind", "spacecraft", "start_s", "magnitude",
+              "detected", "isolated", "latency_s", "identified_class", "expected_class",
+              "false_alarms", "nominal_cycles"]
+    with open(out / "results.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    failed = [s["_id"] for s in runs if s.get("status") != "completed"]
+    hours = _nominal_hours(runs)
+    detectors = ["main"] + sorted({r["detector"] for r in rows} - {"main"})
+    lines = [f"# Campaign report: {name}", "",
+             f"{len(runs)} of {len(ids)} runs finished ({len(failed)} failed"
+             + (f": {', '.join(failed[:10])}" if failed else "") + f"); "
+             f"{hours:.1f} nominal spacecraft-hours judged.", "",
+             "## Detectors side by side", "",
+             "| detector | detected | isolated | identified | latency median / p90 / max (s) | "
+             "false alarms per nominal cycle | per hour |", "|---|---|---|---|---|---|---|"]
+    for d in detectors:
+        st = _stats([r for r in rows if r["detector"] == d], hours)
+        ident = _pct(st["identified"], st["faults"]) if d == "main" else "-"
+        lines.append(f"| {d} | {_pct(st['detected'], st['faults'])} | "
+                     f"{_pct(st['isolated'], st['faults'])} | {ident} | "
+                     f"{_fmt(st['latency_median'])} / {_fmt(st['latency_p90'])} / "
+                     f"{_fmt(st['latency_max'])} | {_fmt(st['false_alarm_rate'], '.4f')} | "
+                     f"{_fmt(st['false_alarms_per_hour'], '.3f')} |")
+    lines += ["", "## Per fault kind and magnitude", "",
+              "| kind | magnitude | detector | faults | detected | missed | isolated | "
+              "latency median / p90 / max (s) |", "|---|---|---|---|---|---|---|---|"]
+    keys = sorted({(r["kind"], r["magnitude"]) for r in rows if r["kind"] != "none"},
+                  key=lambda k: (k[0], -math.inf if k[1] is None else k[1]))
+    for kind, mag in keys:
+        for d in detectors:
+            sel = [r for r in rows if r["detector"] == d and r["kind"] == kind
+                   and r["magnitude"] == mag]
+            st = _stats(sel, hours)
+            lines.append(f"| {kind} | {_fmt(mag, 'g')} | {d} | {st['faults']} | "
+                         f"{_pct(st['detected'], st['faults'])} | {st['faults'] - st['detected']} | "
+                         f"{_pct(st['isolated'], st['faults'])} | {_fmt(st['latency_median'])} / "
+                         f"{_fmt(st['latency_p90'])} / {_fmt(st['latency_max'])} |")
+    lines += ["", "## Identification (main detector)", "", "![confusion](confusion.png)", ""]
+    lines += _confusion(out, [r for r in rows if r["detector"] == "main" and r["kind"] != "none"])
+    lines += ["", "## Latency", "", "![latency](latency.png)", "",
+              "## ROC (threshold scale swept, each detector with its persistence)", "",
+              "![roc](roc.png)", ""]
+    _latency_plot(out, rows, detectors)
+    _roc_plot(out, runs, detectors)
+    path = out / "report.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _confusion(out: Path, rows: list[dict[str, Any]]) -> list[str]:
+    kinds = sorted({r["kind"] for r in rows})
+    m = np.zeros((len(kinds), len(CLASSES)), dtype=int)
+    for r in rows:
+        m[kinds.index(r["kind"]), CLASSES.index(r["identified_class"])
+          if r["identified_class"] in CLASSES else len(CLASSES) - 1] += 1
+    labels = [c or "none/missed" for c in CLASSES]
+    out_lines = ["| injected \\ identified | " + " | ".join(labels) + " |",
+                 "|---|" + "---|" * len(labels)]
+    for k, row in zip(kinds, m):
+        out_lines.append(f"| {k} (→ {EXPECTED_CLASS[k]}) | " + " | ".join(map(str, row)) + " |")
+    fig, ax = plt.subplots(figsize=(8, 0.5 * max(len(kinds), 2) + 2))
+    ax.imshow(m, cmap="Blues")
+    ax.set_xticks(range(len(labels)), labels, rotation=30, ha="right")
+    ax.set_yticks(range(len(kinds)), kinds)
+    for (i, j), v in np.ndenumerate(m):
+        ax.text(j, i, str(v), ha="center", va="center")
+    ax.set_title("identified class against injected kind")
+    fig.tight_layout()
+    fig.savefig(out / "confusion.png", dpi=100)
+    plt.close(fig)
+    return out_lines
+
+
+def _latency_plot(out: Path, rows: list[dict[str, Any]], detectors: list[str]) -> None:
+    fig, ax = plt.subplots(figsize=(8, 4))
+    data = [[r["latency_s"] for r in rows if r["detector"] == d and r["kind"] != "none"
+             and r["isolated"] and r["latency_s"] is not None] for d in detectors]
+    ax.boxplot([d if d else [math.nan] for d in data], tick_labels=detectors)
+    ax.set_ylabel("detection latency (s)")
+    ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "latency.png", dpi=100)
+    plt.close(fig)
+
+
+def _roc_plot(out: Path, runs: list[dict[str, Any]], detectors: list[str]) -> None:
+    fig, ax = plt.subplots(figsize=(6, 5))
+    for d in detectors:
+        fa, det = _roc(runs, d)
+        ax.plot(fa, det, "o-", ms=2, label=d)
+        k = int(np.argmin(np.abs(SCALES - 1.0)))
+        ax.plot(fa[k], det[k], "k*", ms=8)
+    ax.set_xscale("symlog", linthresh=1e-3)
+    ax.set_xlabel("false alarms per nominal FDI cycle")
+    ax.set_ylabel("detection rate")
+    ax.set_title("ROC (star: threshold as configured)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "roc.png", dpi=100)
+    plt.close(fig)
