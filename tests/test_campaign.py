@@ -1,0 +1,162 @@
+"""Campaigns: a campaign file expands into the same run list every time, bad files are clear
+errors before anything runs, a local pool and a real Dask scheduler and worker (separate
+processes on loopback) give identical results, and a campaign interrupted by SIGTERM and
+started again finishes every run exactly once with a complete report."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from deploy.campaign import CampaignError, load_campaign
+from deploy.run_campaign import main as run_campaign
+
+REPO = Path(__file__).resolve().parent.parent
+
+BASE = """name = "cb"
+seed = 1
+duration_s = 60.0
+[target]
+pois = 300
+[rates]
+high_hz = 2.0
+fdi_period_s = 20.0
+[observers]
+count = 2
+initial_attitude = "lvlh"
+rho_x_m = 20.0
+rho_z_m = 25.0
+"""
+
+CAMPAIGN = """name = "tc"
+base = "base.toml"
+seeds = {{ first = 1, count = {seeds} }}
+[[groups]]
+name = "cam"
+[[groups.faults]]
+spacecraft = [1, 2]
+kind = "camera_degradation"
+start_s = {{ min = 0.0, max = 10.0 }}
+magnitude = 0.5
+[[groups]]
+name = "nom"
+nominal = true
+"""
+
+
+def _campaign(tmp: Path, seeds: int = 1, text: str | None = None) -> Path:
+    (tmp / "base.toml").write_text(BASE)
+    path = tmp / "c.toml"
+    path.write_text(text if text is not None else CAMPAIGN.format(seeds=seeds))
+    return path
+
+
+def test_expansion_is_deterministic_and_complete(tmp_path: Path) -> None:
+    path = _campaign(tmp_path, seeds=3)
+    _, runs = load_campaign(path)
+    _, again = load_campaign(path)
+    assert [r.id for r in runs] == [f"cam-{i:04d}" for i in range(6)] + \
+        [f"nom-{i:04d}" for i in range(3)]
+    assert [r.scenario for r in runs] == [r.scenario for r in again]
+    cams = [r for r in runs if r.group == "cam"]
+    assert [(r.seed, r.scenario.faults[0].spacecraft) for r in cams] == \
+        [(1, 1), (1, 2), (2, 1), (2, 2), (3, 1), (3, 2)]
+    starts = [r.scenario.faults[0].start_s for r in cams]
+    assert all(0.0 <= s <= 10.0 for s in starts) and len(set(starts)) == 6
+    assert all(r.scenario.faults == [] for r in runs if r.group == "nom")
+    assert all(r.scenario.seed == r.seed for r in runs)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda t: t.replace('name = "tc"', 'name = "tc"\ncolour = 1'), "colour"),
+    (lambda t: t.replace("max = 10.0", "max = -1.0"), "below min"),
+    (lambda t: t.replace('kind = "camera_degradation"', 'kind = "gremlins"'), "kind"),
+    (lambda t: t.replace("magnitude = 0.5", "magnitude = 1.5"), "cam-0000"),
+    (lambda t: t.replace('base = "base.toml"', 'base = "missing.toml"'), "cannot read"),
+    (lambda t: t + "[[groups]]\nname = \"nom\"\nnominal = true\n", "unique"),
+])
+def test_bad_campaigns_are_clear_errors(tmp_path: Path, edit: object, message: str) -> None:
+    path = _campaign(tmp_path, text=edit(CAMPAIGN.format(seeds=1)))  # type: ignore[operator]
+    with pytest.raises(CampaignError, match=message):
+        load_campaign(path)
+    assert run_campaign(["--campaign", str(path), "--out", str(tmp_path / "out")]) == 2
+    assert not (tmp_path / "out" / "runs").exists()  # nothing ran
+
+
+def _results(out: Path) -> dict[str, dict[str, object]]:
+    """Each run's summary without what may differ between executions (wall time)."""
+    res = {}
+    for d in sorted((out / "runs").iterdir()):
+        s = json.loads((d / "summary.json").read_text())
+        for k in ("wall_s", "real_time_factor", "exec"):
+            s.pop(k, None)
+        res[d.name] = s
+    return res
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def test_local_pool_and_dask_cluster_agree(tmp_path: Path) -> None:
+    path = _campaign(tmp_path)
+    assert run_campaign(["--campaign", str(path), "--out", str(tmp_path / "local"),
+                         "--workers", "2"]) == 0
+    port = _free_port()
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler",
+                               "--host", "127.0.0.1", "--port", str(port),
+                               "--dashboard-address", ":0"], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker",
+                                       f"tcp://127.0.0.1:{port}", "--nworkers", "1",
+                                       "--nthreads", "1", "--host", "127.0.0.1",
+                                       "--dashboard-address", ":0"], env=env,
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        assert run_campaign(["--campaign", str(path), "--out", str(tmp_path / "dask"),
+                             "--cluster", f"tcp://127.0.0.1:{port}"]) == 0
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            p.wait(timeout=30)
+    local, dask = _results(tmp_path / "local"), _results(tmp_path / "dask")
+    assert list(local) == ["cam-0000", "cam-0001", "nom-0000"]
+    assert local == dask
+    rows = list(csv.DictReader(open(tmp_path / "dask" / "results.csv")))
+    assert {r["detector"] for r in rows} == {"main", "chi2_nis", "cusum", "fixed_threshold"}
+    assert len([r for r in rows if r["detector"] == "main"]) == 3
+
+
+def test_interrupted_campaign_resumes_each_run_once(tmp_path: Path) -> None:
+    path = _campaign(tmp_path, seeds=3)
+    out = tmp_path / "out"
+    cmd = [sys.executable, str(REPO / "deploy" / "run_campaign.py"), "--campaign", str(path),
+           "--out", str(out), "--workers", "1"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and not list((out / "runs").glob("*/summary.json")):
+        time.sleep(0.2)
+    proc.send_signal(signal.SIGTERM)
+    assert proc.wait(timeout=60) == 130
+    first = {p.parent.name: p.stat().st_mtime_ns for p in (out / "runs").glob("*/summary.json")}
+    assert 1 <= len(first) < 9
+    assert run_campaign(["--campaign", str(path), "--out", str(out), "--workers", "2"]) == 0
+    after = {p.parent.name: p.stat().st_mtime_ns for p in (out / "runs").glob("*/summary.json")}
+    assert len(after) == 9 and not list((out / "runs").glob("*.partial"))
+    assert all(after[k] == v for k, v in first.items())  # finished runs were not redone
+    report = (out / "report.md").read_text()
+    assert "9 of 9 runs finished (0 failed)" in report
+    assert (out / "roc.png").exists() and (out / "confusion.png").exists()
