@@ -3,11 +3,13 @@ recorder as separate OS processes over Zenoh (default), or all in one process (-
 
     python deploy/run_constellation.py [--scenario deploy/scenarios/default.toml] --out runs/x
         [--transport zenoh|inproc] [--seed N] [--duration S] [--realtime SPEED]
-        [--compare-recovery]
+        [--compare-recovery] [--live PORT]
 
 Writes <out>/run.mcap (every bus message, JSON schemas; opens in Foxglove), <out>/summary.json,
 <out>/report.md with PNG plots, and <out>/logs/ (one log per process).  While it runs, any Zenoh
 client can connect to the endpoint (default tcp/127.0.0.1:7447) and subscribe to insp/**.
+With --live PORT the run is streamed to Foxglove (Foxglove WebSocket protocol, loopback;
+ground/live.py): every bus message on a channel named by its key, and the truth poses in 3D.
 With --compare-recovery the same scenario and seed is run a second time, in-process, with the
 ground's fault recovery switched the other way ([fdir] recovery), into <out>/counterfactual/,
 and summary.json's ``recovery`` section compares the final H of the two.
@@ -56,6 +58,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help=f"Zenoh endpoint the constellation listens on (default {DEFAULT_ENDPOINT})")
     p.add_argument("--mission", help="key-space name (default: scenario name)")
     p.add_argument("--no-report", action="store_true", help="skip report.md and plots")
+    p.add_argument("--live", type=int, metavar="PORT", default=0,
+                   help="stream the run to Foxglove on ws://127.0.0.1:PORT (off by default)")
     p.add_argument("--compare-recovery", action="store_true",
                    help="also run the scenario with [fdir] recovery flipped (in-process) and "
                         "compare final H in summary.json")
@@ -115,9 +119,28 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
 
     if args.realtime:
         log.warning("--realtime is ignored with --transport inproc (lockstep only)")
+    live = _live_view(args)
     with McapRecorder(out / "run.mcap", run_metadata(scenario, "inproc", scenario_text)) as rec:
-        run_inproc(scenario, mission, tap=rec.record)
+        def tap(key: str, type_name: str, payload: bytes) -> None:
+            rec.record(key, type_name, payload)
+            if live is not None:
+                live.forward(key, type_name, payload)
+
+        try:
+            run_inproc(scenario, mission, tap=tap)
+        finally:
+            if live is not None:
+                live.close()
     return "completed", None
+
+
+def _live_view(args: argparse.Namespace) -> Any:
+    """The Foxglove live view when --live PORT is given (ground/live.py), else None."""
+    if not getattr(args, "live", None):
+        return None
+    from ground.live import LiveView
+
+    return LiveView(args.live)
 
 
 def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text: str,
@@ -147,13 +170,19 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
     except Exception as e:  # noqa: BLE001 - zenoh raises ZError
         return "failed", f"cannot listen on {args.endpoint}: {e} (is another run using it?)"
     progress = _Progress(scenario)
+    live = None
     try:
         hub.session.declare_subscriber(topics.key(mission, topics.GROUND, "exec", "heartbeat"),
                                        progress.on_heartbeat)
         hub.session.declare_subscriber(topics.sim_status(mission), progress.on_status)
+        live = _live_view(args)
+        if live is not None:
+            hub.subscribe(topics.mission_wildcard(mission), live.forward)
         return _supervise(scenario, mission, out, args, progress, hub)
     finally:
         hub.close()
+        if live is not None:
+            live.close()
 
 
 def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
