@@ -181,14 +181,13 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     lines += ["", "## Per fault kind and magnitude", "",
               "| kind | magnitude | detector | faults | detected | missed | isolated | "
               "latency median / p90 / max (s) |", "|---|---|---|---|---|---|---|---|"]
-    keys = sorted({(r["kind"], r["magnitude"]) for r in rows if r["kind"] != "none"},
-                  key=lambda k: (k[0], -math.inf if k[1] is None else k[1]))
-    for kind, mag in keys:
+    bins = _magnitude_bins([r for r in rows if r["kind"] != "none"])
+    for (kind, label), members in bins.items():
         for d in detectors:
             sel = [r for r in rows if r["detector"] == d and r["kind"] == kind
-                   and r["magnitude"] == mag]
+                   and (r["run"], r["spacecraft"], r["start_s"]) in members]
             st = _stats(sel, hours)
-            lines.append(f"| {kind} | {_fmt(mag, 'g')} | {d} | {st['faults']} | "
+            lines.append(f"| {kind} | {label} | {d} | {st['faults']} | "
                          f"{_pct(st['detected'], st['faults'])} | {st['faults'] - st['detected']} | "
                          f"{_pct(st['isolated'], st['faults'])} | {_fmt(st['latency_median'])} / "
                          f"{_fmt(st['latency_p90'])} / {_fmt(st['latency_max'])} |")
@@ -202,6 +201,28 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def _magnitude_bins(rows: list[dict[str, Any]], most: int = 4
+                    ) -> dict[tuple[str, str], set[tuple[Any, Any, Any]]]:
+    """Faults grouped by kind and magnitude: each distinct magnitude when a kind has at most
+    ``most`` of them, else three equal-width bins (dispersed magnitudes).  Values: the
+    (run, spacecraft, start) of the faults in the group."""
+    out: dict[tuple[str, str], set[tuple[Any, Any, Any]]] = {}
+    for kind in sorted({r["kind"] for r in rows}):
+        mine = [r for r in rows if r["kind"] == kind]
+        mags = sorted({r["magnitude"] for r in mine if r["magnitude"] is not None})
+        for r in mine:
+            m = r["magnitude"]
+            if m is None or len(mags) <= most:
+                label = _fmt(m, "g")
+            else:
+                lo, hi = mags[0], mags[-1]
+                k = min(2, int(3 * (m - lo) / (hi - lo))) if hi > lo else 0
+                a, b = lo + k * (hi - lo) / 3, lo + (k + 1) * (hi - lo) / 3
+                label = f"{a:.3g}–{b:.3g}"
+            out.setdefault((kind, label), set()).add((r["run"], r["spacecraft"], r["start_s"]))
+    return dict(sorted(out.items()))
 
 
 def _confusion(out: Path, rows: list[dict[str, Any]]) -> list[str]:
