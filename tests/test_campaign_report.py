@@ -1,0 +1,94 @@
+"""The campaign report on constructed run summaries: rates, latencies, false alarms, the
+confusion matrix, magnitude bins and the ROC re-scored from the archived window series."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ground.campaign_report import SCALES, _magnitude_bins, _roc, write_campaign_report
+
+
+def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | None,
+           cls: str | None, expected: str) -> dict[str, object]:
+    return {"spacecraft": sc, "kind": kind, "start_s": start, "detected": detected,
+            "isolated": detected, "latency_s": latency, "identified_class": cls,
+            "expected_class": expected, "identified_correctly": cls == expected}
+
+
+def _write(out: Path, rid: str, summary: dict[str, object]) -> None:
+    d = out / "runs" / rid
+    d.mkdir(parents=True)
+    (d / "summary.json").write_text(json.dumps({"status": "completed", "seed": 1, **summary}))
+
+
+@pytest.fixture()
+def campaign(tmp_path: Path) -> Path:
+    # run a: camera fault on sc2 from 0 s, declared at 200 s (two windows over 0.05)
+    _write(tmp_path, "a", {
+        "injected_faults": [{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0,
+                             "end_s": None, "magnitude": 0.5}],
+        "scores": {"per_fault": [_fault(2, "camera_degradation", 0.0, True, 200.0, "camera",
+                                        "camera")], "false_alarms": 0, "nominal_cycles": 2},
+        "baselines": {"cusum": {"per_fault": [_fault(2, "camera_degradation", 0.0, True, 100.0,
+                                                     None, "camera")],
+                                "false_alarms": 0, "nominal_cycles": 2}},
+        "fdir_series": {"main": [[2, 0, 100, 0.5, 0.05], [2, 100, 200, 0.5, 0.05],
+                                 [1, 0, 100, 0.01, 0.05], [1, 100, 200, 0.01, 0.05]]}})
+    # run b: a thruster fault missed by the main detector, identified by nobody
+    _write(tmp_path, "b", {
+        "injected_faults": [{"spacecraft": 1, "kind": "thruster_bias", "start_s": 100.0,
+                             "end_s": None, "magnitude": 0.3}],
+        "scores": {"per_fault": [_fault(1, "thruster_bias", 100.0, False, None, None,
+                                        "actuator")], "false_alarms": 0, "nominal_cycles": 0},
+        "fdir_series": {"main": [[1, 100, 200, 0.03, 0.05], [1, 200, 300, 0.03, 0.05]]}})
+    # run c: nominal, one false alarm (two windows just over the threshold)
+    _write(tmp_path, "c", {
+        "injected_faults": [],
+        "scores": {"per_fault": [], "false_alarms": 1, "nominal_cycles": 2},
+        "fdir_series": {"main": [[1, 0, 100, 0.06, 0.05], [1, 100, 200, 0.07, 0.05]]}})
+    write_campaign_report(tmp_path, "t", ["a", "b", "c", "missing"])
+    return tmp_path
+
+
+def test_report_figures(campaign: Path) -> None:
+    report = (campaign / "report.md").read_text()
+    assert "3 of 4 runs finished (0 failed)" in report
+    assert "| main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 |" in report
+    assert "| cusum | 100% (1/1) | 100% (1/1) | - | 100 / 100 / 100 |" in report
+    assert "| camera_degradation (→ camera) | 0 | 1 | 0 | 0 | 0 | 0 |" in report
+    assert "| thruster_bias (→ actuator) | 0 | 0 | 0 | 0 | 0 | 1 |" in report
+    rows = list(csv.DictReader(open(campaign / "results.csv")))
+    assert [(r["run"], r["detector"], r["kind"]) for r in rows] == [
+        ("a", "main", "camera_degradation"), ("a", "cusum", "camera_degradation"),
+        ("b", "main", "thruster_bias"), ("c", "main", "none")]
+    for png in ("roc.png", "confusion.png", "latency.png"):
+        assert (campaign / png).stat().st_size > 5000
+
+
+def test_roc_rescoring(campaign: Path) -> None:
+    runs = [json.loads((campaign / "runs" / r / "summary.json").read_text()) for r in "abc"]
+    fa, det = _roc(runs, "main")
+    one = int(np.argmin(np.abs(SCALES - 1.0)))
+    # at the configured threshold: the camera fault detected, the thruster fault missed; one
+    # false alarm (run c) in 4 nominal windows (run a sc1, run c sc1)
+    assert det[one] == pytest.approx(0.5) and fa[one] == pytest.approx(0.25)
+    low = int(np.argmin(np.abs(SCALES - 0.5)))  # threshold 0.025: the 0.03 fault is caught,
+    assert det[low] == pytest.approx(1.0)  # and the nominal sc1 of run a (0.01) still quiet
+    assert fa[low] == pytest.approx(0.25)
+    assert det[-1] == 0.0 and fa[-1] == 0.0  # threshold 0.5: nothing
+    assert np.all(np.diff(det) <= 0) and np.all(np.diff(fa) <= 0)  # monotone in the scale
+
+
+def test_magnitude_bins() -> None:
+    rows = [{"kind": "k", "magnitude": m, "run": str(i), "spacecraft": 1, "start_s": 0.0}
+            for i, m in enumerate([1.0, 1.5, 2.0, 2.5, 3.0, 4.0])]
+    bins = _magnitude_bins(rows)
+    assert list(bins) == [("k", "1–2"), ("k", "2–3"), ("k", "3–4")]
+    assert [len(v) for v in bins.values()] == [2, 2, 2]
+    few = _magnitude_bins(rows[:3])
+    assert list(few) == [("k", "1"), ("k", "1.5"), ("k", "2")]
