@@ -231,13 +231,36 @@ def load_campaign(path: str | Path) -> tuple[Campaign, list[RunSpec]]:
     return campaign, expand(campaign, p.parent)
 
 
-def execute_run(spec: RunSpec, out_root: str) -> dict[str, Any]:
-    """Run one campaign run in-process into ``<out_root>/runs/<id>/`` (run.mcap, summary.json,
-    run.log) and return {id, status, error, wall_s}.  The run is written under
-    ``<id>.partial`` and renamed when complete, so a run directory exists only for a finished
-    run; a crash is caught and recorded as a failed run with its error.  A module-level
-    function, so a Dask worker can import it."""
+def execute_run(spec: RunSpec, out_root: str, transport: str = "inproc") -> dict[str, Any]:
+    """Run one campaign run into ``<out_root>/runs/<id>/`` (run.mcap, summary.json, a log) and
+    return {id, status, error, wall_s}.  The run is written under ``<id>.partial`` and renamed
+    when complete, so a run directory exists only for a finished run; a crash is caught and
+    recorded as a failed run with its error.  ``transport``: ``inproc`` (this process) or
+    ``zenoh`` (deploy/run_constellation.py as a child, one process per node, on a free
+    loopback port and its own mission key space, so runs on one machine never cross).  A
+    module-level function, so a Dask worker can import it."""
     import shutil
+
+    runs = Path(out_root) / "runs"
+    final, partial = runs / spec.id, runs / f"{spec.id}.partial"
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
+    if transport == "zenoh":
+        summary = _zenoh_run(spec, partial)
+    elif transport == "inproc":
+        summary = _inproc_run(spec, partial)
+    else:
+        raise ValueError(f"unknown transport {transport!r}")
+    (partial / "campaign.json").write_text(json.dumps(
+        {"run": spec.id, "group": spec.group, "seed": spec.seed, "transport": transport},
+        indent=2) + "\n")
+    shutil.rmtree(final, ignore_errors=True)
+    partial.rename(final)
+    return {"id": spec.id, "status": summary.get("status"), "error": summary.get("error"),
+            "wall_s": summary.get("wall_s")}
+
+
+def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     import time
     import traceback
 
@@ -246,11 +269,7 @@ def execute_run(spec: RunSpec, out_root: str) -> dict[str, Any]:
     from ground.recorder import McapRecorder
     from ground.summary import write_summary
 
-    runs = Path(out_root) / "runs"
-    final, partial = runs / spec.id, runs / f"{spec.id}.partial"
-    shutil.rmtree(partial, ignore_errors=True)
-    partial.mkdir(parents=True)
-    handler = logging.FileHandler(partial / "run.log")
+    handler = logging.FileHandler(out / "run.log")
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
     root = logging.getLogger()
     root.addHandler(handler)
@@ -258,7 +277,7 @@ def execute_run(spec: RunSpec, out_root: str) -> dict[str, Any]:
     status, error = "completed", None
     try:
         note = f"# campaign run {spec.id} (group {spec.group}, seed {spec.seed}): resolved_json\n"
-        with McapRecorder(partial / "run.mcap", run_metadata(spec.scenario, "inproc", note)) as rec:
+        with McapRecorder(out / "run.mcap", run_metadata(spec.scenario, "inproc", note)) as rec:
             run_inproc(spec.scenario, tap=rec.record)
     except Exception as e:  # noqa: BLE001 - a crashed run is a result, not the campaign's end
         status, error = "failed", f"{type(e).__name__}: {e}\n{traceback.format_exc()}"
@@ -266,10 +285,33 @@ def execute_run(spec: RunSpec, out_root: str) -> dict[str, Any]:
     finally:
         root.removeHandler(handler)
         handler.close()
-    wall = time.monotonic() - t0
-    summary = write_summary(partial, spec.scenario, "inproc", wall, status, error)
-    (partial / "campaign.json").write_text(json.dumps(
-        {"run": spec.id, "group": spec.group, "seed": spec.seed}, indent=2) + "\n")
-    shutil.rmtree(final, ignore_errors=True)
-    partial.rename(final)
-    return {"id": spec.id, "status": summary["status"], "error": error, "wall_s": wall}
+    return write_summary(out, spec.scenario, "inproc", time.monotonic() - t0, status, error)
+
+
+def _zenoh_run(spec: RunSpec, out: Path) -> dict[str, Any]:
+    import socket
+    import subprocess
+    import sys
+
+    from ground.summary import write_summary
+
+    scenario = out / "scenario.json"
+    scenario.write_text(spec.scenario.model_dump_json(indent=1))
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    cmd = [sys.executable, str(Path(__file__).resolve().parent / "run_constellation.py"),
+           "--scenario", str(scenario), "--out", str(out), "--no-report",
+           "--endpoint", f"tcp/127.0.0.1:{port}", "--mission", f"{spec.scenario.name}-{port}"]
+    with open(out / "launcher.log", "w") as log_file:
+        try:
+            subprocess.run(cmd, stdout=log_file, stderr=subprocess.STDOUT, check=False,
+                           timeout=max(600.0, 5.0 * spec.scenario.duration_s))
+        except subprocess.TimeoutExpired:
+            pass  # recorded below from what the launcher left
+    summary_path = out / "summary.json"
+    if summary_path.exists():
+        summary: dict[str, Any] = json.loads(summary_path.read_text())
+        return summary
+    return write_summary(out, spec.scenario, "zenoh", 0.0, "failed",
+                         "the launcher left no summary (see launcher.log)")

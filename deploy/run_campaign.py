@@ -2,9 +2,11 @@
 from one campaign file, on a local process pool or a Dask cluster, resumable.
 
     python deploy/run_campaign.py --campaign deploy/campaigns/paper.toml --out runs/paper
-        [--workers N] [--limit N] [--cluster tcp://HOST:PORT] [--report-only]
+        [--workers N] [--limit N] [--cluster tcp://HOST:PORT] [--transport inproc|zenoh]
+        [--report-only]
 
-Each run goes in-process (deploy/inproc.py) into <out>/runs/<id>/ (run.mcap, summary.json,
+Each run goes in-process (deploy/inproc.py; --transport zenoh: multi-process, each run on its
+own loopback port and key space) into <out>/runs/<id>/ (run.mcap, summary.json,
 run.log); a run directory appears only when its run has finished (written as <id>.partial,
 then renamed), so a campaign started again with the same --out skips finished runs and redoes
 half-written ones.  A run that crashes is recorded as failed, with its error, and the campaign
@@ -50,6 +52,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help="local worker processes (default: one per core)")
     p.add_argument("--limit", type=int, help="run only the first N runs of the list")
     p.add_argument("--cluster", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786")
+    p.add_argument("--transport", choices=("inproc", "zenoh"), default="inproc",
+                   help="each run in one process (default), or multi-process over Zenoh on "
+                        "its own loopback port and key space")
     p.add_argument("--report-only", action="store_true",
                    help="rewrite the report from the run directories, run nothing")
     return p.parse_args(argv)
@@ -82,14 +87,15 @@ def _interrupt(signum: int, _frame: object) -> None:
     raise KeyboardInterrupt(f"signal {signum}")
 
 
-def _local(todo: list[RunSpec], out: Path, workers: int) -> Iterator[dict[str, Any]]:
+def _local(todo: list[RunSpec], out: Path, workers: int, transport: str
+           ) -> Iterator[dict[str, Any]]:
     pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"))
     pending: set[Future[dict[str, Any]]] = set()
     queue = list(reversed(todo))
     try:
         while queue or pending:
             while queue and len(pending) < 2 * max(1, workers):
-                pending.add(pool.submit(execute_run, queue.pop(), str(out)))
+                pending.add(pool.submit(execute_run, queue.pop(), str(out), transport))
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)
             for f in finished:
                 yield f.result()
@@ -99,12 +105,13 @@ def _local(todo: list[RunSpec], out: Path, workers: int) -> Iterator[dict[str, A
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _dask(todo: list[RunSpec], out: Path, address: str) -> Iterator[dict[str, Any]]:
+def _dask(todo: list[RunSpec], out: Path, address: str, transport: str
+          ) -> Iterator[dict[str, Any]]:
     from distributed import Client, as_completed
 
     with Client(address, timeout="30s") as client:
-        futures = [client.submit(execute_run, spec, str(out), key=f"run-{out.name}-{spec.id}",
-                                 pure=False) for spec in todo]
+        futures = [client.submit(execute_run, spec, str(out), transport,
+                                 key=f"run-{out.name}-{spec.id}", pure=False) for spec in todo]
         try:
             for f in as_completed(futures):
                 yield f.result()
@@ -145,8 +152,8 @@ def _run(runs: list[RunSpec], args: argparse.Namespace) -> int:
     main_thread = signal.getsignal(signal.SIGTERM)
     signal.signal(signal.SIGTERM, _interrupt)
     try:
-        results = _dask(todo, args.out, args.cluster) if args.cluster else \
-            _local(todo, args.out, args.workers)
+        results = _dask(todo, args.out, args.cluster, args.transport) if args.cluster else \
+            _local(todo, args.out, args.workers, args.transport)
         for result in results:
             progress.update(result)
     except KeyboardInterrupt:

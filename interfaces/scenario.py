@@ -461,12 +461,18 @@ class ScenarioError(ValueError):
 
 
 def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a scenario TOML file; raise ScenarioError with a readable message."""
+    """Read and validate a scenario TOML file (or, with a ``.json`` suffix, a resolved scenario
+    as written by campaigns); raise ScenarioError with a readable message."""
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
     except OSError as e:
         raise ScenarioError(f"cannot read scenario {p}: {e.strerror}") from e
+    if p.suffix == ".json":
+        try:
+            return Scenario.model_validate_json(text)
+        except ValidationError as e:
+            raise ScenarioError(f"{p}: invalid scenario: {e}") from None
     return parse_scenario(text, source=str(p))
 
 
