@@ -99,11 +99,11 @@ def main(argv: list[str] | None = None) -> int:
                 signal.signal(signal.SIGTERM, previous)
     wall_s = time.monotonic() - wall0
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
-                            status=status, error=error)
+                            status=status, error=error, mission=mission)
     if args.compare_recovery and status == "completed":
         summary = _compare_recovery(scenario, mission, out, scenario_text, args, summary)
     if not args.no_report:
-        write_report(out, scenario)
+        write_report(out, scenario, mission)
     rtf = summary.get("real_time_factor")
     print(f"{status}: {scenario.name} seed {scenario.seed}, {scenario.duration_s:.0f} s simulated in "
           f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time)" if rtf else "") + f"\n  {out}/run.mcap"
@@ -159,7 +159,7 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
         log.exception("counterfactual run failed")
         status, error = "failed", f"{type(e).__name__}: {e}"
     counter = write_summary(other, flipped, transport="inproc", wall_s=time.monotonic() - wall0,
-                            status=status, error=error)
+                            status=status, error=error, mission=mission)
     return add_recovery_comparison(out, summary, counter, scenario.fdir.recovery)
 
 

@@ -160,3 +160,17 @@ def test_interrupted_campaign_resumes_each_run_once(tmp_path: Path) -> None:
     report = (out / "report.md").read_text()
     assert "9 of 9 runs finished (0 failed)" in report
     assert (out / "roc.png").exists() and (out / "confusion.png").exists()
+
+
+def test_zenoh_runs_match_inproc_runs(tmp_path: Path) -> None:
+    """--transport zenoh: each run multi-process on its own port and mission key space, with
+    the same results as in-process for the same scenario and seed."""
+    path = _campaign(tmp_path)
+    for transport in ("inproc", "zenoh"):
+        assert run_campaign(["--campaign", str(path), "--out", str(tmp_path / transport),
+                             "--transport", transport, "--limit", "1"]) == 0
+    a = json.loads((tmp_path / "inproc" / "runs" / "cam-0000" / "summary.json").read_text())
+    b = json.loads((tmp_path / "zenoh" / "runs" / "cam-0000" / "summary.json").read_text())
+    assert b["transport"] == "zenoh" and b["t_sim_final_s"] == a["t_sim_final_s"] == 60.0
+    for k in ("coverage", "detections", "scores", "baselines", "fdir_series", "fault_events"):
+        assert a[k] == b[k], k
