@@ -174,3 +174,27 @@ def test_zenoh_runs_match_inproc_runs(tmp_path: Path) -> None:
     assert b["transport"] == "zenoh" and b["t_sim_final_s"] == a["t_sim_final_s"] == 60.0
     for k in ("coverage", "detections", "scores", "baselines", "fdir_series", "fault_events"):
         assert a[k] == b[k], k
+
+
+def test_a_crashing_run_is_recorded_as_failed(tmp_path: Path,
+                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    """A run that raises is a finished, failed run with its error (the campaign goes on, the
+    report counts it); it is not redone on restart."""
+    import deploy.inproc
+    from deploy.campaign import execute_run
+    from ground.campaign_report import write_campaign_report
+
+    def boom(*_a: object, **_k: object) -> None:
+        raise RuntimeError("sim exploded")
+
+    monkeypatch.setattr(deploy.inproc, "run_inproc", boom)
+    _, runs = load_campaign(_campaign(tmp_path))
+    result = execute_run(runs[0], str(tmp_path / "out"))
+    assert result["status"] == "failed" and "sim exploded" in result["error"]
+    d = tmp_path / "out" / "runs" / runs[0].id
+    summary = json.loads((d / "summary.json").read_text())
+    assert summary["status"] == "failed" and "RuntimeError: sim exploded" in summary["error"]
+    assert "sim exploded" in (d / "run.log").read_text()
+    write_campaign_report(tmp_path / "out", "tc", [r.id for r in runs])
+    assert f"1 of 3 runs finished (1 failed: {runs[0].id})" in \
+        (tmp_path / "out" / "report.md").read_text()
