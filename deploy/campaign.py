@@ -38,7 +38,7 @@ import logging
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -89,7 +89,7 @@ class FaultSpec(_Strict):
 class Group(_Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=64)
     scenario: str | None = None
-    seeds: list[int] | Seeds | None = None
+    seeds: Annotated[list[int], Field(min_length=1)] | Seeds | None = None
     nominal: bool = False
     faults: list[FaultSpec] = Field(default_factory=list)
     overrides: dict[str, dict[str, Any]] = Field(default_factory=dict)
@@ -104,7 +104,7 @@ class Group(_Strict):
 class Campaign(_Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=64)
     base: str
-    seeds: list[int] | Seeds = Field(default_factory=lambda: [1])
+    seeds: Annotated[list[int], Field(min_length=1)] | Seeds = Field(default_factory=lambda: [1])
     duration_s: float | None = Field(default=None, gt=0.0)
     groups: list[Group] = Field(min_length=1)
 
@@ -174,7 +174,10 @@ def _read_toml(path: Path) -> dict[str, Any]:
 def _merge(data: dict[str, Any], overrides: dict[str, dict[str, Any]]) -> dict[str, Any]:
     out = dict(data)
     for section, values in overrides.items():
-        out[section] = {**out.get(section, {}), **values}
+        base = out.get(section, {})
+        if not isinstance(base, dict):
+            raise CampaignError(f"overrides.{section}: not a scenario table")
+        out[section] = {**base, **values}
     return out
 
 
@@ -207,7 +210,13 @@ def expand(campaign: Campaign, root: Path) -> list[RunSpec]:
                 data["name"] = f"{campaign.name}-{run_id}"
                 try:
                     scenario = Scenario.model_validate(data)
-                except ValidationError as e:
+                    late = [f for f in scenario.faults if f.start_s >= scenario.duration_s]
+                    if late:
+                        raise ValueError(f"a fault starts at {late[0].start_s:g} s, not before "
+                                         f"the end of the run ({scenario.duration_s:g} s)")
+                except ValueError as e:
+                    if not isinstance(e, ValidationError):
+                        raise CampaignError(f"run {run_id}: {e}") from None
                     raise CampaignError(f"run {run_id}: invalid scenario: "
                                         + "; ".join(f"{'.'.join(map(str, err['loc']))}: "
                                                     f"{err['msg']}" for err in e.errors())
@@ -251,13 +260,51 @@ def execute_run(spec: RunSpec, out_root: str, transport: str = "inproc") -> dict
         summary = _inproc_run(spec, partial)
     else:
         raise ValueError(f"unknown transport {transport!r}")
-    (partial / "campaign.json").write_text(json.dumps(
-        {"run": spec.id, "group": spec.group, "seed": spec.seed, "transport": transport},
-        indent=2) + "\n")
-    shutil.rmtree(final, ignore_errors=True)
-    partial.rename(final)
+    _finish(spec, partial, final, transport)
     return {"id": spec.id, "status": summary.get("status"), "error": summary.get("error"),
             "wall_s": summary.get("wall_s")}
+
+
+def fingerprint(spec: RunSpec) -> str:
+    """A hash of the run's resolved scenario: a finished run directory is reused on resume only
+    for the same run (an edited campaign file changes it)."""
+    return hashlib.sha256(spec.scenario.model_dump_json().encode()).hexdigest()[:16]
+
+
+def finished(spec: RunSpec, out_root: Path) -> bool:
+    """Whether ``<out_root>/runs/<id>`` holds this very run, finished."""
+    d = out_root / "runs" / spec.id
+    try:
+        meta = json.loads((d / "campaign.json").read_text())
+    except (OSError, ValueError):
+        return False
+    return (d / "summary.json").exists() and meta.get("fingerprint") == fingerprint(spec)
+
+
+def _finish(spec: RunSpec, partial: Path, final: Path, transport: str) -> None:
+    import shutil
+
+    (partial / "campaign.json").write_text(json.dumps(
+        {"run": spec.id, "group": spec.group, "seed": spec.seed, "transport": transport,
+         "fingerprint": fingerprint(spec)}, indent=2) + "\n")
+    shutil.rmtree(final, ignore_errors=True)
+    partial.rename(final)
+
+
+def record_failure(spec: RunSpec, out_root: str, error: str) -> dict[str, Any]:
+    """Record a run whose job died outside the run itself (a worker killed, a disk full...) as
+    finished and failed, with its error; returns its result."""
+    import shutil
+
+    runs = Path(out_root) / "runs"
+    partial = runs / f"{spec.id}.failed"
+    shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
+    (partial / "summary.json").write_text(json.dumps(
+        {"scenario": spec.scenario.name, "seed": spec.seed, "status": "failed", "error": error,
+         "injected_faults": [f.model_dump() for f in spec.scenario.faults]}, indent=2) + "\n")
+    _finish(spec, partial, runs / spec.id, "-")
+    return {"id": spec.id, "status": "failed", "error": error, "wall_s": None}
 
 
 def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
@@ -293,6 +340,7 @@ def _zenoh_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     import subprocess
     import sys
 
+    from deploy.processes import die_with_parent
     from ground.summary import write_summary
 
     scenario = out / "scenario.json"
@@ -306,7 +354,9 @@ def _zenoh_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     with open(out / "launcher.log", "w") as log_file:
         try:
             subprocess.run(cmd, stdout=log_file, stderr=subprocess.STDOUT, check=False,
-                           timeout=max(600.0, 5.0 * spec.scenario.duration_s))
+                           timeout=max(600.0, 5.0 * spec.scenario.duration_s),
+                           preexec_fn=die_with_parent if sys.platform.startswith("linux")
+                           else None)  # a killed worker takes its run down with it
         except subprocess.TimeoutExpired:
             pass  # recorded below from what the launcher left
     summary_path = out / "summary.json"

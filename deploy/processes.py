@@ -15,7 +15,7 @@ from typing import IO
 _PR_SET_PDEATHSIG = 1
 
 
-def _die_with_parent() -> None:
+def die_with_parent() -> None:
     """In the child before exec (Linux): get SIGTERM when the launcher dies, however it dies
     (even SIGKILL), so no orphan keeps a port or a key space busy."""
     libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
@@ -38,7 +38,7 @@ class Child:
         self.proc = subprocess.Popen(
             [sys.executable, *self.argv], cwd=cwd, stdout=self._log, stderr=subprocess.STDOUT,
             start_new_session=True,  # a Ctrl-C at the launcher does not hit children directly
-            preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
+            preexec_fn=die_with_parent if sys.platform.startswith("linux") else None,
         )
 
     @property

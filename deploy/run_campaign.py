@@ -14,12 +14,16 @@ goes on.  SIGINT or SIGTERM stops the campaign: running runs are abandoned (redo
 and the report is written over what has finished.  --cluster sends the runs to an existing
 Dask distributed scheduler (its workers must import this repository and see --out).
 At the end <out>/report.md, PNG plots and results.csv are written (ground/campaign_report.py);
---report-only rewrites them from the run directories without running anything.
+--report-only rewrites them from the run directories without running anything (given only
+--out, from the run list saved there).  The exit status is 1 when a run failed, 130 when
+interrupted.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
 import logging
 import math
 import os
@@ -29,6 +33,7 @@ import sys
 import time
 from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
@@ -37,7 +42,14 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
-from deploy.campaign import CampaignError, RunSpec, execute_run, load_campaign  # noqa: E402
+from deploy.campaign import (  # noqa: E402
+    CampaignError,
+    RunSpec,
+    execute_run,
+    finished,
+    load_campaign,
+    record_failure,
+)
 from ground.campaign_report import write_campaign_report  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
@@ -46,7 +58,8 @@ log = logging.getLogger("insp.campaign")
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--campaign", type=Path, required=True, help="campaign TOML")
+    p.add_argument("--campaign", type=Path,
+                   help="campaign TOML (not needed with --report-only on an existing --out)")
     p.add_argument("--out", type=Path, required=True, help="campaign directory")
     p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                    help="local worker processes (default: one per core)")
@@ -89,32 +102,55 @@ def _interrupt(signum: int, _frame: object) -> None:
 
 def _local(todo: list[RunSpec], out: Path, workers: int, transport: str
            ) -> Iterator[dict[str, Any]]:
-    pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"))
-    pending: set[Future[dict[str, Any]]] = set()
+    """Run on a spawn process pool.  A job that dies outside its run is recorded as failed;
+    a pool broken by a dead worker (killed, out of memory) is replaced and its pending runs
+    resubmitted once (a run that breaks the pool twice is recorded as failed)."""
     queue = list(reversed(todo))
-    try:
-        while queue or pending:
-            while queue and len(pending) < 2 * max(1, workers):
-                pending.add(pool.submit(execute_run, queue.pop(), str(out), transport))
-            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-            for f in finished:
-                yield f.result()
-    finally:
-        for proc in list(getattr(pool, "_processes", {}).values()):
-            proc.terminate()  # an interrupted run is abandoned: redone next time
-        pool.shutdown(wait=True, cancel_futures=True)
+    broke: set[str] = set()
+    while queue:
+        pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"))
+        pending: dict[Future[dict[str, Any]], RunSpec] = {}
+        try:
+            while queue or pending:
+                while queue and len(pending) < 2 * max(1, workers):
+                    spec = queue.pop()
+                    pending[pool.submit(execute_run, spec, str(out), transport)] = spec
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for f in finished:
+                    spec = pending.pop(f)
+                    try:
+                        yield f.result()
+                    except BrokenProcessPool as e:
+                        if spec.id in broke:
+                            yield record_failure(spec, str(out), f"worker died: {e}")
+                        else:
+                            broke.add(spec.id)
+                            queue.append(spec)
+                    except Exception as e:  # noqa: BLE001 - recorded, the campaign goes on
+                        yield record_failure(spec, str(out), f"{type(e).__name__}: {e}")
+                if any(spec.id in broke for spec in queue):
+                    queue.extend(pending.values())
+                    break  # replace the broken pool
+        finally:
+            for proc in list(getattr(pool, "_processes", {}).values()):
+                proc.terminate()  # an interrupted run is abandoned: redone next time
+            pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _dask(todo: list[RunSpec], out: Path, address: str, transport: str
           ) -> Iterator[dict[str, Any]]:
     from distributed import Client, as_completed
 
+    tag = hashlib.sha256(str(out.resolve()).encode()).hexdigest()[:8]
     with Client(address, timeout="30s") as client:
-        futures = [client.submit(execute_run, spec, str(out), transport,
-                                 key=f"run-{out.name}-{spec.id}", pure=False) for spec in todo]
+        futures = {client.submit(execute_run, spec, str(out), transport,
+                                 key=f"run-{tag}-{spec.id}", pure=False): spec for spec in todo}
         try:
-            for f in as_completed(futures):
-                yield f.result()
+            for f in as_completed(list(futures)):
+                try:
+                    yield f.result()
+                except Exception as e:  # noqa: BLE001 - a lost worker: recorded as failed
+                    yield record_failure(futures[f], str(out), f"{type(e).__name__}: {e}")
         finally:
             client.cancel([f for f in futures if not f.done()])
 
@@ -123,6 +159,16 @@ def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s campaign %(levelname)s %(message)s",
                         datefmt="%H:%M:%S")
+    index = args.out / "campaign.json"
+    if args.campaign is None:
+        if not (args.report_only and index.exists()):
+            print("error: --campaign is required (except --report-only on a campaign "
+                  "directory)", file=sys.stderr)
+            return 2
+        saved = json.loads(index.read_text())
+        write_campaign_report(args.out, saved["name"], saved["runs"])
+        print(f"report: {args.out / 'report.md'}", file=sys.stderr)
+        return 0
     try:
         campaign, runs = load_campaign(args.campaign)
     except CampaignError as e:
@@ -131,13 +177,23 @@ def main(argv: list[str] | None = None) -> int:
     if args.limit is not None:
         runs = runs[:max(args.limit, 0)]
     args.out.mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(args.campaign, args.out / "campaign.toml")
+    if args.campaign.resolve() != (args.out / "campaign.toml").resolve():
+        shutil.copyfile(args.campaign, args.out / "campaign.toml")
+    index.write_text(json.dumps({"name": campaign.name, "runs": [r.id for r in runs]},
+                                indent=1) + "\n")
     status = 0
     if not args.report_only:
         status = _run(runs, args)
     write_campaign_report(args.out, campaign.name, [r.id for r in runs])
     print(f"report: {args.out / 'report.md'}", file=sys.stderr)
+    if status == 0 and any(_failed(args.out, r.id) for r in runs):
+        return 1
     return status
+
+
+def _failed(out: Path, run_id: str) -> bool:
+    p = out / "runs" / run_id / "summary.json"
+    return p.exists() and json.loads(p.read_text()).get("status") != "completed"
 
 
 def _run(runs: list[RunSpec], args: argparse.Namespace) -> int:
@@ -145,7 +201,7 @@ def _run(runs: list[RunSpec], args: argparse.Namespace) -> int:
     runs_dir.mkdir(exist_ok=True)
     for partial in runs_dir.glob("*.partial"):
         shutil.rmtree(partial, ignore_errors=True)  # half-written by an interrupted campaign
-    todo = [r for r in runs if not (runs_dir / r.id / "summary.json").exists()]
+    todo = [r for r in runs if not finished(r, args.out)]
     log.info("%d runs, %d already finished, %d to run on %s", len(runs), len(runs) - len(todo),
              len(todo), args.cluster or f"{args.workers} local workers")
     progress = Progress(len(runs), len(runs) - len(todo))

@@ -28,11 +28,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ground.fdir.scoring import EXPECTED_CLASS  # noqa: E402
+from ground.fdir.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
+from interfaces.scenario import Fault  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", None)
-PERSISTENCE = {"main": 2, "chi2_nis": 2, "cusum": 1, "fixed_threshold": 1}
-"""Windows in a row each detector needs (as configured by default; ROC re-scoring only)."""
 SCALES = np.geomspace(0.1, 10.0, 41)
 """Threshold scales of the ROC sweep."""
 
@@ -62,7 +61,8 @@ def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 rows.append({**common, "kind": "none"})
             for i, f in enumerate(faults):
                 inj = s.get("injected_faults", [{}] * len(faults))[i]
-                rows.append({**common, "kind": f["kind"], "spacecraft": f["spacecraft"],
+                rows.append({**common, "fault_index": i, "kind": f["kind"],
+                             "spacecraft": f["spacecraft"],
                              "start_s": f["start_s"], "magnitude": inj.get("magnitude"),
                              "detected": f["detected"], "isolated": f["isolated"],
                              "latency_s": f["latency_s"],
@@ -98,60 +98,72 @@ def _pct(n: int, d: int) -> str:
     return "-" if d == 0 else f"{100.0 * n / d:.0f}% ({n}/{d})"
 
 
-def _nominal_hours(runs: list[dict[str, Any]]) -> float:
-    """Spacecraft-hours judged without a fault, from the main detector's windows."""
+def _nominal_hours(runs: list[dict[str, Any]], detector: str) -> float:
+    """Spacecraft-hours a detector judged without a fault, from its windows."""
     total = 0.0
     for s in runs:
         faults = s.get("injected_faults", [])
-        for sc, t0, t1, _, _ in s.get("fdir_series", {}).get("main", []):
+        for sc, t0, t1, _, _ in s.get("fdir_series", {}).get(detector, []):
             if not any(f["spacecraft"] == sc and f["start_s"] < t1
                        and (f.get("end_s") is None or t0 < f["end_s"]) for f in faults):
                 total += t1 - t0
     return total / 3600.0
 
 
+def _persistence(run: dict[str, Any], detector: str) -> int:
+    """Windows in a row the detector needed in that run (its settings, as summary.json
+    records them; the plain limit checks need one)."""
+    if detector in ("main", "chi2_nis"):
+        return int(run.get("fdir_settings", {}).get("persistence", 2))
+    return 1
+
+
+def _alarms_at(series: list[list[float]], scale: float, n: int) -> list[Alarm]:
+    """The alarms a detector raises on its windows with its threshold scaled: the window
+    completing ``n`` exceedances in a row, once per episode (``threshold.Persistence``)."""
+    out = []
+    for sc in sorted({int(w[0]) for w in series}):
+        run = 0
+        for w in sorted((w for w in series if int(w[0]) == sc), key=lambda w: w[2]):
+            run = run + 1 if w[3] > scale * w[4] else 0
+            if run == n:
+                out.append(Alarm(sc, w[2], None))
+    return out
+
+
 def _roc(runs: list[dict[str, Any]], detector: str) -> tuple[np.ndarray, np.ndarray]:
-    """(false alarms per nominal cycle, detection rate) at each threshold scale in SCALES,
-    re-scoring the detector's windows with its persistence."""
-    n = PERSISTENCE.get(detector, 1)
+    """(false alarms per nominal cycle, detection rate) at each threshold scale in SCALES:
+    each run's windows re-scored with the detector's persistence and scored exactly as
+    summary.json is (``scoring.score``); the main detector's link and data-integrity
+    declarations, which no threshold scales, are kept as they were."""
     fa = np.zeros(len(SCALES))
     det = np.zeros(len(SCALES))
     cycles = faults = 0
     for s in runs:
-        series = s.get("fdir_series", {}).get(detector, [])
-        injected = s.get("injected_faults", [])
+        if detector not in s.get("fdir_series", {}):
+            continue
+        series = s["fdir_series"][detector]
+        injected = [Fault.model_validate(f) for f in s.get("injected_faults", [])]
+        grace = float(s.get("fdir_settings", {}).get("fdi_period_s", 0.0))
+        fixed = [Alarm(d["spacecraft"], d["time_s"], d["class"]) for d in s.get("detections", [])
+                 if detector == "main" and d["class"] in ("link", "data_integrity")]
+        judged = [Judged(int(w[0]), w[1], w[2]) for w in series]
+        n = _persistence(s, detector)
         faults += len(injected)
-        by_sc: dict[int, list[list[float]]] = {}
-        for w in series:
-            by_sc.setdefault(int(w[0]), []).append(w)
-        for sc, ws in by_sc.items():
-            ws.sort(key=lambda w: w[2])
-            mine = [f for f in injected if f["spacecraft"] == sc]
-            grace = ws[0][2] - ws[0][1] if ws else 0.0
-
-            def active(t: float) -> list[dict[str, Any]]:
-                return [f for f in mine if f["start_s"] <= t and
-                        (f.get("end_s") is None or t <= f["end_s"] + grace)]
-
-            cycles += sum(1 for w in ws if not any(
-                f["start_s"] < w[2] and (f.get("end_s") is None or w[1] < f["end_s"])
-                for f in mine))
-            for k, scale in enumerate(SCALES):
-                run, alarms = 0, []
-                for w in ws:
-                    run = run + 1 if w[3] > scale * w[4] else 0
-                    if run == n:
-                        alarms.append(w[2])
-                fa[k] += sum(1 for t in alarms if not active(t))
-                det[k] += sum(1 for f in mine if any(
-                    f["start_s"] <= t and (f.get("end_s") is None or t <= f["end_s"] + grace)
-                    for t in alarms))
+        for k, scale in enumerate(SCALES):
+            sc = score(injected, fixed + _alarms_at(series, scale, n), judged, grace)
+            fa[k] += sc["false_alarms"]
+            det[k] += sum(f["detected"] for f in sc["per_fault"])  # type: ignore[union-attr]
+            if k == 0:
+                cycles += int(sc["nominal_cycles"])  # type: ignore[call-overload]
     return fa / max(cycles, 1), det / max(faults, 1)
 
 
 def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     """Write results.csv, report.md and plots for the runs ``ids`` of campaign ``name``."""
-    runs = _load(out, ids)
+    loaded = _load(out, ids)
+    failed = [s["_id"] for s in loaded if s.get("status") != "completed"]
+    runs = [s for s in loaded if s.get("status") == "completed"]  # failed runs: listed only
     rows = _rows(runs)
     fields = ["run", "seed", "status", "detector", "kind", "spacecraft", "start_s", "magnitude",
               "detected", "isolated", "latency_s", "identified_class", "expected_class",
@@ -160,18 +172,18 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
-    failed = [s["_id"] for s in runs if s.get("status") != "completed"]
-    hours = _nominal_hours(runs)
     detectors = ["main"] + sorted({r["detector"] for r in rows} - {"main"})
+    hours = {d: _nominal_hours(runs, d) for d in detectors}
     lines = [f"# Campaign report: {name}", "",
-             f"{len(runs)} of {len(ids)} runs finished ({len(failed)} failed"
-             + (f": {', '.join(failed[:10])}" if failed else "") + f"); "
-             f"{hours:.1f} nominal spacecraft-hours judged.", "",
+             f"{len(loaded)} of {len(ids)} runs finished ({len(failed)} failed"
+             + (f": {', '.join(failed[:10])}{' ...' if len(failed) > 10 else ''}" if failed
+                else "") + "; failed runs are left out of every figure below); "
+             f"{hours['main']:.1f} nominal spacecraft-hours judged by the main detector.", "",
              "## Detectors side by side", "",
              "| detector | detected | isolated | identified | latency median / p90 / max (s) | "
              "false alarms per nominal cycle | per hour |", "|---|---|---|---|---|---|---|"]
     for d in detectors:
-        st = _stats([r for r in rows if r["detector"] == d], hours)
+        st = _stats([r for r in rows if r["detector"] == d], hours[d])
         ident = _pct(st["identified"], st["faults"]) if d == "main" else "-"
         lines.append(f"| {d} | {_pct(st['detected'], st['faults'])} | "
                      f"{_pct(st['isolated'], st['faults'])} | {ident} | "
@@ -181,12 +193,12 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     lines += ["", "## Per fault kind and magnitude", "",
               "| kind | magnitude | detector | faults | detected | missed | isolated | "
               "latency median / p90 / max (s) |", "|---|---|---|---|---|---|---|---|"]
-    bins = _magnitude_bins([r for r in rows if r["kind"] != "none"])
+    bins = _magnitude_bins([r for r in rows if r["kind"] != "none" and r["detector"] == "main"])
     for (kind, label), members in bins.items():
         for d in detectors:
             sel = [r for r in rows if r["detector"] == d and r["kind"] == kind
-                   and (r["run"], r["spacecraft"], r["start_s"]) in members]
-            st = _stats(sel, hours)
+                   and (r["run"], r["fault_index"]) in members]
+            st = _stats(sel, hours[d])
             lines.append(f"| {kind} | {label} | {d} | {st['faults']} | "
                          f"{_pct(st['detected'], st['faults'])} | {st['faults'] - st['detected']} | "
                          f"{_pct(st['isolated'], st['faults'])} | {_fmt(st['latency_median'])} / "
@@ -204,25 +216,25 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
 
 
 def _magnitude_bins(rows: list[dict[str, Any]], most: int = 4
-                    ) -> dict[tuple[str, str], set[tuple[Any, Any, Any]]]:
-    """Faults grouped by kind and magnitude: each distinct magnitude when a kind has at most
-    ``most`` of them, else three equal-width bins (dispersed magnitudes).  Values: the
-    (run, spacecraft, start) of the faults in the group."""
-    out: dict[tuple[str, str], set[tuple[Any, Any, Any]]] = {}
+                    ) -> dict[tuple[str, str], set[tuple[str, int]]]:
+    """Faults grouped by kind and magnitude, in kind then magnitude order: each distinct
+    magnitude when a kind has at most ``most`` of them, else three equal-width bins (dispersed
+    magnitudes).  Values: the (run, fault index) of the faults in the group."""
+    keyed: dict[tuple[str, float, str], set[tuple[str, int]]] = {}
     for kind in sorted({r["kind"] for r in rows}):
         mine = [r for r in rows if r["kind"] == kind]
         mags = sorted({r["magnitude"] for r in mine if r["magnitude"] is not None})
         for r in mine:
             m = r["magnitude"]
             if m is None or len(mags) <= most:
-                label = _fmt(m, "g")
+                key = (kind, -math.inf if m is None else m, _fmt(m, "g"))
             else:
                 lo, hi = mags[0], mags[-1]
-                k = min(2, int(3 * (m - lo) / (hi - lo))) if hi > lo else 0
+                k = min(2, int(3 * (m - lo) / (hi - lo)))
                 a, b = lo + k * (hi - lo) / 3, lo + (k + 1) * (hi - lo) / 3
-                label = f"{a:.3g}–{b:.3g}"
-            out.setdefault((kind, label), set()).add((r["run"], r["spacecraft"], r["start_s"]))
-    return dict(sorted(out.items()))
+                key = (kind, float(k), f"{a:.4g}–{b:.4g}")
+            keyed.setdefault(key, set()).add((r["run"], r["fault_index"]))
+    return {(kind, label): v for (kind, _, label), v in sorted(keyed.items())}
 
 
 def _confusion(out: Path, rows: list[dict[str, Any]]) -> list[str]:
@@ -253,7 +265,8 @@ def _latency_plot(out: Path, rows: list[dict[str, Any]], detectors: list[str]) -
     fig, ax = plt.subplots(figsize=(8, 4))
     data = [[r["latency_s"] for r in rows if r["detector"] == d and r["kind"] != "none"
              and r["isolated"] and r["latency_s"] is not None] for d in detectors]
-    ax.boxplot([d if d else [math.nan] for d in data], tick_labels=detectors)
+    ax.boxplot([d if d else [math.nan] for d in data])
+    ax.set_xticks(range(1, len(detectors) + 1), detectors)
     ax.set_ylabel("detection latency (s)")
     ax.grid(True, alpha=0.3)
     fig.tight_layout()

@@ -76,6 +76,8 @@ def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[
         "baselines": baseline_scores(archive, scenario, mission),
         "fdir_series": _series(windows, archive.messages(
             topics.key(mission, topics.GROUND, "fdir", "baseline"), BaselineVerdict)),
+        "fdir_settings": {"fdi_period_s": scenario.rates.fdi_period_s,
+                          **scenario.fdir.model_dump()},
     }
 
 

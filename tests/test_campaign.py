@@ -158,7 +158,7 @@ def test_interrupted_campaign_resumes_each_run_once(tmp_path: Path) -> None:
     assert len(after) == 9 and not list((out / "runs").glob("*.partial"))
     assert all(after[k] == v for k, v in first.items())  # finished runs were not redone
     report = (out / "report.md").read_text()
-    assert "9 of 9 runs finished (0 failed)" in report
+    assert "9 of 9 runs finished (0 failed;" in report
     assert (out / "roc.png").exists() and (out / "confusion.png").exists()
 
 
@@ -196,5 +196,5 @@ def test_a_crashing_run_is_recorded_as_failed(tmp_path: Path,
     assert summary["status"] == "failed" and "RuntimeError: sim exploded" in summary["error"]
     assert "sim exploded" in (d / "run.log").read_text()
     write_campaign_report(tmp_path / "out", "tc", [r.id for r in runs])
-    assert f"1 of 3 runs finished (1 failed: {runs[0].id})" in \
+    assert f"1 of 3 runs finished (1 failed: {runs[0].id};" in \
         (tmp_path / "out" / "report.md").read_text()

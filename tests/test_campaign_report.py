@@ -23,7 +23,9 @@ def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | No
 def _write(out: Path, rid: str, summary: dict[str, object]) -> None:
     d = out / "runs" / rid
     d.mkdir(parents=True)
-    (d / "summary.json").write_text(json.dumps({"status": "completed", "seed": 1, **summary}))
+    (d / "summary.json").write_text(json.dumps({
+        "status": "completed", "seed": 1, "detections": [],
+        "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2}, **summary}))
 
 
 @pytest.fixture()
@@ -57,7 +59,7 @@ def campaign(tmp_path: Path) -> Path:
 
 def test_report_figures(campaign: Path) -> None:
     report = (campaign / "report.md").read_text()
-    assert "3 of 4 runs finished (0 failed)" in report
+    assert "3 of 4 runs finished (0 failed;" in report
     assert "| main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 |" in report
     assert "| cusum | 100% (1/1) | 100% (1/1) | - | 100 / 100 / 100 |" in report
     assert "| camera_degradation (→ camera) | 0 | 1 | 0 | 0 | 0 | 0 |" in report
@@ -81,14 +83,34 @@ def test_roc_rescoring(campaign: Path) -> None:
     assert det[low] == pytest.approx(1.0)  # and the nominal sc1 of run a (0.01) still quiet
     assert fa[low] == pytest.approx(0.25)
     assert det[-1] == 0.0 and fa[-1] == 0.0  # threshold 0.5: nothing
-    assert np.all(np.diff(det) <= 0) and np.all(np.diff(fa) <= 0)  # monotone in the scale
+    assert np.all(np.diff(det) <= 0)  # fewer detections as the threshold rises
+
+
+def test_roc_scores_like_the_run(tmp_path: Path) -> None:
+    """At scale 1 the ROC gives the run's own scores: a fault is detected by an alarm on any
+    spacecraft while it is active (not only its own), and link or data-integrity
+    declarations, which no threshold scales, count at every scale."""
+    faults = [{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0, "end_s": None,
+               "magnitude": 0.5},
+              {"spacecraft": 3, "kind": "link_loss", "start_s": 0.0, "end_s": 150.0,
+               "magnitude": None}]
+    run = {"status": "completed", "injected_faults": faults,
+           "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2},
+           "detections": [{"spacecraft": 3, "time_s": 200.0, "class": "link"}],
+           "fdir_series": {"main": [[1, 0, 100, 0.2, 0.05], [1, 100, 200, 0.2, 0.05],
+                                    [2, 0, 100, 0.01, 0.05], [2, 100, 200, 0.01, 0.05]]}}
+    fa, det = _roc([run], "main")
+    one = int(np.argmin(np.abs(SCALES - 1.0)))
+    assert det[one] == 1.0  # sc1's alarm at 200 s falls in sc2's fault: detected
+    assert fa[one] == 0.5  # ... and a false alarm on sc1, whose 2 windows are nominal
+    assert det[-1] == 0.5  # at 10x only the link declaration remains
 
 
 def test_magnitude_bins() -> None:
-    rows = [{"kind": "k", "magnitude": m, "run": str(i), "spacecraft": 1, "start_s": 0.0}
-            for i, m in enumerate([1.0, 1.5, 2.0, 2.5, 3.0, 4.0])]
+    rows = [{"kind": "k", "magnitude": m, "run": str(i), "fault_index": 0}
+            for i, m in enumerate([4.0, 5.5, 7.0, 8.5, 10.0, 13.0])]
     bins = _magnitude_bins(rows)
-    assert list(bins) == [("k", "1–2"), ("k", "2–3"), ("k", "3–4")]
+    assert list(bins) == [("k", "4–7"), ("k", "7–10"), ("k", "10–13")]  # numeric order
     assert [len(v) for v in bins.values()] == [2, 2, 2]
     few = _magnitude_bins(rows[:3])
-    assert list(few) == [("k", "1"), ("k", "1.5"), ("k", "2")]
+    assert list(few) == [("k", "4"), ("k", "5.5"), ("k", "7")]
