@@ -248,6 +248,8 @@ def _confusion(out: Path, rows: list[dict[str, Any]]) -> list[str]:
                  "|---|" + "---|" * len(labels)]
     for k, row in zip(kinds, m):
         out_lines.append(f"| {k} (→ {EXPECTED_CLASS[k]}) | " + " | ".join(map(str, row)) + " |")
+    if not kinds:
+        return out_lines + ["", "(no fault injected)"]
     fig, ax = plt.subplots(figsize=(8, 0.5 * max(len(kinds), 2) + 2))
     ax.imshow(m, cmap="Blues")
     ax.set_xticks(range(len(labels)), labels, rotation=30, ha="right")
