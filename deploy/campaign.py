@@ -319,7 +319,9 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     handler = logging.FileHandler(out / "run.log")
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
     root = logging.getLogger()
+    level = root.level
     root.addHandler(handler)
+    root.setLevel(logging.INFO)  # the run's log keeps its INFO lines (slews, assignments...)
     t0 = time.monotonic()
     status, error = "completed", None
     try:
@@ -331,6 +333,7 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
         logging.getLogger("insp.campaign").error("run %s failed: %s", spec.id, error)
     finally:
         root.removeHandler(handler)
+        root.setLevel(level)
         handler.close()
     return write_summary(out, spec.scenario, "inproc", time.monotonic() - t0, status, error)
 

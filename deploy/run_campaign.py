@@ -22,6 +22,7 @@ interrupted.
 from __future__ import annotations
 
 import argparse
+import fcntl
 import hashlib
 import json
 import logging
@@ -199,6 +200,19 @@ def _failed(out: Path, run_id: str) -> bool:
 def _run(runs: list[RunSpec], args: argparse.Namespace) -> int:
     runs_dir = args.out / "runs"
     runs_dir.mkdir(exist_ok=True)
+    lock = open(args.out / ".lock", "w")  # noqa: SIM115 - held for the whole campaign
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        print(f"error: another campaign is running in {args.out}", file=sys.stderr)
+        return 2
+    try:
+        return _run_locked(runs, args, runs_dir)
+    finally:
+        lock.close()
+
+
+def _run_locked(runs: list[RunSpec], args: argparse.Namespace, runs_dir: Path) -> int:
     for partial in runs_dir.glob("*.partial"):
         shutil.rmtree(partial, ignore_errors=True)  # half-written by an interrupted campaign
     todo = [r for r in runs if not finished(r, args.out)]

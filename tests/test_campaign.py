@@ -198,3 +198,16 @@ def test_a_crashing_run_is_recorded_as_failed(tmp_path: Path,
     write_campaign_report(tmp_path / "out", "tc", [r.id for r in runs])
     assert f"1 of 3 runs finished (1 failed: {runs[0].id};" in \
         (tmp_path / "out" / "report.md").read_text()
+
+
+def test_one_campaign_per_directory(tmp_path: Path) -> None:
+    """A second campaign on a directory in use is refused, not interleaved."""
+    import fcntl
+
+    path = _campaign(tmp_path)
+    out = tmp_path / "out"
+    out.mkdir()
+    with open(out / ".lock", "w") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        assert run_campaign(["--campaign", str(path), "--out", str(out)]) == 2
+    assert not list((out / "runs").iterdir())
