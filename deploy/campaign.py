@@ -284,9 +284,12 @@ def finished(spec: RunSpec, out_root: Path) -> bool:
 def _finish(spec: RunSpec, partial: Path, final: Path, transport: str) -> None:
     import shutil
 
+    from ground.record import software_version
+
     (partial / "campaign.json").write_text(json.dumps(
         {"run": spec.id, "group": spec.group, "seed": spec.seed, "transport": transport,
-         "fingerprint": fingerprint(spec)}, indent=2) + "\n")
+         "fingerprint": fingerprint(spec), "software_version": software_version()},
+        indent=2) + "\n")
     shutil.rmtree(final, ignore_errors=True)
     partial.rename(final)
 

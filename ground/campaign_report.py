@@ -37,14 +37,28 @@ SCALES = np.geomspace(0.1, 10.0, 41)
 
 
 def _load(out: Path, ids: Sequence[str]) -> list[dict[str, Any]]:
+    """The finished runs' summaries, each with its id and the software version that ran it
+    (``_id``, ``_version``)."""
     runs = []
     for rid in ids:
         p = out / "runs" / rid / "summary.json"
         if p.exists():
             s = json.loads(p.read_text())
             s["_id"] = rid
+            meta = p.parent / "campaign.json"
+            s["_version"] = (json.loads(meta.read_text()).get("software_version", "unknown")
+                             if meta.exists() else "unknown")
             runs.append(s)
     return runs
+
+
+def _versions(runs: list[dict[str, Any]]) -> str:
+    counts: dict[str, int] = {}
+    for s in runs:
+        counts[s["_version"]] = counts.get(s["_version"], 0) + 1
+    text = ", ".join(f"{v} ({n} runs)" for v, n in sorted(counts.items()))
+    return f"Software: {text}" + (" -- MIXED: results may not be comparable." if len(counts) > 1
+                                  else ".")
 
 
 def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -179,6 +193,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
              + (f": {', '.join(failed[:10])}{' ...' if len(failed) > 10 else ''}" if failed
                 else "") + "; failed runs are left out of every figure below); "
              f"{hours['main']:.1f} nominal spacecraft-hours judged by the main detector.", "",
+             _versions(loaded), "",
              "## Detectors side by side", "",
              "| detector | detected | isolated | identified | latency median / p90 / max (s) | "
              "false alarms per nominal cycle | per hour |", "|---|---|---|---|---|---|---|"]

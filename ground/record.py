@@ -7,8 +7,11 @@ MCAP file (Foxglove opens it).  SIGINT/SIGTERM finish the file cleanly (summary 
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib.metadata
+import subprocess
 import time
+from pathlib import Path
 
 from ground.recorder import McapRecorder
 from interfaces import topics
@@ -23,11 +26,22 @@ from interfaces.cli import (
 from interfaces.scenario import Scenario
 
 
+@functools.cache
 def software_version() -> str:
+    """The package version, with the git commit of the checkout it runs from when there is
+    one (``0.1.0+g46a41bc``, ``-dirty`` with uncommitted changes)."""
     try:
-        return importlib.metadata.version("insp-fdir")
+        version = importlib.metadata.version("insp-fdir")
     except importlib.metadata.PackageNotFoundError:
-        return "unknown (not installed)"
+        version = "unknown (not installed)"
+    repo = Path(__file__).resolve().parent.parent
+    try:
+        commit = subprocess.run(["git", "-C", str(repo), "describe", "--always", "--dirty",
+                                 "--exclude", "*"], capture_output=True, text=True, timeout=10,
+                                check=True).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return version
+    return f"{version}+g{commit}" if commit else version
 
 
 def run_metadata(scenario: Scenario, transport: str, scenario_toml: str) -> dict[str, dict[str, str]]:

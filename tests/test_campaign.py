@@ -19,6 +19,7 @@ import pytest
 
 from deploy.campaign import CampaignError, load_campaign
 from deploy.run_campaign import main as run_campaign
+from ground.record import software_version
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -159,6 +160,7 @@ def test_interrupted_campaign_resumes_each_run_once(tmp_path: Path) -> None:
     assert all(after[k] == v for k, v in first.items())  # finished runs were not redone
     report = (out / "report.md").read_text()
     assert "9 of 9 runs finished (0 failed;" in report
+    assert f"Software: {software_version()} (9 runs)." in report
     assert (out / "roc.png").exists() and (out / "confusion.png").exists()
 
 

@@ -60,6 +60,7 @@ def campaign(tmp_path: Path) -> Path:
 def test_report_figures(campaign: Path) -> None:
     report = (campaign / "report.md").read_text()
     assert "3 of 4 runs finished (0 failed;" in report
+    assert "Software: unknown (3 runs)." in report  # no campaign.json beside these summaries
     assert "| main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 |" in report
     assert "| cusum | 100% (1/1) | 100% (1/1) | - | 100 / 100 / 100 |" in report
     assert "| camera_degradation (→ camera) | 0 | 1 | 0 | 0 | 0 | 0 |" in report
