@@ -351,20 +351,23 @@ def _zenoh_run(spec: RunSpec, out: Path) -> dict[str, Any]:
 
     scenario = out / "scenario.json"
     scenario.write_text(spec.scenario.model_dump_json(indent=1))
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    cmd = [sys.executable, str(Path(__file__).resolve().parent / "run_constellation.py"),
-           "--scenario", str(scenario), "--out", str(out), "--no-report",
-           "--endpoint", f"tcp/127.0.0.1:{port}", "--mission", f"{spec.scenario.name}-{port}"]
-    with open(out / "launcher.log", "w") as log_file:
-        try:
-            subprocess.run(cmd, stdout=log_file, stderr=subprocess.STDOUT, check=False,
-                           timeout=max(600.0, 5.0 * spec.scenario.duration_s),
-                           preexec_fn=die_with_parent if sys.platform.startswith("linux")
-                           else None)  # a killed worker takes its run down with it
-        except subprocess.TimeoutExpired:
-            pass  # recorded below from what the launcher left
+    for _attempt in range(3):  # a free port can be taken before the launcher binds it
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        cmd = [sys.executable, str(Path(__file__).resolve().parent / "run_constellation.py"),
+               "--scenario", str(scenario), "--out", str(out), "--no-report",
+               "--endpoint", f"tcp/127.0.0.1:{port}", "--mission", f"{spec.scenario.name}-{port}"]
+        with open(out / "launcher.log", "w") as log_file:
+            try:
+                subprocess.run(cmd, stdout=log_file, stderr=subprocess.STDOUT, check=False,
+                               timeout=max(600.0, 5.0 * spec.scenario.duration_s),
+                               preexec_fn=die_with_parent if sys.platform.startswith("linux")
+                               else None)  # a killed worker takes its run down with it
+            except subprocess.TimeoutExpired:
+                pass  # recorded below from what the launcher left
+        if "cannot listen on" not in (out / "launcher.log").read_text(errors="replace"):
+            break
     summary_path = out / "summary.json"
     if summary_path.exists():
         summary: dict[str, Any] = json.loads(summary_path.read_text())
