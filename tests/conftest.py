@@ -77,3 +77,22 @@ def collector(*types: type[Message], key_prefix: dict[str, str] | None = None,
             out[type_name].append(t.model_validate_json(payload))
 
     return tap, out
+
+
+def recorded_run(scenario: Scenario, out: Path, *types: type[Message]
+                 ) -> tuple[dict[str, list[Any]], dict[str, Any]]:
+    """Run ``scenario`` in-process, archiving every message to ``out/run.mcap`` and collecting
+    those of ``types`` (as :func:`collector`); returns (collected by type name, the run's
+    summary.json as written)."""
+    from deploy.inproc import run_inproc
+    from ground.recorder import McapRecorder
+    from ground.summary import write_summary
+
+    tap, got = collector(*types)
+    with McapRecorder(out / "run.mcap", {}) as rec:
+        def both(key: str, type_name: str, payload: bytes) -> None:
+            tap(key, type_name, payload)
+            rec.record(key, type_name, payload)
+
+        run_inproc(scenario, tap=both)
+    return got, write_summary(out, scenario, "inproc", 1.0, "completed")

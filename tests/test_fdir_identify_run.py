@@ -9,11 +9,8 @@ from typing import Any
 
 import pytest
 
-from deploy.inproc import run_inproc
-from ground.recorder import McapRecorder
-from ground.summary import write_summary
 from interfaces.messages import BaselineVerdict, FaultReport
-from tests.conftest import collector, small_scenario
+from tests.conftest import recorded_run, small_scenario
 
 
 @pytest.fixture(scope="module")
@@ -26,15 +23,8 @@ def run(tmp_path_factory: pytest.TempPathFactory
         faults=[{"spacecraft": 1, "kind": "pointing_actuator", "start_s": 0.0, "magnitude": 5.0},
                 {"spacecraft": 2, "kind": "nav_sensor_bias", "start_s": 100.0, "magnitude": 3.0},
                 {"spacecraft": 3, "kind": "packet_loss", "start_s": 100.0, "magnitude": 0.5}])
-    tap, got = collector(FaultReport, BaselineVerdict)
-    path = tmp_path_factory.mktemp("fi") / "run.mcap"
-    with McapRecorder(path, {}) as rec:
-        def both(key: str, type_name: str, payload: bytes) -> None:
-            tap(key, type_name, payload)
-            rec.record(key, type_name, payload)
-
-        run_inproc(sc, tap=both)
-    summary = write_summary(path.parent, sc, "inproc", 1.0, "completed")
+    out = tmp_path_factory.mktemp("fi")
+    got, summary = recorded_run(sc, out, FaultReport, BaselineVerdict)
     return got["FaultReport"], got["BaselineVerdict"], summary
 
 

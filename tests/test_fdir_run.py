@@ -9,13 +9,10 @@ from typing import Any
 
 import pytest
 
-from deploy.inproc import run_inproc
 from ground.fdir.calibrate import main as calibrate_main
-from ground.recorder import McapRecorder
 from ground.report import write_report
-from ground.summary import write_summary
 from interfaces.messages import FaultReport, FdirWindow
-from tests.conftest import collector, small_scenario
+from tests.conftest import recorded_run, small_scenario
 
 
 @pytest.fixture(scope="module")
@@ -29,16 +26,9 @@ def fdir_run(tmp_path_factory: pytest.TempPathFactory
                  "magnitude": 0.5},
                 {"spacecraft": 3, "kind": "link_loss", "start_s": 200.0, "end_s": 300.0},
                 {"spacecraft": 1, "kind": "faulty_data", "start_s": 150.0, "magnitude": 2.0}])
-    tap, got = collector(FdirWindow, FaultReport)
-    path = tmp_path_factory.mktemp("fdir") / "run.mcap"
-    with McapRecorder(path, {}) as rec:
-        def both(key: str, type_name: str, payload: bytes) -> None:
-            tap(key, type_name, payload)
-            rec.record(key, type_name, payload)
-
-        run_inproc(sc, tap=both)
-    summary = write_summary(path.parent, sc, "inproc", 1.0, "completed")
-    write_report(path.parent, sc)
+    out = tmp_path_factory.mktemp("fdir")
+    got, summary = recorded_run(sc, out, FdirWindow, FaultReport)
+    write_report(out, sc)
     return got["FdirWindow"], got["FaultReport"], summary
 
 
