@@ -12,8 +12,8 @@ closes.  For observer i, with ψ the squared fused variance of the ground's map 
 
 * ΔH_i = Σ φψ σ⁻¹ over the observations of its images taken in [a, b) (``twin.delta_h``);
 * ΔH_i^pred: the same sum for the same image times from the nominal twin — the planned
-  position (assigned PRO, or the published transfer plan), the camera on the target centre,
-  the nominal camera model (β = 1);
+  position (assigned PRO, or the published transfer plan), the camera on the aim point the
+  observer reports (the target centre by default), the nominal camera model (β = 1);
 * H_m,i (Eq. 9), τ_i from ``fdir.samples`` pointings within ``fdir.eps_deg`` of the planned
   ones (Eq. 11-12) with the floor ``fdir.floor``, direction by Table 3;
 * a fault is declared after ``fdir.persistence`` exceedances in a row (``Persistence``); an
@@ -33,8 +33,10 @@ closes.  For observer i, with ψ the squared fused variance of the ground's map 
 Only lost images are missing from both sides of the comparison; images taken while the
 observer reports a slew (its attitude plan, not a pointing), or within ``fdir.settle_s`` of the
 end of one (the loop's transient), are left out of both; a window
-without any image or any plan gives no decision.  The twin models centre pointing (the
-default camera policy).
+without any image or any plan gives no decision.  The twin points where the observer says
+its camera policy aims (the target centre by default); it does not model the attitude loop's
+tracking error, which with ``max_variance`` pointing and a camera narrower than the target
+reaches about a degree during retargets.
 """
 
 from __future__ import annotations
@@ -130,7 +132,7 @@ class _Observer:
     nav: _Series = field(default_factory=_Series)
     """reported position (nav estimate), LVLH m"""
     attitude: _Series = field(default_factory=_Series)
-    """reported camera boresight (LVLH, 3) and pointing error (rad)"""
+    """reported camera boresight (LVLH, 3), pointing error (rad) and aim point (LVLH, 3, m)"""
     silent: int = 0
     link_declared: bool = False
     last_seq: int = 0
@@ -255,7 +257,8 @@ class FdirApp(App):
             bisect.insort(obs.modes, (msg.t_sim, msg.mode))
         if msg.t_sim >= self.window_start:
             bore = quat.rotate(np.array(msg.q_lvlh_body), self.boresight_body)
-            obs.attitude.add(msg.t_sim, np.append(bore, msg.pointing_error_rad))
+            obs.attitude.add(msg.t_sim, np.concatenate(
+                (bore, [msg.pointing_error_rad], msg.target_lvlh_m)))
 
     def on_nav(self, msg: StateEstimate) -> None:
         obs = self.observers.get(msg.spacecraft)
@@ -375,7 +378,7 @@ class FdirApp(App):
         dh = sum(delta_h(psi[m.poi], phi[m.poi], np.array(m.precision)) for m in images)
         times = np.array([m.image_t_s for m in images])
         pos = plan.positions(self.n, times)
-        bore = centre_boresights(pos)
+        bore = self._planned_boresights(obs, times, pos)
         dh_pred = predicted_delta_h(pos, bore, self.poi_pos, self.poi_normal, self.camera,
                                     psi, phi)
         h_prev = float(np.sum(phi * psi * self.settled.F[sc - 1]))
@@ -437,6 +440,22 @@ class FdirApp(App):
             valid = [r for r in ratios if r is not None]
             overlap = float(np.median(valid)) if valid else None
         return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc)
+
+    def _planned_boresights(self, obs: _Observer, times: np.ndarray, pos: np.ndarray
+                            ) -> np.ndarray:
+        """The twin's pointing: from each planned position to the aim point the observer
+        reports (its camera policy's choice: the target centre by default, the max-variance
+        POI with ``[camera] pointing = "max_variance"``), or to the target centre when the
+        attitude reports are missing.  A pointing or camera fault leaves the aim as intended,
+        so it still shows against this prediction."""
+        att = obs.attitude.at(times)
+        if att is None:
+            return centre_boresights(pos)
+        los = att[:, 4:7] - pos
+        norm = np.linalg.norm(los, axis=1, keepdims=True)
+        if np.any(norm <= 0.0):
+            return centre_boresights(pos)
+        return los / norm
 
     def _threshold(self, sc: int, a: float, pos: np.ndarray, bore: np.ndarray, psi: np.ndarray,
                    phi: np.ndarray, h_prev: float) -> float | None:
