@@ -123,12 +123,15 @@ class CampaignError(ValueError):
 @dataclass(frozen=True)
 class RunSpec:
     """One run of a campaign: its id (``<group>-<index>``, also its directory name), group,
-    seed, and the validated scenario it runs."""
+    and the validated scenario it runs (with its seed)."""
 
     id: str
     group: str
-    seed: int
     scenario: Scenario
+
+    @property
+    def seed(self) -> int:
+        return self.scenario.seed
 
 
 def _seeds(value: list[int] | Seeds) -> list[int]:
@@ -221,7 +224,7 @@ def expand(campaign: Campaign, root: Path) -> list[RunSpec]:
                                         + "; ".join(f"{'.'.join(map(str, err['loc']))}: "
                                                     f"{err['msg']}" for err in e.errors())
                                         ) from None
-                runs.append(RunSpec(run_id, group.name, seed, scenario))
+                runs.append(RunSpec(run_id, group.name, scenario))
                 index += 1
     return runs
 

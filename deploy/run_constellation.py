@@ -25,7 +25,7 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # run as a script from a checkout
@@ -40,6 +40,9 @@ from interfaces import topics  # noqa: E402
 from interfaces.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
 from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
+
+if TYPE_CHECKING:
+    from ground.live import LiveView
 
 DEFAULT_SCENARIO = REPO / "deploy" / "scenarios" / "default.toml"
 log = logging.getLogger("insp.launcher")
@@ -134,7 +137,7 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
     return "completed", None
 
 
-def _live_view(args: argparse.Namespace) -> Any:
+def _live_view(args: argparse.Namespace) -> LiveView | None:
     """The Foxglove live view when --live PORT is given (ground/live.py), else None."""
     if not getattr(args, "live", None):
         return None

@@ -213,11 +213,11 @@ class MissionPlan:
         the current set by the margin."""
         a = self.scenario.assignment
         t_arrive = t_depart + transfer_s
-        pros, per_observer, gain, bound = self._plan_set(t_depart, t_arrive, fused,
+        w, phi = self._weights(t_arrive, fused, self.dropped)
+        pros, per_observer, gain, bound = self._plan_set(t_depart, t_arrive, w, phi,
                                                          self.dropped, self.impaired)
         current_gain = None
         if self._current_indices is not None:
-            w, phi = self._weights(t_arrive, fused, self.dropped)
             prec = np.array([self._expected(self.library[i], t_arrive)
                              for i in self._current_indices if i >= 0])
             current_gain = set_gain(prec, phi, w)
@@ -257,7 +257,8 @@ class MissionPlan:
         a = self.scenario.assignment
         t_depart = t + UPLINK_LEAD_S
         t_arrive = t_depart + a.transfer_s
-        pros, per_observer, gain, bound = self._plan_set(t_depart, t_arrive, fused, dropped,
+        w, phi = self._weights(t_arrive, fused, dropped)
+        pros, per_observer, gain, bound = self._plan_set(t_depart, t_arrive, w, phi, dropped,
                                                          impaired)
         self.dropped, self.impaired = dropped, impaired
         self._recoveries += 1
@@ -306,21 +307,20 @@ class MissionPlan:
                 w = w + self._expected(pro_of(cur.pros[i]), t_arrive)
         return w, fused.phi[::k] * k
 
-    def _plan_set(self, t_depart: float, t_arrive: float, fused: PoiMap, dropped: set[int],
-                  impaired: dict[int, float]
+    def _plan_set(self, t_depart: float, t_arrive: float, w: npt.NDArray[np.float64],
+                  phi: npt.NDArray[np.float64], dropped: set[int], impaired: dict[int, float]
                   ) -> tuple[dict[int, ProElements], tuple[int, ...], float, float]:
         """Every observer's PRO for an assignment arriving at ``t_arrive``: the ``dropped``
         ones keep theirs (untasked); the ``impaired`` ones, then the healthy ones, get the
         greedy set of library PROs (``greedy_assignment``) clear of the keep-out they need and
         separated from the PROs already fixed, matched to the observers by
-        ``match_to_observers``.  Returns (PROs by observer, library index per observer or -1,
+        ``match_to_observers``; ``w``, ``phi``: as :meth:`_weights` gives them.  Returns (PROs by observer, library index per observer or -1,
         expected gain, online bound).  An impaired group with no feasible set falls back to the
         nominal keep-out (logged)."""
         a = self.scenario.assignment
         nominal = self.scenario.guidance.keep_out_m + a.keep_out_margin_m
         cur = self.current
         fixed = {i: cur.pros[i] for i in sorted(dropped) if cur is not None and i in cur.pros}
-        w, phi = self._weights(t_arrive, fused, dropped)
         chosen: dict[int, int] = {}
         gain = bound = 0.0
         tasked = [i for i in range(1, self.count + 1) if i not in fixed]

@@ -64,6 +64,8 @@ def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[
     faults (ground/fdir/scoring.py; grace of one FDI window)."""
     reports = archive.messages(topics.key(mission, topics.GROUND, "fdir", "report"), FaultReport)
     windows = archive.messages(topics.key(mission, topics.GROUND, "fdir", "window"), FdirWindow)
+    verdicts = archive.messages(topics.key(mission, topics.GROUND, "fdir", "baseline"),
+                                BaselineVerdict)
     alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class) for r in reports]
     judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
               if w.exceeded is not None]
@@ -73,9 +75,8 @@ def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[
                         "evidence": r.evidence}
                        for r in reports],
         "scores": score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
-        "baselines": baseline_scores(archive, scenario, mission),
-        "fdir_series": _series(windows, archive.messages(
-            topics.key(mission, topics.GROUND, "fdir", "baseline"), BaselineVerdict)),
+        "baselines": baseline_scores(verdicts, scenario),
+        "fdir_series": _series(windows, verdicts),
         "fdir_settings": {"fdi_period_s": scenario.rates.fdi_period_s,
                           **scenario.fdir.model_dump()},
     }
@@ -96,12 +97,10 @@ def _series(windows: list[FdirWindow], verdicts: list[BaselineVerdict]
     return out
 
 
-def baseline_scores(archive: RunArchive, scenario: Scenario, mission: str
+def baseline_scores(verdicts: list[BaselineVerdict], scenario: Scenario
                     ) -> dict[str, dict[str, Any]]:
     """``baselines``: each baseline detector (ground/apps/baselines.py) scored like the main
     one, from its per-window verdicts."""
-    verdicts = archive.messages(topics.key(mission, topics.GROUND, "fdir", "baseline"),
-                                BaselineVerdict)
     out = {}
     for name in sorted({v.detector for v in verdicts}):
         mine = [v for v in verdicts if v.detector == name]

@@ -74,7 +74,6 @@ def test_expansion_is_deterministic_and_complete(tmp_path: Path) -> None:
     starts = [r.scenario.faults[0].start_s for r in cams]
     assert all(0.0 <= s <= 10.0 for s in starts) and len(set(starts)) == 6
     assert all(r.scenario.faults == [] for r in runs if r.group == "nom")
-    assert all(r.scenario.seed == r.seed for r in runs)
 
 
 @pytest.mark.parametrize("edit, message", [

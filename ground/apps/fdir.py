@@ -350,13 +350,13 @@ class FdirApp(App):
         if obs.silent:  # the gap is the silence already judged (a link fault), not loss
             return 0
         fraction = lost / (lost + len(seqs))
-        if self.loss.update(sc, fraction > self._loss_limit(lost + len(seqs))):
+        limit = self._loss_limit(lost + len(seqs))
+        if self.loss.update(sc, fraction > limit):
             self.log.warning("FDIR: sc%d lost %.0f%% of its observations: link fault", sc,
                              100.0 * fraction)
             self.publish("report", FaultReport(
                 sender=self.ctx.node, t_sim=b, spacecraft=sc, fault_class="link",
-                metric=fraction, threshold=self._loss_limit(lost + len(seqs)),
-                window_end_s=b))
+                metric=fraction, threshold=limit, window_end_s=b))
         return lost
 
     def _judge(self, sc: int, obs: _Observer, images: list[PoiObservations], a: float,
