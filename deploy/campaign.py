@@ -245,18 +245,14 @@ def load_campaign(path: str | Path) -> tuple[Campaign, list[RunSpec]]:
 
 def execute_run(spec: RunSpec, out_root: str, transport: str = "inproc") -> dict[str, Any]:
     """Run one campaign run into ``<out_root>/runs/<id>/`` (run.mcap, summary.json, a log) and
-    return {id, status, error, wall_s}.  The run is written under ``<id>.partial`` and renamed
+    return {id, status, error, wall_s}.  The run is written under ``<id>.partial-<random>`` and renamed
     when complete, so a run directory exists only for a finished run; a crash is caught and
     recorded as a failed run with its error.  ``transport``: ``inproc`` (this process) or
     ``zenoh`` (deploy/run_constellation.py as a child, one process per node, on a free
     loopback port and its own mission key space, so runs on one machine never cross).  A
     module-level function, so a Dask worker can import it."""
-    import shutil
-
     runs = Path(out_root) / "runs"
-    final, partial = runs / spec.id, runs / f"{spec.id}.partial"
-    shutil.rmtree(partial, ignore_errors=True)
-    partial.mkdir(parents=True)
+    final, partial = runs / spec.id, _attempt_dir(runs, spec.id, "partial")
     if transport == "zenoh":
         summary = _zenoh_run(spec, partial)
     elif transport == "inproc":
@@ -266,6 +262,22 @@ def execute_run(spec: RunSpec, out_root: str, transport: str = "inproc") -> dict
     _finish(spec, partial, final, transport)
     return {"id": spec.id, "status": summary.get("status"), "error": summary.get("error"),
             "wall_s": summary.get("wall_s")}
+
+
+def _attempt_dir(runs: Path, run_id: str, kind: str) -> Path:
+    """A fresh directory of its own for one attempt at a run (``<id>.<kind>-<random>``), after
+    removing what earlier attempts left.  Its own, because an attempt can outlive its campaign:
+    a Dask task cancelled by an interrupt runs on to the end, and must not write into, or
+    rename, the directory of the attempt that a restarted campaign makes meanwhile."""
+    import shutil
+    import uuid
+
+    for pattern in (f"{run_id}.partial*", f"{run_id}.failed*"):
+        for stale in runs.glob(pattern):
+            shutil.rmtree(stale, ignore_errors=True)
+    d = runs / f"{run_id}.{kind}-{uuid.uuid4().hex[:8]}"
+    d.mkdir(parents=True)
+    return d
 
 
 def fingerprint(spec: RunSpec) -> str:
@@ -303,9 +315,7 @@ def record_failure(spec: RunSpec, out_root: str, error: str) -> dict[str, Any]:
     import shutil
 
     runs = Path(out_root) / "runs"
-    partial = runs / f"{spec.id}.failed"
-    shutil.rmtree(partial, ignore_errors=True)
-    partial.mkdir(parents=True)
+    partial = _attempt_dir(runs, spec.id, "failed")
     (partial / "summary.json").write_text(json.dumps(
         {"scenario": spec.scenario.name, "seed": spec.seed, "status": "failed", "error": error,
          "injected_faults": [f.model_dump() for f in spec.scenario.faults]}, indent=2) + "\n")

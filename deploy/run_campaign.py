@@ -7,8 +7,8 @@ from one campaign file, on a local process pool or a Dask cluster, resumable.
 
 Each run goes in-process (deploy/inproc.py; --transport zenoh: multi-process, each run on its
 own loopback port and key space) into <out>/runs/<id>/ (run.mcap, summary.json,
-run.log); a run directory appears only when its run has finished (written as <id>.partial,
-then renamed), so a campaign started again with the same --out skips finished runs and redoes
+run.log); a run directory appears only when its run has finished (each attempt writes its own
+<id>.partial-<random>, then renames it), so a campaign started again with the same --out skips finished runs and redoes
 half-written ones.  A run that crashes is recorded as failed, with its error, and the campaign
 goes on.  SIGINT or SIGTERM stops the campaign: running runs are abandoned (redone next time)
 and the report is written over what has finished.  --cluster sends the runs to an existing
@@ -213,7 +213,7 @@ def _run(runs: list[RunSpec], args: argparse.Namespace) -> int:
 
 
 def _run_locked(runs: list[RunSpec], args: argparse.Namespace, runs_dir: Path) -> int:
-    for partial in runs_dir.glob("*.partial"):
+    for partial in [*runs_dir.glob("*.partial*"), *runs_dir.glob("*.failed-*")]:
         shutil.rmtree(partial, ignore_errors=True)  # half-written by an interrupted campaign
     todo = [r for r in runs if not finished(r, args.out)]
     log.info("%d runs, %d already finished, %d to run on %s", len(runs), len(runs) - len(todo),

@@ -155,7 +155,7 @@ def test_interrupted_campaign_resumes_each_run_once(tmp_path: Path) -> None:
     assert 1 <= len(first) < 9
     assert run_campaign(["--campaign", str(path), "--out", str(out), "--workers", "2"]) == 0
     after = {p.parent.name: p.stat().st_mtime_ns for p in (out / "runs").glob("*/summary.json")}
-    assert len(after) == 9 and not list((out / "runs").glob("*.partial"))
+    assert len(after) == 9 and not list((out / "runs").glob("*.partial*"))
     assert all(after[k] == v for k, v in first.items())  # finished runs were not redone
     report = (out / "report.md").read_text()
     assert "9 of 9 runs finished (0 failed;" in report
@@ -199,6 +199,36 @@ def test_a_crashing_run_is_recorded_as_failed(tmp_path: Path,
     write_campaign_report(tmp_path / "out", "tc", [r.id for r in runs])
     assert f"1 of 3 runs finished (1 failed: {runs[0].id};" in \
         (tmp_path / "out" / "report.md").read_text()
+
+
+def test_an_attempt_that_outlives_its_campaign_cannot_touch_the_next(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A Dask task cancelled by an interrupt runs on; the restarted campaign's attempt at the
+    same run gets a directory of its own and removes the old one, so the old attempt's later
+    writes fail instead of landing in (or renaming) the new attempt's directory."""
+    import deploy.inproc
+    from deploy.campaign import _attempt_dir, execute_run
+
+    _, runs = load_campaign(_campaign(tmp_path))
+    spec, runs_dir = runs[0], tmp_path / "out" / "runs"
+    orphan = _attempt_dir(runs_dir, spec.id, "partial")
+    (orphan / "run.mcap").write_text("half of an old attempt")
+    seen: list[object] = []
+
+    def run_while_the_orphan_writes(*_a: object, **_k: object) -> None:
+        try:
+            (orphan / "summary.json").write_text("{}")
+        except OSError as e:
+            seen.append(e)
+        raise RuntimeError("stop here")
+
+    monkeypatch.setattr(deploy.inproc, "run_inproc", run_while_the_orphan_writes)
+    execute_run(spec, str(tmp_path / "out"))
+    assert len(seen) == 1 and isinstance(seen[0], FileNotFoundError)
+    assert sorted(p.name for p in runs_dir.iterdir()) == [spec.id]
+    final = runs_dir / spec.id
+    assert b"old attempt" not in (final / "run.mcap").read_bytes()
+    assert json.loads((final / "summary.json").read_text())["status"] == "failed"
 
 
 def test_one_campaign_per_directory(tmp_path: Path) -> None:
