@@ -4,7 +4,8 @@ many runs, for the main detector and each baseline side by side (issue 6; DESIGN
 
 Reads ``<out>/runs/<id>/summary.json`` of every run and writes ``<out>/results.csv`` (one row
 per injected fault and detector, plus one per nominal run and detector), ``<out>/report.md``
-and its plots: latency distributions, the confusion matrix of identified class against
+(figures over all runs, per campaign group, per fault kind and magnitude) and its plots:
+latency distributions per group, the confusion matrix of identified class against
 injected kind, and a ROC curve per detector from sweeping a scale on its threshold
 (re-scored from each run's ``fdir_series`` with the detector's persistence).
 
@@ -37,17 +38,20 @@ SCALES = np.geomspace(0.1, 10.0, 41)
 
 
 def _load(out: Path, ids: Sequence[str]) -> list[dict[str, Any]]:
-    """The finished runs' summaries, each with its id and the software version that ran it
-    (``_id``, ``_version``)."""
+    """The finished runs' summaries, each with its id, its campaign group and the software
+    version that ran it (``_id``, ``_group``, ``_version``).  The group is the run's campaign
+    group (one per paper figure in paper.toml); without a campaign.json, the id less its
+    ``-<index>``."""
     runs = []
     for rid in ids:
         p = out / "runs" / rid / "summary.json"
         if p.exists():
             s = json.loads(p.read_text())
+            meta_path = p.parent / "campaign.json"
+            meta = json.loads(meta_path.read_text()) if meta_path.exists() else {}
             s["_id"] = rid
-            meta = p.parent / "campaign.json"
-            s["_version"] = (json.loads(meta.read_text()).get("software_version", "unknown")
-                             if meta.exists() else "unknown")
+            s["_group"] = meta.get("group") or rid.rsplit("-", 1)[0]
+            s["_version"] = meta.get("software_version", "unknown")
             runs.append(s)
     return runs
 
@@ -67,7 +71,8 @@ def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     for s in runs:
         detectors = {"main": s.get("scores", {}), **s.get("baselines", {})}
         for name, sc in detectors.items():
-            common = {"run": s["_id"], "seed": s.get("seed"), "status": s.get("status"),
+            common = {"run": s["_id"], "group": s["_group"], "seed": s.get("seed"),
+                      "status": s.get("status"),
                       "detector": name, "false_alarms": sc.get("false_alarms", 0),
                       "nominal_cycles": sc.get("nominal_cycles", 0)}
             faults = sc.get("per_fault", [])
@@ -102,6 +107,16 @@ def _stats(rows: list[dict[str, Any]], hours: float) -> dict[str, Any]:
         "false_alarm_rate": fa / cycles if cycles else None,
         "false_alarms_per_hour": fa / hours if hours > 0 else None,
     }
+
+
+def _cells(detector: str, st: dict[str, Any]) -> str:
+    """The table cells after the row's labels: detected, isolated, identified (main only),
+    latency median / p90 / max, false alarms per nominal cycle and per hour."""
+    ident = _pct(st["identified"], st["faults"]) if detector == "main" else "-"
+    return (f"{_pct(st['detected'], st['faults'])} | {_pct(st['isolated'], st['faults'])} | "
+            f"{ident} | {_fmt(st['latency_median'])} / {_fmt(st['latency_p90'])} / "
+            f"{_fmt(st['latency_max'])} | {_fmt(st['false_alarm_rate'], '.4f')} | "
+            f"{_fmt(st['false_alarms_per_hour'], '.3f')} |")
 
 
 def _fmt(v: float | None, f: str = ".0f") -> str:
@@ -179,7 +194,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     failed = [s["_id"] for s in loaded if s.get("status") != "completed"]
     runs = [s for s in loaded if s.get("status") == "completed"]  # failed runs: listed only
     rows = _rows(runs)
-    fields = ["run", "seed", "status", "detector", "kind", "spacecraft", "start_s", "magnitude",
+    fields = ["run", "group", "seed", "status", "detector", "kind", "spacecraft", "start_s", "magnitude",
               "detected", "isolated", "latency_s", "identified_class", "expected_class",
               "false_alarms", "nominal_cycles"]
     with open(out / "results.csv", "w", newline="") as f:
@@ -198,13 +213,21 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
              "| detector | detected | isolated | identified | latency median / p90 / max (s) | "
              "false alarms per nominal cycle | per hour |", "|---|---|---|---|---|---|---|"]
     for d in detectors:
-        st = _stats([r for r in rows if r["detector"] == d], hours[d])
-        ident = _pct(st["identified"], st["faults"]) if d == "main" else "-"
-        lines.append(f"| {d} | {_pct(st['detected'], st['faults'])} | "
-                     f"{_pct(st['isolated'], st['faults'])} | {ident} | "
-                     f"{_fmt(st['latency_median'])} / {_fmt(st['latency_p90'])} / "
-                     f"{_fmt(st['latency_max'])} | {_fmt(st['false_alarm_rate'], '.4f')} | "
-                     f"{_fmt(st['false_alarms_per_hour'], '.3f')} |")
+        lines.append(f"| {d} | " + _cells(d, _stats([r for r in rows if r["detector"] == d],
+                                                      hours[d])))
+    groups = list(dict.fromkeys(s["_group"] for s in runs))
+    lines += ["", "## Per campaign group", "",
+              "Each group of the campaign file (in paper.toml, one per paper figure); false "
+              "alarms are those on the group's unfaulted spacecraft.", "",
+              "| group | detector | detected | isolated | identified | latency median / p90 / "
+              "max (s) | false alarms per nominal cycle | per hour |",
+              "|---|---|---|---|---|---|---|---|"]
+    for g in groups:
+        mine = [s for s in runs if s["_group"] == g]
+        for d in detectors:
+            st = _stats([r for r in rows if r["detector"] == d and r["group"] == g],
+                        _nominal_hours(mine, d))
+            lines.append(f"| {g} | {d} | " + _cells(d, st))
     lines += ["", "## Per fault kind and magnitude", "",
               "| kind | magnitude | detector | faults | detected | missed | isolated | "
               "latency median / p90 / max (s) |", "|---|---|---|---|---|---|---|---|"]
@@ -223,7 +246,9 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     lines += ["", "## Latency", "", "![latency](latency.png)", "",
               "## ROC (threshold scale swept, each detector with its persistence)", "",
               "![roc](roc.png)", ""]
-    _latency_plot(out, rows, detectors)
+    _latency_plot(out, rows, detectors, [g for g in groups
+                                         if any(r["group"] == g and r["kind"] != "none"
+                                                for r in rows)])
     _roc_plot(out, runs, detectors)
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
@@ -278,13 +303,36 @@ def _confusion(out: Path, rows: list[dict[str, Any]]) -> list[str]:
     return out_lines
 
 
-def _latency_plot(out: Path, rows: list[dict[str, Any]], detectors: list[str]) -> None:
-    fig, ax = plt.subplots(figsize=(8, 4))
-    data = [[r["latency_s"] for r in rows if r["detector"] == d and r["kind"] != "none"
-             and r["isolated"] and r["latency_s"] is not None] for d in detectors]
-    ax.boxplot([d if d else [math.nan] for d in data])
-    ax.set_xticks(range(1, len(detectors) + 1), detectors)
-    ax.set_ylabel("detection latency (s)")
+def _latency_plot(out: Path, rows: list[dict[str, Any]], detectors: list[str],
+                  groups: list[str]) -> None:
+    """Latency from onset to isolation: one box per detector (coloured) within each campaign
+    group, with the number of faults each detector missed (did not isolate) under it."""
+    fig, ax = plt.subplots(figsize=(max(8.0, 1.0 + 0.6 * len(detectors) * len(groups)), 4.5))
+    width = 0.8 / max(len(detectors), 1)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for j, d in enumerate(detectors):
+        pos, data, missed = [], [], []
+        for i, g in enumerate(groups):
+            faults = [r for r in rows if r["detector"] == d and r["group"] == g
+                      and r["kind"] != "none"]
+            lat = [r["latency_s"] for r in faults if r["isolated"] and r["latency_s"] is not None]
+            pos.append(i + (j - (len(detectors) - 1) / 2) * width)
+            data.append(lat or [math.nan])
+            missed.append(len(faults) - len(lat))
+        c = colours[j % len(colours)]
+        ax.boxplot(data, positions=pos, widths=0.9 * width, patch_artist=True,
+                   boxprops={"facecolor": c, "alpha": 0.6}, medianprops={"color": "k"},
+                   flierprops={"markersize": 3})
+        for x, m in zip(pos, missed):
+            ax.annotate(f"{m}", (x, 0), xycoords=("data", "axes fraction"),
+                        xytext=(0, 3), textcoords="offset points", ha="center", fontsize=7,
+                        color=c)
+        ax.plot([], [], "s", color=c, alpha=0.6, label=d)
+    ax.set_xticks(range(len(groups)), groups, rotation=15, ha="right")
+    ax.set_xlim(-0.6, len(groups) - 0.4)
+    ax.set_ylabel("latency, onset to isolation (s)")
+    ax.set_title("detection latency per campaign group (numbers at the foot: faults missed)")
+    ax.legend(fontsize=8, ncols=len(detectors))
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
     fig.savefig(out / "latency.png", dpi=100)

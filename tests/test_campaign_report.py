@@ -20,9 +20,11 @@ def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | No
             "expected_class": expected, "identified_correctly": cls == expected}
 
 
-def _write(out: Path, rid: str, summary: dict[str, object]) -> None:
+def _write(out: Path, rid: str, summary: dict[str, object], group: str | None = None) -> None:
     d = out / "runs" / rid
     d.mkdir(parents=True)
+    if group is not None:  # as the campaign runner writes it beside the run
+        (d / "campaign.json").write_text(json.dumps({"run": rid, "group": group}))
     (d / "summary.json").write_text(json.dumps({
         "status": "completed", "seed": 1, "detections": [],
         "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2}, **summary}))
@@ -40,14 +42,16 @@ def campaign(tmp_path: Path) -> Path:
                                                      None, "camera")],
                                 "false_alarms": 0, "nominal_cycles": 2}},
         "fdir_series": {"main": [[2, 0, 100, 0.5, 0.05], [2, 100, 200, 0.5, 0.05],
-                                 [1, 0, 100, 0.01, 0.05], [1, 100, 200, 0.01, 0.05]]}})
+                                 [1, 0, 100, 0.01, 0.05], [1, 100, 200, 0.01, 0.05]]}},
+           group="faulty")
     # run b: a thruster fault missed by the main detector, identified by nobody
     _write(tmp_path, "b", {
         "injected_faults": [{"spacecraft": 1, "kind": "thruster_bias", "start_s": 100.0,
                              "end_s": None, "magnitude": 0.3}],
         "scores": {"per_fault": [_fault(1, "thruster_bias", 100.0, False, None, None,
                                         "actuator")], "false_alarms": 0, "nominal_cycles": 0},
-        "fdir_series": {"main": [[1, 100, 200, 0.03, 0.05], [1, 200, 300, 0.03, 0.05]]}})
+        "fdir_series": {"main": [[1, 100, 200, 0.03, 0.05], [1, 200, 300, 0.03, 0.05]]}},
+           group="faulty")
     # run c: nominal, one false alarm (two windows just over the threshold)
     _write(tmp_path, "c", {
         "injected_faults": [],
@@ -60,12 +64,18 @@ def campaign(tmp_path: Path) -> Path:
 def test_report_figures(campaign: Path) -> None:
     report = (campaign / "report.md").read_text()
     assert "3 of 4 runs finished (0 failed;" in report
-    assert "Software: unknown (3 runs)." in report  # no campaign.json beside these summaries
+    assert "Software: unknown (3 runs)." in report  # no version in these campaign.json
     assert "| main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 |" in report
     assert "| cusum | 100% (1/1) | 100% (1/1) | - | 100 / 100 / 100 |" in report
     assert "| camera_degradation (→ camera) | 0 | 1 | 0 | 0 | 0 | 0 |" in report
     assert "| thruster_bias (→ actuator) | 0 | 0 | 0 | 0 | 0 | 1 |" in report
+    # per campaign group: a and b form "faulty" (its nominal cycles are a's sc1); c, with no
+    # campaign.json, is its own group by its id
+    assert "| faulty | main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.0000 |" \
+        in report
+    assert "| c | main | - | - | - | - / - / - | 0.5000 |" in report
     rows = list(csv.DictReader(open(campaign / "results.csv")))
+    assert [r["group"] for r in rows] == ["faulty", "faulty", "faulty", "c"]
     assert [(r["run"], r["detector"], r["kind"]) for r in rows] == [
         ("a", "main", "camera_degradation"), ("a", "cusum", "camera_degradation"),
         ("b", "main", "thruster_bias"), ("c", "main", "none")]
