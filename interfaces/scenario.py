@@ -330,8 +330,9 @@ class FdirSettings(_Section):
     (its last images must have arrived).  A declared performance fault is identified (ground/fdir/identify.py)
     against the nominal bounds ``beta_tol`` (camera health located from the images),
     ``position_tol_m`` (camera from the images vs nav, nav vs plan), ``pointing_tol_deg``
-    (reported pointing error), ``overlap_tol`` (seen vs expected POIs) and ``explained_min``
-    (share of the ΔH gap the reported pose must explain)."""
+    (reported pointing error), ``overlap_tol`` (seen vs expected POIs), ``explained_min``
+    (share of the ΔH gap the reported pose must explain) and ``dv_rate_tol_mps2`` (Δv the
+    observer commands while holding its PRO, per second)."""
 
     samples: int = Field(default=10, ge=1, le=1000)
     eps_deg: float = Field(default=1.0, gt=0.0, lt=45.0)
@@ -355,6 +356,12 @@ class FdirSettings(_Section):
     pointing_tol_deg: float = Field(default=1.0, gt=0.0)
     overlap_tol: float = Field(default=0.8, gt=0.0, le=1.0)
     explained_min: float = Field(default=0.5, gt=0.0, le=1.0)
+    dv_rate_tol_mps2: float = Field(
+        default=5e-4, gt=0.0,
+        description="commanded Δv per second while holding a PRO (natural motion, nominally "
+                    "~1e-5) above which the observer fights a force it does not model: an orbit "
+                    "actuator fault (a 3 m nav bias step costs ~2.6e-4 in its window, a thruster "
+                    "leak of 20% of the maximum thrust ~8.6e-4), m/s²")
     nis_alpha: float = Field(default=1e-3, gt=0.0, lt=1.0,
                              description="baseline chi2_nis: false-alarm probability per window")
     cusum_drift: float = Field(default=0.02, ge=0.0,

@@ -112,6 +112,15 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     ({"nav_vs_plan_m": 6.3, "camera_vs_nav_m": 1.5, "explained_reported": 0.04,
       "explained_located": 0.9}, "actuator"),  # strong leak: nav off plan, lagging the truth
     ({"nav_vs_plan_m": 0.8, "camera_vs_nav_m": 3.0}, "state_sensor"),  # nav bias settling
+    # a weak leak the controller holds near the plan (paper campaign, fig23-thruster-0026:
+    # leak 0.35 of the maximum thrust): the filter lag exceeds the deviation from plan, so the
+    # distances alone say state_sensor; the Δv spent on station says actuator
+    ({"nav_vs_plan_m": 1.66, "camera_vs_nav_m": 1.84, "explained_reported": 0.28,
+      "explained_located": 0.98}, "state_sensor"),
+    ({"nav_vs_plan_m": 1.66, "camera_vs_nav_m": 1.84, "explained_reported": 0.28,
+      "explained_located": 0.98, "dv_rate_mps2": 1.1e-3}, "actuator"),
+    # the window of a 3 m nav bias step: moving onto the offset orbit costs 2.6e-4 m/s²
+    ({"nav_vs_plan_m": 0.3, "camera_vs_nav_m": 3.0, "dv_rate_mps2": 2.6e-4}, "state_sensor"),
     ({"pointing_error_deg": 5.0, "explained_reported": 0.1, "explained_located": 0.2},
      None),  # reported off target, but that does not explain the loss
     ({}, None),  # nothing stands out
@@ -123,3 +132,19 @@ def test_classify_table(change: dict[str, float], expected: str | None) -> None:
 def test_classify_without_evidence() -> None:
     assert classify(Evidence(), TOL) is None
     assert Evidence(beta_hat=0.9).as_dict() == {"beta_hat": 0.9}
+
+
+def test_dv_rate_counts_only_station_keeping() -> None:
+    """The Δv rate is taken over the spans between two consecutive guidance reports that both
+    say hold: a transfer's Δv (planned) does not count, and neither does the time."""
+    from ground.apps.fdir import _Observer
+
+    obs = _Observer()
+    for t_s, dv, hold in [(0.0, 0.0, True), (10.0, 0.001, True), (20.0, 0.5, False),
+                          (30.0, 0.9, True), (40.0, 0.902, True), (200.0, 5.0, True)]:
+        obs.guidance.append((t_s, dv, hold))
+    # spans 0-10 and 30-40 (10-20 ends in a transfer, 20-30 starts in one); 200 is outside
+    assert obs.dv_rate(0.0, 100.0) == pytest.approx(0.003 / 20.0)
+    assert obs.dv_rate(12.0, 25.0) is None  # one report: no span
+    obs.forget_guidance_before(35.0)
+    assert [g[0] for g in obs.guidance] == [30.0, 40.0, 200.0]

@@ -2,7 +2,8 @@
 Sec. III.B-E; DESIGN.md "Information cost and FDIR").
 
 Rate group mid.  Inputs: every observer's POI observations (the images that reached the
-ground), its transfer plans, and the ground's own PRO assignments.  Outputs: one
+ground), its transfer plans, its nav, attitude, guidance and H_i telemetry, and the ground's
+own PRO assignments.  Outputs: one
 ``FdirWindow`` per observer and FDI window on ``ground/fdir/window``, and a ``FaultReport`` on
 ``ground/fdir/report`` when a fault is declared.
 
@@ -21,8 +22,8 @@ closes.  For observer i, with ψ the squared fused variance of the ground's map 
   declared a link fault — missing data is never read as zero information gain;
 * a declared performance fault is identified (``ground/fdir/identify.py``): the camera's
   position and health located from the images themselves, the nav estimate and the reported
-  attitude against the plan, the twin re-run at the reported pose (the gradient test) and the
-  seen POIs against those that pose would see;
+  attitude against the plan, the twin re-run at the reported pose (the gradient test), the
+  seen POIs against those that pose would see, and the Δv it commands on station;
 * the H_i an observer reports (``InfoCostTelemetry``) is checked against the ground's
   recomputation from its observations: inconsistent for ``fdir.persistence`` windows, a
   data-integrity fault;
@@ -78,6 +79,7 @@ from interfaces.messages import (
     AttitudeEstimate,
     FaultReport,
     FdirWindow,
+    GuidanceStatus,
     InfoCostTelemetry,
     PoiObservations,
     ProAssignments,
@@ -133,6 +135,8 @@ class _Observer:
     """reported position (nav estimate), LVLH m"""
     attitude: _Series = field(default_factory=_Series)
     """reported camera boresight (LVLH, 3), pointing error (rad) and aim point (LVLH, 3, m)"""
+    guidance: list[tuple[float, float, bool]] = field(default_factory=list)
+    """reported (time s, Δv commanded so far m/s, holding its PRO), in time order"""
     silent: int = 0
     link_declared: bool = False
     last_seq: int = 0
@@ -156,6 +160,21 @@ class _Observer:
         least ``settle_s`` before t (the loop's transient after a slew is not predicted)."""
         i = bisect.bisect_right(self.modes, (t, "~")) - 1
         return i >= 0 and self.modes[i][1] == "track" and self.modes[i][0] <= t - settle_s
+
+    def dv_rate(self, a: float, b: float) -> float | None:
+        """Commanded Δv per second (m/s²) over the parts of [a, b] between two consecutive
+        guidance reports that both say ``hold``; None without any."""
+        rep = [g for g in self.guidance if a <= g[0] <= b]
+        pairs = [(g0, g1) for g0, g1 in zip(rep, rep[1:]) if g0[2] and g1[2] and g1[0] > g0[0]]
+        if not pairs:
+            return None
+        return (sum(g1[1] - g0[1] for g0, g1 in pairs)
+                / sum(g1[0] - g0[0] for g0, g1 in pairs))
+
+    def forget_guidance_before(self, t: float) -> None:
+        """Drop guidance reports no later window needs (keep the last one before t)."""
+        i = bisect.bisect_left(self.guidance, (t,)) - 1
+        del self.guidance[:max(i, 0)]
 
     def plan_at(self, t: float) -> FlightPlan | None:
         valid = [p for p in self.plans.values() if p.t_from_s <= t]
@@ -189,6 +208,8 @@ class FdirApp(App):
               InfoCostTelemetry, "on_telemetry"),
         Input(lambda c: topics.all_spacecraft(c.mission, "nav", "estimate"), StateEstimate,
               "on_nav"),
+        Input(lambda c: topics.all_spacecraft(c.mission, "guidance", "status"), GuidanceStatus,
+              "on_guidance"),
     )
     OUTPUTS = (
         Output("window", lambda c: topics.key(c.mission, c.node, "fdir", "window"), FdirWindow),
@@ -265,6 +286,11 @@ class FdirApp(App):
         if obs is not None and msg.t_sim >= self.window_start:
             obs.nav.add(msg.t_sim, np.array(msg.x[:3]))
 
+    def on_guidance(self, msg: GuidanceStatus) -> None:
+        obs = self.observers.get(msg.spacecraft)
+        if obs is not None and msg.t_sim >= self.window_start - self.period:
+            bisect.insort(obs.guidance, (msg.t_sim, msg.dv_commanded_mps, msg.mode == "hold"))
+
     def on_assignments(self, msg: ProAssignments) -> None:
         for a in msg.assignments:
             obs = self.observers.get(a.spacecraft)
@@ -292,6 +318,7 @@ class FdirApp(App):
             obs.forget_modes_before(b)
             obs.nav.forget_before(b)
             obs.attitude.forget_before(b)
+            obs.forget_guidance_before(b)
         for m in inside:
             self.settled.add(m.spacecraft, m.poi, m.precision)
         self.pending = [m for m in self.pending if m.image_t_s >= b]
@@ -387,7 +414,7 @@ class FdirApp(App):
         exceeded = None if m_val is None or tau is None else m_val > tau
         dirn = direction(dh, dh_pred, h_prev)
         ev = self._evidence(obs, images, times, pos, psi, phi,
-                            (dh, dh_pred) if exceeded else None)
+                            (dh, dh_pred) if exceeded else None, (a, b))
         self.publish("window", window.model_copy(update={
             "dh": dh, "dh_pred": dh_pred, "metric": m_val, "threshold": tau,
             "direction": dirn, "exceeded": exceeded, "evidence": ev.as_dict()}))
@@ -401,7 +428,7 @@ class FdirApp(App):
 
     def _evidence(self, obs: _Observer, images: list[PoiObservations], times: np.ndarray,
                   planned: np.ndarray, psi: np.ndarray, phi: np.ndarray,
-                  gap: tuple[float, float] | None) -> Evidence:
+                  gap: tuple[float, float] | None, span: tuple[float, float]) -> Evidence:
         """Identification evidence of one window (``identify.Evidence``).  The cheap parts
         (camera fixes, nav and attitude against the plan) every window, so their nominal spread
         is in the archive; the twin at the reported pose and the seen-set overlap only when the
@@ -439,7 +466,8 @@ class FdirApp(App):
             ratios = [seen_overlap(m.poi, np.flatnonzero(v)) for m, v in zip(images[::k], vis)]
             valid = [r for r in ratios if r is not None]
             overlap = float(np.median(valid)) if valid else None
-        return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc)
+        return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc,
+                        obs.dv_rate(*span))
 
     def _planned_boresights(self, obs: _Observer, times: np.ndarray, pos: np.ndarray
                             ) -> np.ndarray:
