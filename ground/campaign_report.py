@@ -320,6 +320,8 @@ def _latency_plot(out: Path, rows: list[dict[str, Any]], detectors: list[str],
             data.append(lat or [math.nan])
             missed.append(len(faults) - len(lat))
         c = colours[j % len(colours)]
+        if not groups:
+            break  # no fault was injected: an empty plot
         ax.boxplot(data, positions=pos, widths=0.9 * width, patch_artist=True,
                    boxprops={"facecolor": c, "alpha": 0.6}, medianprops={"color": "k"},
                    flierprops={"markersize": 3})
@@ -332,7 +334,8 @@ def _latency_plot(out: Path, rows: list[dict[str, Any]], detectors: list[str],
     ax.set_xlim(-0.6, len(groups) - 0.4)
     ax.set_ylabel("latency, onset to isolation (s)")
     ax.set_title("detection latency per campaign group (numbers at the foot: faults missed)")
-    ax.legend(fontsize=8, ncols=len(detectors))
+    if groups:
+        ax.legend(fontsize=8, ncols=len(detectors))
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
     fig.savefig(out / "latency.png", dpi=100)
