@@ -7,7 +7,8 @@ per injected fault and detector, plus one per nominal run and detector), ``<out>
 (figures over all runs, per campaign group, per fault kind and magnitude) and its plots:
 latency distributions per group, the confusion matrix of identified class against
 injected kind, and a ROC curve per detector from sweeping a scale on its threshold
-(re-scored from each run's ``fdir_series`` with the detector's persistence).
+(re-scored from each run's ``fdir_series`` with the detector's persistence), and a table of
+the main detector re-scored under other persistence rules (m of the last n windows).
 
 Definitions as in ground/fdir/scoring.py: a fault is detected when any alarm falls in its
 active span (plus one FDI window), isolated when one names its spacecraft; a false alarm is
@@ -20,6 +21,7 @@ import csv
 import json
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -147,27 +149,40 @@ def _persistence(run: dict[str, Any], detector: str) -> int:
     return 1
 
 
-def _alarms_at(series: list[list[float]], scale: float, n: int) -> list[Alarm]:
-    """The alarms a detector raises on its windows with its threshold scaled: the window
-    completing ``n`` exceedances in a row, once per episode (``threshold.Persistence``)."""
+def _alarms_at(series: list[list[float]], scale: float, m: int, n: int) -> list[Alarm]:
+    """The alarms a detector raises on its windows with its threshold scaled: the window that
+    brings its exceedances among the last ``n`` windows to ``m`` (itself exceeding), once per
+    episode; the episode ends when that no longer holds.  ``m == n`` is ``threshold.
+    Persistence`` (``n`` in a row)."""
     out = []
     for sc in sorted({int(w[0]) for w in series}):
-        run = 0
+        hits: list[bool] = []
+        armed = True
         for w in sorted((w for w in series if int(w[0]) == sc), key=lambda w: w[2]):
-            run = run + 1 if w[3] > scale * w[4] else 0
-            if run == n:
+            hits.append(w[3] > scale * w[4])
+            holds = hits[-1] and sum(hits[-n:]) >= m
+            if holds and armed:
                 out.append(Alarm(sc, w[2], None))
+            armed = not holds
     return out
 
 
-def _roc(runs: list[dict[str, Any]], detector: str) -> tuple[np.ndarray, np.ndarray]:
-    """(false alarms per nominal cycle, detection rate) at each threshold scale in SCALES:
-    each run's windows re-scored with the detector's persistence and scored exactly as
-    summary.json is (``scoring.score``); the main detector's link and data-integrity
+@dataclass
+class Rescored:
+    """A detector's figures over the runs when re-scored from its archived windows."""
+
+    false_alarms: int = 0
+    nominal_cycles: int = 0
+    per_fault: list[dict[str, Any]] = field(default_factory=list)
+
+
+def _rescore(runs: list[dict[str, Any]], detector: str, scale: float,
+             rule: tuple[int, int] | None = None) -> Rescored:
+    """Re-score each run's windows of ``detector`` with its threshold times ``scale`` and the
+    persistence ``rule`` (m of the last n windows; None: the run's own, n in a row) exactly as
+    summary.json is scored (``scoring.score``); the main detector's link and data-integrity
     declarations, which no threshold scales, are kept as they were."""
-    fa = np.zeros(len(SCALES))
-    det = np.zeros(len(SCALES))
-    cycles = faults = 0
+    total = Rescored()
     for s in runs:
         if detector not in s.get("fdir_series", {}):
             continue
@@ -177,15 +192,49 @@ def _roc(runs: list[dict[str, Any]], detector: str) -> tuple[np.ndarray, np.ndar
         fixed = [Alarm(d["spacecraft"], d["time_s"], d["class"]) for d in s.get("detections", [])
                  if detector == "main" and d["class"] in ("link", "data_integrity")]
         judged = [Judged(int(w[0]), w[1], w[2]) for w in series]
-        n = _persistence(s, detector)
-        faults += len(injected)
-        for k, scale in enumerate(SCALES):
-            sc = score(injected, fixed + _alarms_at(series, scale, n), judged, grace)
-            fa[k] += sc["false_alarms"]
-            det[k] += sum(f["detected"] for f in sc["per_fault"])  # type: ignore[union-attr]
-            if k == 0:
-                cycles += int(sc["nominal_cycles"])  # type: ignore[call-overload]
-    return fa / max(cycles, 1), det / max(faults, 1)
+        m, n = rule or (_persistence(s, detector),) * 2
+        sc = score(injected, fixed + _alarms_at(series, scale, m, n), judged, grace)
+        total.false_alarms += int(sc["false_alarms"])  # type: ignore[call-overload]
+        total.nominal_cycles += int(sc["nominal_cycles"])  # type: ignore[call-overload]
+        total.per_fault += sc["per_fault"]  # type: ignore[arg-type]
+    return total
+
+
+def _roc(runs: list[dict[str, Any]], detector: str) -> tuple[np.ndarray, np.ndarray]:
+    """(false alarms per nominal cycle, detection rate) at each threshold scale in SCALES,
+    each run re-scored with its own persistence (``_rescore``)."""
+    fa, det = np.zeros(len(SCALES)), np.zeros(len(SCALES))
+    for k, scale in enumerate(SCALES):
+        r = _rescore(runs, detector, scale)
+        fa[k] = r.false_alarms / max(r.nominal_cycles, 1)
+        det[k] = sum(f["detected"] for f in r.per_fault) / max(len(r.per_fault), 1)
+    return fa, det
+
+
+PERSISTENCE_RULES = ((1, 1), (2, 2), (2, 3), (3, 3))
+"""Persistence rules (m exceedances in the last n windows) the report re-scores the main
+detector with."""
+
+
+def _persistence_table(runs: list[dict[str, Any]]) -> list[str]:
+    """The main detector re-scored from its windows under each of ``PERSISTENCE_RULES``, at
+    its threshold as configured: what persistence buys in false alarms and costs in latency."""
+    own = sorted({_persistence(s, "main") for s in runs})
+    lines = ["| rule | detected | isolated | latency median / p90 / max (s) | "
+             "false alarms per nominal cycle |", "|---|---|---|---|---|"]
+    for m, n in PERSISTENCE_RULES:
+        r = _rescore(runs, "main", 1.0, (m, n))
+        f = r.per_fault
+        lat = [x["latency_s"] for x in f if x["isolated"] and x["latency_s"] is not None]
+        label = f"{m} of {n}" + (" (as run)" if m == n and own == [n] else "")
+        lines.append(
+            f"| {label} | {_pct(sum(x['detected'] for x in f), len(f))} | "
+            f"{_pct(sum(x['isolated'] for x in f), len(f))} | "
+            f"{_fmt(float(np.median(lat)) if lat else None)} / "
+            f"{_fmt(float(np.quantile(lat, 0.9)) if lat else None)} / "
+            f"{_fmt(max(lat) if lat else None)} | "
+            f"{_fmt(r.false_alarms / r.nominal_cycles if r.nominal_cycles else None, '.4f')} |")
+    return lines
 
 
 def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
@@ -245,7 +294,11 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     lines += _confusion(out, [r for r in rows if r["detector"] == "main" and r["kind"] != "none"])
     lines += ["", "## Latency", "", "![latency](latency.png)", "",
               "## ROC (threshold scale swept, each detector with its persistence)", "",
-              "![roc](roc.png)", ""]
+              "![roc](roc.png)", "",
+              "## Persistence (main detector re-scored from its windows)", "",
+              "A fault is declared on the window that brings the exceedances among the last n "
+              "windows to m; the threshold as configured.", ""]
+    lines += _persistence_table(runs)
     _latency_plot(out, rows, detectors, [g for g in groups
                                          if any(r["group"] == g and r["kind"] != "none"
                                                 for r in rows)])

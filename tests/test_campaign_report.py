@@ -10,7 +10,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ground.campaign_report import SCALES, _magnitude_bins, _roc, write_campaign_report
+from ground.campaign_report import (
+    SCALES,
+    _alarms_at,
+    _magnitude_bins,
+    _roc,
+    write_campaign_report,
+)
 
 
 def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | None,
@@ -74,6 +80,11 @@ def test_report_figures(campaign: Path) -> None:
     assert "| faulty | main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.0000 |" \
         in report
     assert "| c | main | - | - | - | - / - / - | 0.5000 |" in report
+    # persistence re-scored: one window in a row declares run a's fault at 100 s, three never
+    # do (it has two windows), and c's false alarm needs only two
+    assert "| 1 of 1 | 50% (1/2) | 50% (1/2) | 100 / 100 / 100 | 0.2500 |" in report
+    assert "| 2 of 2 (as run) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 |" in report
+    assert "| 3 of 3 | 0% (0/2) | 0% (0/2) | - / - / - | 0.0000 |" in report
     rows = list(csv.DictReader(open(campaign / "results.csv")))
     assert [r["group"] for r in rows] == ["faulty", "faulty", "faulty", "c"]
     assert [(r["run"], r["detector"], r["kind"]) for r in rows] == [
@@ -128,3 +139,16 @@ def test_magnitude_bins() -> None:
     assert [len(v) for v in bins.values()] == [2, 2, 2]
     few = _magnitude_bins(rows[:3])
     assert list(few) == [("k", "4"), ("k", "5.5"), ("k", "7")]
+
+
+def test_m_of_n_persistence() -> None:
+    """m exceedances among the last n windows declare once per episode; m == n is n in a row
+    (threshold.Persistence)."""
+    def series(levels: list[float]) -> list[list[float]]:
+        return [[1, 100.0 * i, 100.0 * (i + 1), h, 0.05] for i, h in enumerate(levels)]
+
+    gappy = series([0.1, 0.0, 0.1, 0.1, 0.1, 0.0, 0.0, 0.0, 0.1, 0.0, 0.1])
+    assert [a.t_s for a in _alarms_at(gappy, 1.0, 2, 2)] == [400.0]
+    assert [a.t_s for a in _alarms_at(gappy, 1.0, 2, 3)] == [300.0, 1100.0]
+    assert [a.t_s for a in _alarms_at(gappy, 1.0, 1, 1)] == [100.0, 300.0, 900.0, 1100.0]
+    assert _alarms_at(gappy, 3.0, 1, 1) == []  # threshold scaled above every level
