@@ -7,8 +7,9 @@ per injected fault and detector, plus one per nominal run and detector), ``<out>
 (figures over all runs, per campaign group, per fault kind and magnitude) and its plots:
 latency distributions per group, the confusion matrix of identified class against
 injected kind, and a ROC curve per detector from sweeping a scale on its threshold
-(re-scored from each run's ``fdir_series`` with the detector's persistence), and a table of
-the main detector re-scored under other persistence rules (m of the last n windows).
+(re-scored from each run's ``fdir_series`` with the detector's persistence), a table of
+the main detector re-scored under other persistence rules (m of the last n windows), and the
+distribution of its H_m,i / τ_i in nominal windows and in windows of each fault kind.
 
 Definitions as in ground/fdir/scoring.py: a fault is detected when any alarm falls in its
 active span (plus one FDI window), isolated when one names its spacecraft; a false alarm is
@@ -129,16 +130,38 @@ def _pct(n: int, d: int) -> str:
     return "-" if d == 0 else f"{100.0 * n / d:.0f}% ({n}/{d})"
 
 
+def _fault_in(window: list[float], faults: list[dict[str, Any]]) -> str | None:
+    """The kind of an injected fault active on the window's spacecraft during the window
+    [sc, t0, t1, ...], or None (a nominal window)."""
+    sc, t0, t1 = window[0], window[1], window[2]
+    for f in faults:
+        if f["spacecraft"] == sc and f["start_s"] < t1 and (f.get("end_s") is None
+                                                            or t0 < f["end_s"]):
+            return str(f["kind"])
+    return None
+
+
 def _nominal_hours(runs: list[dict[str, Any]], detector: str) -> float:
     """Spacecraft-hours a detector judged without a fault, from its windows."""
     total = 0.0
     for s in runs:
         faults = s.get("injected_faults", [])
-        for sc, t0, t1, _, _ in s.get("fdir_series", {}).get(detector, []):
-            if not any(f["spacecraft"] == sc and f["start_s"] < t1
-                       and (f.get("end_s") is None or t0 < f["end_s"]) for f in faults):
-                total += t1 - t0
+        for w in s.get("fdir_series", {}).get(detector, []):
+            if _fault_in(w, faults) is None:
+                total += w[2] - w[1]
     return total / 3600.0
+
+
+def _margins(runs: list[dict[str, Any]]) -> dict[str, np.ndarray]:
+    """The main detector's H_m,i / τ_i of every window, by the kind of the fault active in it
+    (``"nominal"`` for none): the margin the threshold leaves on each side."""
+    out: dict[str, list[float]] = {}
+    for s in runs:
+        faults = s.get("injected_faults", [])
+        for w in s.get("fdir_series", {}).get("main", []):
+            if w[4] > 0.0:
+                out.setdefault(_fault_in(w, faults) or "nominal", []).append(w[3] / w[4])
+    return {k: np.array(out[k]) for k in sorted(out, key=lambda k: (k != "nominal", k))}
 
 
 def _persistence(run: dict[str, Any], detector: str) -> int:
@@ -299,10 +322,13 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
               "A fault is declared on the window that brings the exceedances among the last n "
               "windows to m; the threshold as configured.", ""]
     lines += _persistence_table(runs)
+    lines += ["", "## Margins (main detector, H_m,i / τ_i per window)", "",
+              "![margins](margins.png)", ""] + _margin_lines(_margins(runs))
     _latency_plot(out, rows, detectors, [g for g in groups
                                          if any(r["group"] == g and r["kind"] != "none"
                                                 for r in rows)])
     _roc_plot(out, runs, detectors)
+    _margin_plot(out, _margins(runs))
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     return path
@@ -410,4 +436,34 @@ def _roc_plot(out: Path, runs: list[dict[str, Any]], detectors: list[str]) -> No
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out / "roc.png", dpi=100)
+    plt.close(fig)
+
+
+def _margin_lines(margins: dict[str, np.ndarray]) -> list[str]:
+    lines = ["| windows | count | median | p99 | max | share over the threshold |",
+             "|---|---|---|---|---|---|"]
+    for kind, r in margins.items():
+        lines.append(f"| {kind} | {len(r)} | {np.median(r):.3g} | {np.quantile(r, 0.99):.3g} | "
+                     f"{r.max():.3g} | {_pct(int(np.sum(r > 1.0)), len(r))} |")
+    return lines
+
+
+def _margin_plot(out: Path, margins: dict[str, np.ndarray]) -> None:
+    """Histograms of H_m,i / τ_i (log scale) for nominal windows and for windows with each
+    kind of fault active, with the threshold at 1."""
+    fig, ax = plt.subplots(figsize=(8, 4))
+    bins = np.logspace(-4, 3, 71)
+    for kind, r in margins.items():
+        ax.hist(np.clip(r, bins[0], bins[-1]), bins=bins, histtype="step", lw=1.5,
+                label=f"{kind} ({len(r)})", weights=np.full(len(r), 1.0 / len(r)))
+    ax.axvline(1.0, color="k", ls="--", lw=1)
+    ax.set_xscale("log")
+    ax.set_xlabel("H_m,i / τ_i  (a window over 1 exceeds its threshold)")
+    ax.set_ylabel("share of the windows")
+    ax.set_title("the main metric against its threshold, nominal and faulty windows")
+    ax.grid(True, alpha=0.3)
+    if margins:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "margins.png", dpi=100)
     plt.close(fig)

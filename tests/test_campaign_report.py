@@ -85,12 +85,16 @@ def test_report_figures(campaign: Path) -> None:
     assert "| 1 of 1 | 50% (1/2) | 50% (1/2) | 100 / 100 / 100 | 0.2500 |" in report
     assert "| 2 of 2 (as run) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 |" in report
     assert "| 3 of 3 | 0% (0/2) | 0% (0/2) | - / - / - | 0.0000 |" in report
+    # margins H_m/τ by the fault active in the window: a's sc1 and c's windows are nominal
+    assert "| nominal | 4 | 0.7 | 1.39 | 1.4 | 50% (2/4) |" in report
+    assert "| camera_degradation | 2 | 10 | 10 | 10 | 100% (2/2) |" in report
+    assert "| thruster_bias | 2 | 0.6 | 0.6 | 0.6 | 0% (0/2) |" in report
     rows = list(csv.DictReader(open(campaign / "results.csv")))
     assert [r["group"] for r in rows] == ["faulty", "faulty", "faulty", "c"]
     assert [(r["run"], r["detector"], r["kind"]) for r in rows] == [
         ("a", "main", "camera_degradation"), ("a", "cusum", "camera_degradation"),
         ("b", "main", "thruster_bias"), ("c", "main", "none")]
-    for png in ("roc.png", "confusion.png", "latency.png"):
+    for png in ("roc.png", "confusion.png", "latency.png", "margins.png"):
         assert (campaign / png).stat().st_size > 5000
 
 
