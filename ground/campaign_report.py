@@ -164,12 +164,16 @@ def _margins(runs: list[dict[str, Any]]) -> dict[str, np.ndarray]:
     return {k: np.array(out[k]) for k in sorted(out, key=lambda k: (k != "nominal", k))}
 
 
-def _persistence(run: dict[str, Any], detector: str) -> int:
-    """Windows in a row the detector needed in that run (its settings, as summary.json
-    records them; the plain limit checks need one)."""
-    if detector in ("main", "chi2_nis"):
-        return int(run.get("fdir_settings", {}).get("persistence", 2))
-    return 1
+def _persistence(run: dict[str, Any], detector: str) -> tuple[int, int]:
+    """The persistence rule (m exceedances among the last n windows) the detector used in
+    that run, from its settings as summary.json records them: the main detector m of
+    ``persistence_window`` (or in a row), chi2_nis ``persistence`` in a row, the plain limit
+    checks one."""
+    cfg = run.get("fdir_settings", {})
+    m = int(cfg.get("persistence", 2))
+    if detector == "main":
+        return m, int(cfg.get("persistence_window") or m)
+    return (m, m) if detector == "chi2_nis" else (1, 1)
 
 
 def _alarms_at(series: list[list[float]], scale: float, m: int, n: int) -> list[Alarm]:
@@ -215,7 +219,7 @@ def _rescore(runs: list[dict[str, Any]], detector: str, scale: float,
         fixed = [Alarm(d["spacecraft"], d["time_s"], d["class"]) for d in s.get("detections", [])
                  if detector == "main" and d["class"] in ("link", "data_integrity")]
         judged = [Judged(int(w[0]), w[1], w[2]) for w in series]
-        m, n = rule or (_persistence(s, detector),) * 2
+        m, n = rule or _persistence(s, detector)
         sc = score(injected, fixed + _alarms_at(series, scale, m, n), judged, grace)
         total.false_alarms += int(sc["false_alarms"])  # type: ignore[call-overload]
         total.nominal_cycles += int(sc["nominal_cycles"])  # type: ignore[call-overload]
@@ -249,7 +253,7 @@ def _persistence_table(runs: list[dict[str, Any]]) -> list[str]:
         r = _rescore(runs, "main", 1.0, (m, n))
         f = r.per_fault
         lat = [x["latency_s"] for x in f if x["isolated"] and x["latency_s"] is not None]
-        label = f"{m} of {n}" + (" (as run)" if m == n and own == [n] else "")
+        label = f"{m} of {n}" + (" (as run)" if own == [(m, n)] else "")
         lines.append(
             f"| {label} | {_pct(sum(x['detected'] for x in f), len(f))} | "
             f"{_pct(sum(x['isolated'] for x in f), len(f))} | "

@@ -320,8 +320,9 @@ class FdirSettings(_Section):
     FDI window (``rates.fdi_period_s``) each observer's information gain is compared with the
     nominal twin's prediction (Eq. 9) against the adaptive threshold (Eq. 11-12) from
     ``samples`` pointings within ``eps_deg`` of the planned one, floored at ``floor``; a fault
-    is declared after ``persistence`` windows in a row over the threshold, and an observer
-    whose observations stay missing for ``silent_windows`` windows is reported as a link fault.
+    is declared after ``persistence`` windows in a row over the threshold (or, with
+    ``persistence_window`` = n, on the window that brings the exceedances among the last n
+    decided windows to ``persistence``), and an observer whose observations stay missing for ``silent_windows`` windows is reported as a link fault.
     A reported H_i off the ground's recomputation from the observer's own observations by more
     than ``integrity_tol`` (relative) for ``persistence`` windows is a data-integrity fault,
     and more of its observations lost (sequence gaps) than the links' nominal
@@ -338,6 +339,11 @@ class FdirSettings(_Section):
     eps_deg: float = Field(default=1.0, gt=0.0, lt=45.0)
     floor: float = Field(default=0.05, ge=0.0)
     persistence: int = Field(default=2, ge=1)
+    persistence_window: int | None = Field(
+        default=None, ge=1,
+        description="main detector: declare on ``persistence`` exceedances among the last this "
+                    "many windows (None: ``persistence`` in a row); the campaign report "
+                    "re-scores its runs under such rules")
     silent_windows: int = Field(default=2, ge=1)
     latency_s: float = Field(default=3.0, ge=0.0)
     settle_s: float = Field(default=30.0, ge=0.0,
@@ -370,6 +376,13 @@ class FdirSettings(_Section):
     cusum_threshold: float = Field(default=0.15, gt=0.0, description="baseline cusum: alarm level")
     fixed_threshold: float = Field(default=0.1, gt=0.0,
                                    description="baseline fixed_threshold: H_m,i alarm level")
+
+    @model_validator(mode="after")
+    def _window(self) -> FdirSettings:
+        if self.persistence_window is not None and self.persistence_window < self.persistence:
+            raise ValueError(f"persistence_window ({self.persistence_window}) must be at least "
+                             f"persistence ({self.persistence})")
+        return self
 
 
 class SimSettings(_Section):

@@ -10,6 +10,7 @@ import pytest
 from fsw.lib import infocost as ic
 from ground.fdir.metric import direction, global_check, metric, ratio
 from ground.fdir.threshold import Persistence, adaptive_threshold, calibrate_floor
+from interfaces.scenario import FdirSettings
 
 S_1DOF = np.array([[1.0, 1.0, 0.0], [-1.0, -1.0, 0.0]])  # Eq. 13, a = 1
 PHI, W_INV, CAM = 0.5, 0.0, ic.Camera(k=1.0)               # Eq. 22
@@ -95,3 +96,25 @@ def test_persistence_declares_once_per_episode_and_ignores_missing_windows() -> 
     got = [p.update(2, e) for e in seq]
     assert got == [False, False, False, True, False, False, False, False, True]
     assert p.update(1, True) is False  # per spacecraft
+
+
+def test_m_of_n_persistence_matches_the_campaign_rescoring() -> None:
+    """Persistence(m, n) declares on the window that brings the exceedances among the last n
+    to m; the campaign report's re-scoring of archived windows (``_alarms_at``) agrees with it
+    on random sequences, and m of m is m in a row."""
+    from ground.campaign_report import _alarms_at
+
+    p = Persistence(count=2, window=3)
+    seq = [True, False, True, True, True, False, False, False, True, False, True]
+    assert [i for i, e in enumerate(seq) if p.update(1, e)] == [2, 10]
+    rng = np.random.default_rng(4)
+    for m, n in [(1, 1), (2, 2), (2, 3), (3, 3), (2, 4)]:
+        for _ in range(20):
+            hits = rng.random(30) < 0.4
+            p = Persistence(count=m, window=n)
+            ends = [100.0 * (i + 1) for i, e in enumerate(hits) if p.update(1, bool(e))]
+            series = [[1, 100.0 * i, 100.0 * (i + 1), 0.1 if e else 0.0, 0.05]
+                      for i, e in enumerate(hits)]
+            assert ends == [a.t_s for a in _alarms_at(series, 1.0, m, n)], (m, n, hits)
+    with pytest.raises(ValueError, match="persistence_window"):
+        FdirSettings(persistence=3, persistence_window=2)

@@ -229,7 +229,7 @@ class FdirApp(App):
                                       sc.observers.count)
         self.pending: list[PoiObservations] = []
         self.observers = {i: _Observer() for i in range(1, sc.observers.count + 1)}
-        self.persistence = Persistence(self.cfg.persistence)
+        self.persistence = Persistence(self.cfg.persistence, self.cfg.persistence_window)
         self.integrity = Persistence(self.cfg.persistence)
         self.loss = Persistence(self.cfg.persistence)
         self.boresight_body = np.array(sc.attitude.boresight_body, dtype=float)

@@ -58,24 +58,27 @@ def calibrate_floor(nominal_metrics: Sequence[float], false_alarm_rate: float,
 
 @dataclass
 class Persistence:
-    """Consecutive-exceedance counter per spacecraft: ``update`` returns True on the window that
-    completes ``count`` exceedances in a row (once per episode); a window without a decision
-    (None: missing or degenerate) neither counts nor resets."""
+    """Exceedance counter per spacecraft: ``update`` returns True on the window that brings the
+    exceedances among the last ``window`` decided windows to ``count``, itself exceeding (None:
+    ``count`` in a row), once per episode: the episode ends when that no longer holds.  A
+    window without a decision (None: missing or degenerate) neither counts nor resets."""
 
     count: int = 3
-    _run: dict[int, int] = field(default_factory=dict)
+    window: int | None = None
+    _hits: dict[int, list[bool]] = field(default_factory=dict)
     _declared: set[int] = field(default_factory=set)
 
     def update(self, spacecraft: int, exceeded: bool | None) -> bool:
         if exceeded is None:
             return False
-        if not exceeded:
-            self._run[spacecraft] = 0
+        n = self.window or self.count
+        hits = self._hits.setdefault(spacecraft, [])
+        hits.append(exceeded)
+        del hits[:-n]
+        if not (exceeded and sum(hits) >= self.count):
             self._declared.discard(spacecraft)
             return False
-        run = self._run.get(spacecraft, 0) + 1
-        self._run[spacecraft] = run
-        if run >= self.count and spacecraft not in self._declared:
-            self._declared.add(spacecraft)
-            return True
-        return False
+        if spacecraft in self._declared:
+            return False
+        self._declared.add(spacecraft)
+        return True
