@@ -118,8 +118,14 @@ def _cells(detector: str, st: dict[str, Any]) -> str:
     ident = _pct(st["identified"], st["faults"]) if detector == "main" else "-"
     return (f"{_pct(st['detected'], st['faults'])} | {_pct(st['isolated'], st['faults'])} | "
             f"{ident} | {_fmt(st['latency_median'])} / {_fmt(st['latency_p90'])} / "
-            f"{_fmt(st['latency_max'])} | {_fmt(st['false_alarm_rate'], '.4f')} | "
+            f"{_fmt(st['latency_max'])} | "
+            f"{_rate(st['false_alarms'], st['nominal_cycles'])} | "
             f"{_fmt(st['false_alarms_per_hour'], '.3f')} |")
+
+
+def _rate(false_alarms: int, cycles: int) -> str:
+    """False alarms per nominal cycle, with the counts it comes from."""
+    return "-" if cycles == 0 else f"{false_alarms / cycles:.4f} ({false_alarms}/{cycles})"
 
 
 def _fmt(v: float | None, f: str = ".0f") -> str:
@@ -260,7 +266,7 @@ def _persistence_table(runs: list[dict[str, Any]]) -> list[str]:
             f"{_fmt(float(np.median(lat)) if lat else None)} / "
             f"{_fmt(float(np.quantile(lat, 0.9)) if lat else None)} / "
             f"{_fmt(max(lat) if lat else None)} | "
-            f"{_fmt(r.false_alarms / r.nominal_cycles if r.nominal_cycles else None, '.4f')} |")
+            f"{_rate(r.false_alarms, r.nominal_cycles)} |")
     return lines
 
 
