@@ -68,6 +68,15 @@ def _versions(runs: list[dict[str, Any]]) -> str:
                                   else ".")
 
 
+def _wall_time(runs: list[dict[str, Any]]) -> str:
+    """The runs' own wall time (one worker each, from summary.json ``wall_s``)."""
+    wall = [float(s["wall_s"]) for s in runs if s.get("wall_s") is not None]
+    if not wall:
+        return "Run wall time: not recorded."
+    return (f"Run wall time (each on one worker): median {np.median(wall):.0f} s, max "
+            f"{max(wall):.0f} s, {sum(wall) / 3600.0:.2f} worker-hours in all.")
+
+
 def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """results.csv rows: per run, detector and fault (or one nominal row per detector)."""
     rows = []
@@ -290,7 +299,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
              + (f": {', '.join(failed[:10])}{' ...' if len(failed) > 10 else ''}" if failed
                 else "") + "; failed runs are left out of every figure below); "
              f"{hours['main']:.1f} nominal spacecraft-hours judged by the main detector.", "",
-             _versions(loaded), "",
+             _versions(loaded), "", _wall_time(loaded), "",
              "## Detectors side by side", "",
              "| detector | detected | isolated | identified | latency median / p90 / max (s) | "
              "false alarms per nominal cycle | per hour |", "|---|---|---|---|---|---|---|"]

@@ -33,7 +33,7 @@ def _write(out: Path, rid: str, summary: dict[str, object], group: str | None = 
         (d / "campaign.json").write_text(json.dumps({"run": rid, "group": group}))
     (d / "summary.json").write_text(json.dumps({
         "status": "completed", "seed": 1, "detections": [],
-        "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2}, **summary}))
+        "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2}, "wall_s": 60.0, **summary}))
 
 
 @pytest.fixture()
@@ -71,6 +71,7 @@ def test_report_figures(campaign: Path) -> None:
     report = (campaign / "report.md").read_text()
     assert "3 of 4 runs finished (0 failed;" in report
     assert "Software: unknown (3 runs)." in report  # no version in these campaign.json
+    assert "median 60 s, max 60 s, 0.05 worker-hours in all." in report
     assert "| main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 (1/4) |" in report
     assert "| cusum | 100% (1/1) | 100% (1/1) | - | 100 / 100 / 100 |" in report
     assert "| camera_degradation (→ camera) | 0 | 1 | 0 | 0 | 0 | 0 |" in report
