@@ -33,6 +33,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ground.fdir.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
+from ground.fdir.threshold import Persistence  # noqa: E402
 from interfaces.scenario import Fault  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", None)
@@ -102,9 +103,16 @@ def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return rows
 
 
+def _latency(faults: Sequence[dict[str, Any]]) -> str:
+    """"median / p90 / max" of the latency of the isolated faults, s."""
+    lat = [f["latency_s"] for f in faults if f["isolated"] and f["latency_s"] is not None]
+    if not lat:
+        return "- / - / -"
+    return f"{np.median(lat):.0f} / {np.quantile(lat, 0.9):.0f} / {max(lat):.0f}"
+
+
 def _stats(rows: list[dict[str, Any]], hours: float) -> dict[str, Any]:
     faults = [r for r in rows if r["kind"] != "none"]
-    lat = [r["latency_s"] for r in faults if r["isolated"] and r["latency_s"] is not None]
     fa = sum(r["false_alarms"] for r in {(r["run"]): r for r in rows}.values())
     cycles = sum(r["nominal_cycles"] for r in {(r["run"]): r for r in rows}.values())
     return {
@@ -112,11 +120,8 @@ def _stats(rows: list[dict[str, Any]], hours: float) -> dict[str, Any]:
         "detected": sum(r["detected"] for r in faults),
         "isolated": sum(r["isolated"] for r in faults),
         "identified": sum(r.get("identified_class") == r["expected_class"] for r in faults),
-        "latency_median": float(np.median(lat)) if lat else None,
-        "latency_p90": float(np.quantile(lat, 0.9)) if lat else None,
-        "latency_max": float(max(lat)) if lat else None,
+        "latency": _latency(faults),
         "false_alarms": fa, "nominal_cycles": cycles,
-        "false_alarm_rate": fa / cycles if cycles else None,
         "false_alarms_per_hour": fa / hours if hours > 0 else None,
     }
 
@@ -126,9 +131,7 @@ def _cells(detector: str, st: dict[str, Any]) -> str:
     latency median / p90 / max, false alarms per nominal cycle and per hour."""
     ident = _pct(st["identified"], st["faults"]) if detector == "main" else "-"
     return (f"{_pct(st['detected'], st['faults'])} | {_pct(st['isolated'], st['faults'])} | "
-            f"{ident} | {_fmt(st['latency_median'])} / {_fmt(st['latency_p90'])} / "
-            f"{_fmt(st['latency_max'])} | "
-            f"{_rate(st['false_alarms'], st['nominal_cycles'])} | "
+            f"{ident} | {st['latency']} | {_rate(st['false_alarms'], st['nominal_cycles'])} | "
             f"{_fmt(st['false_alarms_per_hour'], '.3f')} |")
 
 
@@ -192,21 +195,13 @@ def _persistence(run: dict[str, Any], detector: str) -> tuple[int, int]:
 
 
 def _alarms_at(series: list[list[float]], scale: float, m: int, n: int) -> list[Alarm]:
-    """The alarms a detector raises on its windows with its threshold scaled: the window that
-    brings its exceedances among the last ``n`` windows to ``m`` (itself exceeding), once per
-    episode; the episode ends when that no longer holds.  ``m == n`` is ``threshold.
-    Persistence`` (``n`` in a row)."""
-    out = []
-    for sc in sorted({int(w[0]) for w in series}):
-        hits: list[bool] = []
-        armed = True
-        for w in sorted((w for w in series if int(w[0]) == sc), key=lambda w: w[2]):
-            hits.append(w[3] > scale * w[4])
-            holds = hits[-1] and sum(hits[-n:]) >= m
-            if holds and armed:
-                out.append(Alarm(sc, w[2], None))
-            armed = not holds
-    return out
+    """The alarms a detector raises on its windows with its threshold scaled, under the
+    detector's own rule (``threshold.Persistence``: ``m`` exceedances among the last ``n``
+    windows, once per episode)."""
+    rule = Persistence(m, n)
+    return [Alarm(int(w[0]), w[2], None)
+            for w in sorted(series, key=lambda w: (w[0], w[2]))
+            if rule.update(int(w[0]), w[3] > scale * w[4])]
 
 
 @dataclass
@@ -267,15 +262,10 @@ def _persistence_table(runs: list[dict[str, Any]]) -> list[str]:
     for m, n in PERSISTENCE_RULES:
         r = _rescore(runs, "main", 1.0, (m, n))
         f = r.per_fault
-        lat = [x["latency_s"] for x in f if x["isolated"] and x["latency_s"] is not None]
         label = f"{m} of {n}" + (" (as run)" if own == [(m, n)] else "")
         lines.append(
             f"| {label} | {_pct(sum(x['detected'] for x in f), len(f))} | "
-            f"{_pct(sum(x['isolated'] for x in f), len(f))} | "
-            f"{_fmt(float(np.median(lat)) if lat else None)} / "
-            f"{_fmt(float(np.quantile(lat, 0.9)) if lat else None)} / "
-            f"{_fmt(max(lat) if lat else None)} | "
-            f"{_rate(r.false_alarms, r.nominal_cycles)} |")
+            f"{_pct(sum(x['isolated'] for x in f), len(f))} | {_latency(f)} | {_rate(r.false_alarms, r.nominal_cycles)} |")
     return lines
 
 
@@ -330,8 +320,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
             st = _stats(sel, hours[d])
             lines.append(f"| {kind} | {label} | {d} | {st['faults']} | "
                          f"{_pct(st['detected'], st['faults'])} | {st['faults'] - st['detected']} | "
-                         f"{_pct(st['isolated'], st['faults'])} | {_fmt(st['latency_median'])} / "
-                         f"{_fmt(st['latency_p90'])} / {_fmt(st['latency_max'])} |")
+                         f"{_pct(st['isolated'], st['faults'])} | {st['latency']} |")
     lines += ["", "## Identification (main detector)", "", "![confusion](confusion.png)", ""]
     lines += _confusion(out, [r for r in rows if r["detector"] == "main" and r["kind"] != "none"])
     lines += ["", "## Latency", "", "![latency](latency.png)", "",
@@ -341,13 +330,14 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
               "A fault is declared on the window that brings the exceedances among the last n "
               "windows to m; the threshold as configured.", ""]
     lines += _persistence_table(runs)
+    margins = _margins(runs)
     lines += ["", "## Margins (main detector, H_m,i / τ_i per window)", "",
-              "![margins](margins.png)", ""] + _margin_lines(_margins(runs))
+              "![margins](margins.png)", ""] + _margin_lines(margins)
     _latency_plot(out, rows, detectors, [g for g in groups
                                          if any(r["group"] == g and r["kind"] != "none"
                                                 for r in rows)])
     _roc_plot(out, runs, detectors)
-    _margin_plot(out, _margins(runs))
+    _margin_plot(out, margins)
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     return path
