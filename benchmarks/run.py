@@ -1,0 +1,226 @@
+"""The project's speed figures in one run, each beside its target (issue 13, DESIGN.md "Targets").
+
+    python benchmarks/run.py [--quick] [--only NAME ...] [--json FILE]
+
+Measures, with the real commands a user runs (``deploy/run_constellation.py``,
+``deploy/run_campaign.py``) in child processes:
+
+* ``lockstep``: the raw lockstep limit over Zenoh (a ticker and 6 idle node processes);
+* ``reference``: the reference mission (default scenario, two orbits = 11,354 s, FDIR and
+  baselines on, full archive) in-process and over Zenoh: real-time factor, wall time, the time
+  to write summary and report, peak resident memory of the whole process tree, archive MB per
+  simulated hour;
+* ``scaling``: the nominal set-up (FDIR on) with 5/10/20 observers × 5,000/50,000 POIs,
+  in-process: real-time factor;
+* ``campaign``: wall time per run of ``deploy/campaigns/paper.toml`` with ``--workers 2``.
+
+``--quick`` shortens every workload (reference 1,200 s, scaling 60 s, 4 campaign runs) so the
+whole set runs in a few minutes; its ratios are indicative (start-up weighs more in short runs).
+Real-time factors are simulated seconds over the wall time of the whole command, start-up
+included.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import psutil
+
+REPO = Path(__file__).resolve().parent.parent
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+from benchmarks.lockstep_limit import free_port, measure as lockstep_rate  # noqa: E402
+from interfaces.scenario import load_scenario  # noqa: E402
+
+TWO_ORBITS_S = 11354.0
+TARGETS = {
+    "rtf_inproc": 365.0, "rtf_zenoh": 100.0, "report_s": 30.0, "archive_mb_per_h": 100.0,
+    "peak_rss_gb": 1.5, "campaign_s_per_run": 4.5, "rtf_scaling": 30.0,
+}
+
+
+@dataclass
+class Measured:
+    wall_s: float
+    peak_rss_mb: float
+    summary: dict
+
+
+def run_tree(cmd: list[str], poll_s: float = 0.25) -> tuple[float, float]:
+    """Run ``cmd``; return (wall s, peak summed RSS of its process tree, MB)."""
+    start = time.perf_counter()
+    proc = psutil.Popen(cmd, cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    peak = 0.0
+    while proc.poll() is None:
+        try:
+            tree = [proc, *proc.children(recursive=True)]
+            peak = max(peak, sum(_rss(p) for p in tree))
+        except psutil.NoSuchProcess:
+            pass
+        time.sleep(poll_s)
+    wall = time.perf_counter() - start
+    if proc.returncode != 0:
+        err = proc.stderr.read().decode(errors="replace") if proc.stderr else ""
+        raise RuntimeError(f"{' '.join(cmd)} exited {proc.returncode}:\n{err[-2000:]}")
+    return wall, peak / 1e6
+
+
+def _rss(p: psutil.Process) -> int:
+    try:
+        return p.memory_info().rss
+    except (psutil.NoSuchProcess, psutil.AccessDenied):
+        return 0
+
+
+def constellation(scenario: Path, out: Path, transport: str, duration: float,
+                  report: bool = False) -> Measured:
+    cmd = [sys.executable, "deploy/run_constellation.py", "--scenario", str(scenario),
+           "--out", str(out), "--transport", transport, "--duration", str(duration),
+           "--endpoint", f"tcp/127.0.0.1:{free_port()}"]
+    if not report:
+        cmd.append("--no-report")
+    wall, rss = run_tree(cmd)
+    return Measured(wall, rss, json.loads((out / "summary.json").read_text()))
+
+
+def scaled_scenario(tmp: Path, observers: int, pois: int) -> Path:
+    """The nominal set-up with ``observers`` observers and ``pois`` POIs, as resolved JSON."""
+    base = load_scenario(REPO / "deploy" / "scenarios" / "nominal.toml")
+    data = base.model_dump()
+    data["observers"]["count"] = observers
+    data["target"]["pois"] = pois
+    data["name"] = f"scale-{observers}x{pois}"
+    path = tmp / f"scale-{observers}x{pois}.json"
+    path.write_text(type(base).model_validate(data).model_dump_json())
+    return path
+
+
+def ratio(value: float, target: float, higher_is_better: bool = True) -> str:
+    r = value / target if higher_is_better else target / max(value, 1e-9)
+    return f"{r:5.2f} of target {'✓' if r >= 1.0 else '✗'}"
+
+
+def bench_lockstep(quick: bool, rows: list[tuple[str, str, str]], res: dict) -> None:
+    rate = lockstep_rate(6, 1000 if quick else 5000)
+    res["lockstep_ticks_per_s"] = rate
+    rtf = rate * 0.1
+    rows.append(("lockstep limit over Zenoh, 6 idle nodes",
+                 f"{rate:.0f} ticks/s ({rtf:.0f}x real time at 10 Hz)",
+                 ratio(rtf, TARGETS["rtf_zenoh"])))
+
+
+def bench_reference(quick: bool, tmp: Path, rows: list, res: dict) -> None:
+    duration = 1200.0 if quick else TWO_ORBITS_S
+    scenario = REPO / "deploy" / "scenarios" / "default.toml"
+    for transport in ("inproc", "zenoh"):
+        out = tmp / f"ref-{transport}"
+        m = constellation(scenario, out, transport, duration)
+        rtf = duration / m.wall_s
+        key = "rtf_inproc" if transport == "inproc" else "rtf_zenoh"
+        res[f"reference_{transport}"] = {"wall_s": m.wall_s, "rtf": rtf,
+                                         "peak_rss_mb": m.peak_rss_mb,
+                                         "run_wall_s": m.summary.get("wall_s")}
+        rows.append((f"reference mission {duration:.0f} s, {transport}",
+                     f"{rtf:.0f}x real time ({m.wall_s:.1f} s wall)", ratio(rtf, TARGETS[key])))
+        rows.append((f"  peak RSS, whole tree ({transport})", f"{m.peak_rss_mb:.0f} MB",
+                     ratio(m.peak_rss_mb / 1e3, TARGETS["peak_rss_gb"], False)))
+        if transport == "inproc":
+            mb_h = (out / "run.mcap").stat().st_size / 1e6 / (duration / 3600.0)
+            res["archive_mb_per_h"] = mb_h
+            rows.append(("  archive", f"{mb_h:.0f} MB per simulated hour",
+                         ratio(mb_h, TARGETS["archive_mb_per_h"], False)))
+            t0 = time.perf_counter()
+            subprocess.run([sys.executable, "-c", _REPORT_AGAIN, str(out), str(scenario),
+                            str(duration)], cwd=REPO, check=True, capture_output=True)
+            report_s = time.perf_counter() - t0
+            res["summary_and_report_s"] = report_s
+            rows.append(("  summary + report from the archive", f"{report_s:.1f} s",
+                         ratio(report_s, TARGETS["report_s"], False)))
+
+
+_REPORT_AGAIN = """
+import sys
+from pathlib import Path
+from ground.report import write_report
+from ground.summary import write_summary
+from interfaces.scenario import load_scenario
+out, scen, dur = Path(sys.argv[1]), load_scenario(sys.argv[2]), float(sys.argv[3])
+scen = scen.with_overrides(None, dur)
+write_summary(out, scen, transport="inproc", wall_s=1.0, status="completed", error=None,
+              mission=scen.name)
+write_report(out, scen, scen.name)
+"""
+
+
+def bench_scaling(quick: bool, tmp: Path, rows: list, res: dict) -> None:
+    duration = 60.0 if quick else 300.0
+    grid = {}
+    for observers in (5, 10, 20):
+        for pois in (5000, 50000):
+            path = scaled_scenario(tmp, observers, pois)
+            m = constellation(path, tmp / path.stem, "inproc", duration)
+            rtf = duration / m.wall_s
+            grid[f"{observers}x{pois}"] = rtf
+            target = TARGETS["rtf_scaling"] if (observers, pois) == (20, 50000) else None
+            rows.append((f"scaling {observers} observers x {pois} POIs, inproc, {duration:.0f} s",
+                         f"{rtf:.1f}x real time", ratio(rtf, target) if target else ""))
+    res["scaling_rtf"] = grid
+
+
+def bench_campaign(quick: bool, tmp: Path, rows: list, res: dict) -> None:
+    n = 4 if quick else 10
+    out = tmp / "campaign"
+    wall, _ = run_tree([sys.executable, "deploy/run_campaign.py", "--campaign",
+                        "deploy/campaigns/paper.toml", "--out", str(out), "--workers", "2",
+                        "--limit", str(n)])
+    per_run = wall / n
+    res["campaign_s_per_run"] = per_run
+    rows.append((f"paper campaign, first {n} runs, --workers 2",
+                 f"{per_run:.1f} s per run ({per_run * 200 / 60:.0f} min for 200)",
+                 ratio(per_run, TARGETS["campaign_s_per_run"], False)))
+
+
+BENCHES = {"lockstep": bench_lockstep, "reference": bench_reference, "scaling": bench_scaling,
+           "campaign": bench_campaign}
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--quick", action="store_true", help="short workloads (a few minutes)")
+    p.add_argument("--only", nargs="+", choices=list(BENCHES), help="run only these")
+    p.add_argument("--json", type=Path, help="also write the figures as JSON here")
+    p.add_argument("--keep", type=Path, help="keep the runs in this directory")
+    args = p.parse_args()
+    rows: list[tuple[str, str, str]] = []
+    res: dict = {"quick": args.quick}
+    tmp = args.keep or Path(tempfile.mkdtemp(prefix="insp-bench-"))
+    tmp.mkdir(parents=True, exist_ok=True)
+    try:
+        for name in args.only or list(BENCHES):
+            t0 = time.perf_counter()
+            kwargs = {} if name == "lockstep" else {"tmp": tmp}
+            BENCHES[name](args.quick, rows=rows, res=res, **kwargs)
+            print(f"[{name} done in {time.perf_counter() - t0:.0f} s]", file=sys.stderr, flush=True)
+    finally:
+        if args.keep is None:
+            shutil.rmtree(tmp, ignore_errors=True)
+    width = max(len(r[0]) for r in rows)
+    print(f"\n{'workload':<{width}}  {'measured':<44} ratio to target")
+    for what, value, r in rows:
+        print(f"{what:<{width}}  {value:<44} {r}")
+    if args.json:
+        args.json.write_text(json.dumps(res, indent=1))
+
+
+if __name__ == "__main__":
+    main()
