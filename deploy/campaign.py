@@ -343,7 +343,7 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     try:
         note = f"# campaign run {spec.id} (group {spec.group}, seed {spec.seed}): resolved_json\n"
         with McapRecorder(out / "run.mcap", run_metadata(spec.scenario, "inproc", note)) as rec:
-            run_inproc(spec.scenario, tap=rec.record)
+            run_inproc(spec.scenario, sample_tap=rec.record_sample)
     except Exception as e:  # noqa: BLE001 - a crashed run is a result, not the campaign's end
         status, error = "failed", f"{type(e).__name__}: {e}\n{traceback.format_exc()}"
         logging.getLogger("insp.campaign").error("run %s failed: %s", spec.id, error)

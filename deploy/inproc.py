@@ -16,7 +16,7 @@ from interfaces.bus import Bus
 from interfaces.channel import ChannelModel
 from interfaces.executive import Executive, TickClient
 from interfaces.scenario import Scenario
-from interfaces.transport import InprocNetwork, RawHandler
+from interfaces.transport import InprocNetwork, RawHandler, SampleHandler
 from sim.node import SimNode
 
 
@@ -25,13 +25,18 @@ def run_inproc(
     mission: str | None = None,
     tap: RawHandler | None = None,
     ground: bool = True,
+    sample_tap: SampleHandler | None = None,
 ) -> tuple[SimNode, dict[str, Executive]]:
     """Run ``scenario`` to the end in this process.  ``tap`` receives every message raw (key,
-    type, payload), as the recorder does.  Returns the sim and the executives by node."""
+    type, payload), as the recorder does; ``sample_tap`` every message as a Sample (the
+    message object with its JSON bytes encoded on demand, once: the recorder's fast path).
+    Returns the sim and the executives by node."""
     mission = mission or scenario.name
     net = InprocNetwork()
     if tap is not None:
         Bus("ground", mission, net.endpoint()).subscribe_raw(topics.mission_wildcard(mission), tap)
+    if sample_tap is not None:
+        net.endpoint().subscribe_samples(topics.mission_wildcard(mission), sample_tap)
     builders: dict[str, Callable[[Bus, Scenario], Executive]] = {
         topics.sc_node(i): (lambda b, s, i=i: spacecraft_executive(b, s, i))
         for i in range(1, scenario.observers.count + 1)

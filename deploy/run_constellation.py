@@ -39,6 +39,7 @@ from ground.summary import add_recovery_comparison, write_summary  # noqa: E402
 from interfaces import topics  # noqa: E402
 from interfaces.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
+from interfaces.transport import Sample  # noqa: E402
 from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
 
 if TYPE_CHECKING:
@@ -124,13 +125,13 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
         log.warning("--realtime is ignored with --transport inproc (lockstep only)")
     live = _live_view(args)
     with McapRecorder(out / "run.mcap", run_metadata(scenario, "inproc", scenario_text)) as rec:
-        def tap(key: str, type_name: str, payload: bytes) -> None:
-            rec.record(key, type_name, payload)
+        def tap(sample: Sample) -> None:
+            rec.record_sample(sample)
             if live is not None:
-                live.forward(key, type_name, payload)
+                live.forward(sample.key, sample.type_name, sample.payload)
 
         try:
-            run_inproc(scenario, mission, tap=tap)
+            run_inproc(scenario, mission, sample_tap=tap)
         finally:
             if live is not None:
                 live.close()

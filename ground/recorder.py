@@ -48,6 +48,7 @@ from mcap.writer import CompressionType, IndexType, Writer
 from pydantic_core import from_json
 
 from interfaces.messages import Message, json_schema, registry
+from interfaces.transport import Sample
 
 LIBRARY: Final = "insp-recorder"
 """Library name written in the MCAP header."""
@@ -274,6 +275,20 @@ class McapRecorder:
         self._pending.append(
             (key, type_name, payload, log_time_ns, is_object, t_ns, sequence, publish_ns)
         )
+        self._drain()
+
+    def record_sample(self, sample: Sample) -> None:
+        """Record one bus sample (thread-safe).  A sample that carries its validated message
+        (in-process transport) is stored from the message's own sim time and sequence number,
+        with the JSON bytes encoded once for every raw consumer; bytes alone take
+        :meth:`record`'s path (parsed, never trusted)."""
+        msg = sample.message
+        if msg is None or not 0.0 <= msg.t_sim <= _MAX_T_SIM_S or msg.seq > _MAX_U32:
+            self.record(sample.key, sample.type_name, sample.payload)
+            return
+        self._pending.append((sample.key[:_MAX_KEY_CHARS], sample.type_name[:_MAX_TYPE_CHARS],
+                              sample.payload, None, True, round(msg.t_sim * 1e9), msg.seq,
+                              time.time_ns()))
         self._drain()
 
     def _drain(self) -> None:

@@ -4,9 +4,11 @@ What the Bus guarantees, identically on every transport:
 
 * **Own key space.** A node publishes only under its own prefix (``topics.node_prefix``).
 * **Sequence numbers.** Each key has its own sequence count starting at 1, set on publish.
-* **Validation.** A received message that is not valid JSON of the subscribed model (wrong
-  fields, NaN, oversize) is dropped, counted in ``invalid_dropped`` and logged; nothing else
-  happens, the node goes on.
+* **Validation where bytes come in.** A received payload that is not valid JSON of the subscribed
+  model (wrong fields, NaN, oversize) is dropped, counted in ``invalid_dropped`` and logged;
+  nothing else happens, the node goes on.  In one process (in-process transport) a subscriber
+  of the message's own type receives the publisher's validated, immutable object, with no JSON
+  in between; JSON is made only for the transports and raw subscribers that need bytes.
 * **Deterministic delivery.** Deferred subscriptions (the default) are delivered by
   ``dispatch(t_now)`` on the caller's thread, sorted by (send time, key, sequence).  Messages of
   other flight/ground nodes become eligible one tick after they were sent (at the earliest) and
@@ -31,8 +33,8 @@ from pydantic import ValidationError
 
 from interfaces import topics
 from interfaces.channel import ChannelModel, Verdict, applies
-from interfaces.messages import Message, TruthState, json_schema, registry
-from interfaces.transport import LivenessHandler, RawHandler, Transport
+from interfaces.messages import Message, TruthState, json_schema, registry, stamp
+from interfaces.transport import LivenessHandler, RawHandler, Sample, Transport
 
 M = TypeVar("M", bound=Message)
 MAX_PAYLOAD_BYTES = 1 << 20
@@ -108,11 +110,11 @@ class Bus:
         self._seq[key] = seq
         if announce:
             self._published_since[key] = seq
-        msg.sender, msg.seq, msg.t_wall = self.node, seq, time.time()
+        stamp(msg, self.node, seq, time.time())
         self.stats.published += 1
         for sub in self._local_subs(key):
             self._enqueue(_Envelope(msg, key, self.node, True, [sub]))
-        self.transport.publish(key, type(msg).__name__, msg.model_dump_json().encode())
+        self.transport.send(Sample(key, type(msg).__name__, message=msg))
 
     def published_since_last(self) -> dict[str, int]:
         """Keys published since the previous call, with their last sequence number."""
@@ -134,7 +136,8 @@ class Bus:
         group = self._groups.get(key_expr)
         if group is None:
             self._groups[key_expr] = group = []
-            self.transport.subscribe(key_expr, lambda k, t, p, e=key_expr: self._on_raw(e, k, p))
+            self.transport.subscribe_samples(key_expr,
+                                             lambda smp, e=key_expr: self._on_sample(e, smp))
         group.append(sub)
         self._local_cache.clear()
         self._await_cache.clear()
@@ -151,11 +154,14 @@ class Bus:
             self._local_cache[key] = subs
         return subs
 
-    def _on_raw(self, key_expr: str, key: str, payload: bytes) -> None:
-        """Transport callback (any thread): validate, count, queue or call."""
+    def _on_sample(self, key_expr: str, sample: Sample) -> None:
+        """Transport callback (any thread): validate bytes (an object of the subscribed type is
+        taken as it is), count, queue or call."""
         self.stats.received += 1
-        if len(payload) > MAX_PAYLOAD_BYTES:
-            self._invalid(key, f"payload of {len(payload)} bytes exceeds {MAX_PAYLOAD_BYTES}")
+        key, obj = sample.key, sample.message
+        if obj is None and len(sample.payload) > MAX_PAYLOAD_BYTES:
+            self._invalid(key, f"payload of {len(sample.payload)} bytes exceeds "
+                               f"{MAX_PAYLOAD_BYTES}")
             return
         subs = self._groups.get(key_expr, [])
         decoded: dict[type[Message], Message] = {}
@@ -163,11 +169,15 @@ class Bus:
         for sub in subs:
             msg = decoded.get(sub.msg_type)
             if msg is None:
-                try:
-                    msg = sub.msg_type.model_validate_json(payload)
-                except ValidationError as e:
-                    self._invalid(key, f"not a valid {sub.msg_type.__name__}: {_first_error(e)}")
-                    return
+                if type(obj) is sub.msg_type:
+                    msg = obj
+                else:
+                    try:
+                        msg = sub.msg_type.model_validate_json(sample.payload)
+                    except ValidationError as e:
+                        self._invalid(key, f"not a valid {sub.msg_type.__name__}: "
+                                           f"{_first_error(e)}")
+                        return
                 decoded[sub.msg_type] = msg
                 with self._cond:
                     if msg.seq > self._received_seq.get(key, 0):

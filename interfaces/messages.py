@@ -27,9 +27,10 @@ RateGroupName = Literal["high", "mid", "low"]
 
 
 class Message(BaseModel):
-    """Base of every bus message."""
+    """Base of every bus message.  Immutable once built (the in-process bus hands the same
+    object to every subscriber); the Bus stamps sender, seq and t_wall on publish (``stamp``)."""
 
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
     WALL_CLOCK_FIELDS: ClassVar[frozenset[str]] = frozenset({"t_wall"})
     """Fields that measure the wall clock (not reproducible); subclasses may add their own."""
 
@@ -37,6 +38,14 @@ class Message(BaseModel):
     seq: int = Field(default=0, ge=0, description="per-key sequence count, set by the Bus")
     t_sim: float = Field(ge=0.0, description="simulation time of the message, s")
     t_wall: float = Field(default=0.0, description="publisher wall clock, UNIX s (not reproducible)")
+
+
+def stamp(msg: Message, sender: str, seq: int, t_wall: float) -> None:
+    """Set the Bus's fields of a message being published (the one write to a frozen message:
+    the values are the Bus's own, valid by construction)."""
+    fields = msg.__dict__
+    fields["sender"], fields["seq"], fields["t_wall"] = sender, seq, t_wall
+    msg.__pydantic_fields_set__.update(("sender", "seq", "t_wall"))
 
 
 # --- time and lockstep -----------------------------------------------------------------------

@@ -1,8 +1,13 @@
 """The transport interface the Bus runs on, and the in-process transport.
 
-A transport moves raw samples ``(key, type_name, payload)`` between Bus endpoints.  It delivers
-to an endpoint only samples published by *other* endpoints: each Bus delivers its own messages
-to its own subscribers itself, identically on every transport.
+A transport moves samples between Bus endpoints: a key, a message type name and the message,
+as JSON bytes and/or, inside one process, as the validated object itself (:class:`Sample`).  It
+delivers to an endpoint only samples published by *other* endpoints: each Bus delivers its own
+messages to its own subscribers itself, identically on every transport.
+
+JSON is made only where bytes are needed: on the wire (Zenoh) and for raw subscribers (the
+recorder, the live view), once per message however many of them there are.  In one process a
+Bus subscriber of the message's own type receives the publisher's (immutable) object.
 """
 
 from __future__ import annotations
@@ -10,10 +15,38 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from interfaces.topics import matches
 
+if TYPE_CHECKING:
+    from interfaces.messages import Message
+
+
+class Sample:
+    """One message on its way between endpoints: ``key``, ``type_name``, and the message as
+    ``message`` (the object, in one process; None when it came as bytes) and/or ``payload``
+    (its JSON bytes, encoded from the object on first use and kept)."""
+
+    __slots__ = ("key", "type_name", "message", "_payload")
+
+    def __init__(self, key: str, type_name: str, payload: bytes | None = None,
+                 message: Message | None = None) -> None:
+        if payload is None and message is None:
+            raise ValueError("a sample needs a payload or a message")
+        self.key, self.type_name, self.message, self._payload = key, type_name, message, payload
+
+    @property
+    def payload(self) -> bytes:
+        """The message's JSON bytes (encoded once)."""
+        if self._payload is None:
+            assert self.message is not None
+            self._payload = self.message.model_dump_json().encode()
+        return self._payload
+
+
+SampleHandler = Callable[[Sample], None]
+"""Receives a Sample (the Bus); may run on a transport thread."""
 RawHandler = Callable[[str, str, bytes], None]
 """Receives (key, message type name, JSON payload); may run on a transport thread."""
 Responder = Callable[[str], bytes | None]
@@ -23,9 +56,17 @@ LivenessHandler = Callable[[str, bool], None]
 
 
 class Transport(Protocol):
-    def publish(self, key: str, type_name: str, payload: bytes) -> None: ...
+    def send(self, sample: Sample) -> None:
+        """Publish a sample (the Bus's path: bytes only if this transport needs them)."""
 
-    def subscribe(self, key_expr: str, handler: RawHandler) -> None: ...
+    def publish(self, key: str, type_name: str, payload: bytes) -> None:
+        """Publish raw bytes (tools, tests: a hostile or foreign publisher)."""
+
+    def subscribe(self, key_expr: str, handler: RawHandler) -> None:
+        """Raw samples as (key, type name, JSON bytes)."""
+
+    def subscribe_samples(self, key_expr: str, handler: SampleHandler) -> None:
+        """Samples as they come: the object where the transport has it (the Bus's path)."""
 
     def serve(self, key_expr: str, responder: Responder) -> None: ...
 
@@ -46,7 +87,8 @@ class InprocNetwork:
 
     _endpoints: list[InprocTransport] = field(default_factory=list)
     _lock: threading.RLock = field(default_factory=threading.RLock)
-    _routes: dict[tuple[int, str], list[RawHandler]] = field(default_factory=dict)
+    _routes: dict[tuple[int, str], list[tuple[Callable[..., None], bool]]] = field(
+        default_factory=dict)
 
     def endpoint(self) -> InprocTransport:
         t = InprocTransport(self)
@@ -60,17 +102,21 @@ class InprocNetwork:
         with self._lock:
             self._routes.clear()
 
-    def _deliver(self, origin: InprocTransport, key: str, type_name: str, payload: bytes) -> None:
+    def _deliver(self, origin: InprocTransport, sample: Sample) -> None:
+        key = sample.key
         with self._lock:
             targets = self._routes.get((id(origin), key))
             if targets is None:
                 targets = [
-                    h for ep in self._endpoints if ep is not origin and not ep.closed
-                    for expr, h in ep.subs if matches(expr, key)
+                    (h, raw) for ep in self._endpoints if ep is not origin and not ep.closed
+                    for expr, h, raw in ep.subs if matches(expr, key)
                 ]
                 self._routes[(id(origin), key)] = targets
-        for h in targets:
-            h(key, type_name, payload)
+        for h, raw in targets:
+            if raw:
+                h(key, sample.type_name, sample.payload)
+            else:
+                h(sample)
 
     def _query(self, selector: str) -> list[tuple[str, bytes]]:
         with self._lock:
@@ -95,17 +141,25 @@ class InprocTransport:
     """In-process transport: one process, no network; same API and semantics as Zenoh's."""
 
     network: InprocNetwork
-    subs: list[tuple[str, RawHandler]] = field(default_factory=list)
+    subs: list[tuple[str, Callable[..., None], bool]] = field(default_factory=list)
+    """(key expression, handler, raw): raw handlers get bytes, the others the Sample."""
     servers: list[tuple[str, Responder]] = field(default_factory=list)
     watchers: list[LivenessHandler] = field(default_factory=list)
     alive: list[str] = field(default_factory=list)
     closed: bool = False
 
+    def send(self, sample: Sample) -> None:
+        self.network._deliver(self, sample)
+
     def publish(self, key: str, type_name: str, payload: bytes) -> None:
-        self.network._deliver(self, key, type_name, payload)
+        self.network._deliver(self, Sample(key, type_name, payload=payload))
 
     def subscribe(self, key_expr: str, handler: RawHandler) -> None:
-        self.subs.append((key_expr, handler))
+        self.subs.append((key_expr, handler, True))
+        self.network.invalidate()
+
+    def subscribe_samples(self, key_expr: str, handler: SampleHandler) -> None:
+        self.subs.append((key_expr, handler, False))
         self.network.invalidate()
 
     def serve(self, key_expr: str, responder: Responder) -> None:

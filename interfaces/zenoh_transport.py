@@ -23,7 +23,7 @@ from typing import Any, Literal
 
 import zenoh
 
-from interfaces.transport import LivenessHandler, RawHandler, Responder
+from interfaces.transport import LivenessHandler, RawHandler, Responder, Sample, SampleHandler
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 
@@ -76,6 +76,9 @@ class ZenohTransport:
     def session(self) -> Any:
         return self._session
 
+    def send(self, sample: Sample) -> None:
+        self.publish(sample.key, sample.type_name, sample.payload)
+
     def publish(self, key: str, type_name: str, payload: bytes) -> None:
         pub = self._publishers.get((key, type_name))
         if pub is None:
@@ -98,6 +101,9 @@ class ZenohTransport:
             key_expr, on_sample, allowed_origin=zenoh.Locality.REMOTE
         )
         self._entities.append(sub)
+
+    def subscribe_samples(self, key_expr: str, handler: SampleHandler) -> None:
+        self.subscribe(key_expr, lambda k, t, p: handler(Sample(k, t, payload=p)))
 
     def serve(self, key_expr: str, responder: Responder) -> None:
         def on_query(query: zenoh.Query) -> None:
