@@ -5,6 +5,10 @@ has a fix), the nav state estimate (own position) and the camera's pointing targ
 camera app publishes one: the target's centre, the LVLH origin).  Outputs: the reaction-wheel
 torque command every tick and the attitude estimate/status at ω_mid.
 
+The 10 Hz chain runs on the compiled kernels of ``fsw.lib.attitude_kernels`` (the same
+mathematics as ``fsw.lib.mekf``, ``fsw.lib.attitude.repoint`` and
+``fsw.lib.attitude_control.tracking_torque``, which stay the tested reference).
+
 Each cycle: the MEKF (``fsw.lib.mekf``) propagates with the gyro and updates with the star
 tracker; the desired attitude puts the camera boresight on the line of sight to the pointing
 target (LVLH, carried into ECI by the onboard LVLH model ``fsw.lib.frames``) by the shortest
@@ -25,9 +29,10 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from fsw.lib import attitude_kernels as kern
 from fsw.lib import hcw, mekf, quat
 from fsw.lib.attitude import AttitudePlan, repoint, scp_slew, slerp_plan
-from fsw.lib.attitude_control import gains_for, tracking_torque
+from fsw.lib.attitude_control import gains_for
 from fsw.lib.frames import lvlh_to_eci_quat
 from interfaces import topics
 from interfaces.app import App, AppContext, Input, Output
@@ -75,6 +80,7 @@ class AttitudeApp(App):
         self.st_axis = int(np.argmax(np.abs(self.boresight)))  # star tracker co-aligned
         self.w_max = math.radians(sc.attitude.slew_rate_max_dps)
         self.gains = gains_for(sc.attitude.settling_time_s, w_max_radps=self.w_max)
+        self._w_limit = -1.0 if self.gains.w_max_radps is None else self.gains.w_max_radps
         self.tau_max = sc.actuators.wheel_max_torque_nm
         s = sc.sensors
         self.sigma_v, self.sigma_u = s.gyro_arw_rad_rts, s.gyro_bias_rw_rad_s15
@@ -98,12 +104,14 @@ class AttitudeApp(App):
         self._meas: list[AttitudeMeasurement] = []
         self.t_att: float | None = None  # time of the MEKF state, s
         self._est: StateEstimate | None = None
+        self._x_est = np.zeros(6)  # the nav estimate as an array (LVLH, m, m/s)
 
     def on_sensors(self, msg: AttitudeMeasurement) -> None:
         self._meas.append(msg)
 
     def on_estimate(self, msg: StateEstimate) -> None:
         self._est = msg
+        self._x_est = np.array(msg.x)
 
     def on_target(self, msg: PointingTarget) -> None:
         self.target = np.array(msg.target_lvlh_m)
@@ -145,7 +153,7 @@ class AttitudeApp(App):
         w_meas = np.array(meas.gyro_radps)
         dt = meas.t_sim - self.t_att if self.t_att is not None else 0.0
         if self.q is not None and dt > 1e-9:
-            self.q, self.b, self.P = mekf.mekf_propagate(self.q, self.b, self.P, w_meas, dt,
+            self.q, self.b, self.P = kern.mekf_propagate(self.q, self.b, self.P, w_meas, dt,
                                                          self.sigma_v, self.sigma_u)
         if meas.star_tracker is not None:
             R = np.diag(np.full(3, meas.st_sigma_cross_rad**2))
@@ -154,7 +162,7 @@ class AttitudeApp(App):
                 self.q, self.b, self.P = mekf.mekf_init(np.array(meas.star_tracker), R,
                                                         self.bias_sigma0)
             else:
-                self.q, self.b, self.P, self.nis = mekf.mekf_update(
+                self.q, self.b, self.P, self.nis = kern.mekf_update(
                     self.q, self.b, self.P, np.array(meas.star_tracker), R)
         if self.q is not None:
             self.t_att = meas.t_sim
@@ -164,9 +172,13 @@ class AttitudeApp(App):
         """Line of sight to the pointing target at time t, ECI axes (m), from the nav estimate
         and the target, each extrapolated with its velocity."""
         assert self._est is not None
-        x = self._est.x
-        r = np.array(x[:3]) + np.array(x[3:]) * (t - self._est.t_sim)
-        return quat.rotate(lvlh_to_eci_quat(t, self.n, self.incl), self._target_at(t) - r)
+        los = kern.los_eci(t, self.n, self.incl, self._x_est, self._est.t_sim, self.target,
+                           self.target_rate, self.target_accel, self.target_t)
+        n2 = float(los @ los)
+        if not (n2 > 0.0 and math.isfinite(n2)):
+            raise ValueError(f"no line of sight to the pointing target at t={t:.1f} s "
+                             f"(target on the spacecraft, or non-finite)")
+        return los
 
     def _control(self, t: float) -> np.ndarray:
         """Wheel torque tracking the slew plan, or the pointing attitude (quaternions R_eci_body,
@@ -175,30 +187,23 @@ class AttitudeApp(App):
         if self.mode == "slew" and self.slew is not None and t - self.slew_t0 <= self.slew_end:
             r_des, w_des, wdot_des = self.slew.at_quat(t - self.slew_t0)
         else:
-            q_des = repoint(self.q if self.q_point is None else self.q_point, self._los_eci(t),
-                            self.boresight)
-            w_des, wdot_des = self._desired_rates(t, q_des)
-            angle = float(np.linalg.norm(quat.log(quat.mul(quat.conj(q_des), self.q))))
+            h = DESIRED_RATE_STEP_S
+            q_des, w_des, wdot_des = kern.pointing_reference(
+                self.q if self.q_point is None else self.q_point, self._los_eci(t - h),
+                self._los_eci(t), self._los_eci(t + h), self.boresight, h)
+            angle = kern.angle_between(q_des, self.q)
             if angle > math.radians(self.cfg.slew_threshold_deg):
                 self._plan_slew(t, angle)
                 self.q_point = None
                 r_des, w_des, wdot_des = self.slew.at_quat(0.0)
             else:
                 self.mode, self.q_point, r_des = "track", q_des, q_des
-        tau, _ = tracking_torque(self.q, self.w_est, r_des, w_des, wdot_des, self.J,
-                                 self.h_wheels, self.gains, self.tau_max)
+        tau, _ = kern.tracking_torque(self.q, self.w_est, r_des, w_des, wdot_des, self.J,
+                                      self.h_wheels, self.gains.kp, self.gains.kd,
+                                      self._w_limit, self.tau_max)
+        if not np.isfinite(tau).all():
+            raise ValueError(f"non-finite torque command {tau.tolist()} (safe mode: zero torque)")
         return tau
-
-    def _desired_rates(self, t: float, q_des: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Desired body rate (rad/s) and its derivative (rad/s²) of the pointing attitude, by
-        central differences of the pointing attitudes h before and after t (target and own
-        position extrapolated): the feed-forward of the LOS motion, including a moving aim."""
-        h = DESIRED_RATE_STEP_S
-        q_prev = repoint(q_des, self._los_eci(t - h), self.boresight)
-        q_next = repoint(q_des, self._los_eci(t + h), self.boresight)
-        back = quat.log(quat.mul(quat.conj(q_prev), q_des))
-        ahead = quat.log(quat.mul(quat.conj(q_des), q_next))
-        return (back + ahead) / (2.0 * h), (ahead - back) / (h * h)
 
     def _plan_slew(self, t: float, angle: float) -> None:
         """Plan a rate-limited slew (SCP, slerp as fallback) onto the pointing attitude."""
