@@ -150,14 +150,16 @@ def bench_reference(quick: bool, tmp: Path, rows: list, res: dict) -> None:
 _REPORT_AGAIN = """
 import sys
 from pathlib import Path
+from ground.reader import load_run
 from ground.report import write_report
 from ground.summary import write_summary
 from interfaces.scenario import load_scenario
 out, scen, dur = Path(sys.argv[1]), load_scenario(sys.argv[2]), float(sys.argv[3])
 scen = scen.with_overrides(None, dur)
+archive = load_run(out / "run.mcap")
 write_summary(out, scen, transport="inproc", wall_s=1.0, status="completed", error=None,
-              mission=scen.name)
-write_report(out, scen, scen.name)
+              mission=scen.name, archive=archive)
+write_report(out, scen, scen.name, archive=archive)
 """
 
 

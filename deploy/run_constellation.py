@@ -32,6 +32,7 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.processes import Child, Supervisor  # noqa: E402
+from ground.reader import ArchiveError, RunArchive, load_run  # noqa: E402
 from ground.record import run_metadata  # noqa: E402
 from ground.recorder import McapRecorder  # noqa: E402
 from ground.report import write_report  # noqa: E402
@@ -102,12 +103,13 @@ def main(argv: list[str] | None = None) -> int:
             if main_thread:
                 signal.signal(signal.SIGTERM, previous)
     wall_s = time.monotonic() - wall0
+    archive = _read_archive(out)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
-                            status=status, error=error, mission=mission)
+                            status=status, error=error, mission=mission, archive=archive)
     if args.compare_recovery and status == "completed":
         summary = _compare_recovery(scenario, mission, out, scenario_text, args, summary)
     if not args.no_report:
-        write_report(out, scenario, mission)
+        write_report(out, scenario, mission, archive=archive)
     rtf = summary.get("real_time_factor")
     print(f"{status}: {scenario.name} seed {scenario.seed}, {scenario.duration_s:.0f} s simulated in "
           f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time)" if rtf else "") + f"\n  {out}/run.mcap"
@@ -115,6 +117,15 @@ def main(argv: list[str] | None = None) -> int:
     if error:
         print(f"error: {error}", file=sys.stderr)
     return 0 if status == "completed" else 1
+
+
+def _read_archive(out: Path) -> RunArchive | None:
+    """The run's archive, read once for the summary and the report (None if it cannot be read:
+    the summary then reports why)."""
+    try:
+        return load_run(out / "run.mcap")
+    except (ArchiveError, OSError):
+        return None
 
 
 def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,

@@ -125,6 +125,7 @@ class RunArchive:
         self._records = records
         self._channel_types = channel_types
         self._match_cache: dict[str, frozenset[str]] = {}
+        self._decoded: dict[tuple[str, type[Message]], list[Message]] = {}
 
     def __len__(self) -> int:
         return len(self._records)
@@ -179,7 +180,8 @@ class RunArchive:
         *,
         skip_invalid: bool = False,
     ) -> list[Message]:
-        """Decoded messages of the matching keys, by log time then file order.
+        """Decoded messages of the matching keys, by log time then file order (decoded once per
+        key expression and type: later calls return the same immutable messages in a new list).
 
         ``msg_type`` (a model class or a type name) keeps only records of that type and decodes
         them with it; None decodes every matching record through the registry.  A record that
@@ -196,16 +198,23 @@ class RunArchive:
             model = msg_type
         out: list[Message] = []
         if model is not None:
+            cached = self._decoded.get((key_expr, model))
+            if cached is not None:  # messages are immutable: the summary and report share them
+                return list(cached)
             name = model.__name__
+            complete = True
             for rec in selected:
                 if rec.type_name != name:
                     continue
                 try:
                     out.append(_decode(rec, model))
                 except ArchiveError:
+                    complete = False
                     if not skip_invalid:
                         raise
-            return out
+            if complete:
+                self._decoded[(key_expr, model)] = out
+            return list(out)
         models = registry()
         for rec in selected:
             rec_model = models.get(rec.type_name)

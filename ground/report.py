@@ -20,8 +20,10 @@ from interfaces.messages import FdirWindow, TruthState  # noqa: E402
 from interfaces.scenario import Scenario  # noqa: E402
 
 
-def write_report(out: Path, scenario: Scenario, mission: str | None = None) -> Path:
-    """Write ``<out>/report.md`` (and its plots) from ``run.mcap`` and ``summary.json``."""
+def write_report(out: Path, scenario: Scenario, mission: str | None = None,
+                 archive: RunArchive | None = None) -> Path:
+    """Write ``<out>/report.md`` (and its plots) from ``run.mcap`` and ``summary.json``
+    (``archive``: the run's archive already read, e.g. by :func:`ground.summary.write_summary`)."""
     mission = mission or scenario.name
     summary = json.loads((out / "summary.json").read_text())
     lines = [f"# Run report: {scenario.name}", "",
@@ -33,7 +35,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None) -> P
     if summary.get("error"):
         lines += ["```", summary["error"], "```", ""]
     try:
-        archive = load_run(out / "run.mcap")
+        archive = archive or load_run(out / "run.mcap")
     except (ArchiveError, OSError) as e:
         lines.append(f"The archive could not be read: {e}")
         return _write(out, lines)

@@ -5,16 +5,17 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from ground.coverage import coverage, coverage_summary
 from ground.evaluation import nav_errors
 from ground.fdir.scoring import Alarm, Judged, score
 from ground.gnc_evaluation import gnc_series, gnc_summary
-from ground.reader import ArchiveError, RunArchive, load_run
+from ground.reader import ArchiveError, Record, RunArchive, load_run
 from interfaces import topics
 from interfaces.messages import (
     BaselineVerdict,
+    Message,
     ExecStats,
     FaultEvent,
     FaultReport,
@@ -26,20 +27,23 @@ from interfaces.messages import (
 )
 from interfaces.scenario import Scenario
 
+M = TypeVar("M", bound=Message)
+
 NAV_SETTLE_S = 10.0
 """Nav statistics skip the filter's first seconds (initial transient)."""
 
 
 def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[str, Any]:
     """The run's figures from its archive (no transport or wall-clock information)."""
-    ticks = archive.messages(topics.tick(mission), Tick)
-    execs = {m.node: m for m in archive.messages(f"{topics.ROOT}/{mission}/**/exec/stats", ExecStats)}
-    links = {m.node: m for m in archive.messages(f"{topics.ROOT}/{mission}/**/bus/link_stats", LinkStats)}
+    ticks = [r for r in archive.records(topics.tick(mission)) if r.type_name == Tick.__name__]
+    last_tick = ticks[-1].message() if ticks else None
+    execs = _last_per_key(archive, f"{topics.ROOT}/{mission}/**/exec/stats", ExecStats)
+    links = _last_per_key(archive, f"{topics.ROOT}/{mission}/**/bus/link_stats", LinkStats)
     tlm = archive.messages(topics.key(mission, topics.GROUND, "tlm", "status"), TelemetryStatus)
     sim = archive.messages(topics.sim_status(mission), SimStatus)
     return {
         "ticks": len(ticks),
-        "t_sim_final_s": ticks[-1].t_sim if ticks else 0.0,
+        "t_sim_final_s": last_tick.t_sim if last_tick is not None else 0.0,
         "messages": {"total": len(archive), "by_type": _by_type(archive)},
         "nav": {str(sc): e.stats(skip_s=NAV_SETTLE_S)
                 for sc, e in nav_errors(archive, mission).items()},
@@ -118,10 +122,23 @@ def _by_type(archive: RunArchive) -> dict[str, int]:
     return dict(sorted(out.items()))
 
 
+def _last_per_key(archive: RunArchive, key_expr: str, model: type[M]) -> dict[str, M]:
+    """The last message of each matching key, by its node (cumulative counters: only the last
+    one counts, so only it is decoded)."""
+    last: dict[str, Record] = {}
+    for rec in archive.records(key_expr):
+        if rec.type_name == model.__name__:
+            last[rec.key] = rec
+    msgs = [model.model_validate_json(r.payload) for r in last.values()]
+    return {m.node: m for m in msgs}  # type: ignore[attr-defined]
+
+
 def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, status: str,
-                  error: str | None = None, mission: str | None = None) -> dict[str, Any]:
+                  error: str | None = None, mission: str | None = None,
+                  archive: RunArchive | None = None) -> dict[str, Any]:
     """Write ``<out>/summary.json`` and return it.  A damaged or missing archive is reported in
-    the summary (``archive_error``), never hidden."""
+    the summary (``archive_error``), never hidden.  ``archive``: the run's archive already read
+    (the report then reuses its decoded messages), else ``<out>/run.mcap`` is read."""
     summary: dict[str, Any] = {
         "scenario": scenario.name,
         "seed": scenario.seed,
@@ -133,7 +150,7 @@ def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, 
         "injected_faults": [f.model_dump() for f in scenario.faults],
     }
     try:
-        archive = load_run(out / "run.mcap")
+        archive = archive or load_run(out / "run.mcap")
         summary["archive"] = {"truncated": archive.truncated}
         summary.update(build_summary(archive, scenario, mission or scenario.name))
         t_final = summary["t_sim_final_s"]
