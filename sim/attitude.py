@@ -36,6 +36,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
+from sim import kernels
+
 __all__ = ["AttitudeTruth"]
 
 FloatArray = npt.NDArray[np.float64]
@@ -76,6 +78,7 @@ class AttitudeTruth:
         J: npt.ArrayLike,
         h0: npt.ArrayLike,
         t0_s: float = 0.0,
+        compiled: bool = True,
     ) -> None:
         """Initialise the truth state.
 
@@ -86,7 +89,10 @@ class AttitudeTruth:
             J: inertia, kg·m², (3, 3) shared by all or (N, 3, 3); symmetric positive definite.
             h0: initial wheel momenta, body axes (N, 3), N·m·s.
             t0_s: initial time, s.
+            compiled: integrate with the compiled kernel (:func:`sim.kernels.attitude_rk4`);
+                False runs the numpy reference (:meth:`_rk4_numpy`).
         """
+        self.compiled = compiled
         q = _as_stack("q0", q0, None, 4)
         norms = np.linalg.norm(q, axis=1)
         if np.any(norms < 1e-12):
@@ -200,11 +206,26 @@ class AttitudeTruth:
         tau = _as_stack("tau_body", tau_body, self.n, 3)
         ext = (np.zeros_like(tau) if tau_ext_body is None
                else _as_stack("tau_ext_body", tau_ext_body, self.n, 3))
-        hs = dt / int(substeps)
         tau_total = tau + ext
         y = np.concatenate((self._q, self._w, self._h), axis=1)
-        theta = np.zeros_like(self._w)
-        for _ in range(int(substeps)):
+        if self.compiled:
+            y, theta = kernels.attitude_rk4(y, self._J, self._Jinv, tau_total, tau, float(dt),
+                                            int(substeps))
+        else:
+            y, theta = self._rk4_numpy(y, tau_total, tau, dt, int(substeps))
+        q, w, h = y[:, 0:4].copy(), y[:, 4:7].copy(), y[:, 7:10].copy()
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))):
+            raise FloatingPointError("attitude truth diverged (non-finite state); reduce dt")
+        self._q, self._w, self._h = q, w, h
+        self._mean_rate = theta / dt
+        self.t_s += dt
+
+    def _rk4_numpy(self, y: FloatArray, tau_total: FloatArray, tau: FloatArray, dt: float,
+                   substeps: int) -> tuple[FloatArray, FloatArray]:
+        """The reference RK4 (numpy, vectorised over the spacecraft): (y, ∫w dt)."""
+        hs = dt / substeps
+        theta = np.zeros((y.shape[0], 3))
+        for _ in range(substeps):
             k1 = self._deriv(y, tau_total, tau)
             y2 = y + (0.5 * hs) * k1
             k2 = self._deriv(y2, tau_total, tau)
@@ -216,9 +237,4 @@ class AttitudeTruth:
             theta += (hs / 6.0) * (y[:, 4:7] + 2.0 * (y2[:, 4:7] + y3[:, 4:7]) + y4[:, 4:7])
             y = y + (hs / 6.0) * (k1 + 2.0 * (k2 + k3) + k4)
             y[:, 0:4] /= np.sqrt((y[:, 0:4] ** 2).sum(axis=1, keepdims=True))
-        q, w, h = y[:, 0:4].copy(), y[:, 4:7].copy(), y[:, 7:10].copy()
-        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(w))):
-            raise FloatingPointError("attitude truth diverged (non-finite state); reduce dt")
-        self._q, self._w, self._h = q, w, h
-        self._mean_rate = theta / dt
-        self.t_s += dt
+        return y, theta

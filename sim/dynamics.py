@@ -33,6 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from fsw.lib.constants import J2_EARTH, MU_EARTH_M3_S2, R_EARTH_M
+from sim import kernels
 
 __all__ = [
     "RelativeTruth",
@@ -361,6 +362,7 @@ class RelativeTruth:
         energy_match: bool = True,
         t0_s: float = 0.0,
         *,
+        compiled: bool = True,
         mu: float = MU_EARTH_M3_S2,
         r_earth: float = R_EARTH_M,
         j2_coeff: float = J2_EARTH,
@@ -376,6 +378,8 @@ class RelativeTruth:
                 deputies so that their two-body semi-major axes equal the
                 chief's (no secular drift of an HCW-designed PRO).
             t0_s: initial time, s.
+            compiled: integrate with the compiled kernel (:func:`sim.kernels.relative_rk4`);
+                False runs the numpy reference below.
             mu: gravitational parameter, m^3/s^2.
             r_earth: equatorial radius for J2, m.
             j2_coeff: J2 coefficient.
@@ -396,6 +400,7 @@ class RelativeTruth:
         self._j2 = bool(j2)
         self._j2_k = -1.5 * float(j2_coeff) * float(mu) * float(r_earth) ** 2
         self.t_s: float = float(t0_s)
+        self.compiled = compiled
 
     # ----- state access ---------------------------------------------------
 
@@ -490,6 +495,12 @@ class RelativeTruth:
         a: FloatArray | None = None
         if accel_lvlh is not None:
             a = np.broadcast_to(np.asarray(accel_lvlh, dtype=float), (self.n_deputies, 3))
+        if self.compiled:
+            accel = np.zeros((self.n_deputies, 3)) if a is None else np.ascontiguousarray(a)
+            self._y = kernels.relative_rk4(self._y, accel, a is not None, self._mu, self._j2,
+                                           self._j2_k, float(dt_s), int(substeps))
+            self.t_s += float(dt_s)
+            return
         h = float(dt_s) / substeps
         y = self._y
         f = self._deriv
