@@ -143,23 +143,25 @@ def bench_reference(quick: bool, tmp: Path, rows: list, res: dict) -> None:
                             str(duration)], cwd=REPO, check=True, capture_output=True)
             report_s = time.perf_counter() - t0
             res["summary_and_report_s"] = report_s
-            rows.append(("  summary + report from the archive", f"{report_s:.1f} s",
-                         ratio(report_s, TARGETS["report_s"], False)))
+            target = TARGETS["report_s"] * duration / TWO_ORBITS_S  # the target is for two orbits
+            rows.append(("  summary + report from the archive",
+                         f"{report_s:.1f} s (target {target:.1f} s for {duration:.0f} s)",
+                         ratio(report_s, target, False)))
 
 
 _REPORT_AGAIN = """
 import sys
 from pathlib import Path
-from ground.reader import load_run
+from ground.digest import digest_run
 from ground.report import write_report
 from ground.summary import write_summary
 from interfaces.scenario import load_scenario
 out, scen, dur = Path(sys.argv[1]), load_scenario(sys.argv[2]), float(sys.argv[3])
 scen = scen.with_overrides(None, dur)
-archive = load_run(out / "run.mcap")
+digest = digest_run(out / "run.mcap", scen, scen.name)
 write_summary(out, scen, transport="inproc", wall_s=1.0, status="completed", error=None,
-              mission=scen.name, archive=archive)
-write_report(out, scen, scen.name, archive=archive)
+              mission=scen.name, digest=digest)
+write_report(out, scen, scen.name, digest=digest)
 """
 
 

@@ -32,7 +32,8 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.processes import Child, Supervisor  # noqa: E402
-from ground.reader import ArchiveError, RunArchive, load_run  # noqa: E402
+from ground.digest import RunDigest, digest_run  # noqa: E402
+from ground.reader import ArchiveError  # noqa: E402
 from ground.record import run_metadata  # noqa: E402
 from ground.recorder import McapRecorder  # noqa: E402
 from ground.report import write_report  # noqa: E402
@@ -103,13 +104,13 @@ def main(argv: list[str] | None = None) -> int:
             if main_thread:
                 signal.signal(signal.SIGTERM, previous)
     wall_s = time.monotonic() - wall0
-    archive = _read_archive(out)
+    digest = _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
-                            status=status, error=error, mission=mission, archive=archive)
+                            status=status, error=error, mission=mission, digest=digest)
     if args.compare_recovery and status == "completed":
         summary = _compare_recovery(scenario, mission, out, scenario_text, args, summary)
     if not args.no_report:
-        write_report(out, scenario, mission, archive=archive)
+        write_report(out, scenario, mission, digest=digest)
     rtf = summary.get("real_time_factor")
     print(f"{status}: {scenario.name} seed {scenario.seed}, {scenario.duration_s:.0f} s simulated in "
           f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time)" if rtf else "") + f"\n  {out}/run.mcap"
@@ -119,11 +120,11 @@ def main(argv: list[str] | None = None) -> int:
     return 0 if status == "completed" else 1
 
 
-def _read_archive(out: Path) -> RunArchive | None:
+def _read_archive(out: Path, scenario: Scenario, mission: str) -> RunDigest | None:
     """The run's archive, read once for the summary and the report (None if it cannot be read:
     the summary then reports why)."""
     try:
-        return load_run(out / "run.mcap")
+        return digest_run(out / "run.mcap", scenario, mission)
     except (ArchiveError, OSError):
         return None
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from fsw.lib.poi_map import PoiMap
-from ground.reader import RunArchive
+from ground.reader import Record, RunArchive
 from interfaces import topics
 from interfaces.messages import AssignmentDecision, CameraImage, InfoCostTelemetry
 from interfaces.scenario import Scenario
@@ -26,31 +26,65 @@ class Coverage:
     decisions: list[AssignmentDecision] = field(default_factory=list)
 
 
+def camera_images(mission: str) -> str:
+    """Key expression of the sim's camera images (the truth of what was observed)."""
+    return f"{topics.ROOT}/{mission}/sim/sensors/*/camera"
+
+
+@dataclass
+class CoverageFuser:
+    """Fuses camera images one at a time, in time order, into the coverage H(t): the images of a
+    long run need not be held at once (``load_run(stream={camera_images(m): fuser.add_record})``;
+    the sim publishes them in time order, spacecraft by spacecraft, and the archive keeps that
+    order)."""
+
+    scenario: Scenario
+    sample_every_s: float = 10.0
+
+    def __post_init__(self) -> None:
+        tgt = self.scenario.target
+        self.fused = PoiMap.uniform(tgt.pois, tgt.prior_variance, self.scenario.observers.count)
+        self.out = Coverage(h_initial=self.fused.cost())
+        self._next_sample = 0.0
+        self._last_t = 0.0
+
+    def add(self, img: CameraImage) -> None:
+        """Fuse one image (H is sampled before the first image at or after each sample time)."""
+        if img.t_sim >= self._next_sample - 1e-9:
+            self.out.t_s.append(img.t_sim)
+            self.out.h.append(self.fused.cost())
+            self._next_sample = img.t_sim + self.sample_every_s
+        self.fused.add(img.spacecraft, img.poi, img.precision)
+        self._last_t = img.t_sim
+
+    def add_record(self, rec: Record) -> None:
+        """Decode an archived image and fuse it."""
+        self.add(rec.decode(CameraImage))
+
+    def finish(self, archive: RunArchive, mission: str) -> Coverage:
+        """The coverage, with each observer's H_i telemetry and the ground's orbit decisions
+        from ``archive``."""
+        out = self.out
+        out.t_s.append(self._last_t)
+        out.h.append(self.fused.cost())
+        out.fraction_observed = self.fused.seen() / self.scenario.target.pois
+        for tm in archive.messages(topics.all_spacecraft(mission, "infocost", "telemetry"),
+                                   InfoCostTelemetry):
+            ts, hs = out.h_i.setdefault(tm.spacecraft, ([], []))
+            ts.append(tm.t_sim)
+            hs.append(tm.h_i)
+        out.decisions = archive.messages(topics.assignment_decisions(mission), AssignmentDecision)
+        return out
+
+
 def coverage(archive: RunArchive, scenario: Scenario, mission: str,
              sample_every_s: float = 10.0) -> Coverage:
     """Fuse every camera image in time order; sample H every ``sample_every_s``."""
-    tgt = scenario.target
-    fused = PoiMap.uniform(tgt.pois, tgt.prior_variance, scenario.observers.count)
-    out = Coverage(h_initial=fused.cost())
-    images = sorted(archive.messages(f"{topics.ROOT}/{mission}/sim/sensors/*/camera", CameraImage),
-                    key=lambda m: (m.t_sim, m.spacecraft))
-    next_sample = 0.0
-    for img in images:
-        if img.t_sim >= next_sample - 1e-9:
-            out.t_s.append(img.t_sim)
-            out.h.append(fused.cost())
-            next_sample = img.t_sim + sample_every_s
-        fused.add(img.spacecraft, img.poi, img.precision)
-    out.t_s.append(images[-1].t_sim if images else 0.0)
-    out.h.append(fused.cost())
-    out.fraction_observed = fused.seen() / tgt.pois
-    for tm in archive.messages(topics.all_spacecraft(mission, "infocost", "telemetry"),
-                               InfoCostTelemetry):
-        ts, hs = out.h_i.setdefault(tm.spacecraft, ([], []))
-        ts.append(tm.t_sim)
-        hs.append(tm.h_i)
-    out.decisions = archive.messages(topics.assignment_decisions(mission), AssignmentDecision)
-    return out
+    fuser = CoverageFuser(scenario, sample_every_s)
+    for img in sorted(archive.messages(camera_images(mission), CameraImage),
+                      key=lambda m: (m.t_sim, m.spacecraft)):
+        fuser.add(img)
+    return fuser.finish(archive, mission)
 
 
 def coverage_summary(c: Coverage) -> dict[str, float | dict[str, float]]:

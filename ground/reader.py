@@ -18,24 +18,38 @@ file whose writer was killed:
 * a file that does not start with the MCAP magic raises :class:`ArchiveError`.
 
 The archive is held in memory: :class:`Record` s ordered by log time (mission elapsed time, ns),
-ties in file order.  Records are filtered by key expression with
+ties in file order.  Keys given to ``load_run(stream=...)`` are not held: their records go, in
+file order, to a sink as they are read (a two-orbit run's camera images alone are 1.7 GB of
+JSON); they are counted all the same.  Records are filtered by key expression with
 :func:`interfaces.topics.matches` (``*`` one chunk, ``**`` any number) and decoded through the
 message registry on demand.
 """
 
 from __future__ import annotations
 
+import io
 import os
 import struct
 from dataclasses import dataclass
 from operator import attrgetter
 from pathlib import Path
+from collections.abc import Callable, Mapping
 from typing import IO, Final, TypeVar, overload
 
 import zstandard
 from mcap.exceptions import EndOfFile, McapError, RecordLengthLimitExceeded
-from mcap.records import Channel, Footer, Header, Message as McapMessage, Metadata, Schema
-from mcap.stream_reader import StreamReader
+from mcap.data_stream import ReadDataStream
+from mcap.opcode import Opcode
+from mcap.records import (
+    Channel,
+    Chunk,
+    Footer,
+    Header,
+    Metadata,
+    Schema,
+)
+from mcap.records import Message as McapMessage
+from mcap.stream_reader import StreamReader, get_chunk_data_stream
 from pydantic import ValidationError
 
 from interfaces.messages import Message, registry
@@ -73,6 +87,10 @@ class Record:
             raise ArchiveError(f"{self.key}: unknown message type {self.type_name!r}")
         return _decode(self, model)
 
+    def decode(self, model: type[M]) -> M:
+        """Decode the payload as ``model`` (:class:`ArchiveError` if it does not validate)."""
+        return _decode(self, model)
+
 
 @dataclass(frozen=True, slots=True)
 class SchemaInfo:
@@ -94,6 +112,10 @@ def _decode(record: Record, model: type[M]) -> M:
         ) from exc
 
 
+RecordSink = Callable[["Record"], None]
+"""Receives a streamed record (``load_run(stream=...)``)."""
+
+
 class RunArchive:
     """The content of one run archive (see the module docstring).
 
@@ -113,8 +135,10 @@ class RunArchive:
         stop_reason: str | None,
         library: str,
         profile: str,
+        streamed: dict[str, int] | None = None,
     ) -> None:
-        """Build from parsed content; ``records`` must already be in log-time order."""
+        """Build from parsed content; ``records`` must already be in log-time order;
+        ``streamed``: records per key handed to a sink at load and not held."""
         self.path = path
         self.metadata = metadata
         self.schemas = schemas
@@ -126,9 +150,10 @@ class RunArchive:
         self._channel_types = channel_types
         self._match_cache: dict[str, frozenset[str]] = {}
         self._decoded: dict[tuple[str, type[Message]], list[Message]] = {}
+        self._streamed = dict(streamed or {})
 
     def __len__(self) -> int:
-        return len(self._records)
+        return len(self._records) + sum(self._streamed.values())
 
     def __repr__(self) -> str:
         state = f"truncated ({self.stop_reason})" if self.truncated else "complete"
@@ -141,6 +166,7 @@ class RunArchive:
         type names joined by ``"|"``.
         """
         counts: dict[str, int] = dict.fromkeys(self._channel_types, 0)
+        counts.update(self._streamed)
         for rec in self._records:
             counts[rec.key] += 1
         return {
@@ -157,7 +183,11 @@ class RunArchive:
 
     def records(self, key_expr: str = "**") -> list[Record]:
         """Records whose key matches ``key_expr`` (e.g. ``"insp/m/sc/*/**"``), by log time then
-        file order."""
+        file order.  Keys streamed at load are not held: asking for one raises ArchiveError."""
+        gone = [k for k in self._streamed if matches(key_expr, k)]
+        if gone:
+            raise ArchiveError(f"{gone[0]} was streamed when the archive was read, not kept "
+                               f"(load_run(stream=...)); read the file again without it")
         if key_expr == "**":
             return list(self._records)
         keys = self._keys_matching(key_expr)
@@ -257,12 +287,122 @@ _READ_ERRORS: Final = (
 """What a damaged or cut MCAP stream can raise while being parsed."""
 
 
-def load_run(path: str | Path) -> RunArchive:
+_U64 = struct.Struct("<Q")
+_MESSAGE_HEAD = struct.Struct("<HIQQ")
+"""A Message record's fixed fields: channel id, sequence, log time, publish time (MCAP spec)."""
+
+_ChunkItem = tuple[int, int, int, bytes] | Channel | Schema
+"""What a chunk holds: a message as (channel id, log time, publish time, data), or a record."""
+
+
+def _chunk_items(chunk: Chunk) -> list[_ChunkItem]:
+    """The records of a chunk, decompressed and CRC-checked by the mcap library, split here with
+    one ``struct`` call per message (the library's per-field reads cost ~15 µs a message, most
+    of a long run's reading time).  A record that overruns the chunk raises: the chunk is
+    damaged and dropped whole."""
+    stream, size = get_chunk_data_stream(chunk, validate_crc=True)
+    data = stream.read(size)
+    items: list[_ChunkItem] = []
+    pos = 0
+    while pos < size:
+        opcode = data[pos]
+        (length,) = _U64.unpack_from(data, pos + 1)
+        start, pos = pos + 9, pos + 9 + length
+        if pos > size:
+            raise McapError("a record overruns its chunk")
+        if opcode == Opcode.MESSAGE:
+            channel_id, _, log_time, publish_time = _MESSAGE_HEAD.unpack_from(data, start)
+            items.append((channel_id, log_time, publish_time,
+                          data[start + _MESSAGE_HEAD.size:pos]))
+        elif opcode in (Opcode.CHANNEL, Opcode.SCHEMA):
+            body = ReadDataStream(io.BytesIO(data[start:pos]))
+            items.append(Channel.read(body) if opcode == Opcode.CHANNEL else Schema.read(body))
+    return items
+
+
+class _Loader:
+    """The state of one archive read: channels, schemas, kept records and streamed counts."""
+
+    def __init__(self, sinks: Mapping[str, RecordSink]) -> None:
+        self.sinks = dict(sinks)
+        self.schemas_by_id: dict[int, Schema] = {}
+        self.channels: dict[int, tuple[str, str, RecordSink | None]] = {}
+        self.channel_types: dict[str, list[str]] = {}
+        self.metadata: dict[str, dict[str, str]] = {}
+        self.records: list[Record] = []
+        self.streamed: dict[str, int] = {}
+        self.header: Header | None = None
+        self.footer_seen = False
+
+    def message(self, channel_id: int, log_time: int, publish_time: int, data: bytes
+                ) -> str | None:
+        """Keep or stream one message; a stop reason if its channel is unknown."""
+        channel = self.channels.get(channel_id)
+        if channel is None:  # a message before its channel: not MCAP-conformant
+            return f"message on unknown channel {channel_id}"
+        record = Record(channel[0], channel[1], log_time, publish_time, data)
+        sink = channel[2]
+        if sink is None:
+            self.records.append(record)
+        else:
+            self.streamed[record.key] = self.streamed.get(record.key, 0) + 1
+            sink(record)
+        return None
+
+    def item(self, rec: object) -> str | None:
+        """Take one record or chunk item; a stop reason if reading must stop."""
+        if isinstance(rec, tuple):
+            return self.message(*rec)
+        if isinstance(rec, McapMessage):
+            return self.message(rec.channel_id, rec.log_time, rec.publish_time, rec.data)
+        if isinstance(rec, Channel):
+            schema = self.schemas_by_id.get(rec.schema_id)
+            type_name = schema.name if schema is not None else ""
+            if rec.id not in self.channels:
+                self.channel_types.setdefault(rec.topic, []).append(type_name)
+            sink = next((f for e, f in self.sinks.items() if matches(e, rec.topic)), None)
+            self.channels[rec.id] = (rec.topic, type_name, sink)
+        elif isinstance(rec, Schema):
+            self.schemas_by_id[rec.id] = rec
+        elif isinstance(rec, Metadata):
+            self.metadata[rec.name] = dict(rec.metadata)
+        elif isinstance(rec, Header):
+            self.header = rec
+        elif isinstance(rec, Footer):
+            self.footer_seen = True
+        return None
+
+
+def _read_records(reader: StreamReader, loader: _Loader) -> str | None:
+    """Feed every record of the file to ``loader``; the reason reading stopped early, if it
+    did (a chunk is taken whole or not at all)."""
+    stream = iter(reader.records)
+    while True:
+        try:
+            rec = next(stream)
+            items = _chunk_items(rec) if isinstance(rec, Chunk) else [rec]
+        except StopIteration:
+            return None
+        except (EndOfFile, RecordLengthLimitExceeded):  # the limit is the file size
+            return "file ends before its footer (writer killed or still running)"
+        except _READ_ERRORS as exc:
+            return f"damaged record: {type(exc).__name__}: {exc}"
+        for item in items:
+            stop = loader.item(item)
+            if stop is not None:
+                return stop
+
+
+def load_run(path: str | Path, stream: Mapping[str, RecordSink] | None = None) -> RunArchive:
     """Read a run archive (complete or cut short by a kill); see the module docstring.
+
+    ``stream`` maps key expressions to sinks: a record of a matching key (the first matching
+    expression decides) goes to its sink as it is read, in file order, and is not kept.
 
     Raises :class:`ArchiveError` if the file is not MCAP, ``OSError`` if it cannot be read.
     """
     path = Path(path)
+    loader = _Loader(stream or {})
     with open(path, "rb") as file:
         head = file.read(len(MCAP_MAGIC))
         if head != MCAP_MAGIC:
@@ -274,71 +414,31 @@ def load_run(path: str | Path) -> RunArchive:
         reader = StreamReader(
             _ExactReader(file),  # type: ignore[arg-type]  # duck-typed binary stream
             skip_magic=False,
-            emit_chunks=False,
+            emit_chunks=True,
             validate_crcs=True,
             record_size_limit=max(size, 1),
         )
-
-        schemas_by_id: dict[int, Schema] = {}
-        channels: dict[int, tuple[str, str]] = {}  # id -> (topic, schema name)
-        channel_types: dict[str, list[str]] = {}
-        metadata: dict[str, dict[str, str]] = {}
-        records: list[Record] = []
-        header: Header | None = None
-        footer_seen = False
-        stop_reason: str | None = None
-
-        stream = iter(reader.records)
-        while True:
-            try:
-                rec = next(stream)
-            except StopIteration:
-                break
-            except (EndOfFile, RecordLengthLimitExceeded):  # the limit is the file size
-                stop_reason = "file ends before its footer (writer killed or still running)"
-                break
-            except _READ_ERRORS as exc:
-                stop_reason = f"damaged record: {type(exc).__name__}: {exc}"
-                break
-            if isinstance(rec, McapMessage):
-                channel = channels.get(rec.channel_id)
-                if channel is None:  # a message before its channel: not MCAP-conformant
-                    stop_reason = f"message on unknown channel {rec.channel_id}"
-                    break
-                records.append(
-                    Record(channel[0], channel[1], rec.log_time, rec.publish_time, rec.data)
-                )
-            elif isinstance(rec, Channel):
-                schema = schemas_by_id.get(rec.schema_id)
-                type_name = schema.name if schema is not None else ""
-                if rec.id not in channels:
-                    channel_types.setdefault(rec.topic, []).append(type_name)
-                channels[rec.id] = (rec.topic, type_name)
-            elif isinstance(rec, Schema):
-                schemas_by_id[rec.id] = rec
-            elif isinstance(rec, Metadata):
-                metadata[rec.name] = dict(rec.metadata)
-            elif isinstance(rec, Header):
-                header = rec
-            elif isinstance(rec, Footer):
-                footer_seen = True
-
-    truncated = stop_reason is not None or not footer_seen
+        stop_reason = _read_records(reader, loader)
+    truncated = stop_reason is not None or not loader.footer_seen
     if truncated and stop_reason is None:  # pragma: no cover - StreamReader stops at the footer
         stop_reason = "no footer"
-    records.sort(key=attrgetter("log_time_ns"))  # stable: ties keep file order
-    schemas = {s.name: SchemaInfo(s.name, s.encoding, s.data) for s in schemas_by_id.values()}
+    loader.records.sort(key=attrgetter("log_time_ns"))  # stable: ties keep file order
+    schemas = {s.name: SchemaInfo(s.name, s.encoding, s.data)
+               for s in loader.schemas_by_id.values()}
+    header = loader.header
     return RunArchive(
         path=path,
-        records=records,
-        channel_types=channel_types,
-        metadata=metadata,
+        records=loader.records,
+        channel_types=loader.channel_types,
+        metadata=loader.metadata,
         schemas=schemas,
         truncated=truncated,
         stop_reason=stop_reason,
         library=header.library if header is not None else "",
         profile=header.profile if header is not None else "",
+        streamed=loader.streamed,
     )
 
 
-__all__ = ["ArchiveError", "MCAP_MAGIC", "Record", "RunArchive", "SchemaInfo", "load_run"]
+__all__ = ["ArchiveError", "MCAP_MAGIC", "Record", "RecordSink", "RunArchive", "SchemaInfo",
+           "load_run"]

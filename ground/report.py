@@ -11,19 +11,20 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ground.coverage import Coverage, coverage  # noqa: E402
+from ground.coverage import Coverage  # noqa: E402
+from ground.digest import RunDigest, digest_run  # noqa: E402
 from ground.evaluation import NavErrors, nav_errors  # noqa: E402
 from ground.gnc_evaluation import GncSeries, gnc_series  # noqa: E402
-from ground.reader import ArchiveError, RunArchive, load_run  # noqa: E402
+from ground.reader import ArchiveError, RunArchive  # noqa: E402
 from interfaces import topics  # noqa: E402
 from interfaces.messages import FdirWindow, TruthState  # noqa: E402
 from interfaces.scenario import Scenario  # noqa: E402
 
 
 def write_report(out: Path, scenario: Scenario, mission: str | None = None,
-                 archive: RunArchive | None = None) -> Path:
+                 digest: RunDigest | None = None) -> Path:
     """Write ``<out>/report.md`` (and its plots) from ``run.mcap`` and ``summary.json``
-    (``archive``: the run's archive already read, e.g. by :func:`ground.summary.write_summary`)."""
+    (``digest``: the run's archive already read for the summary, ``ground.digest``)."""
     mission = mission or scenario.name
     summary = json.loads((out / "summary.json").read_text())
     lines = [f"# Run report: {scenario.name}", "",
@@ -35,14 +36,15 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     if summary.get("error"):
         lines += ["```", summary["error"], "```", ""]
     try:
-        archive = archive or load_run(out / "run.mcap")
+        digest = digest or digest_run(out / "run.mcap", scenario, mission)
     except (ArchiveError, OSError) as e:
         lines.append(f"The archive could not be read: {e}")
         return _write(out, lines)
+    archive = digest.archive
     lines += _trajectory_section(out, archive, mission)
     lines += _nav_section(out, nav_errors(archive, mission), summary)
     lines += _gnc_section(out, gnc_series(archive, scenario, mission), summary)
-    lines += _coverage_section(out, coverage(archive, scenario, mission), summary)
+    lines += _coverage_section(out, digest.coverage, summary)
     lines += _fdir_section(out, archive, mission, summary)
     lines += _links_section(summary) + _exec_section(summary)
     return _write(out, lines)

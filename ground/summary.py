@@ -7,11 +7,12 @@ import math
 from pathlib import Path
 from typing import Any, TypeVar
 
-from ground.coverage import coverage, coverage_summary
+from ground.coverage import coverage_summary
+from ground.digest import RunDigest, digest_run
 from ground.evaluation import nav_errors
 from ground.fdir.scoring import Alarm, Judged, score
 from ground.gnc_evaluation import gnc_series, gnc_summary
-from ground.reader import ArchiveError, Record, RunArchive, load_run
+from ground.reader import ArchiveError, RunArchive
 from interfaces import topics
 from interfaces.messages import (
     BaselineVerdict,
@@ -33,22 +34,23 @@ NAV_SETTLE_S = 10.0
 """Nav statistics skip the filter's first seconds (initial transient)."""
 
 
-def build_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[str, Any]:
+def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[str, Any]:
     """The run's figures from its archive (no transport or wall-clock information)."""
-    ticks = [r for r in archive.records(topics.tick(mission)) if r.type_name == Tick.__name__]
-    last_tick = ticks[-1].message() if ticks else None
-    execs = _last_per_key(archive, f"{topics.ROOT}/{mission}/**/exec/stats", ExecStats)
-    links = _last_per_key(archive, f"{topics.ROOT}/{mission}/**/bus/link_stats", LinkStats)
+    archive = digest.archive
+    tick_key = (topics.tick(mission), Tick.__name__)
+    last_tick = digest.counters.last.get(tick_key)
+    execs = _last_of(digest, ExecStats)
+    links = _last_of(digest, LinkStats)
     tlm = archive.messages(topics.key(mission, topics.GROUND, "tlm", "status"), TelemetryStatus)
     sim = archive.messages(topics.sim_status(mission), SimStatus)
     return {
-        "ticks": len(ticks),
-        "t_sim_final_s": last_tick.t_sim if last_tick is not None else 0.0,
+        "ticks": digest.counters.counts.get(tick_key, 0),
+        "t_sim_final_s": last_tick.decode(Tick).t_sim if last_tick is not None else 0.0,
         "messages": {"total": len(archive), "by_type": _by_type(archive)},
         "nav": {str(sc): e.stats(skip_s=NAV_SETTLE_S)
                 for sc, e in nav_errors(archive, mission).items()},
         "gnc": gnc_summary(gnc_series(archive, scenario, mission)),
-        "coverage": coverage_summary(coverage(archive, scenario, mission)),
+        "coverage": coverage_summary(digest.coverage),
         "links": [c.model_dump() for node in sorted(links) for c in links[node].links],
         "exec": {node: {"cycle_slips": {g: s.cycle_slips for g, s in m.groups.items()},
                         "max_exec_ms": {g: round(s.max_exec_ms, 3) for g, s in m.groups.items()},
@@ -122,23 +124,19 @@ def _by_type(archive: RunArchive) -> dict[str, int]:
     return dict(sorted(out.items()))
 
 
-def _last_per_key(archive: RunArchive, key_expr: str, model: type[M]) -> dict[str, M]:
-    """The last message of each matching key, by its node (cumulative counters: only the last
-    one counts, so only it is decoded)."""
-    last: dict[str, Record] = {}
-    for rec in archive.records(key_expr):
-        if rec.type_name == model.__name__:
-            last[rec.key] = rec
-    msgs = [model.model_validate_json(r.payload) for r in last.values()]
+def _last_of(digest: RunDigest, model: type[M]) -> dict[str, M]:
+    """The last ``model`` message of each key, by node (cumulative counters)."""
+    msgs = [rec.decode(model) for (_, type_name), rec in digest.counters.last.items()
+            if type_name == model.__name__]
     return {m.node: m for m in msgs}  # type: ignore[attr-defined]
 
 
 def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, status: str,
                   error: str | None = None, mission: str | None = None,
-                  archive: RunArchive | None = None) -> dict[str, Any]:
+                  digest: RunDigest | None = None) -> dict[str, Any]:
     """Write ``<out>/summary.json`` and return it.  A damaged or missing archive is reported in
-    the summary (``archive_error``), never hidden.  ``archive``: the run's archive already read
-    (the report then reuses its decoded messages), else ``<out>/run.mcap`` is read."""
+    the summary (``archive_error``), never hidden.  ``digest``: the run's archive already read
+    (``ground.digest``; the report then reuses it), else ``<out>/run.mcap`` is read."""
     summary: dict[str, Any] = {
         "scenario": scenario.name,
         "seed": scenario.seed,
@@ -150,9 +148,10 @@ def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, 
         "injected_faults": [f.model_dump() for f in scenario.faults],
     }
     try:
-        archive = archive or load_run(out / "run.mcap")
-        summary["archive"] = {"truncated": archive.truncated}
-        summary.update(build_summary(archive, scenario, mission or scenario.name))
+        mission = mission or scenario.name
+        digest = digest or digest_run(out / "run.mcap", scenario, mission)
+        summary["archive"] = {"truncated": digest.archive.truncated}
+        summary.update(build_summary(digest, scenario, mission))
         t_final = summary["t_sim_final_s"]
         summary["real_time_factor"] = round(t_final / wall_s, 2) if wall_s > 0 else None
     except (ArchiveError, OSError) as e:

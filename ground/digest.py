@@ -1,0 +1,81 @@
+"""A run's archive read once, in one pass and bounded memory, for its summary and report.
+
+A two-orbit run archives about 4 GB of JSON, 1.7 GB of it camera images and as much again the
+observations that repeat them; held whole and decoded, the summary of such a run needed 13 GB.
+The digest keeps only what the summary and report read: the camera images are fused into the
+coverage as they stream past (:class:`ground.coverage.CoverageFuser`), the cumulative counters
+(ticks, executive and link statistics) keep their last record, and the bulk neither reads
+(observations, attitude sensors, wheel commands, lockstep answers, heartbeats) is counted and
+dropped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ground.coverage import Coverage, CoverageFuser, camera_images, coverage
+from ground.reader import Record, RunArchive, load_run
+from interfaces import topics
+from interfaces.scenario import Scenario
+
+
+@dataclass
+class LastRecords:
+    """A record sink keeping, per (key, type name), the last record and the count."""
+
+    last: dict[tuple[str, str], Record] = field(default_factory=dict)
+    counts: dict[tuple[str, str], int] = field(default_factory=dict)
+
+    def __call__(self, rec: Record) -> None:
+        k = (rec.key, rec.type_name)
+        self.last[k] = rec
+        self.counts[k] = self.counts.get(k, 0) + 1
+
+
+@dataclass
+class RunDigest:
+    """What a run's summary and report read: the archive without the bulk, the coverage, and the
+    last record (and count) of each tick and statistics key."""
+
+    archive: RunArchive
+    coverage: Coverage
+    counters: LastRecords
+
+
+def counter_keys(mission: str) -> list[str]:
+    """Keys whose last message is all that counts (cumulative) and the tick key (counted)."""
+    return [topics.tick(mission), f"{topics.ROOT}/{mission}/**/exec/stats",
+            f"{topics.ROOT}/{mission}/**/bus/link_stats"]
+
+
+def unread_keys(mission: str) -> list[str]:
+    """The bulk of an archive that neither the summary nor the report reads."""
+    root = f"{topics.ROOT}/{mission}"
+    return [f"{root}/sc/*/camera/observations", f"{root}/sim/sensors/*/attitude",
+            f"{root}/sim/sensors/*/relnav", f"{root}/sc/*/act/wheels",
+            f"{root}/**/exec/tick_done", f"{root}/**/exec/heartbeat"]
+
+
+def _drop(_rec: Record) -> None:
+    """Sink of the records nobody reads (they are still counted by the archive)."""
+
+
+def digest_run(path: Path, scenario: Scenario, mission: str) -> RunDigest:
+    """Read ``path`` once for the summary and report (see the module docstring)."""
+    fuser = CoverageFuser(scenario)
+    counters = LastRecords()
+    stream = {camera_images(mission): fuser.add_record,
+              **dict.fromkeys(counter_keys(mission), counters),
+              **dict.fromkeys(unread_keys(mission), _drop)}
+    archive = load_run(path, stream=stream)
+    return RunDigest(archive, fuser.finish(archive, mission), counters)
+
+
+def digest_archive(archive: RunArchive, scenario: Scenario, mission: str) -> RunDigest:
+    """The same from an archive already held whole."""
+    counters = LastRecords()
+    for expr in counter_keys(mission):
+        for rec in archive.records(expr):
+            counters(rec)
+    return RunDigest(archive, coverage(archive, scenario, mission), counters)

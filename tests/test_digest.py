@@ -1,0 +1,65 @@
+"""Reading an archive once for summary and report: streamed keys, the chunk reader, the digest."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from deploy.inproc import run_inproc
+from ground.digest import digest_archive, digest_run, unread_keys
+from ground.reader import ArchiveError, Record, load_run
+from ground.recorder import McapRecorder
+from ground.summary import build_summary
+from interfaces.scenario import Scenario, load_scenario
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Scenario]:
+    """A 40 s nominal run recorded through the in-process fast path, in small chunks."""
+    sc = load_scenario(REPO / "deploy" / "scenarios" / "nominal.toml").with_overrides(None, 40.0)
+    path = tmp_path_factory.mktemp("digest") / "run.mcap"
+    with McapRecorder(path, {}, chunk_size=64 * 1024) as rec:
+        run_inproc(sc, sample_tap=rec.record_sample)
+    return path, sc
+
+
+def test_chunk_reader_matches_the_mcap_library(run: tuple[Path, Scenario]) -> None:
+    path, _ = run
+    with open(path, "rb") as f:
+        lib = [(ch.topic, m.log_time, m.publish_time, m.data)
+               for _, ch, m in make_reader(f).iter_messages(log_time_order=False)]
+    ours = load_run(path)
+    in_file_order = sorted(ours.records(), key=lambda r: r.publish_time_ns)
+    assert len(lib) > 1000 and len(ours) == len(lib)
+    assert sorted(lib) == sorted((r.key, r.log_time_ns, r.publish_time_ns, r.payload)
+                                 for r in in_file_order)
+
+
+def test_streamed_keys_are_counted_not_kept(run: tuple[Path, Scenario]) -> None:
+    path, sc = run
+    seen: list[Record] = []
+    whole = load_run(path)
+    part = load_run(path, stream={e: seen.append for e in unread_keys(sc.name)})
+    assert len(part) == len(whole) and part.topics() == whole.topics()
+    streamed_keys = {r.key for r in seen}
+    assert any(k.endswith("/camera/observations") for k in streamed_keys)
+    assert len(seen) + len(part.records(f"insp/{sc.name}/sim/truth/**")) <= len(whole)
+    assert sorted(seen, key=lambda r: r.publish_time_ns) == sorted(
+        (r for r in whole.records() if r.key in streamed_keys), key=lambda r: r.publish_time_ns)
+    with pytest.raises(ArchiveError, match="streamed"):
+        part.records(f"insp/{sc.name}/sc/*/camera/observations")
+
+
+def test_digest_gives_the_summary_of_the_whole_archive(run: tuple[Path, Scenario]) -> None:
+    path, sc = run
+    streamed = digest_run(path, sc, sc.name)
+    whole = digest_archive(load_run(path), sc, sc.name)
+    assert streamed.coverage.t_s == whole.coverage.t_s
+    assert streamed.coverage.h == whole.coverage.h
+    assert streamed.coverage.h[-1] < streamed.coverage.h_initial  # the cameras saw something
+    assert streamed.counters.counts == whole.counters.counts
+    assert build_summary(streamed, sc, sc.name) == build_summary(whole, sc, sc.name)
