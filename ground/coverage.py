@@ -54,7 +54,7 @@ class CoverageFuser:
             self.out.t_s.append(img.t_sim)
             self.out.h.append(self.fused.cost())
             self._next_sample = img.t_sim + self.sample_every_s
-        self.fused.add(img.spacecraft, img.poi, img.precision)
+        self.fused.add(img.spacecraft, *img.arrays())
         self._last_t = img.t_sim
 
     def add_record(self, rec: Record) -> None:

@@ -16,7 +16,8 @@ from typing import Annotated, ClassVar, Literal
 
 import math
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec6 = Annotated[list[float], Field(min_length=6, max_length=6)]
@@ -142,11 +143,26 @@ class _PoiPrecisions(Message):
     poi: list[Annotated[int, Field(ge=0)]] = Field(max_length=1_000_000)
     precision: list[Annotated[float, Field(ge=0.0)]] = Field(max_length=1_000_000)
 
+    _arrays: tuple[list[int], np.ndarray, np.ndarray] | None = PrivateAttr(default=None)
+
     @model_validator(mode="after")
     def _same_length(self) -> _PoiPrecisions:
         if len(self.poi) != len(self.precision):
             raise ValueError("poi and precision must have the same length")
         return self
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """``poi`` (int64) and ``precision`` (float64) as read-only numpy arrays, converted once
+        per message: in one process every subscriber of the same message shares them."""
+        cached = self._arrays
+        if cached is None or cached[0] is not self.poi:  # a model_copy may carry another list
+            idx = np.asarray(self.poi, dtype=np.int64)
+            prec = np.asarray(self.precision, dtype=np.float64)
+            idx.setflags(write=False)
+            prec.setflags(write=False)
+            cached = (self.poi, idx, prec)
+            self.__pydantic_private__["_arrays"] = cached  # type: ignore[index]
+        return cached[1], cached[2]
 
 
 class CameraImage(_PoiPrecisions):

@@ -80,7 +80,7 @@ class CameraApp(App):
 
     def on_observations(self, msg: PoiObservations) -> None:
         if self.max_variance:  # the map only serves the max-variance choice
-            self.map.add(msg.spacecraft, msg.poi, msg.precision)
+            self.map.add(msg.spacecraft, *msg.arrays())
 
     def on_estimate(self, msg: StateEstimate) -> None:
         self._est = msg

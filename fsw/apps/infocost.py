@@ -42,7 +42,7 @@ class InfoCostApp(App):
         (fsw/faults.py)."""
 
     def on_observations(self, msg: PoiObservations) -> None:
-        self.map.add(msg.spacecraft, msg.poi, msg.precision)
+        self.map.add(msg.spacecraft, *msg.arrays())
         if msg.spacecraft == self.sc_id:
             self.images += 1
         else:

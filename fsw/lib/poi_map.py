@@ -54,7 +54,11 @@ class PoiMap:
             raise ValueError(f"agent {agent} outside 1..{self.n_agents}")
         if len(idx) and (idx.min() < 0 or idx.max() >= len(self.phi) or (prec < 0).any()):
             raise ValueError("POI index out of range or negative precision")
-        np.add.at(self.F[agent - 1], idx, prec)
+        row = self.F[agent - 1]
+        if len(idx) < 2 or bool((idx[1:] > idx[:-1]).all()):  # distinct (an image's POIs)
+            row[idx] += prec
+        else:
+            np.add.at(row, idx, prec)
 
     def variance(self) -> FloatArray:
         """Fused variance H_POI per POI (M,)."""

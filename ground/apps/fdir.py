@@ -254,7 +254,7 @@ class FdirApp(App):
         if msg.image_t_s >= self.window_start:
             self.pending.append(msg)
         else:  # too late for its window's verdict, not for the ground's map
-            self.settled.add(msg.spacecraft, msg.poi, msg.precision)
+            self.settled.add(msg.spacecraft, *msg.arrays())
 
     def on_transfer(self, msg: TransferPlanMsg) -> None:
         if msg.spacecraft not in self.observers or len(msg.t_s) < 2:
@@ -320,7 +320,7 @@ class FdirApp(App):
             obs.attitude.forget_before(b)
             obs.forget_guidance_before(b)
         for m in inside:
-            self.settled.add(m.spacecraft, m.poi, m.precision)
+            self.settled.add(m.spacecraft, *m.arrays())
         self.pending = [m for m in self.pending if m.image_t_s >= b]
         self._check_reports(b)
 
@@ -402,7 +402,7 @@ class FdirApp(App):
         if not images:
             self.publish("window", window)
             return
-        dh = sum(delta_h(psi[m.poi], phi[m.poi], np.array(m.precision)) for m in images)
+        dh = sum(delta_h(psi[poi], phi[poi], prec) for poi, prec in (m.arrays() for m in images))
         times = np.array([m.image_t_s for m in images])
         pos = plan.positions(self.n, times)
         bore = self._planned_boresights(obs, times, pos)
@@ -434,8 +434,8 @@ class FdirApp(App):
         is in the archive; the twin at the reported pose and the seen-set overlap only when the
         window exceeded its threshold (``gap`` = (ΔH_i, ΔH_i^pred))."""
         sc_cfg = self.ctx.scenario
-        fixes = [locate_camera(self.poi_pos[m.poi], np.array(m.precision), self.camera.k,
-                               sc_cfg.target.radius_m) for m in images]
+        fixes = [locate_camera(self.poi_pos[poi], prec, self.camera.k, sc_cfg.target.radius_m)
+                 for poi, prec in (m.arrays() for m in images)]
         nav = obs.nav.at(times)
         att = obs.attitude.at(times)
         located = [(i, f) for i, f in enumerate(fixes) if f is not None]

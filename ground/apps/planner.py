@@ -56,7 +56,7 @@ class MissionPlanner(App):
 
     def on_observations(self, msg: PoiObservations) -> None:
         if msg.spacecraft <= self.map.n_agents:
-            self.map.add(msg.spacecraft, msg.poi, msg.precision)
+            self.map.add(msg.spacecraft, *msg.arrays())
 
     def on_fault(self, msg: FaultReport) -> None:
         if self.ctx.scenario.fdir.recovery:
