@@ -35,7 +35,7 @@ from deploy.processes import Child, Supervisor  # noqa: E402
 from ground.digest import RunDigest, digest_run  # noqa: E402
 from ground.reader import ArchiveError  # noqa: E402
 from ground.record import run_metadata  # noqa: E402
-from ground.recorder import McapRecorder  # noqa: E402
+from ground.recorder_process import RecorderProcess  # noqa: E402
 from ground.report import write_report  # noqa: E402
 from ground.summary import add_recovery_comparison, write_summary  # noqa: E402
 from interfaces import topics  # noqa: E402
@@ -136,7 +136,7 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
     if args.realtime:
         log.warning("--realtime is ignored with --transport inproc (lockstep only)")
     live = _live_view(args)
-    with McapRecorder(out / "run.mcap", run_metadata(scenario, "inproc", scenario_text)) as rec:
+    with RecorderProcess(out / "run.mcap", run_metadata(scenario, "inproc", scenario_text)) as rec:
         def tap(sample: Sample) -> None:
             rec.record_sample(sample)
             if live is not None:

@@ -72,9 +72,28 @@ _MAX_U64: Final = 0xFFFFFFFFFFFFFFFF
 _MAX_PENDING: Final = 10_000
 """Samples waiting for the writing thread above which ``record`` blocks (back-pressure)."""
 
-_Pending = tuple[str, str, bytes, int | None, bool, int | None, int, int]
+Pending = tuple[str, str, bytes, int | None, bool, int | None, int, int]
 """A sample waiting to be written: key, type name, payload, explicit log time, is a JSON object,
 t_sim in ns, MCAP sequence, publish time."""
+
+
+def prepare_sample(sample: Sample) -> Pending | None:
+    """A sample that carries its validated message (in-process transport), ready to write: its
+    sim time and sequence number are the message's own, its JSON bytes encoded once for every
+    raw consumer.  None for bytes alone (or out-of-range times), which take
+    :meth:`McapRecorder.record`'s path: parsed, never trusted."""
+    msg = sample.message
+    if msg is None or not 0.0 <= msg.t_sim <= _MAX_T_SIM_S or msg.seq > _MAX_U32:
+        return None
+    return (sample.key[:_MAX_KEY_CHARS], sample.type_name[:_MAX_TYPE_CHARS], sample.payload,
+            None, True, round(msg.t_sim * 1e9), msg.seq, time.time_ns())
+
+
+def prepare_raw(key: str, type_name: str, payload: bytes) -> Pending:
+    """A raw sample ready to write (its payload parsed for t_sim and seq, never trusted)."""
+    is_object, t_ns, sequence = _parse_payload(payload)
+    return (key[:_MAX_KEY_CHARS], type_name[:_MAX_TYPE_CHARS], payload, None, is_object, t_ns,
+            sequence, time.time_ns())
 
 
 class _UnbufferedSink:
@@ -230,7 +249,7 @@ class McapRecorder:
         self._dropped = 0
         self._after_close = 0
         self._closed = False
-        self._pending: deque[_Pending] = deque()
+        self._pending: deque[Pending] = deque()
         self._sink = _UnbufferedSink(self._path)
         try:
             self._writer = Writer(
@@ -285,13 +304,16 @@ class McapRecorder:
         (in-process transport) is stored from the message's own sim time and sequence number,
         with the JSON bytes encoded once for every raw consumer; bytes alone take
         :meth:`record`'s path (parsed, never trusted)."""
-        msg = sample.message
-        if msg is None or not 0.0 <= msg.t_sim <= _MAX_T_SIM_S or msg.seq > _MAX_U32:
+        pending = prepare_sample(sample)
+        if pending is None:
             self.record(sample.key, sample.type_name, sample.payload)
             return
-        self._pending.append((sample.key[:_MAX_KEY_CHARS], sample.type_name[:_MAX_TYPE_CHARS],
-                              sample.payload, None, True, round(msg.t_sim * 1e9), msg.seq,
-                              time.time_ns()))
+        self._pending.append(pending)
+        self._drain()
+
+    def record_prepared(self, batch: list[Pending]) -> None:
+        """Record samples already prepared by :func:`prepare_sample` (the recorder process)."""
+        self._pending.extend(batch)
         self._drain()
 
     def _drain(self) -> None:
@@ -501,4 +523,5 @@ class McapRecorder:
         return f"McapRecorder({str(self._path)!r}, {state}, recorded={self._recorded})"
 
 
-__all__ = ["LIBRARY", "McapRecorder", "MESSAGE_ENCODING", "SCHEMA_ENCODING"]
+__all__ = ["LIBRARY", "McapRecorder", "MESSAGE_ENCODING", "Pending", "SCHEMA_ENCODING",
+           "prepare_raw", "prepare_sample"]
