@@ -23,6 +23,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
+from interfaces import catalogue as cat  # noqa: E402
 from interfaces import topics  # noqa: E402
 from interfaces.bus import Bus  # noqa: E402
 from interfaces.messages import Tick, TickDone  # noqa: E402
@@ -41,14 +42,14 @@ def echo(node: str, endpoint: str) -> None:
     """A node that answers every tick at once, until the final tick."""
     bus = Bus(node, MISSION, ZenohTransport(ZenohSettings(connect=(endpoint,))))
     done = threading.Event()
-    key = topics.tick_done(MISSION, node)
+    key = cat.TICK_DONE.key(MISSION, node)
 
     def on_tick(t: Tick) -> None:
         bus.publish(key, TickDone(sender=node, t_sim=t.t_sim, k=t.k), announce=False)
         if t.final:
             done.set()
 
-    bus.subscribe(topics.tick(MISSION), Tick, on_tick, immediate=True)
+    bus.subscribe(cat.TICK.key(MISSION), Tick, on_tick, immediate=True)
     bus.declare_alive()
     done.wait(600.0)
     time.sleep(0.2)
@@ -75,7 +76,7 @@ def ticker(nodes: list[str], ticks: int, endpoint: str) -> float:
             cond.notify_all()
 
     for n in nodes:
-        bus.subscribe(topics.tick_done(MISSION, n), TickDone, on_done, immediate=True)
+        bus.subscribe(cat.TICK_DONE.key(MISSION, n), TickDone, on_done, immediate=True)
     bus.watch_alive(on_alive)
     with cond:
         if not cond.wait_for(lambda: set(nodes) <= alive, timeout=60.0):
@@ -86,7 +87,7 @@ def ticker(nodes: list[str], ticks: int, endpoint: str) -> float:
         with cond:
             answered.clear()
             state["k"] = k
-        bus.publish(topics.tick(MISSION), Tick(sender=topics.SIM, t_sim=0.1 * k, k=k, dt_s=0.1,
+        bus.publish(cat.TICK.key(MISSION), Tick(sender=topics.SIM, t_sim=0.1 * k, k=k, dt_s=0.1,
                                                final=k == ticks - 1), announce=False)
         with cond:
             if not cond.wait_for(lambda: len(answered) == len(nodes), timeout=10.0):

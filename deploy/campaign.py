@@ -312,7 +312,6 @@ def _finish(spec: RunSpec, partial: Path, final: Path, transport: str) -> None:
 def record_failure(spec: RunSpec, out_root: str, error: str) -> dict[str, Any]:
     """Record a run whose job died outside the run itself (a worker killed, a disk full...) as
     finished and failed, with its error; returns its result."""
-    import shutil
 
     runs = Path(out_root) / "runs"
     partial = _attempt_dir(runs, spec.id, "failed")

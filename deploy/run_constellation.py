@@ -38,6 +38,7 @@ from ground.record import run_metadata  # noqa: E402
 from ground.recorder_process import RecorderProcess  # noqa: E402
 from ground.report import write_report  # noqa: E402
 from ground.summary import add_recovery_comparison, write_summary  # noqa: E402
+from interfaces import catalogue as cat  # noqa: E402
 from interfaces import topics  # noqa: E402
 from interfaces.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
@@ -188,9 +189,9 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
     progress = _Progress(scenario)
     live = None
     try:
-        hub.session.declare_subscriber(topics.key(mission, topics.GROUND, "exec", "heartbeat"),
+        hub.session.declare_subscriber(cat.HEARTBEAT.key(mission, topics.GROUND),
                                        progress.on_heartbeat)
-        hub.session.declare_subscriber(topics.sim_status(mission), progress.on_status)
+        hub.session.declare_subscriber(cat.SIM_STATUS.key(mission), progress.on_status)
         live = _live_view(args)
         if live is not None:
             hub.subscribe(topics.mission_wildcard(mission), live.forward)

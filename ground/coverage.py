@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 
 from fsw.lib.poi_map import PoiMap
 from ground.reader import Record, RunArchive
-from interfaces import topics
-from interfaces.messages import AssignmentDecision, CameraImage, InfoCostTelemetry
+from interfaces import catalogue as cat
+from interfaces.messages import AssignmentDecision, CameraImage
 from interfaces.scenario import Scenario
 
 
@@ -28,7 +28,7 @@ class Coverage:
 
 def camera_images(mission: str) -> str:
     """Key expression of the sim's camera images (the truth of what was observed)."""
-    return f"{topics.ROOT}/{mission}/sim/sensors/*/camera"
+    return cat.CAMERA_IMAGE.every(mission)
 
 
 @dataclass
@@ -68,12 +68,11 @@ class CoverageFuser:
         out.t_s.append(self._last_t)
         out.h.append(self.fused.cost())
         out.fraction_observed = self.fused.seen() / self.scenario.target.pois
-        for tm in archive.messages(topics.all_spacecraft(mission, "infocost", "telemetry"),
-                                   InfoCostTelemetry):
+        for tm in archive.of(cat.INFO_COST, mission):
             ts, hs = out.h_i.setdefault(tm.spacecraft, ([], []))
             ts.append(tm.t_sim)
             hs.append(tm.h_i)
-        out.decisions = archive.messages(topics.assignment_decisions(mission), AssignmentDecision)
+        out.decisions = archive.of(cat.DECISIONS, mission)
         return out
 
 

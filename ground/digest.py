@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ground.coverage import Coverage, CoverageFuser, camera_images, coverage
 from ground.reader import Record, RunArchive, load_run
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.scenario import Scenario
 
 
@@ -45,16 +45,13 @@ class RunDigest:
 
 def counter_keys(mission: str) -> list[str]:
     """Keys whose last message is all that counts (cumulative) and the tick key (counted)."""
-    return [topics.tick(mission), f"{topics.ROOT}/{mission}/**/exec/stats",
-            f"{topics.ROOT}/{mission}/**/bus/link_stats"]
+    return [cat.TICK.key(mission), cat.EXEC_STATS.every(mission), cat.LINK_STATS.every(mission)]
 
 
 def unread_keys(mission: str) -> list[str]:
     """The bulk of an archive that neither the summary nor the report reads."""
-    root = f"{topics.ROOT}/{mission}"
-    return [f"{root}/sc/*/camera/observations", f"{root}/sim/sensors/*/attitude",
-            f"{root}/sim/sensors/*/relnav", f"{root}/sc/*/act/wheels",
-            f"{root}/**/exec/tick_done", f"{root}/**/exec/heartbeat"]
+    return [t.every(mission) for t in (cat.OBSERVATIONS, cat.ATTITUDE_SENSORS, cat.RELNAV,
+                                       cat.WHEELS, cat.TICK_DONE, cat.HEARTBEAT)]
 
 
 def _drop(_rec: Record) -> None:

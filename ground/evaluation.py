@@ -9,8 +9,8 @@ from scipy.stats import chi2
 
 from fsw.lib.kalman import nees
 from ground.reader import RunArchive
-from interfaces import topics
-from interfaces.messages import StateEstimate, TruthState
+from interfaces import catalogue as cat
+from interfaces.messages import StateEstimate
 
 
 @dataclass(frozen=True)
@@ -46,11 +46,11 @@ class NavErrors:
 def nav_errors(archive: RunArchive, mission: str) -> dict[int, NavErrors]:
     """Per spacecraft, the state estimates compared with the truth at the same sim time."""
     truth: dict[float, tuple[list[int], np.ndarray]] = {}
-    for ts in archive.messages(topics.truth(mission), TruthState):
+    for ts in archive.of(cat.TRUTH, mission):
         truth[round(ts.t_sim, 6)] = (ts.spacecraft, np.hstack([ts.r_lvlh_m, ts.v_lvlh_mps]))
     out: dict[int, NavErrors] = {}
     by_sc: dict[int, list[StateEstimate]] = {}
-    for est in archive.messages(topics.all_spacecraft(mission, "nav", "estimate"), StateEstimate):
+    for est in archive.of(cat.NAV_ESTIMATE, mission):
         by_sc.setdefault(est.spacecraft, []).append(est)
     for sc, ests in sorted(by_sc.items()):
         rows = []

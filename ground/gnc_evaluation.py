@@ -19,12 +19,8 @@ from scipy.spatial.transform import Rotation
 
 from fsw.lib import hcw
 from ground.reader import RunArchive
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.messages import (
-    AttitudeEstimate,
-    GuidanceStatus,
-    ProAssignments,
-    TransferPlanMsg,
     TruthState,
 )
 from interfaces.scenario import Scenario
@@ -49,7 +45,7 @@ class GncSeries:
 
 
 def _truth_by_time(archive: RunArchive, mission: str) -> dict[float, TruthState]:
-    return {round(m.t_sim, 6): m for m in archive.messages(topics.truth(mission), TruthState)}
+    return {round(m.t_sim, 6): m for m in archive.of(cat.TRUTH, mission)}
 
 
 def gnc_series(archive: RunArchive, scenario: Scenario, mission: str) -> dict[int, GncSeries]:
@@ -68,9 +64,9 @@ def gnc_series(archive: RunArchive, scenario: Scenario, mission: str) -> dict[in
             s.range_min_m = min(s.range_min_m, float(np.linalg.norm(ts.r_lvlh_m[j])))
     _delta_v(truth, out, scenario.rates.mid_hz)
     assignments = {(a.spacecraft, a.assignment_id): a
-                   for m in archive.messages(topics.assignments(mission), ProAssignments)
+                   for m in archive.of(cat.ASSIGNMENTS, mission)
                    for a in m.assignments}
-    for st in archive.messages(topics.all_spacecraft(mission, "guidance", "status"), GuidanceStatus):
+    for st in archive.of(cat.GUIDANCE_STATUS, mission):
         s = out.get(st.spacecraft)
         tr = truth.get(round(st.t_sim, 6))
         if s is None:
@@ -86,12 +82,11 @@ def gnc_series(archive: RunArchive, scenario: Scenario, mission: str) -> dict[in
         r = np.array(tr.r_lvlh_m[tr.spacecraft.index(st.spacecraft)])
         s.hold_t_s.append(st.t_sim)
         s.hold_error_m.append(float(np.linalg.norm(r - ref[:3])))
-    for plan in archive.messages(topics.all_spacecraft(mission, "guidance", "plan"), TransferPlanMsg):
+    for plan in archive.of(cat.TRANSFER_PLAN, mission):
         if plan.spacecraft in out and plan.status == "solved":
             out[plan.spacecraft].dv_planned_mps += plan.dv_mps
             out[plan.spacecraft].transfers += 1
-    for est in archive.messages(topics.all_spacecraft(mission, "attitude", "estimate"),
-                                AttitudeEstimate):
+    for est in archive.of(cat.ATTITUDE_ESTIMATE, mission):
         s = out.get(est.spacecraft)
         tr = truth.get(round(est.t_sim, 6))
         if s is None or tr is None or est.spacecraft not in tr.spacecraft or not tr.q_lvlh_body:

@@ -52,6 +52,7 @@ from mcap.records import Message as McapMessage
 from mcap.stream_reader import StreamReader, get_chunk_data_stream
 from pydantic import ValidationError
 
+from interfaces.catalogue import Topic
 from interfaces.messages import Message, registry
 from interfaces.topics import matches
 
@@ -192,6 +193,10 @@ class RunArchive:
             return list(self._records)
         keys = self._keys_matching(key_expr)
         return [r for r in self._records if r.key in keys]
+
+    def of(self, topic: Topic[M], mission: str) -> list[M]:
+        """Decoded messages of a catalogued topic from every publisher of ``mission``."""
+        return self.messages(topic.every(mission), topic.type)
 
     @overload
     def messages(

@@ -16,8 +16,8 @@ from ground.digest import RunDigest, digest_run  # noqa: E402
 from ground.evaluation import NavErrors, nav_errors  # noqa: E402
 from ground.gnc_evaluation import GncSeries, gnc_series  # noqa: E402
 from ground.reader import ArchiveError, RunArchive  # noqa: E402
-from interfaces import topics  # noqa: E402
-from interfaces.messages import FdirWindow, TruthState  # noqa: E402
+from interfaces import catalogue as cat  # noqa: E402
+from interfaces.messages import FdirWindow  # noqa: E402
 from interfaces.scenario import Scenario  # noqa: E402
 
 
@@ -57,7 +57,7 @@ def _write(out: Path, lines: list[str]) -> Path:
 
 
 def _trajectory_section(out: Path, archive: RunArchive, mission: str) -> list[str]:
-    truth = archive.messages(topics.truth(mission), TruthState)
+    truth = archive.of(cat.TRUTH, mission)
     if not truth:
         return ["No truth recorded.", ""]
     r = np.array([t.r_lvlh_m for t in truth])  # (K, N, 3)
@@ -190,7 +190,7 @@ def _decision_rows(c: Coverage) -> list[str]:
 def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -> list[str]:
     """Per observer: log10 of the metric H_m,i against log10 of the threshold τ_i (as the
     paper's Fig. 23-26, right), fault onsets (red) and declared faults (black)."""
-    windows = archive.messages(topics.key(mission, topics.GROUND, "fdir", "window"), FdirWindow)
+    windows = archive.of(cat.FDIR_WINDOW, mission)
     judged = [w for w in windows if w.metric is not None and w.threshold is not None]
     if not judged:
         return ["No FDIR decision recorded.", ""]

@@ -13,17 +13,13 @@ from ground.evaluation import nav_errors
 from ground.fdir.scoring import Alarm, Judged, score
 from ground.gnc_evaluation import gnc_series, gnc_summary
 from ground.reader import ArchiveError, RunArchive
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.messages import (
     BaselineVerdict,
     Message,
     ExecStats,
-    FaultEvent,
-    FaultReport,
     FdirWindow,
     LinkStats,
-    SimStatus,
-    TelemetryStatus,
     Tick,
 )
 from interfaces.scenario import Scenario
@@ -37,12 +33,12 @@ NAV_SETTLE_S = 10.0
 def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[str, Any]:
     """The run's figures from its archive (no transport or wall-clock information)."""
     archive = digest.archive
-    tick_key = (topics.tick(mission), Tick.__name__)
+    tick_key = (cat.TICK.key(mission), Tick.__name__)
     last_tick = digest.counters.last.get(tick_key)
     execs = _last_of(digest, ExecStats)
     links = _last_of(digest, LinkStats)
-    tlm = archive.messages(topics.key(mission, topics.GROUND, "tlm", "status"), TelemetryStatus)
-    sim = archive.messages(topics.sim_status(mission), SimStatus)
+    tlm = archive.of(cat.TLM_STATUS, mission)
+    sim = archive.of(cat.SIM_STATUS, mission)
     return {
         "ticks": digest.counters.counts.get(tick_key, 0),
         "t_sim_final_s": last_tick.decode(Tick).t_sim if last_tick is not None else 0.0,
@@ -60,7 +56,7 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[s
         "telemetry": [e.model_dump() for e in tlm[-1].entries] if tlm else [],
         "sim": {"rejected_commands": sim[-1].rejected_commands if sim else None},
         "fault_events": [e.model_dump(exclude={"sender", "seq", "t_wall"})
-                         for e in archive.messages(topics.fault_events(mission), FaultEvent)],
+                         for e in archive.of(cat.FAULT_EVENTS, mission)],
         **fdir_summary(archive, scenario, mission),
     }
 
@@ -68,10 +64,9 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[s
 def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[str, Any]:
     """``detections`` (the ground FDIR's fault reports) and ``scores`` against the injected
     faults (ground/fdir/scoring.py; grace of one FDI window)."""
-    reports = archive.messages(topics.key(mission, topics.GROUND, "fdir", "report"), FaultReport)
-    windows = archive.messages(topics.key(mission, topics.GROUND, "fdir", "window"), FdirWindow)
-    verdicts = archive.messages(topics.key(mission, topics.GROUND, "fdir", "baseline"),
-                                BaselineVerdict)
+    reports = archive.of(cat.FAULT_REPORT, mission)
+    windows = archive.of(cat.FDIR_WINDOW, mission)
+    verdicts = archive.of(cat.BASELINE, mission)
     alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class) for r in reports]
     judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
               if w.exceeded is not None]

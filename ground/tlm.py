@@ -14,7 +14,7 @@ import threading
 import time
 from dataclasses import dataclass
 
-from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport, type_of_encoding
+from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
 
 SKIP_FIELDS = {"sender", "seq", "t_sim", "t_wall"}
 

@@ -9,13 +9,13 @@ an app's step stays short.
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
 
 from interfaces.bus import Bus
+from interfaces.catalogue import Topic
 from interfaces.messages import Message, RateGroupName
 from interfaces.scenario import Scenario
 
@@ -38,25 +38,32 @@ class AppContext:
         return self.bus.mission
 
 
-TopicFn = Callable[[AppContext], str]
-
-
 @dataclass(frozen=True)
 class Input:
-    """A subscription: messages of ``msg_type`` on ``topic(ctx)`` go to method ``handler``."""
+    """A subscription: messages of ``topic`` go to method ``handler``.  ``every_spacecraft``:
+    from every spacecraft; otherwise the key that concerns this node (its own spacecraft's,
+    its hardware's sensors, or the sim's/ground's single key)."""
 
-    topic: TopicFn
-    msg_type: type[Message]
+    topic: Topic
     handler: str
+    every_spacecraft: bool = False
+
+    @property
+    def msg_type(self) -> type[Message]:
+        return self.topic.type
+
+    def key_expr(self, ctx: AppContext) -> str:
+        if self.every_spacecraft:
+            return self.topic.every_spacecraft(ctx.mission)
+        return self.topic.key(ctx.mission, ctx.node)
 
 
 @dataclass(frozen=True)
 class Output:
-    """A publication named ``name``: messages of ``msg_type`` on ``topic(ctx)``."""
+    """A publication named ``name`` on ``topic`` (in the app's own node's key space)."""
 
     name: str
-    topic: TopicFn
-    msg_type: type[Message]
+    topic: Topic
 
 
 class App:
@@ -70,12 +77,13 @@ class App:
     def __init__(self, ctx: AppContext) -> None:
         self.ctx = ctx
         self.log = ctx.log.getChild(self.NAME)
-        self._outputs = {o.name: (o.topic(ctx), o.msg_type) for o in self.OUTPUTS}
+        self._outputs = {o.name: (o.topic.key(ctx.mission, ctx.node), o.topic.type)
+                         for o in self.OUTPUTS}
 
     def wire(self) -> None:
         """Subscribe the declared inputs (called once by the executive)."""
         for i in self.INPUTS:
-            self.ctx.bus.subscribe(i.topic(self.ctx), i.msg_type, getattr(self, i.handler))
+            self.ctx.bus.subscribe(i.key_expr(self.ctx), i.msg_type, getattr(self, i.handler))
 
     def publish(self, name: str, msg: Message) -> None:
         """Publish on a declared output; anything else is a programming error."""

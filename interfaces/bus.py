@@ -3,6 +3,8 @@
 What the Bus guarantees, identically on every transport:
 
 * **Own key space.** A node publishes only under its own prefix (``topics.node_prefix``).
+* **Typed topics.** A key of the topic catalogue (``interfaces.catalogue``) is published and
+  subscribed with its catalogue type only; anything else is a programming error (TypeError).
 * **Sequence numbers.** Each key has its own sequence count starting at 1, set on publish.
 * **Validation where bytes come in.** A received payload that is not valid JSON of the subscribed
   model (wrong fields, NaN, oversize) is dropped, counted in ``invalid_dropped`` and logged;
@@ -31,7 +33,7 @@ from typing import TypeVar
 
 from pydantic import ValidationError
 
-from interfaces import topics
+from interfaces import catalogue, topics
 from interfaces.channel import ChannelModel, Verdict, applies
 from interfaces.messages import Message, TruthState, json_schema, registry, stamp
 from interfaces.transport import LivenessHandler, RawHandler, Sample, Transport
@@ -39,6 +41,8 @@ from interfaces.transport import LivenessHandler, RawHandler, Sample, Transport
 M = TypeVar("M", bound=Message)
 MAX_PAYLOAD_BYTES = 1 << 20
 _EPS_S = 1e-6
+_UNKNOWN = object()
+"""Marks a key not yet looked up in the catalogue."""
 
 
 @dataclass
@@ -87,6 +91,8 @@ class Bus:
     _pending: list[_Envelope] = field(default_factory=list)
     _received_seq: dict[str, int] = field(default_factory=dict)
     _await_cache: dict[str, bool] = field(default_factory=dict)
+    _key_types: dict[str, object] = field(default_factory=dict)
+    """Catalogue type of each key published or subscribed (None: not catalogued)."""
     _cond: threading.Condition = field(default_factory=threading.Condition)
 
     def __post_init__(self) -> None:
@@ -94,7 +100,8 @@ class Bus:
         if self.log is None:
             self.log = logging.getLogger(f"insp.bus.{self.node}")
         if self.channel is not None:
-            self.subscribe(topics.truth(self.mission), TruthState, self._on_truth, immediate=True)
+            self.subscribe(catalogue.TRUTH.key(self.mission), TruthState, self._on_truth,
+                           immediate=True)
 
     # --- publishing ------------------------------------------------------------------------
 
@@ -106,6 +113,7 @@ class Bus:
         messages that nobody must wait for)."""
         if not key.startswith(self.prefix + "/"):
             raise ValueError(f"node {self.node} may not publish on {key!r} (own space: {self.prefix})")
+        self._check_type(key, type(msg))
         seq = self._seq.get(key, 0) + 1
         self._seq[key] = seq
         if announce:
@@ -115,6 +123,15 @@ class Bus:
         for sub in self._local_subs(key):
             self._enqueue(_Envelope(msg, key, self.node, True, [sub]))
         self.transport.send(Sample(key, type(msg).__name__, message=msg))
+
+    def _check_type(self, key: str, msg_type: type[Message]) -> None:
+        """A catalogued key carries its catalogue type only (``interfaces.catalogue``)."""
+        expected = self._key_types.get(key, _UNKNOWN)
+        if expected is _UNKNOWN:
+            topic = catalogue.topic_of(key)
+            self._key_types[key] = expected = None if topic is None else topic.type
+        if expected is not None and msg_type is not expected:
+            raise TypeError(f"{key} carries {expected.__name__}, not {msg_type.__name__}")
 
     def published_since_last(self) -> dict[str, int]:
         """Keys published since the previous call, with their last sequence number."""
@@ -132,6 +149,7 @@ class Bus:
     ) -> None:
         """Deliver messages of ``msg_type`` on ``key_expr`` to ``handler``: at ``dispatch`` time
         (default) or at once on the transport thread (``immediate``)."""
+        self._check_type(key_expr, msg_type)
         sub = _Sub(key_expr, msg_type, handler, immediate)  # type: ignore[arg-type]
         group = self._groups.get(key_expr)
         if group is None:
@@ -141,6 +159,10 @@ class Bus:
         group.append(sub)
         self._local_cache.clear()
         self._await_cache.clear()
+
+    def subscriptions(self) -> dict[str, list[type[Message]]]:
+        """The typed subscriptions of this node: key expression -> subscribed message types."""
+        return {e: [s.msg_type for s in g] for e, g in self._groups.items()}
 
     def subscribe_raw(self, key_expr: str, handler: RawHandler) -> None:
         """Raw samples (key, type name, payload) at once, unvalidated (recorder, tools)."""

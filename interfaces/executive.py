@@ -17,10 +17,13 @@ import queue
 import threading
 import time
 from dataclasses import dataclass, field
+from typing import ClassVar
 
+from interfaces import catalogue as cat
 from interfaces import topics
 from interfaces.app import RATE_GROUPS, App
 from interfaces.bus import Bus
+from interfaces.catalogue import Topic
 from interfaces.messages import (
     ExecStats,
     GroupStats,
@@ -35,6 +38,12 @@ from interfaces.scenario import Scenario
 
 @dataclass(eq=False)
 class Executive:
+    """A node's rate-group executive (its own topics are declared for the wiring check; its
+    lockstep inputs are ``TickClient.SUBSCRIBES``)."""
+
+    PUBLISHES: ClassVar[tuple[Topic, ...]] = (
+        cat.TICK_DONE, cat.HEARTBEAT, cat.EXEC_STATS, cat.LINK_STATS)
+
     bus: Bus
     scenario: Scenario
     apps: list[App]
@@ -54,10 +63,8 @@ class Executive:
         self.ticks = 0
         m, n = self.bus.mission, self.bus.node
         self._keys = {
-            "done": topics.tick_done(m, n),
-            "heartbeat": topics.key(m, n, "exec", "heartbeat"),
-            "stats": topics.key(m, n, "exec", "stats"),
-            "links": topics.key(m, n, "bus", "link_stats"),
+            "done": cat.TICK_DONE.key(m, n), "heartbeat": cat.HEARTBEAT.key(m, n),
+            "stats": cat.EXEC_STATS.key(m, n), "links": cat.LINK_STATS.key(m, n),
         }
         for app in self.apps:
             app.wire()
@@ -121,6 +128,8 @@ class TickClient:
     Otherwise ticks queue up and ``serve()`` runs them on the calling (main) thread until the sim
     reports the run finished, or the sim's liveliness token disappears."""
 
+    SUBSCRIBES: ClassVar[tuple[Topic, ...]] = (cat.TICK, cat.SIM_STATUS)
+
     executive: Executive
     synchronous: bool = False
     _ticks: queue.Queue[Tick | None] = field(default_factory=queue.Queue)
@@ -129,8 +138,8 @@ class TickClient:
 
     def __post_init__(self) -> None:
         bus = self.executive.bus
-        bus.subscribe(topics.tick(bus.mission), Tick, self._on_tick, immediate=True)
-        bus.subscribe(topics.sim_status(bus.mission), SimStatus, self._on_status, immediate=True)
+        bus.subscribe(cat.TICK.key(bus.mission), Tick, self._on_tick, immediate=True)
+        bus.subscribe(cat.SIM_STATUS.key(bus.mission), SimStatus, self._on_status, immediate=True)
 
     def _on_tick(self, tick: Tick) -> None:
         if self.synchronous:

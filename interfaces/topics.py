@@ -72,53 +72,8 @@ def all_spacecraft(mission: str, *path: str) -> str:
     return "/".join((ROOT, mission, "sc", "*", *path))
 
 
-# Concrete keys used by the framework (apps build their own with ``key``).
-def tick(mission: str) -> str:
-    return key(mission, SIM, "clock", "tick")
-
-
-def sim_status(mission: str) -> str:
-    return key(mission, SIM, "clock", "status")
-
-
-def truth(mission: str) -> str:
-    return key(mission, SIM, "truth", "state")
-
-
-def fault_events(mission: str) -> str:
-    """Truth of the injected faults (on/off switches)."""
-    return key(mission, SIM, "truth", "faults")
-
-
-def relnav(mission: str, spacecraft: int) -> str:
-    return key(mission, SIM, "sensors", f"sc{spacecraft}", "relnav")
-
-
-def attitude_sensors(mission: str, spacecraft: int) -> str:
-    return key(mission, SIM, "sensors", f"sc{spacecraft}", "attitude")
-
-
-def camera_image(mission: str, spacecraft: int) -> str:
-    return key(mission, SIM, "sensors", f"sc{spacecraft}", "camera")
-
-
-def actuator(mission: str, spacecraft: int, device: str) -> str:
-    """Command to the hardware of a spacecraft: ``sc/<id>/act/<device>`` (thrust, wheels)."""
-    return key(mission, sc_node(spacecraft), "act", device)
-
-
-def assignments(mission: str) -> str:
-    """The ground's PRO assignments (mission planner, later orbit assignment)."""
-    return key(mission, GROUND, "planner", "assignments")
-
-
-def assignment_decisions(mission: str) -> str:
-    """The ground's information-driven orbit decisions (with their gains and bounds)."""
-    return key(mission, GROUND, "planner", "decisions")
-
-
-def tick_done(mission: str, node: str) -> str:
-    return key(mission, node, "exec", "tick_done")
+# The message topics and their types are in ``interfaces.catalogue``; the keys below carry no
+# message (services and liveliness).
 
 
 def schema_queryable(mission: str, node: str) -> str:

@@ -14,6 +14,7 @@ import logging
 import threading
 import time
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -24,8 +25,10 @@ from fsw.lib import quat
 from fsw.lib.hcw import mean_motion, pro_state
 from fsw.lib.infocost import Camera
 from fsw.lib.poi import sphere_pois
+from interfaces import catalogue as cat
 from interfaces import topics
 from interfaces.bus import Bus
+from interfaces.catalogue import Topic
 from interfaces.messages import (
     AttitudeMeasurement,
     CameraImage,
@@ -63,6 +66,13 @@ def initial_states(scenario: Scenario) -> np.ndarray:
 
 @dataclass(eq=False)
 class SimNode:
+    """The sim's side of the bus (its topics are declared below for the wiring check)."""
+
+    PUBLISHES: ClassVar[tuple[Topic, ...]] = (
+        cat.TICK, cat.SIM_STATUS, cat.TRUTH, cat.FAULT_EVENTS,
+        cat.RELNAV, cat.ATTITUDE_SENSORS, cat.CAMERA_IMAGE)
+    SUBSCRIBES: ClassVar[tuple[Topic, ...]] = (cat.TICK_DONE, cat.THRUST, cat.WHEELS)
+
     bus: Bus
     scenario: Scenario
     participants: list[str]
@@ -90,12 +100,13 @@ class SimNode:
         ]
         self.faults = FaultInjector(sc, self.hw, self.cameras, self.sensors)
         m = self.bus.mission
+        nodes = [topics.sc_node(i) for i in self.ids]
         self._keys = {
-            "tick": topics.tick(m), "status": topics.sim_status(m), "truth": topics.truth(m),
-            "faults": topics.fault_events(m),
-            "relnav": [topics.relnav(m, i) for i in self.ids],
-            "attitude": [topics.attitude_sensors(m, i) for i in self.ids],
-            "camera": [topics.camera_image(m, i) for i in self.ids],
+            "tick": cat.TICK.key(m), "status": cat.SIM_STATUS.key(m), "truth": cat.TRUTH.key(m),
+            "faults": cat.FAULT_EVENTS.key(m),
+            "relnav": [cat.RELNAV.key(m, n) for n in nodes],
+            "attitude": [cat.ATTITUDE_SENSORS.key(m, n) for n in nodes],
+            "camera": [cat.CAMERA_IMAGE.key(m, n) for n in nodes],
         }
         self._cond = threading.Condition()
         self._answers: dict[str, dict[str, int]] = {}
@@ -108,11 +119,11 @@ class SimNode:
         self._q_now = np.array([0.0, 0.0, 0.0, 1.0])  # ECI -> LVLH now (set each tick)
         self._dt = sc.rates.dt_s
         for node in self.participants:
-            self.bus.subscribe(topics.tick_done(m, node), TickDone, self._on_done, immediate=True)
-        for index, i in enumerate(self.ids):
-            self.bus.subscribe(topics.actuator(m, i, "thrust"), ThrustCommand,
+            self.bus.subscribe(cat.TICK_DONE.key(m, node), TickDone, self._on_done, immediate=True)
+        for index, node in enumerate(nodes):
+            self.bus.subscribe(cat.THRUST.key(m, node), ThrustCommand,
                                lambda msg, index=index: self._on_thrust(index, msg))
-            self.bus.subscribe(topics.actuator(m, i, "wheels"), WheelCommand,
+            self.bus.subscribe(cat.WHEELS.key(m, node), WheelCommand,
                                lambda msg, index=index: self._on_wheels(index, msg))
 
     # --- commands to the hardware ---------------------------------------------------------

@@ -16,6 +16,7 @@ import numpy as np
 from deploy.inproc import run_inproc
 from ground.reader import load_run
 from ground.recorder import McapRecorder
+from interfaces import catalogue as cat
 from interfaces import topics
 from interfaces.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry
 from interfaces.zenoh_transport import ZenohSettings, ZenohTransport
@@ -102,7 +103,7 @@ def test_malformed_messages_are_dropped_and_the_app_goes_on(tmp_path: Path, free
     p = _launch(path, out, free_port, "--realtime", "20")
     _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
     hostile = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",), mode="client"))
-    key = topics.relnav("bad", 1)  # what sc1's nav app subscribes to
+    key = cat.RELNAV.key("bad", "sc1")  # what sc1's nav app subscribes to
     running = threading.Semaphore(0)
     try:
         # inject only once sc1 is demonstrably subscribed and running (not on a timer: a loaded

@@ -19,13 +19,11 @@ from fsw.lib.pro import Pro
 from ground.mission_plan import UPLINK_LEAD_S, MissionPlan
 from ground.reader import load_run
 from interfaces.messages import (
-    AssignmentDecision,
     AttitudeEstimate,
     GuidanceStatus,
     TransferPlanMsg,
-    TruthState,
 )
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.scenario import load_scenario
 
 SCENARIO = """
@@ -66,11 +64,11 @@ def test_reconfiguration_arrives_on_the_new_pro_and_holds_it(run: tuple[Path, di
     sc = load_scenario(out.parent / "gnc.toml")
     n = mean_motion(sc.orbit.altitude_km * 1e3)
     archive = load_run(out / "run.mcap")
-    truth = {round(m.t_sim, 6): m for m in archive.messages(topics.truth("gnc"), TruthState)}
+    truth = {round(m.t_sim, 6): m for m in archive.of(cat.TRUTH, "gnc")}
     phase = sc.phases[0]
     t_arrive = phase.start_s + phase.transfer_s
     # the ground's choice, as archived: decided at the uplink time, flown as decided
-    (decision,) = archive.messages(topics.assignment_decisions("gnc"), AssignmentDecision)
+    (decision,) = archive.of(cat.DECISIONS, "gnc")
     assert decision.reason == "phase" and decision.switched
     assert decision.t_sim == phase.start_s - UPLINK_LEAD_S
     assert 0.0 < decision.expected_gain <= decision.upper_bound

@@ -34,7 +34,7 @@ from fsw.lib import hcw, mekf, quat
 from fsw.lib.attitude import AttitudePlan, repoint, scp_slew, slerp_plan
 from fsw.lib.attitude_control import gains_for
 from fsw.lib.frames import lvlh_to_eci_quat
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import (
     AttitudeEstimate,
@@ -52,19 +52,11 @@ class AttitudeApp(App):
     NAME = "attitude"
     RATE = "high"
     INPUTS = (
-        Input(lambda c: topics.attitude_sensors(c.mission, c.spacecraft or 0), AttitudeMeasurement,
-              "on_sensors"),
-        Input(lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate,
-              "on_estimate"),
-        Input(lambda c: topics.key(c.mission, c.node, "camera", "pointing"), PointingTarget,
-              "on_target"),
+        Input(cat.ATTITUDE_SENSORS, "on_sensors"),
+        Input(cat.NAV_ESTIMATE, "on_estimate"),
+        Input(cat.POINTING, "on_target"),
     )
-    OUTPUTS = (
-        Output("wheels", lambda c: topics.actuator(c.mission, c.spacecraft or 0, "wheels"),
-               WheelCommand),
-        Output("estimate", lambda c: topics.key(c.mission, c.node, "attitude", "estimate"),
-               AttitudeEstimate),
-    )
+    OUTPUTS = (Output("wheels", cat.WHEELS), Output("estimate", cat.ATTITUDE_ESTIMATE))
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

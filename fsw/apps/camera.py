@@ -24,7 +24,7 @@ import numpy as np
 
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import (
     AttitudeEstimate,
@@ -44,20 +44,12 @@ class CameraApp(App):
     NAME = "camera"
     RATE = "mid"
     INPUTS = (
-        Input(lambda c: topics.camera_image(c.mission, c.spacecraft or 0), CameraImage, "on_image"),
-        Input(lambda c: topics.all_spacecraft(c.mission, "camera", "observations"),
-              PoiObservations, "on_observations"),
-        Input(lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate,
-              "on_estimate"),
-        Input(lambda c: topics.key(c.mission, c.node, "attitude", "estimate"), AttitudeEstimate,
-              "on_attitude"),
+        Input(cat.CAMERA_IMAGE, "on_image"),
+        Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
+        Input(cat.NAV_ESTIMATE, "on_estimate"),
+        Input(cat.ATTITUDE_ESTIMATE, "on_attitude"),
     )
-    OUTPUTS = (
-        Output("observations", lambda c: topics.key(c.mission, c.node, "camera", "observations"),
-               PoiObservations),
-        Output("pointing", lambda c: topics.key(c.mission, c.node, "camera", "pointing"),
-               PointingTarget),
-    )
+    OUTPUTS = (Output("observations", cat.OBSERVATIONS), Output("pointing", cat.POINTING))
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

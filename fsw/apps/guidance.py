@@ -31,7 +31,7 @@ from fsw.lib.constants import R_EARTH_M
 from fsw.lib.mpc import MpcConfig, MpcTracker
 from fsw.lib.pro import Pro, energy_matched_state
 from fsw.lib.scp import TransferPlan, plan_transfer
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import (
     AttitudeEstimate,
@@ -57,19 +57,14 @@ class GuidanceApp(App):
     NAME = "guidance"
     RATE = "low"
     INPUTS = (
-        Input(lambda c: topics.assignments(c.mission), ProAssignments, "on_assignments"),
-        Input(lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate,
-              "on_estimate"),
-        Input(lambda c: topics.key(c.mission, c.node, "attitude", "estimate"), AttitudeEstimate,
-              "on_attitude"),
+        Input(cat.ASSIGNMENTS, "on_assignments"),
+        Input(cat.NAV_ESTIMATE, "on_estimate"),
+        Input(cat.ATTITUDE_ESTIMATE, "on_attitude"),
     )
     OUTPUTS = (
-        Output("thrust", lambda c: topics.actuator(c.mission, c.spacecraft or 0, "thrust"),
-               ThrustCommand),
-        Output("plan", lambda c: topics.key(c.mission, c.node, "guidance", "plan"),
-               TransferPlanMsg),
-        Output("status", lambda c: topics.key(c.mission, c.node, "guidance", "status"),
-               GuidanceStatus),
+        Output("thrust", cat.THRUST),
+        Output("plan", cat.TRANSFER_PLAN),
+        Output("status", cat.GUIDANCE_STATUS),
     )
 
     def __init__(self, ctx: AppContext) -> None:

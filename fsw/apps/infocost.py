@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from fsw.lib.poi_map import PoiMap
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import InfoCostTelemetry, PoiObservations
 
@@ -19,14 +19,8 @@ from interfaces.messages import InfoCostTelemetry, PoiObservations
 class InfoCostApp(App):
     NAME = "infocost"
     RATE = "mid"
-    INPUTS = (
-        Input(lambda c: topics.all_spacecraft(c.mission, "camera", "observations"),
-              PoiObservations, "on_observations"),
-    )
-    OUTPUTS = (
-        Output("telemetry", lambda c: topics.key(c.mission, c.node, "infocost", "telemetry"),
-               InfoCostTelemetry),
-    )
+    INPUTS = (Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),)
+    OUTPUTS = (Output("telemetry", cat.INFO_COST),)
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

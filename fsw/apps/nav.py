@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from fsw.lib import hcw, kalman
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import GuidanceStatus, RelNavMeasurement, StateEstimate
 
@@ -26,14 +26,8 @@ THRUST_ERROR_FRAC = 0.05
 class NavApp(App):
     NAME = "nav"
     RATE = "mid"
-    INPUTS = (
-        Input(lambda c: topics.relnav(c.mission, c.spacecraft or 0), RelNavMeasurement, "on_relnav"),
-        Input(lambda c: topics.key(c.mission, c.node, "guidance", "status"), GuidanceStatus,
-              "on_guidance"),
-    )
-    OUTPUTS = (
-        Output("estimate", lambda c: topics.key(c.mission, c.node, "nav", "estimate"), StateEstimate),
-    )
+    INPUTS = (Input(cat.RELNAV, "on_relnav"), Input(cat.GUIDANCE_STATUS, "on_guidance"))
+    OUTPUTS = (Output("estimate", cat.NAV_ESTIMATE),)
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

@@ -14,7 +14,7 @@ from typing import Literal
 
 from ground.fdir.baselines import Cusum, nis_window_test
 from ground.fdir.threshold import Persistence
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import BaselineVerdict, FdirWindow, StateEstimate
 
@@ -25,15 +25,10 @@ class BaselinesApp(App):
     NAME = "baselines"
     RATE = "mid"
     INPUTS = (
-        Input(lambda c: topics.key(c.mission, topics.GROUND, "fdir", "window"), FdirWindow,
-              "on_window"),
-        Input(lambda c: topics.all_spacecraft(c.mission, "nav", "estimate"), StateEstimate,
-              "on_nav"),
+        Input(cat.FDIR_WINDOW, "on_window"),
+        Input(cat.NAV_ESTIMATE, "on_nav", every_spacecraft=True),
     )
-    OUTPUTS = (
-        Output("verdict", lambda c: topics.key(c.mission, c.node, "fdir", "baseline"),
-               BaselineVerdict),
-    )
+    OUTPUTS = (Output("verdict", cat.BASELINE),)
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

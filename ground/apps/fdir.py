@@ -73,7 +73,7 @@ from ground.fdir.twin import (
     perturbed_boresights,
     predicted_delta_h,
 )
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import (
     AttitudeEstimate,
@@ -197,24 +197,15 @@ class FdirApp(App):
     NAME = "fdir"
     RATE = "mid"
     INPUTS = (
-        Input(lambda c: topics.all_spacecraft(c.mission, "camera", "observations"),
-              PoiObservations, "on_observations"),
-        Input(lambda c: topics.all_spacecraft(c.mission, "guidance", "plan"), TransferPlanMsg,
-              "on_transfer"),
-        Input(lambda c: topics.assignments(c.mission), ProAssignments, "on_assignments"),
-        Input(lambda c: topics.all_spacecraft(c.mission, "attitude", "estimate"),
-              AttitudeEstimate, "on_attitude"),
-        Input(lambda c: topics.all_spacecraft(c.mission, "infocost", "telemetry"),
-              InfoCostTelemetry, "on_telemetry"),
-        Input(lambda c: topics.all_spacecraft(c.mission, "nav", "estimate"), StateEstimate,
-              "on_nav"),
-        Input(lambda c: topics.all_spacecraft(c.mission, "guidance", "status"), GuidanceStatus,
-              "on_guidance"),
+        Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
+        Input(cat.TRANSFER_PLAN, "on_transfer", every_spacecraft=True),
+        Input(cat.ASSIGNMENTS, "on_assignments"),
+        Input(cat.ATTITUDE_ESTIMATE, "on_attitude", every_spacecraft=True),
+        Input(cat.INFO_COST, "on_telemetry", every_spacecraft=True),
+        Input(cat.NAV_ESTIMATE, "on_nav", every_spacecraft=True),
+        Input(cat.GUIDANCE_STATUS, "on_guidance", every_spacecraft=True),
     )
-    OUTPUTS = (
-        Output("window", lambda c: topics.key(c.mission, c.node, "fdir", "window"), FdirWindow),
-        Output("report", lambda c: topics.key(c.mission, c.node, "fdir", "report"), FaultReport),
-    )
+    OUTPUTS = (Output("window", cat.FDIR_WINDOW), Output("report", cat.FAULT_REPORT))
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

@@ -19,7 +19,7 @@ from __future__ import annotations
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
 from ground.mission_plan import MissionPlan
-from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import (
     AssignmentDecision,
@@ -34,16 +34,10 @@ class MissionPlanner(App):
     NAME = "planner"
     RATE = "low"
     INPUTS = (
-        Input(lambda c: topics.all_spacecraft(c.mission, "camera", "observations"),
-              PoiObservations, "on_observations"),
-        Input(lambda c: topics.key(c.mission, topics.GROUND, "fdir", "report"), FaultReport,
-              "on_fault"),
+        Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
+        Input(cat.FAULT_REPORT, "on_fault"),
     )
-    OUTPUTS = (
-        Output("assignments", lambda c: topics.assignments(c.mission), ProAssignments),
-        Output("decisions", lambda c: topics.assignment_decisions(c.mission),
-               AssignmentDecision),
-    )
+    OUTPUTS = (Output("assignments", cat.ASSIGNMENTS), Output("decisions", cat.DECISIONS))
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

@@ -11,8 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from interfaces import topics
+from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import Heartbeat, Message, StateEstimate, TelemetryStatus
+from interfaces.messages import Message, TelemetryStatus
 
 
 @dataclass
@@ -27,12 +28,10 @@ class TelemetryMonitor(App):
     NAME = "tlm_monitor"
     RATE = "low"
     INPUTS = (
-        Input(lambda c: topics.all_spacecraft(c.mission, "nav", "estimate"), StateEstimate, "on_tlm"),
-        Input(lambda c: topics.all_spacecraft(c.mission, "exec", "heartbeat"), Heartbeat, "on_tlm"),
+        Input(cat.NAV_ESTIMATE, "on_tlm", every_spacecraft=True),
+        Input(cat.HEARTBEAT, "on_tlm", every_spacecraft=True),
     )
-    OUTPUTS = (
-        Output("status", lambda c: topics.key(c.mission, c.node, "tlm", "status"), TelemetryStatus),
-    )
+    OUTPUTS = (Output("status", cat.TLM_STATUS),)
     STALE_AFTER_S = 10.0
     """A spacecraft silent for longer than this (sim seconds) is reported stale."""
 
