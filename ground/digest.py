@@ -4,7 +4,8 @@ A two-orbit run archives about 4 GB of JSON, 1.7 GB of it camera images and as m
 observations that repeat them; held whole and decoded, the summary of such a run needed 13 GB.
 The digest keeps only what the summary and report read: the camera images are fused into the
 coverage as they stream past (:class:`ground.coverage.CoverageFuser`), the cumulative counters
-(ticks, executive and link statistics) keep their last record, and the bulk neither reads
+(ticks, executive and link statistics) keep their last record, the truth is packed into arrays
+(:class:`ground.truth_table.TruthTable`), and the bulk neither reads
 (observations, attitude sensors, wheel commands, lockstep answers, heartbeats) is counted and
 dropped.
 """
@@ -15,7 +16,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ground.coverage import Coverage, CoverageFuser, camera_images, coverage
+from ground.evaluation import NavErrors, nav_errors
+from ground.gnc_evaluation import GncSeries, gnc_series
 from ground.reader import Record, RunArchive, load_run
+from ground.truth_table import TruthTable, TruthTableBuilder
 from interfaces import catalogue as cat
 from interfaces.scenario import Scenario
 
@@ -35,12 +39,26 @@ class LastRecords:
 
 @dataclass
 class RunDigest:
-    """What a run's summary and report read: the archive without the bulk, the coverage, and the
-    last record (and count) of each tick and statistics key."""
+    """What a run's summary and report read: the archive without the bulk, the coverage, the
+    truth as arrays, and the last record (and count) of each tick and statistics key.  The
+    navigation and GNC evaluations are computed once and shared by the summary and the report."""
 
     archive: RunArchive
     coverage: Coverage
     counters: LastRecords
+    truth: TruthTable
+    _nav: dict[int, NavErrors] | None = None
+    _gnc: dict[int, GncSeries] | None = None
+
+    def nav_errors(self, mission: str) -> dict[int, NavErrors]:
+        if self._nav is None:
+            self._nav = nav_errors(self.archive, mission, self.truth)
+        return self._nav
+
+    def gnc_series(self, scenario: Scenario, mission: str) -> dict[int, GncSeries]:
+        if self._gnc is None:
+            self._gnc = gnc_series(self.archive, scenario, mission, self.truth)
+        return self._gnc
 
 
 def counter_keys(mission: str) -> list[str]:
@@ -62,11 +80,12 @@ def digest_run(path: Path, scenario: Scenario, mission: str) -> RunDigest:
     """Read ``path`` once for the summary and report (see the module docstring)."""
     fuser = CoverageFuser(scenario)
     counters = LastRecords()
-    stream = {camera_images(mission): fuser.add_record,
+    truth = TruthTableBuilder()
+    stream = {camera_images(mission): fuser.add_record, cat.TRUTH.key(mission): truth.add_record,
               **dict.fromkeys(counter_keys(mission), counters),
               **dict.fromkeys(unread_keys(mission), _drop)}
     archive = load_run(path, stream=stream)
-    return RunDigest(archive, fuser.finish(archive, mission), counters)
+    return RunDigest(archive, fuser.finish(archive, mission), counters, truth.finish())
 
 
 def digest_archive(archive: RunArchive, scenario: Scenario, mission: str) -> RunDigest:
@@ -75,4 +94,5 @@ def digest_archive(archive: RunArchive, scenario: Scenario, mission: str) -> Run
     for expr in counter_keys(mission):
         for rec in archive.records(expr):
             counters(rec)
-    return RunDigest(archive, coverage(archive, scenario, mission), counters)
+    return RunDigest(archive, coverage(archive, scenario, mission), counters,
+                     TruthTable.from_archive(archive, mission))

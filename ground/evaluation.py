@@ -9,6 +9,7 @@ from scipy.stats import chi2
 
 from fsw.lib.kalman import nees
 from ground.reader import RunArchive
+from ground.truth_table import TruthTable
 from interfaces import catalogue as cat
 from interfaces.messages import StateEstimate
 
@@ -43,26 +44,28 @@ class NavErrors:
         }
 
 
-def nav_errors(archive: RunArchive, mission: str) -> dict[int, NavErrors]:
-    """Per spacecraft, the state estimates compared with the truth at the same sim time."""
-    truth: dict[float, tuple[list[int], np.ndarray]] = {}
-    for ts in archive.of(cat.TRUTH, mission):
-        truth[round(ts.t_sim, 6)] = (ts.spacecraft, np.hstack([ts.r_lvlh_m, ts.v_lvlh_mps]))
-    out: dict[int, NavErrors] = {}
+def nav_errors(archive: RunArchive, mission: str,
+               truth: TruthTable | None = None) -> dict[int, NavErrors]:
+    """Per spacecraft, the state estimates compared with the truth at the same sim time
+    (``truth``: the run's truth table if already built, else built from ``archive``)."""
+    if truth is None:
+        truth = TruthTable.from_archive(archive, mission)
     by_sc: dict[int, list[StateEstimate]] = {}
     for est in archive.of(cat.NAV_ESTIMATE, mission):
         by_sc.setdefault(est.spacecraft, []).append(est)
+    out: dict[int, NavErrors] = {}
     for sc, ests in sorted(by_sc.items()):
+        j = truth.column(sc)
         rows = []
         for est in ests:
-            tr = truth.get(round(est.t_sim, 6))
-            if tr is None or sc not in tr[0]:
+            i = truth.row(est.t_sim)
+            if i is None or j is None:
                 continue
-            x_true = tr[1][tr[0].index(sc)]
+            x_true = np.concatenate([truth.r_m[i, j], truth.v_mps[i, j]])
             x, P = np.array(est.x), np.array(est.P)
             rows.append((est.t_sim, x - x_true, np.sqrt(np.diag(P)), nees(x, P, x_true),
                          np.nan if est.nis is None else est.nis))
         if rows:
-            t, e, s, q, nis = zip(*rows)
-            out[sc] = NavErrors(np.array(t), np.array(e), np.array(s), np.array(q), np.array(nis))
+            t, e, sd, q, nis = zip(*rows)
+            out[sc] = NavErrors(np.array(t), np.array(e), np.array(sd), np.array(q), np.array(nis))
     return out

@@ -19,10 +19,9 @@ from scipy.spatial.transform import Rotation
 
 from fsw.lib import hcw
 from ground.reader import RunArchive
+from ground.truth_table import TIME_DECIMALS, TruthTable
 from interfaces import catalogue as cat
-from interfaces.messages import (
-    TruthState,
-)
+from interfaces.messages import AttitudeEstimate
 from interfaces.scenario import Scenario
 
 
@@ -44,74 +43,92 @@ class GncSeries:
     transfers: int = 0
 
 
-def _truth_by_time(archive: RunArchive, mission: str) -> dict[float, TruthState]:
-    return {round(m.t_sim, 6): m for m in archive.of(cat.TRUTH, mission)}
-
-
-def gnc_series(archive: RunArchive, scenario: Scenario, mission: str) -> dict[int, GncSeries]:
-    """Per observer, the GNC series compared with the truth."""
-    n = hcw.mean_motion(scenario.orbit.altitude_km * 1e3)
-    bore = np.array(scenario.attitude.boresight_body, dtype=float)
-    truth = _truth_by_time(archive, mission)
+def gnc_series(archive: RunArchive, scenario: Scenario, mission: str,
+               truth: TruthTable | None = None) -> dict[int, GncSeries]:
+    """Per observer, the GNC series compared with the truth (``truth``: the run's truth table
+    if already built, else built from ``archive``)."""
+    if truth is None:
+        truth = TruthTable.from_archive(archive, mission)
     out = {i: GncSeries() for i in range(1, scenario.observers.count + 1)}
     t_flying = (scenario.phases[0].start_s if scenario.observers.start == "deploy"
                 and scenario.phases else 0.0)
-    for ts in truth.values():
-        if ts.t_sim < t_flying:
-            continue
-        for j, sc in enumerate(ts.spacecraft):
-            s = out[sc]
-            s.range_min_m = min(s.range_min_m, float(np.linalg.norm(ts.r_lvlh_m[j])))
+    flying = truth.t_s >= t_flying
+    if flying.any():
+        closest = np.linalg.norm(truth.r_m[flying], axis=2).min(axis=0)
+        for j, sc in enumerate(truth.spacecraft):
+            out[sc].range_min_m = float(closest[j])
     _delta_v(truth, out, scenario.rates.mid_hz)
-    assignments = {(a.spacecraft, a.assignment_id): a
-                   for m in archive.of(cat.ASSIGNMENTS, mission)
-                   for a in m.assignments}
-    for st in archive.of(cat.GUIDANCE_STATUS, mission):
-        s = out.get(st.spacecraft)
-        tr = truth.get(round(st.t_sim, 6))
-        if s is None:
-            continue
-        s.dv_commanded_mps = max(s.dv_commanded_mps, st.dv_commanded_mps)
-        a = assignments.get((st.spacecraft, st.assignment_id))
-        if (st.mode != "hold" or a is None or st.t_sim < a.t_arrive_s or tr is None
-                or st.spacecraft not in tr.spacecraft):
-            continue
-        pro = a.pro
-        ref = hcw.pro_state(n, pro.rho_x_m, pro.alpha_x_rad, pro.rho_y_m, pro.rho_z_m,
-                            pro.alpha_z_rad, st.t_sim)
-        r = np.array(tr.r_lvlh_m[tr.spacecraft.index(st.spacecraft)])
-        s.hold_t_s.append(st.t_sim)
-        s.hold_error_m.append(float(np.linalg.norm(r - ref[:3])))
+    _hold_errors(archive, scenario, mission, truth, out)
     for plan in archive.of(cat.TRANSFER_PLAN, mission):
         if plan.spacecraft in out and plan.status == "solved":
             out[plan.spacecraft].dv_planned_mps += plan.dv_mps
             out[plan.spacecraft].transfers += 1
-    for est in archive.of(cat.ATTITUDE_ESTIMATE, mission):
-        s = out.get(est.spacecraft)
-        tr = truth.get(round(est.t_sim, 6))
-        if s is None or tr is None or est.spacecraft not in tr.spacecraft or not tr.q_lvlh_body:
-            continue
-        j = tr.spacecraft.index(est.spacecraft)
-        r_true = Rotation.from_quat(tr.q_lvlh_body[j])
-        los = np.array(est.target_lvlh_m) - np.array(tr.r_lvlh_m[j])
-        b = r_true.apply(bore)
-        cos = float(b @ los) / max(1e-12, float(np.linalg.norm(los)))
-        s.point_t_s.append(est.t_sim)
-        s.pointing_error_rad.append(float(np.arccos(np.clip(cos, -1.0, 1.0))))
-        s.knowledge_error_rad.append((Rotation.from_quat(est.q_lvlh_body).inv() * r_true).magnitude())
-        s.modes.append(est.mode)
+    _pointing(archive, scenario, mission, truth, out)
     return out
 
 
-def _delta_v(truth: dict[float, TruthState], out: dict[int, GncSeries], mid_hz: float) -> None:
+def _delta_v(truth: TruthTable, out: dict[int, GncSeries], mid_hz: float) -> None:
     """Delivered Δv series (sampled at ω_mid to keep it small)."""
+    if not truth.has_attitude:
+        return
     step = 1.0 / mid_hz
-    for t, ts in sorted(truth.items()):
-        if not ts.dv_mps or abs(t / step - round(t / step)) > 1e-6:
+    t = np.round(truth.t_s, TIME_DECIMALS)
+    order = np.argsort(t, kind="stable")
+    keep = order[np.abs(t[order] / step - np.round(t[order] / step)) <= 1e-6]
+    for j, sc in enumerate(truth.spacecraft):
+        out[sc].dv_t_s.extend(t[keep].tolist())
+        out[sc].dv_mps.extend(truth.dv_mps[keep, j].tolist())
+
+
+def _hold_errors(archive: RunArchive, scenario: Scenario, mission: str, truth: TruthTable,
+                 out: dict[int, GncSeries]) -> None:
+    """Commanded Δv, and the distance of the true position from the assigned PRO while
+    guidance holds it (from the assignment's arrival time on)."""
+    n = hcw.mean_motion(scenario.orbit.altitude_km * 1e3)
+    assignments = {(a.spacecraft, a.assignment_id): a
+                   for m in archive.of(cat.ASSIGNMENTS, mission) for a in m.assignments}
+    for st in archive.of(cat.GUIDANCE_STATUS, mission):
+        s = out.get(st.spacecraft)
+        if s is None:
             continue
-        for j, sc in enumerate(ts.spacecraft):
-            out[sc].dv_t_s.append(t)
-            out[sc].dv_mps.append(ts.dv_mps[j])
+        s.dv_commanded_mps = max(s.dv_commanded_mps, st.dv_commanded_mps)
+        a = assignments.get((st.spacecraft, st.assignment_id))
+        i, j = truth.row(st.t_sim), truth.column(st.spacecraft)
+        if st.mode != "hold" or a is None or st.t_sim < a.t_arrive_s or i is None or j is None:
+            continue
+        pro = a.pro
+        ref = hcw.pro_state(n, pro.rho_x_m, pro.alpha_x_rad, pro.rho_y_m, pro.rho_z_m,
+                            pro.alpha_z_rad, st.t_sim)
+        s.hold_t_s.append(st.t_sim)
+        s.hold_error_m.append(float(np.linalg.norm(truth.r_m[i, j] - ref[:3])))
+
+
+def _pointing(archive: RunArchive, scenario: Scenario, mission: str, truth: TruthTable,
+              out: dict[int, GncSeries]) -> None:
+    """Pointing error (true boresight against the true line of sight to the commanded target)
+    and attitude knowledge error, per attitude estimate, all of an observer's at once."""
+    if not truth.has_attitude:
+        return
+    bore = np.array(scenario.attitude.boresight_body, dtype=float)
+    by_sc: dict[int, list[tuple[int, AttitudeEstimate]]] = {}
+    for est in archive.of(cat.ATTITUDE_ESTIMATE, mission):
+        i = truth.row(est.t_sim)
+        if est.spacecraft in out and i is not None and truth.column(est.spacecraft) is not None:
+            by_sc.setdefault(est.spacecraft, []).append((i, est))
+    for sc, pairs in by_sc.items():
+        j = truth.column(sc)
+        rows = np.array([i for i, _ in pairs])
+        ests = [e for _, e in pairs]
+        r_true = Rotation.from_quat(truth.q_lvlh_body[rows, j])
+        los = np.array([e.target_lvlh_m for e in ests]) - truth.r_m[rows, j]
+        cos = np.einsum("ij,ij->i", r_true.apply(bore), los) / np.maximum(
+            1e-12, np.linalg.norm(los, axis=1))
+        knowledge = (Rotation.from_quat([e.q_lvlh_body for e in ests]).inv() * r_true).magnitude()
+        s = out[sc]
+        s.point_t_s.extend(e.t_sim for e in ests)
+        s.pointing_error_rad.extend(np.arccos(np.clip(cos, -1.0, 1.0)).tolist())
+        s.knowledge_error_rad.extend(np.atleast_1d(knowledge).tolist())
+        s.modes.extend(e.mode for e in ests)
 
 
 def gnc_summary(series: dict[int, GncSeries]) -> dict[str, dict[str, float | int | None]]:

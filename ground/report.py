@@ -13,9 +13,10 @@ import numpy as np  # noqa: E402
 
 from ground.coverage import Coverage  # noqa: E402
 from ground.digest import RunDigest, digest_run  # noqa: E402
-from ground.evaluation import NavErrors, nav_errors  # noqa: E402
-from ground.gnc_evaluation import GncSeries, gnc_series  # noqa: E402
+from ground.evaluation import NavErrors  # noqa: E402
+from ground.gnc_evaluation import GncSeries  # noqa: E402
 from ground.reader import ArchiveError, RunArchive  # noqa: E402
+from ground.truth_table import TruthTable  # noqa: E402
 from interfaces import catalogue as cat  # noqa: E402
 from interfaces.messages import FdirWindow  # noqa: E402
 from interfaces.scenario import Scenario  # noqa: E402
@@ -41,9 +42,9 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
         lines.append(f"The archive could not be read: {e}")
         return _write(out, lines)
     archive = digest.archive
-    lines += _trajectory_section(out, archive, mission)
-    lines += _nav_section(out, nav_errors(archive, mission), summary)
-    lines += _gnc_section(out, gnc_series(archive, scenario, mission), summary)
+    lines += _trajectory_section(out, digest.truth)
+    lines += _nav_section(out, digest.nav_errors(mission), summary)
+    lines += _gnc_section(out, digest.gnc_series(scenario, mission), summary)
     lines += _coverage_section(out, digest.coverage, summary)
     lines += _fdir_section(out, archive, mission, summary)
     lines += _links_section(summary) + _exec_section(summary)
@@ -56,13 +57,12 @@ def _write(out: Path, lines: list[str]) -> Path:
     return path
 
 
-def _trajectory_section(out: Path, archive: RunArchive, mission: str) -> list[str]:
-    truth = archive.of(cat.TRUTH, mission)
-    if not truth:
+def _trajectory_section(out: Path, truth: TruthTable) -> list[str]:
+    if not len(truth):
         return ["No truth recorded.", ""]
-    r = np.array([t.r_lvlh_m for t in truth])  # (K, N, 3)
+    r = truth.r_m  # (K, N, 3)
     fig, axes = plt.subplots(1, 2, figsize=(11, 5))
-    for i, sc in enumerate(truth[0].spacecraft):
+    for i, sc in enumerate(truth.spacecraft):
         axes[0].plot(r[:, i, 1], r[:, i, 0], label=f"sc{sc}")
         axes[1].plot(r[:, i, 1], r[:, i, 2], label=f"sc{sc}")
     for ax, (yl, title) in zip(axes, (("radial x (m)", "in-plane"), ("cross-track z (m)", "along-track / cross-track"))):

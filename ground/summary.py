@@ -9,9 +9,8 @@ from typing import Any, TypeVar
 
 from ground.coverage import coverage_summary
 from ground.digest import RunDigest, digest_run
-from ground.evaluation import nav_errors
 from ground.fdir.scoring import Alarm, Judged, score
-from ground.gnc_evaluation import gnc_series, gnc_summary
+from ground.gnc_evaluation import gnc_summary
 from ground.reader import ArchiveError, RunArchive
 from interfaces import catalogue as cat
 from interfaces.messages import (
@@ -44,8 +43,8 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[s
         "t_sim_final_s": last_tick.decode(Tick).t_sim if last_tick is not None else 0.0,
         "messages": {"total": len(archive), "by_type": _by_type(archive)},
         "nav": {str(sc): e.stats(skip_s=NAV_SETTLE_S)
-                for sc, e in nav_errors(archive, mission).items()},
-        "gnc": gnc_summary(gnc_series(archive, scenario, mission)),
+                for sc, e in digest.nav_errors(mission).items()},
+        "gnc": gnc_summary(digest.gnc_series(scenario, mission)),
         "coverage": coverage_summary(digest.coverage),
         "links": [c.model_dump() for node in sorted(links) for c in links[node].links],
         "exec": {node: {"cycle_slips": {g: s.cycle_slips for g, s in m.groups.items()},
