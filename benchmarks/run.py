@@ -152,9 +152,9 @@ def bench_reference(quick: bool, tmp: Path, rows: list, res: dict) -> None:
 _REPORT_AGAIN = """
 import sys
 from pathlib import Path
-from ground.digest import digest_run
-from ground.report import write_report
-from ground.summary import write_summary
+from ground.analysis.digest import digest_run
+from ground.analysis.report import write_report
+from ground.analysis.summary import write_summary
 from interfaces.scenario import load_scenario
 out, scen, dur = Path(sys.argv[1]), load_scenario(sys.argv[2]), float(sys.argv[3])
 scen = scen.with_overrides(None, dur)

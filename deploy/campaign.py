@@ -299,7 +299,7 @@ def finished(spec: RunSpec, out_root: Path) -> bool:
 def _finish(spec: RunSpec, partial: Path, final: Path, transport: str) -> None:
     import shutil
 
-    from ground.record import software_version
+    from ground.archive.record import software_version
 
     (partial / "campaign.json").write_text(json.dumps(
         {"run": spec.id, "group": spec.group, "seed": spec.seed, "transport": transport,
@@ -327,9 +327,9 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     import traceback
 
     from deploy.inproc import run_inproc
-    from ground.record import run_metadata
-    from ground.recorder import McapRecorder
-    from ground.summary import write_summary
+    from ground.archive.record import run_metadata
+    from ground.archive.recorder import McapRecorder
+    from ground.analysis.summary import write_summary
 
     handler = logging.FileHandler(out / "run.log")
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
@@ -359,7 +359,7 @@ def _zenoh_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     import sys
 
     from deploy.processes import die_with_parent
-    from ground.summary import write_summary
+    from ground.analysis.summary import write_summary
 
     scenario = out / "scenario.json"
     scenario.write_text(spec.scenario.model_dump_json(indent=1))

@@ -13,7 +13,7 @@ half-written ones.  A run that crashes is recorded as failed, with its error, an
 goes on.  SIGINT or SIGTERM stops the campaign: running runs are abandoned (redone next time)
 and the report is written over what has finished.  --cluster sends the runs to an existing
 Dask distributed scheduler (its workers must import this repository and see --out).
-At the end <out>/report.md, PNG plots and results.csv are written (ground/campaign_report.py);
+At the end <out>/report.md, PNG plots and results.csv are written (ground/analysis/campaign_report.py);
 --report-only rewrites them from the run directories without running anything (given only
 --out, from the run list saved there).  The exit status is 1 when a run failed, 130 when
 interrupted.
@@ -51,7 +51,7 @@ from deploy.campaign import (  # noqa: E402
     load_campaign,
     record_failure,
 )
-from ground.campaign_report import write_campaign_report  # noqa: E402
+from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
 

@@ -9,7 +9,7 @@ Writes <out>/run.mcap (every bus message, JSON schemas; opens in Foxglove), <out
 <out>/report.md with PNG plots, and <out>/logs/ (one log per process).  While it runs, any Zenoh
 client can connect to the endpoint (default tcp/127.0.0.1:7447) and subscribe to insp/**.
 With --live PORT the run is streamed to Foxglove (Foxglove WebSocket protocol, loopback;
-ground/live.py): every bus message on a channel named by its key, and the truth poses in 3D.
+ground/tools/live.py): every bus message on a channel named by its key, and the truth poses in 3D.
 With --compare-recovery the same scenario and seed is run a second time, in-process, with the
 ground's fault recovery switched the other way ([fdir] recovery), into <out>/counterfactual/,
 and summary.json's ``recovery`` section compares the final H of the two.
@@ -32,12 +32,12 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.processes import Child, Supervisor  # noqa: E402
-from ground.digest import RunDigest, digest_run  # noqa: E402
-from ground.reader import ArchiveError  # noqa: E402
-from ground.record import run_metadata  # noqa: E402
-from ground.recorder_process import RecorderProcess  # noqa: E402
-from ground.report import write_report  # noqa: E402
-from ground.summary import add_recovery_comparison, write_summary  # noqa: E402
+from ground.analysis.digest import RunDigest, digest_run  # noqa: E402
+from ground.archive.reader import ArchiveError  # noqa: E402
+from ground.archive.record import run_metadata  # noqa: E402
+from ground.archive.recorder_process import RecorderProcess  # noqa: E402
+from ground.analysis.report import write_report  # noqa: E402
+from ground.analysis.summary import add_recovery_comparison, write_summary  # noqa: E402
 from interfaces import catalogue as cat  # noqa: E402
 from interfaces import topics  # noqa: E402
 from interfaces.messages import Heartbeat, SimStatus  # noqa: E402
@@ -46,7 +46,7 @@ from interfaces.transport import Sample  # noqa: E402
 from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
 
 if TYPE_CHECKING:
-    from ground.live import LiveView
+    from ground.tools.live import LiveView
 
 DEFAULT_SCENARIO = REPO / "deploy" / "scenarios" / "default.toml"
 log = logging.getLogger("insp.launcher")
@@ -152,10 +152,10 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
 
 
 def _live_view(args: argparse.Namespace) -> LiveView | None:
-    """The Foxglove live view when --live PORT is given (ground/live.py), else None."""
+    """The Foxglove live view when --live PORT is given (ground/tools/live.py), else None."""
     if not getattr(args, "live", None):
         return None
-    from ground.live import LiveView
+    from ground.tools.live import LiveView
 
     return LiveView(args.live)
 
@@ -212,7 +212,7 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         common += ["--duration", str(args.duration)]
     sup = Supervisor(REPO)
     logs = out / "logs"
-    recorder = sup.start(Child("recorder", ["-m", "ground.record", *common, "--out",
+    recorder = sup.start(Child("recorder", ["-m", "ground.archive.record", *common, "--out",
                                             str(out / "run.mcap"), "--transport-name", "zenoh"],
                                logs / "recorder.log"))
     if not _wait_token(hub, topics.recorder_token(mission), recorder, timeout_s=30.0):

@@ -317,7 +317,7 @@ class BaselineVerdict(Message):
 
 
 class AssignmentDecision(Message):
-    """The ground's information-driven orbit choice (ground/mission_plan.py): the greedy set,
+    """The ground's information-driven orbit choice (ground/planning/mission_plan.py): the greedy set,
     its expected information gain and online bound, the expected gain of keeping the current
     PROs, the measured H decrease per check window that led to it, and whether it was flown."""
 

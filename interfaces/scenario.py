@@ -218,8 +218,8 @@ class Phase(_ProFormation):
 
 
 class AssignmentSettings(_Section):
-    """The central agent's information-driven orbit assignment (``ground/orbit_assignment.py``,
-    ``ground/mission_plan.py``), for phases with ``assign = "information"``.
+    """The central agent's information-driven orbit assignment (``ground/planning/orbit_assignment.py``,
+    ``ground/planning/mission_plan.py``), for phases with ``assign = "information"``.
 
     Candidates: every combination of ``rho_x_m`` × ``rho_z_m`` × ``phases`` in-plane phases
     (evenly spread) × ``cross_phase_offsets_deg``; those passing closer than the guidance
@@ -349,7 +349,7 @@ class FdirSettings(_Section):
     settle_s: float = Field(default=30.0, ge=0.0,
                             description="images this soon after a slew are not judged")
     recovery: bool = Field(default=True, description="replan on an identified camera or "
-                                                     "actuator fault (ground/mission_plan.py)")
+                                                     "actuator fault (ground/planning/mission_plan.py)")
     integrity_tol: float = Field(
         default=0.2, gt=0.0,
         description="relative difference between a reported H_i and the ground's recomputation "

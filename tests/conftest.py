@@ -85,8 +85,8 @@ def recorded_run(scenario: Scenario, out: Path, *types: type[Message]
     those of ``types`` (as :func:`collector`); returns (collected by type name, the run's
     summary.json as written)."""
     from deploy.inproc import run_inproc
-    from ground.recorder import McapRecorder
-    from ground.summary import write_summary
+    from ground.archive.recorder import McapRecorder
+    from ground.analysis.summary import write_summary
 
     tap, got = collector(*types)
     with McapRecorder(out / "run.mcap", {}) as rec:

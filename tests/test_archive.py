@@ -1,7 +1,7 @@
-"""Tests of the MCAP run archive: ground.recorder.McapRecorder and ground.reader.load_run.
+"""Tests of the MCAP run archive: ground.archive.recorder.McapRecorder and ground.archive.reader.load_run.
 
 Files are real MCAP files in ``tmp_path``; the file structure is checked with the ``mcap``
-library's own reader (independent of ground.reader), and a SIGKILLed writer is a real process.
+library's own reader (independent of ground.archive.reader), and a SIGKILLed writer is a real process.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from ground.reader import ArchiveError, Record, load_run
-from ground.recorder import LIBRARY, McapRecorder
+from ground.archive.reader import ArchiveError, Record, load_run
+from ground.archive.recorder import LIBRARY, McapRecorder
 from interfaces.messages import (
     ExecStats,
     GroupStats,
@@ -382,7 +382,7 @@ def test_damaged_chunk_stops_reading_at_the_previous_chunk(tmp_path: Path) -> No
 _KILLED_WRITER = """
 import sys, time
 sys.path.insert(0, sys.argv[2])
-from ground.recorder import McapRecorder
+from ground.archive.recorder import McapRecorder
 from interfaces.messages import RelNavMeasurement
 
 rec = McapRecorder(sys.argv[1], metadata={"run": {"seed": "1"}}, chunk_size=4096)

@@ -19,7 +19,7 @@ import pytest
 
 from deploy.campaign import CampaignError, load_campaign
 from deploy.run_campaign import main as run_campaign
-from ground.record import software_version
+from ground.archive.record import software_version
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -183,7 +183,7 @@ def test_a_crashing_run_is_recorded_as_failed(tmp_path: Path,
     report counts it); it is not redone on restart."""
     import deploy.inproc
     from deploy.campaign import execute_run
-    from ground.campaign_report import write_campaign_report
+    from ground.analysis.campaign_report import write_campaign_report
 
     def boom(*_a: object, **_k: object) -> None:
         raise RuntimeError("sim exploded")

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ground.campaign_report import (
+from ground.analysis.campaign_report import (
     SCALES,
     _alarms_at,
     _magnitude_bins,

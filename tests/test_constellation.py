@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from deploy.inproc import run_inproc
-from ground.reader import load_run
-from ground.recorder import McapRecorder
+from ground.archive.reader import load_run
+from ground.archive.recorder import McapRecorder
 from interfaces import catalogue as cat
 from interfaces import topics
 from interfaces.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry

@@ -8,10 +8,10 @@ import pytest
 from mcap.reader import make_reader
 
 from deploy.inproc import run_inproc
-from ground.digest import digest_archive, digest_run, unread_keys
-from ground.reader import ArchiveError, Record, load_run
-from ground.recorder import McapRecorder
-from ground.summary import build_summary
+from ground.analysis.digest import digest_archive, digest_run, unread_keys
+from ground.archive.reader import ArchiveError, Record, load_run
+from ground.archive.recorder import McapRecorder
+from ground.analysis.summary import build_summary
 from interfaces.scenario import Scenario, load_scenario
 
 REPO = Path(__file__).resolve().parent.parent

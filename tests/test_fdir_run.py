@@ -9,8 +9,8 @@ from typing import Any
 
 import pytest
 
-from ground.fdir.calibrate import main as calibrate_main
-from ground.report import write_report
+from ground.analysis.calibrate import main as calibrate_main
+from ground.analysis.report import write_report
 from interfaces.messages import FaultReport, FdirWindow
 from tests.conftest import recorded_run, small_scenario
 

@@ -1,10 +1,10 @@
-"""Scoring (ground/fdir/scoring.py) on constructed alarm sequences."""
+"""Scoring (ground/analysis/scoring.py) on constructed alarm sequences."""
 
 from __future__ import annotations
 
 import pytest
 
-from ground.fdir.scoring import Alarm, Judged, score
+from ground.analysis.scoring import Alarm, Judged, score
 from interfaces.scenario import Fault
 
 FAULTS = [Fault(spacecraft=2, kind="camera_degradation", start_s=100.0, magnitude=0.5),

@@ -16,8 +16,8 @@ from fsw.apps.guidance import KEEP_OUT_MARGIN_M
 from fsw.lib.hcw import mean_motion
 from fsw.lib.poi import sphere_pois
 from fsw.lib.pro import Pro
-from ground.mission_plan import UPLINK_LEAD_S, MissionPlan
-from ground.reader import load_run
+from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
+from ground.archive.reader import load_run
 from interfaces.messages import (
     AttitudeEstimate,
     GuidanceStatus,

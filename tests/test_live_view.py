@@ -11,7 +11,7 @@ import struct
 
 from tornado.websocket import websocket_connect
 
-from ground.live import POSES_TOPIC, LiveView
+from ground.tools.live import POSES_TOPIC, LiveView
 from interfaces.messages import FaultReport, TruthState
 
 

@@ -1,5 +1,5 @@
-"""Tests of ground.mission_plan: scenario phases issued as given, information phases chosen by
-the greedy of ground.orbit_assignment (checked against an independent call and brute-force
+"""Tests of ground.planning.mission_plan: scenario phases issued as given, information phases chosen by
+the greedy of ground.planning.orbit_assignment (checked against an independent call and brute-force
 matching), and reassignment when the measured gain saturates, closed on a fused map fed with
 what the issued orbits see."""
 
@@ -14,8 +14,8 @@ import pytest
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
 from fsw.lib.pro import Pro, min_distance_between, min_distance_to_origin
-from ground.mission_plan import UPLINK_LEAD_S, MissionPlan
-from ground.orbit_assignment import expected_precision, greedy_assignment
+from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
+from ground.planning.orbit_assignment import expected_precision, greedy_assignment
 from interfaces.scenario import Scenario
 
 POS, NOR = sphere_pois(400, 5.0)

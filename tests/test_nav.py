@@ -7,9 +7,9 @@ from scipy.stats import chi2
 
 from deploy.inproc import run_inproc
 from fsw.lib import kalman
-from ground.evaluation import nav_errors
-from ground.reader import load_run
-from ground.recorder import McapRecorder
+from ground.analysis.nav import nav_errors
+from ground.archive.reader import load_run
+from ground.archive.recorder import McapRecorder
 from tests.conftest import small_scenario
 
 

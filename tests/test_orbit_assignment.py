@@ -1,4 +1,4 @@
-"""Tests of ground.orbit_assignment against independent truth: exhaustive search with the
+"""Tests of ground.planning.orbit_assignment against independent truth: exhaustive search with the
 information cost of fsw.lib.infocost, a hand-written visibility model, dense sampling of PRO
 distances, brute-force permutations."""
 
@@ -14,7 +14,7 @@ from fsw.lib.hcw import mean_motion
 from fsw.lib.infocost import Camera, information_cost
 from fsw.lib.poi import sphere_pois
 from fsw.lib.pro import Pro
-from ground.orbit_assignment import (
+from ground.planning.orbit_assignment import (
     expected_precision,
     gain_saturated,
     greedy_assignment,

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from ground.reader import load_run
-from ground.recorder import McapRecorder
-from ground.recorder_process import BATCH, RecorderDied, RecorderProcess
+from ground.archive.reader import load_run
+from ground.archive.recorder import McapRecorder
+from ground.archive.recorder_process import BATCH, RecorderDied, RecorderProcess
 from interfaces.messages import Heartbeat
 from interfaces.transport import Sample
 
@@ -52,7 +52,7 @@ def test_a_killed_run_leaves_a_complete_archive_of_what_it_sent(tmp_path: Path) 
         import os, signal, sys
         sys.path.insert(0, {str(REPO)!r})
         from tests.test_recorder_process import _samples
-        from ground.recorder_process import BATCH, RecorderProcess
+        from ground.archive.recorder_process import BATCH, RecorderProcess
         rec = RecorderProcess({str(path)!r})
         for s in _samples(3 * BATCH)[:3 * BATCH]:
             rec.record_sample(s)

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ground.reader import ArchiveError
-from ground.truth_table import TruthTable
+from ground.archive.reader import ArchiveError
+from ground.analysis.truth_table import TruthTable
 from interfaces.messages import TruthState
 
 

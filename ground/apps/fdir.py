@@ -63,7 +63,7 @@ from ground.fdir.identify import (
     seen_overlap,
 )
 from ground.fdir.metric import direction, metric
-from ground.mission_plan import pro_of
+from ground.planning.mission_plan import pro_of
 from ground.fdir.threshold import Persistence, adaptive_threshold
 from ground.fdir.twin import (
     FlightPlan,

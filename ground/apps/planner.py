@@ -5,7 +5,7 @@ target, so it hears every observer in range of it), fused into the ground's POI 
 ``ProAssignments`` (every observer's current assignment) on ``ground/planner/assignments`` and
 each information-driven ``AssignmentDecision`` on ``ground/planner/decisions``.
 
-What to fly comes from :class:`ground.mission_plan.MissionPlan`: the scenario's phases, with
+What to fly comes from :class:`ground.planning.mission_plan.MissionPlan`: the scenario's phases, with
 ``assign = "information"`` phases chosen by expected information gain and reassigned when the
 set's gain saturates, and -- with ``fdir.recovery`` -- a recovery assignment when the FDIR
 reports an identified camera or actuator fault (input ``ground/fdir/report``).  An
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
-from ground.mission_plan import MissionPlan
+from ground.planning.mission_plan import MissionPlan
 from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.messages import (

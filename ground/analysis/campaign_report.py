@@ -11,7 +11,7 @@ injected kind, and a ROC curve per detector from sweeping a scale on its thresho
 the main detector re-scored under other persistence rules (m of the last n windows), and the
 distribution of its H_m,i / τ_i in nominal windows and in windows of each fault kind.
 
-Definitions as in ground/fdir/scoring.py: a fault is detected when any alarm falls in its
+Definitions as in ground/analysis/scoring.py: a fault is detected when any alarm falls in its
 active span (plus one FDI window), isolated when one names its spacecraft; a false alarm is
 an alarm on a spacecraft with no active fault; rates are per nominal FDI cycle and per hour.
 """
@@ -32,7 +32,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ground.fdir.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
+from ground.analysis.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
 from ground.fdir.threshold import Persistence  # noqa: E402
 from interfaces.scenario import Fault  # noqa: E402
 

@@ -1,4 +1,4 @@
-"""Reading a run archive written by :class:`ground.recorder.McapRecorder`.
+"""Reading a run archive written by :class:`ground.archive.recorder.McapRecorder`.
 
 :func:`load_run` reads the whole MCAP file **sequentially** (``mcap.stream_reader.StreamReader``)
 rather than through the summary/index at the end, so one code path serves a finished file and a

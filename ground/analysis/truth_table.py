@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ground.reader import ArchiveError, Record, RunArchive
+from ground.archive.reader import ArchiveError, Record, RunArchive
 from interfaces import catalogue as cat
 from interfaces.messages import TruthState
 

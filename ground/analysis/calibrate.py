@@ -1,7 +1,7 @@
 """Calibrate the FDIR threshold floor from nominal runs (DESIGN.md: "a floor calibrated from
 nominal runs for a chosen false-alarm rate").
 
-    python -m ground.fdir.calibrate runs/nominal [runs/nominal-seed2 ...] [--rate 1e-3]
+    python -m ground.analysis.calibrate runs/nominal [runs/nominal-seed2 ...] [--rate 1e-3]
         [--persistence 2] [--skip-s 0]
 
 Reads every ``ground/fdir/window`` verdict of the given run directories (``run.mcap``; windows
@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ground.fdir.threshold import calibrate_floor
-from ground.reader import ArchiveError, load_run
+from ground.archive.reader import ArchiveError, load_run
 from interfaces.messages import FdirWindow
 
 
@@ -45,7 +45,7 @@ def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[FdirWindow]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m ground.fdir.calibrate", description=__doc__,
+    p = argparse.ArgumentParser(prog="python -m ground.analysis.calibrate", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("runs", type=Path, nargs="+", help="run directories of nominal runs")
     p.add_argument("--rate", type=float, default=1e-3,

@@ -7,11 +7,11 @@ import math
 from pathlib import Path
 from typing import Any, TypeVar
 
-from ground.coverage import coverage_summary
-from ground.digest import RunDigest, digest_run
-from ground.fdir.scoring import Alarm, Judged, score
-from ground.gnc_evaluation import gnc_summary
-from ground.reader import ArchiveError, RunArchive
+from ground.analysis.coverage import coverage_summary
+from ground.analysis.digest import RunDigest, digest_run
+from ground.analysis.scoring import Alarm, Judged, score
+from ground.analysis.gnc import gnc_summary
+from ground.archive.reader import ArchiveError, RunArchive
 from interfaces import catalogue as cat
 from interfaces.messages import (
     BaselineVerdict,
@@ -62,7 +62,7 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[s
 
 def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[str, Any]:
     """``detections`` (the ground FDIR's fault reports) and ``scores`` against the injected
-    faults (ground/fdir/scoring.py; grace of one FDI window)."""
+    faults (ground/analysis/scoring.py; grace of one FDI window)."""
     reports = archive.of(cat.FAULT_REPORT, mission)
     windows = archive.of(cat.FDIR_WINDOW, mission)
     verdicts = archive.of(cat.BASELINE, mission)
@@ -130,7 +130,7 @@ def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, 
                   digest: RunDigest | None = None) -> dict[str, Any]:
     """Write ``<out>/summary.json`` and return it.  A damaged or missing archive is reported in
     the summary (``archive_error``), never hidden.  ``digest``: the run's archive already read
-    (``ground.digest``; the report then reuses it), else ``<out>/run.mcap`` is read."""
+    (``ground.analysis.digest``; the report then reuses it), else ``<out>/run.mcap`` is read."""
     summary: dict[str, Any] = {
         "scenario": scenario.name,
         "seed": scenario.seed,

@@ -1,4 +1,4 @@
-"""Live telemetry: ``python -m ground.tlm [--filter 'insp/**/nav/**'] [--stream]``.
+"""Live telemetry: ``python -m ground.tools.tlm [--filter 'insp/**/nav/**'] [--stream]``.
 
 Joins the constellation's Zenoh network as a client (default ``tcp/127.0.0.1:7447``) and shows
 the latest message of every key matching the filter as a table refreshed once per second, or,
@@ -74,7 +74,7 @@ def table(rows: dict[str, _Row]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m ground.tlm", description=__doc__,
+    p = argparse.ArgumentParser(prog="python -m ground.tools.tlm", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--filter", default="insp/**", help="Zenoh key expression (default insp/**)")
     p.add_argument("--connect", default=DEFAULT_ENDPOINT, help="Zenoh endpoint of the constellation")

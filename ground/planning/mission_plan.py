@@ -3,11 +3,11 @@ hierarchical planner of Sec. II.C).
 
 Scenario phases (``assign = "scenario"``) give their PROs directly.  Information phases
 (``assign = "information"``) are decided when they are uplinked, from the ground's fused view of
-the POIs at that moment: the greedy set of :func:`ground.orbit_assignment.greedy_assignment`,
-matched to the observers by :func:`ground.orbit_assignment.match_to_observers`.  While an
+the POIs at that moment: the greedy set of :func:`ground.planning.orbit_assignment.greedy_assignment`,
+matched to the observers by :func:`ground.planning.orbit_assignment.match_to_observers`.  While an
 information phase is the latest one, the plan measures how much the fused cost H falls in each
 ``check_period_s`` window after arrival, and when the set's gain saturates
-(:func:`ground.orbit_assignment.gain_saturated`) it chooses a new set; the new set is flown only
+(:func:`ground.planning.orbit_assignment.gain_saturated`) it chooses a new set; the new set is flown only
 if its expected gain beats keeping the current one by ``min_improvement`` (a transfer costs
 fuel and time).  Every decision is kept with its figures (expected gain, online bound) for the
 archive.
@@ -39,7 +39,7 @@ from fsw.lib.hcw import mean_motion
 from fsw.lib.infocost import Camera
 from fsw.lib.poi_map import PoiMap
 from fsw.lib.pro import Pro, min_distance_between, min_distance_to_origin
-from ground.orbit_assignment import (
+from ground.planning.orbit_assignment import (
     expected_precision,
     gain_saturated,
     greedy_assignment,

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from fsw.lib.poi_map import PoiMap
-from ground.reader import Record, RunArchive
+from ground.archive.reader import Record, RunArchive
 from interfaces import catalogue as cat
 from interfaces.messages import AssignmentDecision, CameraImage
 from interfaces.scenario import Scenario

@@ -2,14 +2,14 @@
 compression leave the simulation loop for the other core.
 
 The run's process prepares each sample (key, type, the JSON bytes it already has, sim time and
-sequence from the message: :func:`ground.recorder.prepare_sample`) and sends them in batches
-over a pipe; the child hands them to an :class:`ground.recorder.McapRecorder`.  The pipe is
+sequence from the message: :func:`ground.archive.recorder.prepare_sample`) and sends them in batches
+over a pipe; the child hands them to an :class:`ground.archive.recorder.McapRecorder`.  The pipe is
 the back-pressure: a writer that falls behind blocks the run, nothing is dropped.
 
 Failure: if the run's process dies, the child reads the end of the pipe, writes what it
 received and closes the file (a complete archive up to the last batch sent).  If the child
 dies, the next send raises :class:`RecorderDied` with its exit code; the file stays readable
-up to its last complete chunk (``ground.reader.load_run``).
+up to its last complete chunk (``ground.archive.reader.load_run``).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from types import TracebackType
 
-from ground.recorder import McapRecorder, Pending, prepare_raw, prepare_sample
+from ground.archive.recorder import McapRecorder, Pending, prepare_raw, prepare_sample
 from interfaces.transport import Sample
 
 BATCH = 1024
@@ -46,7 +46,7 @@ def _serve(conn: Connection, path: str, metadata: dict[str, dict[str, str]] | No
 
 
 class RecorderProcess:
-    """An :class:`~ground.recorder.McapRecorder` in a child process (see the module docstring);
+    """An :class:`~ground.archive.recorder.McapRecorder` in a child process (see the module docstring);
     use as a context manager or call :meth:`close`."""
 
     def __init__(self, path: str | Path, metadata: dict[str, dict[str, str]] | None = None,

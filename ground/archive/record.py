@@ -1,4 +1,4 @@
-"""Recorder process: ``python -m ground.record --scenario F --out run.mcap``.
+"""Recorder process: ``python -m ground.archive.record --scenario F --out run.mcap``.
 
 Subscribes to every key of the mission and archives each message, with its JSON schema, in an
 MCAP file (Foxglove opens it).  SIGINT/SIGTERM finish the file cleanly (summary and footer).
@@ -13,7 +13,7 @@ import subprocess
 import time
 from pathlib import Path
 
-from ground.recorder import McapRecorder
+from ground.archive.recorder import McapRecorder
 from interfaces import topics
 from interfaces.cli import (
     add_node_args,
@@ -55,7 +55,7 @@ def run_metadata(scenario: Scenario, transport: str, scenario_toml: str) -> dict
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m ground.record", description=__doc__)
+    parser = argparse.ArgumentParser(prog="python -m ground.archive.record", description=__doc__)
     add_node_args(parser)
     parser.add_argument("--out", required=True, help="MCAP file to write")
     parser.add_argument("--transport-name", default="zenoh", help="recorded in the metadata")

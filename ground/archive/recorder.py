@@ -23,12 +23,12 @@ File layout (Foxglove opens it as is):
 
 Payloads that are not a JSON object (not JSON, NaN/Infinity, an array, ...) are stored as received
 and counted in :attr:`McapRecorder.invalid`; payloads are not validated against their model here
-(that is the reader's :meth:`~ground.reader.Record.message`).
+(that is the reader's :meth:`~ground.archive.reader.Record.message`).
 
 Crash safety: messages are grouped in zstd chunks of about ``chunk_size`` bytes (uncompressed).
 The file is written without a user-space buffer, so each chunk reaches the operating system the
 moment it is complete: after a SIGKILL every complete chunk is in the file and
-:func:`ground.reader.load_run` recovers it (``truncated=True``).  The chunk in progress (at most
+:func:`ground.archive.reader.load_run` recovers it (``truncated=True``).  The chunk in progress (at most
 ``chunk_size`` bytes of messages) is lost; call :meth:`McapRecorder.flush` to close it early.
 The recorder does not fsync (a process kill does not need it; a power loss does).
 """
@@ -205,7 +205,7 @@ class McapRecorder:
     """Thread-safe MCAP writer of raw bus samples (see the module docstring for the layout).
 
     Use as a context manager or call :meth:`close`; an unclosed file (process killed) is still
-    readable up to its last complete chunk with :func:`ground.reader.load_run`.
+    readable up to its last complete chunk with :func:`ground.archive.reader.load_run`.
 
     Counters (read-only properties): :attr:`recorded`, :attr:`invalid`, :attr:`unknown_type`,
     :attr:`dropped`, :attr:`after_close`, :attr:`counts` (messages per key).

@@ -11,12 +11,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ground.coverage import Coverage  # noqa: E402
-from ground.digest import RunDigest, digest_run  # noqa: E402
-from ground.evaluation import NavErrors  # noqa: E402
-from ground.gnc_evaluation import GncSeries  # noqa: E402
-from ground.reader import ArchiveError, RunArchive  # noqa: E402
-from ground.truth_table import TruthTable  # noqa: E402
+from ground.analysis.coverage import Coverage  # noqa: E402
+from ground.analysis.digest import RunDigest, digest_run  # noqa: E402
+from ground.analysis.nav import NavErrors  # noqa: E402
+from ground.analysis.gnc import GncSeries  # noqa: E402
+from ground.archive.reader import ArchiveError, RunArchive  # noqa: E402
+from ground.analysis.truth_table import TruthTable  # noqa: E402
 from interfaces import catalogue as cat  # noqa: E402
 from interfaces.messages import FdirWindow  # noqa: E402
 from interfaces.scenario import Scenario  # noqa: E402
@@ -25,7 +25,7 @@ from interfaces.scenario import Scenario  # noqa: E402
 def write_report(out: Path, scenario: Scenario, mission: str | None = None,
                  digest: RunDigest | None = None) -> Path:
     """Write ``<out>/report.md`` (and its plots) from ``run.mcap`` and ``summary.json``
-    (``digest``: the run's archive already read for the summary, ``ground.digest``)."""
+    (``digest``: the run's archive already read for the summary, ``ground.analysis.digest``)."""
     mission = mission or scenario.name
     summary = json.loads((out / "summary.json").read_text())
     lines = [f"# Run report: {scenario.name}", "",

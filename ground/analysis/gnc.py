@@ -18,8 +18,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from fsw.lib import hcw
-from ground.reader import RunArchive
-from ground.truth_table import TIME_DECIMALS, TruthTable
+from ground.archive.reader import RunArchive
+from ground.analysis.truth_table import TIME_DECIMALS, TruthTable
 from interfaces import catalogue as cat
 from interfaces.messages import AttitudeEstimate
 from interfaces.scenario import Scenario

@@ -9,7 +9,7 @@ metadata the recorder wrote (scenario, seed, transport, software version), the m
 per type, the injected faults and the FDIR's declarations; ``export`` writes the messages of
 a key expression (``*`` one chunk, ``**`` any number) as CSV, one row per message, nested
 fields flattened (``r_m.0``, ``P.2.3``), to ``--out`` or stdout.  A damaged archive is read up
-to its last complete chunk (ground/reader.py) and said so.
+to its last complete chunk (ground/archive/reader.py) and said so.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, TextIO
 
-from ground.reader import ArchiveError, RunArchive, load_run
+from ground.archive.reader import ArchiveError, RunArchive, load_run
 
 
 def flatten(value: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:

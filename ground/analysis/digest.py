@@ -3,9 +3,9 @@
 A two-orbit run archives about 4 GB of JSON, 1.7 GB of it camera images and as much again the
 observations that repeat them; held whole and decoded, the summary of such a run needed 13 GB.
 The digest keeps only what the summary and report read: the camera images are fused into the
-coverage as they stream past (:class:`ground.coverage.CoverageFuser`), the cumulative counters
+coverage as they stream past (:class:`ground.analysis.coverage.CoverageFuser`), the cumulative counters
 (ticks, executive and link statistics) keep their last record, the truth is packed into arrays
-(:class:`ground.truth_table.TruthTable`), and the bulk neither reads
+(:class:`ground.analysis.truth_table.TruthTable`), and the bulk neither reads
 (observations, attitude sensors, wheel commands, lockstep answers, heartbeats) is counted and
 dropped.
 """
@@ -15,11 +15,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ground.coverage import Coverage, CoverageFuser, camera_images, coverage
-from ground.evaluation import NavErrors, nav_errors
-from ground.gnc_evaluation import GncSeries, gnc_series
-from ground.reader import Record, RunArchive, load_run
-from ground.truth_table import TruthTable, TruthTableBuilder
+from ground.analysis.coverage import Coverage, CoverageFuser, camera_images, coverage
+from ground.analysis.nav import NavErrors, nav_errors
+from ground.analysis.gnc import GncSeries, gnc_series
+from ground.archive.reader import Record, RunArchive, load_run
+from ground.analysis.truth_table import TruthTable, TruthTableBuilder
 from interfaces import catalogue as cat
 from interfaces.scenario import Scenario
 

@@ -8,8 +8,8 @@ import numpy as np
 from scipy.stats import chi2
 
 from fsw.lib.kalman import nees
-from ground.reader import RunArchive
-from ground.truth_table import TruthTable
+from ground.archive.reader import RunArchive
+from ground.analysis.truth_table import TruthTable
 from interfaces import catalogue as cat
 from interfaces.messages import StateEstimate
 

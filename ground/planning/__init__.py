@@ -1,0 +1,1 @@
+"""Mission planning: the phase plan and the information-driven orbit assignment."""

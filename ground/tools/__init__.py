@@ -1,0 +1,1 @@
+"""Tools for people: live telemetry table, Foxglove live view."""
