@@ -299,7 +299,7 @@ def finished(spec: RunSpec, out_root: Path) -> bool:
 def _finish(spec: RunSpec, partial: Path, final: Path, transport: str) -> None:
     import shutil
 
-    from ground.archive.record import software_version
+    from ground.archive.metadata import software_version
 
     (partial / "campaign.json").write_text(json.dumps(
         {"run": spec.id, "group": spec.group, "seed": spec.seed, "transport": transport,
@@ -327,7 +327,7 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     import traceback
 
     from deploy.inproc import run_inproc
-    from ground.archive.record import run_metadata
+    from ground.archive.metadata import run_metadata
     from ground.archive.recorder import McapRecorder
     from ground.analysis.summary import write_summary
 

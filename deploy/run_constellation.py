@@ -34,7 +34,7 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
 from deploy.processes import Child, Supervisor  # noqa: E402
 from ground.analysis.digest import RunDigest, digest_run  # noqa: E402
 from ground.archive.reader import ArchiveError  # noqa: E402
-from ground.archive.record import run_metadata  # noqa: E402
+from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
 from ground.analysis.report import write_report  # noqa: E402
 from ground.analysis.summary import add_recovery_comparison, write_summary  # noqa: E402

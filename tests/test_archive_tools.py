@@ -12,7 +12,7 @@ import pytest
 from deploy.inproc import run_inproc
 from ground.archive.cli import export_csv, flatten, main
 from ground.archive.reader import load_run
-from ground.archive.record import run_metadata, software_version
+from ground.archive.metadata import run_metadata, software_version
 from ground.archive.recorder import McapRecorder
 from tests.conftest import small_scenario
 

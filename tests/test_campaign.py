@@ -19,7 +19,7 @@ import pytest
 
 from deploy.campaign import CampaignError, load_campaign
 from deploy.run_campaign import main as run_campaign
-from ground.archive.record import software_version
+from ground.archive.metadata import software_version
 
 REPO = Path(__file__).resolve().parent.parent
 

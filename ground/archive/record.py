@@ -7,12 +7,8 @@ MCAP file (Foxglove opens it).  SIGINT/SIGTERM finish the file cleanly (summary 
 from __future__ import annotations
 
 import argparse
-import functools
-import importlib.metadata
-import subprocess
-import time
-from pathlib import Path
 
+from ground.archive.metadata import run_metadata
 from ground.archive.recorder import McapRecorder
 from interfaces import topics
 from interfaces.cli import (
@@ -23,35 +19,6 @@ from interfaces.cli import (
     setup_logging,
     stop_on_signals,
 )
-from interfaces.scenario import Scenario
-
-
-@functools.cache
-def software_version() -> str:
-    """The package version, with the git commit of the checkout it runs from when there is
-    one (``0.1.0+g46a41bc``, ``-dirty`` with uncommitted changes)."""
-    try:
-        version = importlib.metadata.version("insp-fdir")
-    except importlib.metadata.PackageNotFoundError:
-        version = "unknown (not installed)"
-    repo = Path(__file__).resolve().parent.parent
-    try:
-        commit = subprocess.run(["git", "-C", str(repo), "describe", "--always", "--dirty",
-                                 "--exclude", "*"], capture_output=True, text=True, timeout=10,
-                                check=True).stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        return version
-    return f"{version}+g{commit}" if commit else version
-
-
-def run_metadata(scenario: Scenario, transport: str, scenario_toml: str) -> dict[str, dict[str, str]]:
-    """MCAP metadata records of a run: what ran, with which seed and software."""
-    return {
-        "run": {"scenario": scenario.name, "seed": str(scenario.seed), "transport": transport,
-                "duration_s": str(scenario.duration_s), "software_version": software_version(),
-                "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())},
-        "scenario": {"toml": scenario_toml, "resolved_json": scenario.model_dump_json()},
-    }
 
 
 def main(argv: list[str] | None = None) -> int:
