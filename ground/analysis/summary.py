@@ -17,6 +17,7 @@ from interfaces.messages import (
     BaselineVerdict,
     Message,
     ExecStats,
+    FaultReport,
     FdirWindow,
     LinkStats,
     Tick,
@@ -63,9 +64,15 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[s
 def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[str, Any]:
     """``detections`` (the ground FDIR's fault reports) and ``scores`` against the injected
     faults (ground/analysis/scoring.py; grace of one FDI window)."""
-    reports = archive.of(cat.FAULT_REPORT, mission)
-    windows = archive.of(cat.FDIR_WINDOW, mission)
-    verdicts = archive.of(cat.BASELINE, mission)
+    return fdir_results(archive.of(cat.FAULT_REPORT, mission),
+                        archive.of(cat.FDIR_WINDOW, mission), archive.of(cat.BASELINE, mission),
+                        scenario)
+
+
+def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
+                 verdicts: list[BaselineVerdict], scenario: Scenario) -> dict[str, Any]:
+    """The FDIR part of summary.json from the ground's own output messages (a live run's
+    archive or a replay): detections, scores, baselines, series and settings."""
     alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class) for r in reports]
     judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
               if w.exceeded is not None]

@@ -1,0 +1,123 @@
+"""Replay (ground/fdir/replay.py): the live ground re-run on a recorded run reproduces the live
+detections, windows and verdicts exactly -- with lossy, range-limited and cut links and three
+faults -- and, under another setting, what the live run with that setting declared, up to the
+first uplink the two runs differ in."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from deploy.inproc import run_inproc
+from ground.analysis.summary import write_summary
+from ground.archive.metadata import run_metadata
+from ground.archive.reader import ArchiveError, load_run
+from ground.archive.recorder import McapRecorder
+from ground.fdir.replay import GroundOutput, main, replay_run, with_settings
+from interfaces.scenario import Scenario, ScenarioError
+from tests.conftest import small_scenario
+
+
+def _scenario(**fdir: object) -> Scenario:
+    return small_scenario(
+        "replay", duration_s=400.0, target={"pois": 1000},
+        rates={"high_hz": 5.0, "fdi_period_s": 50.0},
+        observers={"count": 3, "initial_attitude": "lvlh"},
+        comms={"range_m": 39.0, "packet_loss": 0.15, "burst": {"mean_length_packets": 3.0},
+               "cuts": [{"a": "sc3", "b": "ground", "start_s": 120.0, "end_s": 180.0}]},
+        faults=[{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0, "magnitude": 0.5},
+                {"spacecraft": 1, "kind": "faulty_data", "start_s": 150.0, "magnitude": 2.0},
+                {"spacecraft": 3, "kind": "link_loss", "start_s": 250.0, "end_s": 330.0}],
+        fdir=fdir)
+
+
+def _record(scenario: Scenario, out: Path) -> dict[str, Any]:
+    out.mkdir(parents=True, exist_ok=True)
+    with McapRecorder(out / "run.mcap", run_metadata(scenario, "inproc", "# test\n")) as rec:
+        run_inproc(scenario, sample_tap=rec.record_sample)
+    return write_summary(out, scenario, "inproc", 1.0, "completed")
+
+
+@pytest.fixture(scope="module")
+def live(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    out = tmp_path_factory.mktemp("replay") / "live"
+    return out, _record(_scenario(), out)
+
+
+FDIR_FIELDS = ("scores", "baselines", "fdir_series", "fdir_settings")
+
+
+def test_replay_reproduces_the_live_ground_exactly(live: tuple[Path, dict[str, Any]]) -> None:
+    out, summary = live
+    archive = load_run(out / "run.mcap")
+    links = [c for c in json.loads((out / "summary.json").read_text())["links"]
+             if c["dst"] == "ground"]
+    assert sum(c["dropped_loss"] for c in links) > 0, "the links lost messages"
+    assert sum(c["dropped_range"] for c in links) > 0, "range cut some"
+    assert sum(c["dropped_cut"] for c in links) > 0, "and scheduled cuts others"
+    assert len({d["spacecraft"] for d in summary["detections"]}) >= 2
+    replay = replay_run(out / "run.mcap")
+    assert replay.matches_live()
+    res = replay.results()
+    assert res["faithful_until_s"] == 400.0
+    assert [{k: v for k, v in d.items() if k != "faithful"} for d in res["detections"]] \
+        == summary["detections"]
+    for k in FDIR_FIELDS:
+        assert res[k] == summary[k], k
+    live_out = GroundOutput.of_archive(archive, "replay")
+    assert len(live_out.windows) == len(replay.replayed.windows) > 20
+
+
+def test_another_setting_replays_as_the_live_run_with_it(
+        live: tuple[Path, dict[str, Any]], tmp_path: Path) -> None:
+    out, summary = live
+    replay = replay_run(out / "run.mcap", {"fdir.persistence": "1"})
+    other = _record(_scenario(persistence=1), tmp_path / "other")
+    horizon = replay.faithful_until_s()
+    def first_camera(dets: list[dict[str, Any]]) -> float:
+        return min(d["time_s"] for d in dets if d["class"] == "camera")
+
+    assert first_camera(other["detections"]) < first_camera(summary["detections"]), \
+        "the setting declares the camera fault sooner"
+    assert horizon < 400.0, "and its recovery uplink differs from the live run's"
+    before = [d for d in replay.results()["detections"] if d["time_s"] <= horizon]
+    assert before and all(d["faithful"] for d in before)
+    assert [{k: v for k, v in d.items() if k != "faithful"} for d in before] \
+        == [d for d in other["detections"] if d["time_s"] <= horizon]
+    other_windows = GroundOutput.of_archive(load_run(tmp_path / "other" / "run.mcap"),
+                                            "replay").windows
+    mine = [w.model_dump(exclude={"t_wall"}) for w in replay.replayed.windows
+            if w.t_sim <= horizon]
+    assert mine == [w.model_dump(exclude={"t_wall"}) for w in other_windows
+                    if w.t_sim <= horizon]
+
+
+def test_settings_that_change_the_flight_are_refused() -> None:
+    sc = _scenario()
+    assert with_settings(sc, {"fdir.floor": "0.07"}).fdir.floor == 0.07
+    assert with_settings(sc, {"rates.fdi_period_s": "25"}).rates.fdi_period_s == 25.0
+    with pytest.raises(ScenarioError, match="changes what was flown"):
+        with_settings(sc, {"comms.packet_loss": "0.5"})
+    with pytest.raises(ScenarioError, match="no such setting"):
+        with_settings(sc, {"fdir.nope": "1"})
+    with pytest.raises(ScenarioError, match="greater than or equal"):
+        with_settings(sc, {"fdir.floor": "-1"})
+
+
+def test_command_line_writes_the_replay_and_refuses_an_archive_without_scenario(
+        live: tuple[Path, dict[str, Any]], tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    out, _ = live
+    assert main([str(out), "--out", str(tmp_path)]) == 0
+    res = json.loads((tmp_path / "live.replay.json").read_text())
+    assert res["matches_live"] is True and "matches the live run" in capsys.readouterr().out
+    bare = tmp_path / "bare.mcap"
+    with McapRecorder(bare, {}):
+        pass
+    assert main([str(bare)]) == 1
+    assert "no scenario" in capsys.readouterr().err
+    with pytest.raises(ArchiveError, match="no scenario"):
+        replay_run(bare)
