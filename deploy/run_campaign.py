@@ -4,6 +4,9 @@ from one campaign file, on a local process pool or a Dask cluster, resumable.
     python deploy/run_campaign.py --campaign deploy/campaigns/paper.toml --out runs/paper
         [--workers N] [--limit N] [--cluster tcp://HOST:PORT] [--transport inproc|zenoh]
         [--report-only]
+    python deploy/run_campaign.py --out runs/paper --replay [--set fdir.KEY=VALUE ...]
+        [--out-report DIR] [--workers N] [--cluster ...]
+    python deploy/run_campaign.py --out runs/paper --sweep fdir.KEY=V1,V2,... [--set ...]
 
 Each run goes in-process (deploy/inproc.py; --transport zenoh: multi-process, each run on its
 own loopback port and key space) into <out>/runs/<id>/ (run.mcap, summary.json,
@@ -15,8 +18,10 @@ and the report is written over what has finished.  --cluster sends the runs to a
 Dask distributed scheduler (its workers must import this repository and see --out).
 At the end <out>/report.md, PNG plots and results.csv are written (ground/analysis/campaign_report.py);
 --report-only rewrites them from the run directories without running anything (given only
---out, from the run list saved there).  The exit status is 1 when a run failed, 130 when
-interrupted.
+--out, from the run list saved there).  --replay re-judges the finished runs under other
+detector settings without simulating (deploy/campaign_replay.py) and writes the full report in
+--out-report; --sweep does it once per value of one setting and writes one table, sweep.md.
+The exit status is 1 when a run failed, 130 when interrupted, 2 for bad arguments.
 """
 
 from __future__ import annotations
@@ -51,7 +56,10 @@ from deploy.campaign import (  # noqa: E402
     load_campaign,
     record_failure,
 )
+from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
 from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
+from ground.fdir.replay import parse_settings  # noqa: E402
+from interfaces.scenario import ScenarioError  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
 
@@ -71,6 +79,15 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                         "its own loopback port and key space")
     p.add_argument("--report-only", action="store_true",
                    help="rewrite the report from the run directories, run nothing")
+    p.add_argument("--replay", action="store_true",
+                   help="re-judge the finished runs of --out under --set detector settings "
+                        "(ground.fdir.replay), simulating nothing")
+    p.add_argument("--set", dest="settings", action="append", default=[],
+                   metavar="fdir.KEY=VALUE", help="with --replay/--sweep: a detector setting")
+    p.add_argument("--sweep", metavar="fdir.KEY=V1,V2,...",
+                   help="replay the campaign once per value and write one table (sweep.md)")
+    p.add_argument("--out-report", type=Path,
+                   help="with --replay/--sweep: where to write (default: <out>/replay-<settings>)")
     return p.parse_args(argv)
 
 
@@ -161,6 +178,8 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.INFO, format="%(asctime)s campaign %(levelname)s %(message)s",
                         datefmt="%H:%M:%S")
     index = args.out / "campaign.json"
+    if args.replay or args.sweep:
+        return _replay(args)
     if args.campaign is None:
         if not (args.report_only and index.exists()):
             print("error: --campaign is required (except --report-only on a campaign "
@@ -190,6 +209,35 @@ def main(argv: list[str] | None = None) -> int:
     if status == 0 and any(_failed(args.out, r.id) for r in runs):
         return 1
     return status
+
+
+def _replay(args: argparse.Namespace) -> int:
+    """--replay / --sweep: re-judge a finished campaign (deploy/campaign_replay.py)."""
+    if not (args.out / "campaign.json").exists():
+        print(f"error: {args.out} holds no campaign to replay (no campaign.json)", file=sys.stderr)
+        return 2
+    try:
+        settings = parse_settings(args.settings)
+        name, values = _sweep_values(args.sweep) if args.sweep else ("", [])
+        slug = "_".join(f"{k}={v}" for k, v in settings.items())
+        dest = args.out_report or args.out / (f"sweep-{name}" if args.sweep else
+                                              f"replay-{slug or 'own-settings'}")
+        kw = {"workers": args.workers, "cluster": args.cluster, "progress": print_progress}
+        path = (sweep(args.out, name, values, dest, settings, **kw) if args.sweep
+                else rejudge(args.out, settings, dest, **kw))
+    except ScenarioError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    print(f"report: {path}", file=sys.stderr)
+    return 0
+
+
+def _sweep_values(text: str) -> tuple[str, list[str]]:
+    name, sep, values = text.partition("=")
+    out = [v.strip() for v in values.split(",") if v.strip()]
+    if not sep or not name or not out:
+        raise ScenarioError(f"--sweep {text!r}: expected SECTION.KEY=V1,V2,...")
+    return name.strip(), out
 
 
 def _failed(out: Path, run_id: str) -> bool:

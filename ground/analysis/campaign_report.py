@@ -126,6 +126,26 @@ def _stats(rows: list[dict[str, Any]], hours: float) -> dict[str, Any]:
     }
 
 
+def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> dict[str, Any]:
+    """One detector's figures over the finished runs ``ids`` of ``out`` (a campaign or its
+    replay): faults, detected, isolated, identified (counts), latency median and p90 of the
+    isolated faults (s), false alarms and nominal cycles, runs, and runs whose replay (if any)
+    stayed faithful to the end."""
+    runs = _load(out, ids)
+    rows = [r for r in _rows(runs) if r["detector"] == detector]
+    st = _stats(rows, 0.0)
+    lat = [r["latency_s"] for r in rows if r["kind"] != "none" and r["isolated"]
+           and r["latency_s"] is not None]
+    faithful = sum(s.get("replay", {}).get("faithful_until_s", math.inf) >= s["duration_s"]
+                   for s in runs)
+    return {"faults": st["faults"], "detected": st["detected"], "isolated": st["isolated"],
+            "identified": st["identified"],
+            "latency_median_s": float(np.median(lat)) if lat else None,
+            "latency_p90_s": float(np.quantile(lat, 0.9)) if lat else None,
+            "false_alarms": st["false_alarms"], "nominal_cycles": st["nominal_cycles"],
+            "runs": len(runs), "faithful_runs": int(faithful)}
+
+
 def _cells(detector: str, st: dict[str, Any]) -> str:
     """The table cells after the row's labels: detected, isolated, identified (main only),
     latency median / p90 / max, false alarms per nominal cycle and per hour."""

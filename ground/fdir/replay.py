@@ -222,7 +222,8 @@ def _archive_path(run: Path) -> Path:
     return run / "run.mcap" if run.is_dir() else run
 
 
-def _settings(pairs: list[str]) -> dict[str, str]:
+def parse_settings(pairs: list[str]) -> dict[str, str]:
+    """``SECTION.KEY=VALUE`` strings as a settings dict (ScenarioError if malformed)."""
     out = {}
     for p in pairs:
         name, sep, value = p.partition("=")
@@ -243,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)
     try:
-        settings = _settings(args.settings)
+        settings = parse_settings(args.settings)
     except ScenarioError as e:
         p.error(str(e))
     failed = 0
