@@ -27,7 +27,8 @@ from fsw.lib.poi import sphere_pois  # noqa: E402
 
 
 def kernel(p: np.ndarray, b: np.ndarray, s: np.ndarray, n: np.ndarray, cam: ic.Camera,
-           phi: np.ndarray, w_inv: np.ndarray, f: np.ndarray, buf: np.ndarray) -> tuple[float, np.ndarray]:
+           phi: np.ndarray, w_inv: np.ndarray, f: np.ndarray,
+           buf: np.ndarray) -> tuple[float, np.ndarray]:
     """One image per observer: new precision (into the reused ``buf``), ``f += σ⁻¹`` in place,
     then H and H_i."""
     f += ic.precision(p, b, s, n, cam, out=buf)
@@ -53,7 +54,8 @@ def bench(n_obs: int, m: int, repeats: int, rng: np.random.Generator) -> dict[st
         kernel(p, b, s, nrm, cam, phi, w_inv, f, buf)
         times.append(time.perf_counter() - t0)
     visible = float(ic.visibility(p, b, s, nrm, cam).mean())
-    return {"median": float(np.median(times)), "p90": float(np.percentile(times, 90)), "visible": visible}
+    return {"median": float(np.median(times)), "p90": float(np.percentile(times, 90)),
+            "visible": visible}
 
 
 def main() -> None:
@@ -62,7 +64,8 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1)
     args = ap.parse_args()
     rng = np.random.default_rng(args.seed)
-    print(f"{'observers':>9} {'POIs':>7} {'median ms':>10} {'p90 ms':>8} {'ns/pair':>8} {'visible':>8}")
+    print(f"{'observers':>9} {'POIs':>7} {'median ms':>10} {'p90 ms':>8} {'ns/pair':>8} "
+          f"{'visible':>8}")
     for n_obs, m in ((5, 5000), (20, 5000), (5, 50000), (20, 50000)):
         reps = max(10, args.repeats * 25000 // (n_obs * m))
         r = bench(n_obs, m, reps, rng)

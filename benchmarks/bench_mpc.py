@@ -1,4 +1,5 @@
-"""Speed of the OSQP tracking MPC (fsw/lib/mpc.py): set-up time and warm-started solve time per step.
+"""Speed of the OSQP tracking MPC (fsw/lib/mpc.py): set-up time and warm-started solve time per
+step.
 
     python benchmarks/bench_mpc.py [--steps N] [--horizon H] [--dt S] [--seed N]
 
@@ -67,7 +68,8 @@ def setup_time(n: float, cfg: MpcConfig, repeats: int = 20) -> tuple[float, floa
 
 
 def main() -> None:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--steps", type=int, default=400, help="closed-loop steps per variant")
     p.add_argument("--horizon", type=int, default=20)
     p.add_argument("--dt", type=float, default=10.0, help="MPC step, s")
@@ -91,7 +93,8 @@ def main() -> None:
     for name, cfg, cold in variants:
         r = closed_loop(n, cfg, args.steps, np.random.default_rng(args.seed), cold)
         o, w, it = r["osqp"], r["wall"], r["iters"]
-        assert isinstance(o, np.ndarray) and isinstance(w, np.ndarray) and isinstance(it, np.ndarray)
+        assert (isinstance(o, np.ndarray) and isinstance(w, np.ndarray)
+                and isinstance(it, np.ndarray))
         statuses = r["statuses"]
         assert isinstance(statuses, list)
         bad = sum(s != "solved" for s in statuses)

@@ -245,9 +245,9 @@ def load_campaign(path: str | Path) -> tuple[Campaign, list[RunSpec]]:
 
 def execute_run(spec: RunSpec, out_root: str, transport: str = "inproc") -> dict[str, Any]:
     """Run one campaign run into ``<out_root>/runs/<id>/`` (run.mcap, summary.json, a log) and
-    return {id, status, error, wall_s}.  The run is written under ``<id>.partial-<random>`` and renamed
-    when complete, so a run directory exists only for a finished run; a crash is caught and
-    recorded as a failed run with its error.  ``transport``: ``inproc`` (this process) or
+    return {id, status, error, wall_s}.  The run is written under ``<id>.partial-<random>`` and
+    renamed when complete, so a run directory exists only for a finished run; a crash is caught
+    and recorded as a failed run with its error.  ``transport``: ``inproc`` (this process) or
     ``zenoh`` (deploy/run_constellation.py as a child, one process per node, on a free
     loopback port and its own mission key space, so runs on one machine never cross).  A
     module-level function, so a Dask worker can import it."""

@@ -11,12 +11,14 @@ from one campaign file, on a local process pool or a Dask cluster, resumable.
 Each run goes in-process (deploy/inproc.py; --transport zenoh: multi-process, each run on its
 own loopback port and key space) into <out>/runs/<id>/ (run.mcap, summary.json,
 run.log); a run directory appears only when its run has finished (each attempt writes its own
-<id>.partial-<random>, then renames it), so a campaign started again with the same --out skips finished runs and redoes
+<id>.partial-<random>, then renames it), so a campaign started again with the same --out skips
+finished runs and redoes
 half-written ones.  A run that crashes is recorded as failed, with its error, and the campaign
 goes on.  SIGINT or SIGTERM stops the campaign: running runs are abandoned (redone next time)
 and the report is written over what has finished.  --cluster sends the runs to an existing
 Dask distributed scheduler (its workers must import this repository and see --out).
-At the end <out>/report.md, PNG plots and results.csv are written (ground/analysis/campaign_report.py);
+At the end <out>/report.md, PNG plots and results.csv are written
+(ground/analysis/campaign_report.py);
 --report-only rewrites them from the run directories without running anything (given only
 --out, from the run list saved there).  --replay re-judges the finished runs under other
 detector settings without simulating (deploy/campaign_replay.py) and writes the full report in

@@ -53,7 +53,8 @@ log = logging.getLogger("insp.launcher")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO, help="scenario TOML")
     p.add_argument("--out", type=Path, help="output directory (default runs/<scenario>-<time>)")
     p.add_argument("--transport", choices=("zenoh", "inproc"), default="zenoh")
@@ -113,8 +114,10 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_report:
         write_report(out, scenario, mission, digest=digest)
     rtf = summary.get("real_time_factor")
-    print(f"{status}: {scenario.name} seed {scenario.seed}, {scenario.duration_s:.0f} s simulated in "
-          f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time)" if rtf else "") + f"\n  {out}/run.mcap"
+    print(f"{status}: {scenario.name} seed {scenario.seed}, "
+          f"{scenario.duration_s:.0f} s simulated in "
+          f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time)" if rtf else "")
+          + f"\n  {out}/run.mcap"
           f"\n  {out}/summary.json" + ("" if args.no_report else f"\n  {out}/report.md"))
     if error:
         print(f"error: {error}", file=sys.stderr)
@@ -217,8 +220,10 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
                                logs / "recorder.log"))
     if not _wait_token(hub, topics.recorder_token(mission), recorder, timeout_s=30.0):
         sup.stop_all()
-        return "failed", f"recorder did not start ({recorder.describe_exit()}):\n{recorder.log_tail()}"
-    sim_argv = ["-m", "sim", *common] + (["--realtime", str(args.realtime)] if args.realtime else [])
+        return "failed", (f"recorder did not start ({recorder.describe_exit()}):\n"
+                          f"{recorder.log_tail()}")
+    sim_argv = ["-m", "sim", *common] + (["--realtime", str(args.realtime)]
+                                         if args.realtime else [])
     sup.start(Child("sim", sim_argv, logs / "sim.log"))
     nodes = [f"sc{i}" for i in range(1, scenario.observers.count + 1)]
     for i, node in enumerate(nodes, start=1):
@@ -235,7 +240,8 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
             if failed is not None:
                 error = (f"{failed.name} (pid {failed.proc.pid if failed.proc else '?'}) "
                          f"{failed.describe_exit()} at sim t≈{progress.t_sim:.1f} s; stopping the "
-                         f"constellation.\n--- last lines of {failed.log_path}:\n{failed.log_tail()}")
+                         f"constellation.\n--- last lines of {failed.log_path}:\n"
+                         f"{failed.log_tail()}")
                 break
             if all(c.returncode == 0 for c in participants):
                 break

@@ -89,7 +89,8 @@ class App:
         """Publish on a declared output; anything else is a programming error."""
         key, msg_type = self._outputs[name]
         if not isinstance(msg, msg_type):
-            raise TypeError(f"{self.NAME}.{name} publishes {msg_type.__name__}, got {type(msg).__name__}")
+            raise TypeError(f"{self.NAME}.{name} publishes {msg_type.__name__}, "
+                            f"got {type(msg).__name__}")
         self.ctx.bus.publish(key, msg)
 
     def step(self, t: float) -> None:

@@ -112,7 +112,8 @@ class Bus:
         ``announce=False`` leaves the key out of ``published_since_last`` (lockstep control
         messages that nobody must wait for)."""
         if not key.startswith(self.prefix + "/"):
-            raise ValueError(f"node {self.node} may not publish on {key!r} (own space: {self.prefix})")
+            raise ValueError(f"node {self.node} may not publish on {key!r} "
+                             f"(own space: {self.prefix})")
         self._check_type(key, type(msg))
         seq = self._seq.get(key, 0) + 1
         self._seq[key] = seq

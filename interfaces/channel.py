@@ -122,7 +122,8 @@ class ChannelModel:
 
     # --- inputs --------------------------------------------------------------------------
 
-    def observe_truth(self, t_sim: float, spacecraft: list[int], r_lvlh_m: list[list[float]]) -> None:
+    def observe_truth(self, t_sim: float, spacecraft: list[int],
+                      r_lvlh_m: list[list[float]]) -> None:
         """Record true positions at ``t_sim`` (from the sim's TruthState); thread-safe."""
         pos = {f"sc{sc}": np.asarray(r, dtype=float) for sc, r in zip(spacecraft, r_lvlh_m)}
         pos[GROUND] = np.zeros(3)

@@ -38,7 +38,8 @@ class Message(BaseModel):
     sender: str = Field(max_length=64, description="node that published the message")
     seq: int = Field(default=0, ge=0, description="per-key sequence count, set by the Bus")
     t_sim: float = Field(ge=0.0, description="simulation time of the message, s")
-    t_wall: float = Field(default=0.0, description="publisher wall clock, UNIX s (not reproducible)")
+    t_wall: float = Field(default=0.0,
+                          description="publisher wall clock, UNIX s (not reproducible)")
 
 
 def stamp(msg: Message, sender: str, seq: int, t_wall: float) -> None:
@@ -317,8 +318,8 @@ class BaselineVerdict(Message):
 
 
 class AssignmentDecision(Message):
-    """The ground's information-driven orbit choice (ground/planning/mission_plan.py): the greedy set,
-    its expected information gain and online bound, the expected gain of keeping the current
+    """The ground's information-driven orbit choice (ground/planning/mission_plan.py): the greedy
+    set, its expected information gain and online bound, the expected gain of keeping the current
     PROs, the measured H decrease per check window that led to it, and whether it was flown."""
 
     phase: str = Field(max_length=64)

@@ -28,7 +28,8 @@ class RelNavSensor:
     bias_m: np.ndarray = field(default_factory=lambda: np.zeros(3))
     """Position bias, LVLH, m (fault hook: ``nav_sensor_bias``)."""
 
-    def measure(self, r_true_m: np.ndarray, v_true_mps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def measure(self, r_true_m: np.ndarray,
+                v_true_mps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Noisy (position m, velocity m/s) of a true relative state, plus the bias."""
         noise = self.rng.standard_normal(6)
         return (r_true_m + self.bias_m + self.sigma_r_m * noise[:3],

@@ -1,7 +1,9 @@
-"""Tests of the MCAP run archive: ground.archive.recorder.McapRecorder and ground.archive.reader.load_run.
+"""Tests of the MCAP run archive: ground.archive.recorder.McapRecorder and
+ground.archive.reader.load_run.
 
 Files are real MCAP files in ``tmp_path``; the file structure is checked with the ``mcap``
-library's own reader (independent of ground.archive.reader), and a SIGKILLed writer is a real process.
+library's own reader (independent of ground.archive.reader), and a SIGKILLed writer is a real
+process.
 """
 
 from __future__ import annotations
@@ -389,8 +391,9 @@ rec = McapRecorder(sys.argv[1], metadata={"run": {"seed": "1"}}, chunk_size=4096
 i = 0
 def record():
     global i
-    m = RelNavMeasurement(sender="sim", seq=i, t_sim=i * 0.1, spacecraft=1, r_m=[float(i), 0.0, 0.0],
-                          v_mps=[0.0, 0.0, 0.0], sigma_r_m=1.0, sigma_v_mps=1.0)
+    m = RelNavMeasurement(sender="sim", seq=i, t_sim=i * 0.1, spacecraft=1,
+                          r_m=[float(i), 0.0, 0.0], v_mps=[0.0, 0.0, 0.0], sigma_r_m=1.0,
+                          sigma_v_mps=1.0)
     rec.record("insp/m1/sim/sensors/sc1/relnav", "RelNavMeasurement", m.model_dump_json().encode())
     i += 1
 for _ in range(1000):

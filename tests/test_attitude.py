@@ -42,7 +42,8 @@ DEG = math.pi / 180.0
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
 
 
 def _qmul(p: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -98,15 +99,17 @@ def _simulate(
 ) -> _Run:
     """Closed loop: controller at 1/DT Hz with zero-order-hold torque."""
     y = np.concatenate([r0.as_quat(), w0, h0])
-    rows: dict[str, list[np.ndarray | float]] = {k: [] for k in ("t", "q", "w", "h", "tau", "e", "et")}
+    rows: dict[str, list[np.ndarray | float]] = {
+        k: [] for k in ("t", "q", "w", "h", "tau", "e", "et")}
     steps = int(round(t_end / DT))
     for k in range(steps + 1):
         t = k * DT
         r = Rotation.from_quat(y[0:4])
         r_d, w_d, wdot_d = desired(t)
         tau, err = tracking_torque(r, y[4:7], r_d, w_d, wdot_d, j, y[7:10], gains, tau_max)
-        for key, val in (("t", t), ("q", y[0:4].copy()), ("w", y[4:7].copy()), ("h", y[7:10].copy()),
-                         ("tau", tau), ("e", err), ("et", (r_d.inv() * r).magnitude())):
+        for key, val in (("t", t), ("q", y[0:4].copy()), ("w", y[4:7].copy()),
+                         ("h", y[7:10].copy()), ("tau", tau), ("e", err),
+                         ("et", (r_d.inv() * r).magnitude())):
             rows[key].append(val)
         if k == steps:
             break
@@ -532,7 +535,8 @@ def test_controller_bad_input() -> None:
     g = AttitudeGains.gains_for(10.0)
     ok = (Rotation.identity(), np.zeros(3), Rotation.identity(), np.zeros(3), np.zeros(3),
           J_DIAG, np.zeros(3), g, TAU_MAX)
-    for i, bad in ((1, [np.nan, 0.0, 0.0]), (5, np.eye(2)), (5, J_DIAG + np.triu(np.ones((3, 3)), 1)),
+    for i, bad in ((1, [np.nan, 0.0, 0.0]), (5, np.eye(2)),
+                   (5, J_DIAG + np.triu(np.ones((3, 3)), 1)),
                    (6, [0.0, 0.0]), (8, 0.0), (8, -1.0), (8, np.nan)):
         args = list(ok)
         args[i] = bad

@@ -55,7 +55,8 @@ def test_delivery_order_sequence_and_validation(pair) -> None:  # noqa: ANN001
     # hostile input: garbage, wrong schema, NaN, oversize; then a valid message again
     raw.publish(key, "Heartbeat", b"\x00not json")
     raw.publish(key, "Heartbeat", json.dumps({"sender": "sc1", "t_sim": 1.0}).encode())
-    raw.publish(key, "Heartbeat", b'{"sender":"sc1","seq":9,"t_sim":NaN,"node":"a","apps":[],"k":0}')
+    raw.publish(key, "Heartbeat",
+                b'{"sender":"sc1","seq":9,"t_sim":NaN,"node":"a","apps":[],"k":0}')
     raw.publish(key, "Heartbeat", b" " * (2 << 20))
     bus_a.publish(key, _hb(4.0))
     _settle(lambda: bus_b.wait_for({key: 4}, 0.01) == [] and bus_b.stats.invalid_dropped == 4)

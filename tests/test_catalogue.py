@@ -99,7 +99,8 @@ def wiring_problems(producers: Producers, consumers: Producers) -> list[str]:
     """What is wrong with a wiring: an input with no producer or with several, a producer of
     an uncatalogued topic."""
     out = [f"{t} read by {', '.join(c)} has {len(producers.get(t, []))} producers "
-           f"{producers.get(t, [])}" for t, c in consumers.items() if len(producers.get(t, [])) != 1]
+           f"{producers.get(t, [])}" for t, c in consumers.items()
+           if len(producers.get(t, [])) != 1]
     out += [f"{t} produced by {p} is not in the catalogue" for t, p in producers.items()
             if t not in cat.ALL]
     return out

@@ -30,7 +30,8 @@ def test_paper_sensor_fault_numbers_through_the_metric() -> None:
     psi = ic.h_poi(W_INV, f0) ** 2
     h_prev = ic.agent_contributions(PHI, W_INV, f0, psi=psi)
     pred = ic.agent_contributions(PHI, W_INV, f0 + step, psi=psi) - h_prev
-    real = ic.agent_contributions(PHI, W_INV, f0 + step * np.array([[1.0], [0.7]]), psi=psi) - h_prev
+    real = ic.agent_contributions(PHI, W_INV, f0 + step * np.array([[1.0], [0.7]]),
+                                  psi=psi) - h_prev
     hm = [metric(real[i], pred[i], h_prev[i]) for i in range(2)]
     assert hm[0] == pytest.approx(0.0, abs=1e-12) and hm[1] == pytest.approx(0.3, abs=1e-12)
     assert direction(real[1], pred[1], h_prev[1]) == "degraded"

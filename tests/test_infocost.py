@@ -45,7 +45,8 @@ def test_sphere_pois_near_uniform() -> None:
 
 
 def test_sphere_pois_bad_input() -> None:
-    for count, radius in [(0, 1.0), (-3, 1.0), (2.5, 1.0), (10, 0.0), (10, -1.0), (10, float("nan"))]:
+    for count, radius in [(0, 1.0), (-3, 1.0), (2.5, 1.0), (10, 0.0), (10, -1.0),
+                          (10, float("nan"))]:
         with pytest.raises(ValueError):
             sphere_pois(count, radius)  # type: ignore[arg-type]
 
@@ -94,7 +95,8 @@ def test_visibility_matches_brute_force() -> None:
 
 
 def test_visibility_cases() -> None:
-    """On the boresight, in range, facing: seen; back-facing, outside the cone, beyond range: not."""
+    """On the boresight, in range, facing: seen; back-facing, outside the cone, beyond range:
+    not."""
     cam = ic.Camera(half_angle_rad=math.radians(20.0), max_range_m=10.0)
     s, n = np.array([[1.0, 0.0, 0.0]]), np.array([[1.0, 0.0, 0.0]])
     look = np.array([[-1.0, 0.0, 0.0]])
@@ -169,7 +171,8 @@ def test_unseen_poi_contributes_phi_w_and_zero_prior_is_rejected() -> None:
     h = ic.h_poi(w_inv, f)
     assert h[2] == pytest.approx(1.0 / 0.4, rel=1e-15)
     keep = [0, 1, 3]
-    assert ic.information_cost(phi, w_inv, f) - ic.information_cost(phi[keep], w_inv[keep], f[:, keep]) \
+    assert ic.information_cost(phi, w_inv, f) \
+        - ic.information_cost(phi[keep], w_inv[keep], f[:, keep]) \
         == pytest.approx(phi[2] / w_inv[2], rel=1e-12)
     with pytest.raises(ValueError, match="POI 2"):
         ic.information_cost(phi, 0.0, f)
@@ -252,13 +255,15 @@ LOOK = np.array([[0.0, 1.0, 0.0], [0.0, 1.0, 0.0]])        # irrelevant when VIS
 
 def _obs(x: np.ndarray) -> np.ndarray:
     """One observation per agent at (x_i, 0, 0): σ⁻¹ (2, 2) through the library (Eq. 14)."""
-    return ic.precision(np.column_stack((x, np.zeros(2), np.zeros(2))), LOOK, S_1DOF, None, CAM, visible=VIS)
+    return ic.precision(np.column_stack((x, np.zeros(2), np.zeros(2))), LOOK, S_1DOF, None, CAM,
+                        visible=VIS)
 
 
 def _grad_x(x: np.ndarray) -> np.ndarray:
     """∂H/∂x_i (Eq. 17) through the library: no prior information, observations at x."""
     p = np.column_stack((x, np.zeros(2), np.zeros(2)))
-    return ic.cost_gradient(p, LOOK, S_1DOF, None, CAM, PHI, W_INV, np.zeros((2, 2)), visible=VIS)[:, 0]
+    return ic.cost_gradient(p, LOOK, S_1DOF, None, CAM, PHI, W_INV, np.zeros((2, 2)),
+                            visible=VIS)[:, 0]
 
 
 def _cost(x: np.ndarray) -> float:

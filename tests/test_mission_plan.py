@@ -1,7 +1,7 @@
-"""Tests of ground.planning.mission_plan: scenario phases issued as given, information phases chosen by
-the greedy of ground.planning.orbit_assignment (checked against an independent call and brute-force
-matching), and reassignment when the measured gain saturates, closed on a fused map fed with
-what the issued orbits see."""
+"""Tests of ground.planning.mission_plan: scenario phases issued as given, information phases
+chosen by the greedy of ground.planning.orbit_assignment (checked against an independent call
+and brute-force matching), and reassignment when the measured gain saturates, closed on a fused
+map fed with what the issued orbits see."""
 
 from __future__ import annotations
 
@@ -172,7 +172,8 @@ def test_poi_subsample_evaluates_every_kth_poi_with_scaled_importance() -> None:
     (d,) = plan.decisions
     a = sc.assignment
     ref = greedy_assignment(plan.library, 3, plan.n, 1100.0, a.window_s, a.samples, POS[::4],
-                            NOR[::4], 4.0 * fused.phi[::4], (fused.w_inv + fused.F.sum(axis=0))[::4],
+                            NOR[::4], 4.0 * fused.phi[::4],
+                            (fused.w_inv + fused.F.sum(axis=0))[::4],
                             plan.camera, a.min_separation_m,
                             sc.guidance.keep_out_m + a.keep_out_margin_m)
     assert sorted(d.library_indices) == sorted(ref.indices)

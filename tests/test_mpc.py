@@ -38,7 +38,8 @@ def zoh_input_matrix(n: float, dt: float) -> FloatArray:
 
 
 class Truth:
-    """Exact HCW propagation over one step with a ZOH acceleration (independent of the MPC model)."""
+    """Exact HCW propagation over one step with a ZOH acceleration (independent of the MPC
+    model)."""
 
     def __init__(self, n: float, dt: float) -> None:
         self.phi = hcw.hcw_stm(n, dt)
@@ -57,7 +58,8 @@ def closed_loop(
     mpc: MpcTracker, truth: Truth, x0: FloatArray, ref: FloatArray, steps: int,
     disturbance: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray, list[MpcResult]]:
-    """Run the MPC in closed loop; returns states (steps+1, 6), applied inputs (steps, 3), results."""
+    """Run the MPC in closed loop; returns states (steps+1, 6), applied inputs (steps, 3),
+    results."""
     h = mpc.horizon
     d = np.zeros(3) if disturbance is None else disturbance
     xs = np.empty((steps + 1, 6))
@@ -80,12 +82,14 @@ def test_truth_propagator_matches_ode() -> None:
     for _ in range(3):
         x = rng.normal(0.0, [30, 30, 30, 0.03, 0.03, 0.03])
         u = rng.uniform(-U_MAX, U_MAX, 3)
-        sol = solve_ivp(lambda _t, s: a @ s + b @ u, (0.0, DT), x, rtol=1e-12, atol=1e-13, method="DOP853")
+        sol = solve_ivp(lambda _t, s: a @ s + b @ u, (0.0, DT), x, rtol=1e-12, atol=1e-13,
+                        method="DOP853")
         np.testing.assert_allclose(truth.step(x, u), sol.y[:, -1], rtol=1e-10, atol=1e-11)
 
 
 def test_on_pro_no_disturbance_thrust_stays_zero() -> None:
-    """Starting exactly on a natural PRO and tracking it: no Δv over 10 orbits, state stays on it."""
+    """Starting exactly on a natural PRO and tracking it: no Δv over 10 orbits, state stays on
+    it."""
     steps = int(math.ceil(10 * PERIOD / DT))
     ref = pro_table(N_500, steps + H)
     mpc = MpcTracker(N_500, MpcConfig())
@@ -139,7 +143,8 @@ def test_converges_from_offset_within_limits(offset: FloatArray) -> None:
 
 
 def _batch_least_squares(
-    a: FloatArray, b: FloatArray, x0: FloatArray, ref: FloatArray, u_ref: FloatArray, cfg: MpcConfig,
+    a: FloatArray, b: FloatArray, x0: FloatArray, ref: FloatArray, u_ref: FloatArray,
+    cfg: MpcConfig,
 ) -> FloatArray:
     """Unconstrained finite-horizon LQR by stacking the predictions: X = Sx x0 + Su U, minimise
     Σ (X - R)'Q̄(X - R) + r_quad dt² |U - U_ref|² (normal equations)."""

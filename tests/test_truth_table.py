@@ -17,7 +17,8 @@ def _truth(t: float, rng: np.random.Generator, ids: list[int], attitude: bool) -
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     extra = dict(q_lvlh_body=q.tolist(), w_body_radps=rng.normal(size=(n, 3)).tolist(),
                  dv_mps=rng.uniform(0, 1, n).tolist()) if attitude else {}
-    return TruthState(sender="sim", t_sim=t, spacecraft=ids, r_lvlh_m=rng.normal(size=(n, 3)).tolist(),
+    return TruthState(sender="sim", t_sim=t, spacecraft=ids,
+                      r_lvlh_m=rng.normal(size=(n, 3)).tolist(),
                       v_lvlh_mps=rng.normal(size=(n, 3)).tolist(), **extra)
 
 

@@ -218,7 +218,8 @@ class AttitudeApp(App):
         if self._est is not None:
             los = self._los_eci(t)
             b = quat.rotate(self.q, self.boresight)
-            error = math.acos(min(1.0, max(-1.0, float(b @ los) / max(1e-12, float(np.linalg.norm(los))))))
+            error = math.acos(min(1.0, max(-1.0, float(b @ los)
+                                                 / max(1e-12, float(np.linalg.norm(los))))))
         self.publish("estimate", AttitudeEstimate(
             sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, q_eci_body=self.q.tolist(),
             q_lvlh_body=q_lvlh.tolist(), gyro_bias_radps=self.b.tolist(),

@@ -11,9 +11,9 @@ front-facing and in camera range from the estimated position, and within ``RETAR
 of the current line of sight.  The aim point does not jump to it: it glides there over the
 next ``RETARGET_S`` on a smoothstep (rate zero at both ends, at most 1.2°/s of line-of-sight
 turn, below the attitude app's rate limit), and its rate is published with the target so the
-attitude app tracks it with feed-forward instead of chasing steps.  It retargets only while the attitude app is
-tracking (a target moving during a slew would end it off target).  Until it has a position
-estimate it points at the target's centre.
+attitude app tracks it with feed-forward instead of chasing steps.  It retargets only while
+the attitude app is tracking (a target moving during a slew would end it off target).  Until
+it has a position estimate it points at the target's centre.
 """
 
 from __future__ import annotations

@@ -133,7 +133,8 @@ class GuidanceApp(App):
         if not res.ok:
             self.log.warning("MPC %s at t=%.0f s: no thrust this cycle", res.status, t)
         u = self._command(t, u)
-        mode = "transfer" if self.plan is not None and t < self.plan_t0 + self.plan.t_s[-1] else "hold"
+        mode = ("transfer" if self.plan is not None and t < self.plan_t0 + self.plan.t_s[-1]
+                else "hold")
         err = x - refs[0]
         self._status(t, mode, err, u, res.status, 1e3 * res.solve_time_s)
 

@@ -483,7 +483,8 @@ _OSQP_SETTINGS: tuple[tuple[str, object], ...] = (
 
 
 def _scp_cost(n: int) -> sp.csc_matrix:
-    """Upper triangle of the OSQP Hessian P (cost ``½ zᵀ P z + cᵀ z``), z = [q_0..q_N, u_0..u_{N−1}].
+    """Upper triangle of the OSQP Hessian P (cost ``½ zᵀ P z + cᵀ z``),
+    z = [q_0..q_N, u_0..u_{N−1}].
 
     Cost ``N Σ‖u_{k+1} − u_k‖² + (ε/N) Σ‖u_k‖² + ρ (‖q − q̄‖² + ‖u − ū‖²)``; the first
     two terms are grid-independent approximations of ``T ∫|u̇|² dt`` and

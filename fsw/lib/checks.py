@@ -9,7 +9,8 @@ import numpy.typing as npt
 __all__ = ["finite_array"]
 
 
-def finite_array(name: str, value: npt.ArrayLike, shape: tuple[int, ...]) -> npt.NDArray[np.float64]:
+def finite_array(name: str, value: npt.ArrayLike,
+                 shape: tuple[int, ...]) -> npt.NDArray[np.float64]:
     """``value`` as a float array of exactly ``shape`` with only finite entries.
 
     Raises:

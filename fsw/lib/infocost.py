@@ -129,8 +129,8 @@ def _fused_variance(w_inv: FloatArray, f: FloatArray) -> FloatArray:
     unseen = np.flatnonzero(total <= 0.0)
     if unseen.size:
         raise ValueError(
-            f"H_POI is infinite for POI {int(unseen[0])} ({unseen.size} in all): prior w_inv = 0 and "
-            "nobody has observed it; use w_inv > 0 or observe every POI")
+            f"H_POI is infinite for POI {int(unseen[0])} ({unseen.size} in all): "
+            "prior w_inv = 0 and nobody has observed it; use w_inv > 0 or observe every POI")
     return 1.0 / total
 
 

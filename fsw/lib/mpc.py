@@ -235,7 +235,8 @@ class MpcTracker:
 
         # Cost.  OSQP minimises 1/2 z'Pz + q'z, hence the factors of 2 on P.
         q_diag = np.array([cfg.q_pos] * 3 + [cfg.q_vel] * 3) * self._s**2
-        stage = np.concatenate([np.zeros(_NX)] + [q_diag] * (h - 1) + [cfg.q_terminal_scale * q_diag])
+        stage = np.concatenate([np.zeros(_NX)] + [q_diag] * (h - 1)
+                               + [cfg.q_terminal_scale * q_diag])
         self._p_v = 2.0 * cfg.r_quad * (cfg.u_max_mps2 * cfg.dt_s) ** 2
         p_diag = np.concatenate([2.0 * stage, np.full(nu_tot, self._p_v), np.zeros(nu_tot)])
         p_mat = sp.diags(p_diag, format="csc")

@@ -21,8 +21,10 @@ __all__ = ["GOLDEN_ANGLE_RAD", "sphere_pois"]
 GOLDEN_ANGLE_RAD: float = math.pi * (3.0 - math.sqrt(5.0))
 
 
-def sphere_pois(count: int, radius_m: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """``count`` points spread near-uniformly on a sphere of radius ``radius_m`` centred at the origin.
+def sphere_pois(count: int,
+                radius_m: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """``count`` points spread near-uniformly on a sphere of radius ``radius_m`` centred at the
+    origin.
 
     Fibonacci (golden-angle) lattice (Swinbank & Purser, "Fibonacci grids: a novel approach to
     global modelling", QJRMS 132, 2006; González, "Measurement of areas on a sphere using
@@ -44,7 +46,8 @@ def sphere_pois(count: int, radius_m: float) -> tuple[npt.NDArray[np.float64], n
     """
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
         raise ValueError(f"count must be an integer >= 1, got {count!r}")
-    if not (isinstance(radius_m, (int, float, np.floating)) and math.isfinite(radius_m) and radius_m > 0):
+    if not (isinstance(radius_m, (int, float, np.floating)) and math.isfinite(radius_m)
+            and radius_m > 0):
         raise ValueError(f"radius_m must be a positive finite number, got {radius_m!r}")
     i = np.arange(int(count), dtype=float)
     z = 1.0 - (2.0 * i + 1.0) / count

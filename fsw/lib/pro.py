@@ -247,7 +247,8 @@ def _dist2_coefficients(pro: Pro) -> tuple[float, complex, complex]:
     rx, ry, rz = pro.rho_x_m, pro.rho_y_m, pro.rho_z_m
     c0 = 2.5 * rx * rx + ry * ry + 0.5 * rz * rz
     a1 = 4.0 * ry * rx * cmath.exp(1j * pro.alpha_x_rad)
-    a2 = 1.5 * rx * rx * cmath.exp(2j * pro.alpha_x_rad) - 0.5 * rz * rz * cmath.exp(2j * pro.alpha_z_rad)
+    a2 = (1.5 * rx * rx * cmath.exp(2j * pro.alpha_x_rad)
+          - 0.5 * rz * rz * cmath.exp(2j * pro.alpha_z_rad))
     return c0, a1, a2
 
 

@@ -1,1 +1,2 @@
-"""Offline analysis of run archives: summary, report, coverage, nav and GNC evaluation, scoring, calibration, campaign report."""
+"""Offline analysis of run archives: summary, report, coverage, nav and GNC evaluation, scoring,
+calibration, campaign report."""

@@ -285,7 +285,8 @@ def _persistence_table(runs: list[dict[str, Any]]) -> list[str]:
         label = f"{m} of {n}" + (" (as run)" if own == [(m, n)] else "")
         lines.append(
             f"| {label} | {_pct(sum(x['detected'] for x in f), len(f))} | "
-            f"{_pct(sum(x['isolated'] for x in f), len(f))} | {_latency(f)} | {_rate(r.false_alarms, r.nominal_cycles)} |")
+            f"{_pct(sum(x['isolated'] for x in f), len(f))} | {_latency(f)} | "
+            f"{_rate(r.false_alarms, r.nominal_cycles)} |")
     return lines
 
 
@@ -295,9 +296,9 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     failed = [s["_id"] for s in loaded if s.get("status") != "completed"]
     runs = [s for s in loaded if s.get("status") == "completed"]  # failed runs: listed only
     rows = _rows(runs)
-    fields = ["run", "group", "seed", "status", "detector", "kind", "spacecraft", "start_s", "magnitude",
-              "detected", "isolated", "latency_s", "identified_class", "expected_class",
-              "false_alarms", "nominal_cycles"]
+    fields = ["run", "group", "seed", "status", "detector", "kind", "spacecraft", "start_s",
+              "magnitude", "detected", "isolated", "latency_s", "identified_class",
+              "expected_class", "false_alarms", "nominal_cycles"]
     with open(out / "results.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -339,7 +340,8 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
                    and (r["run"], r["fault_index"]) in members]
             st = _stats(sel, hours[d])
             lines.append(f"| {kind} | {label} | {d} | {st['faults']} | "
-                         f"{_pct(st['detected'], st['faults'])} | {st['faults'] - st['detected']} | "
+                         f"{_pct(st['detected'], st['faults'])} | "
+                         f"{st['faults'] - st['detected']} | "
                          f"{_pct(st['isolated'], st['faults'])} | {st['latency']} |")
     lines += ["", "## Identification (main detector)", "", "![confusion](confusion.png)", ""]
     lines += _confusion(out, [r for r in rows if r["detector"] == "main" and r["kind"] != "none"])

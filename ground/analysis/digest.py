@@ -3,9 +3,9 @@
 A two-orbit run archives about 4 GB of JSON, 1.7 GB of it camera images and as much again the
 observations that repeat them; held whole and decoded, the summary of such a run needed 13 GB.
 The digest keeps only what the summary and report read: the camera images are fused into the
-coverage as they stream past (:class:`ground.analysis.coverage.CoverageFuser`), the cumulative counters
-(ticks, executive and link statistics) keep their last record, the truth is packed into arrays
-(:class:`ground.analysis.truth_table.TruthTable`), and the bulk neither reads
+coverage as they stream past (:class:`ground.analysis.coverage.CoverageFuser`), the cumulative
+counters (ticks, executive and link statistics) keep their last record, the truth is packed into
+arrays (:class:`ground.analysis.truth_table.TruthTable`), and the bulk neither reads
 (observations, attitude sensors, wheel commands, lockstep answers, heartbeats) is counted and
 dropped.
 """

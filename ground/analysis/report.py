@@ -32,7 +32,8 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
              f"Status **{summary['status']}**, seed {scenario.seed}, transport "
              f"{summary['transport']}, {summary.get('t_sim_final_s', 0):.0f} s simulated in "
              f"{summary['wall_s']:.1f} s wall"
-             + (f" ({summary['real_time_factor']:.0f}× real time)." if summary.get("real_time_factor") else "."),
+             + (f" ({summary['real_time_factor']:.0f}× real time)."
+                if summary.get("real_time_factor") else "."),
              ""]
     if summary.get("error"):
         lines += ["```", summary["error"], "```", ""]
@@ -65,7 +66,8 @@ def _trajectory_section(out: Path, truth: TruthTable) -> list[str]:
     for i, sc in enumerate(truth.spacecraft):
         axes[0].plot(r[:, i, 1], r[:, i, 0], label=f"sc{sc}")
         axes[1].plot(r[:, i, 1], r[:, i, 2], label=f"sc{sc}")
-    for ax, (yl, title) in zip(axes, (("radial x (m)", "in-plane"), ("cross-track z (m)", "along-track / cross-track"))):
+    for ax, (yl, title) in zip(axes, (("radial x (m)", "in-plane"),
+                                      ("cross-track z (m)", "along-track / cross-track"))):
         ax.plot(0, 0, "k*", ms=12, label="target")
         ax.set_xlabel("along-track y (m)")
         ax.set_ylabel(yl)
@@ -83,7 +85,8 @@ def _trajectory_section(out: Path, truth: TruthTable) -> list[str]:
 def _nav_section(out: Path, errs: dict[int, NavErrors], summary: dict) -> list[str]:
     if not errs:
         return ["No navigation estimates recorded.", ""]
-    fig, axes = plt.subplots(len(errs), 1, figsize=(10, 2.2 * len(errs)), sharex=True, squeeze=False)
+    fig, axes = plt.subplots(len(errs), 1, figsize=(10, 2.2 * len(errs)), sharex=True,
+                             squeeze=False)
     for ax, (sc, e) in zip(axes[:, 0], errs.items()):
         pos = np.linalg.norm(e.error[:, :3], axis=1)
         bound = 3 * np.sqrt(np.sum(e.sigma[:, :3] ** 2, axis=1))
@@ -97,13 +100,15 @@ def _nav_section(out: Path, errs: dict[int, NavErrors], summary: dict) -> list[s
     fig.tight_layout()
     fig.savefig(out / "nav_error.png", dpi=110)
     plt.close(fig)
-    rows = ["| sc | pos RMS (m) | pos max (m) | vel RMS (m/s) | mean NEES (6 dof) | NEES in 95% | mean NIS |",
+    rows = ["| sc | pos RMS (m) | pos max (m) | vel RMS (m/s) | "
+            "mean NEES (6 dof) | NEES in 95% | mean NIS |",
             "|---|---|---|---|---|---|---|"]
     for sc, st in summary.get("nav", {}).items():
         if st:
             rows.append(f"| {sc} | {st['pos_rms_m']:.3f} | {st['pos_max_m']:.3f} | "
                         f"{st['vel_rms_mps']:.4f} | {st['nees_mean']:.2f} | "
-                        f"{100 * st['nees_in_95_bounds']:.0f}% | {st['nis_mean'] or float('nan'):.2f} |")
+                        f"{100 * st['nees_in_95_bounds']:.0f}% | "
+                        f"{st['nis_mean'] or float('nan'):.2f} |")
     return ["## Navigation", "", "![nav error](nav_error.png)", "", *rows, ""]
 
 
@@ -165,7 +170,8 @@ def _coverage_section(out: Path, c: Coverage, summary: dict) -> list[str]:
     plt.close(fig)
     cov = summary.get("coverage", {})
     return ["## Inspection", "", "![coverage](coverage.png)", "",
-            f"H from {cov.get('H_initial', float('nan')):.4f} to {cov.get('H_final', float('nan')):.4f}; "
+            f"H from {cov.get('H_initial', float('nan')):.4f} to "
+            f"{cov.get('H_final', float('nan')):.4f}; "
             f"{100 * cov.get('fraction_observed', 0):.1f}% of the POIs observed.", ""] \
         + _decision_rows(c)
 
@@ -331,7 +337,8 @@ def _gain_plot(out: Path, judged: list[FdirWindow], ids: list[int]) -> None:
 
 
 def _links_section(summary: dict) -> list[str]:
-    rows = ["## Links", "", "| link | sent | delivered | dropped (range) | dropped (loss) | dropped (cut) |",
+    rows = ["## Links", "",
+            "| link | sent | delivered | dropped (range) | dropped (loss) | dropped (cut) |",
             "|---|---|---|---|---|---|"]
     for c in summary.get("links", []):
         rows.append(f"| {c['src']} → {c['dst']} | {c['sent']} | {c['delivered']} | "
@@ -340,7 +347,9 @@ def _links_section(summary: dict) -> list[str]:
 
 
 def _exec_section(summary: dict) -> list[str]:
-    rows = ["## Executives", "", "| node | cycle slips (high/mid/low) | max exec ms (high/mid/low) | app errors | invalid msgs | barrier timeouts |",
+    rows = ["## Executives", "",
+            "| node | cycle slips (high/mid/low) | max exec ms (high/mid/low) | app errors "
+            "| invalid msgs | barrier timeouts |",
             "|---|---|---|---|---|---|"]
     for node, e in summary.get("exec", {}).items():
         slips = "/".join(str(e["cycle_slips"].get(g, 0)) for g in ("high", "mid", "low"))

@@ -10,8 +10,8 @@ Definitions (one run):
   the first alarm on that spacecraft, and ``identified_class`` is that alarm's class.
 * A *false alarm* is an alarm on a spacecraft with no fault active at its time (within the
   same grace).  ``nominal_cycles`` counts the FDI windows judged (a decision was possible) that
-  do not overlap a fault of their spacecraft; ``false_alarm_rate`` is false alarms per nominal cycle, and
-  ``false_alarms_per_hour`` per hour of nominal spacecraft time.
+  do not overlap a fault of their spacecraft; ``false_alarm_rate`` is false alarms per nominal
+  cycle, and ``false_alarms_per_hour`` per hour of nominal spacecraft time.
 """
 
 from __future__ import annotations

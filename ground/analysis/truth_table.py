@@ -90,7 +90,8 @@ class TruthTableBuilder:
         if ids != self._ids or bool(msg.q_lvlh_body) != self._attitude:
             raise ArchiveError(f"truth at t={msg.t_sim} s carries spacecraft {list(ids)}"
                                f"{' with' if msg.q_lvlh_body else ' without'} attitude, earlier "
-                               f"truth {list(self._ids)}{' with' if self._attitude else ' without'}")
+                               f"truth {list(self._ids)}"
+                               f"{' with' if self._attitude else ' without'}")
         parts = [msg.r_lvlh_m, msg.v_lvlh_mps]
         if self._attitude:
             parts += [msg.q_lvlh_body, msg.w_body_radps, [[d] for d in msg.dv_mps]]

@@ -5,7 +5,8 @@ H_m,i) and every observer's nav estimate (its NIS).  Output: one ``BaselineVerdi
 detector, observer and FDI window on ``ground/fdir/baseline``; ``alarm`` marks the window that
 declares a fault (``chi2_nis`` and ``fixed_threshold`` after ``fdir.persistence`` exceedances
 in a row for the first, at once for the second, as a plain limit check; ``cusum`` when its sum
-first crosses ``fdir.cusum_threshold``, once per episode).  summary.json scores each like the main detector.
+first crosses ``fdir.cusum_threshold``, once per episode).  summary.json scores each like the
+main detector.
 """
 
 from __future__ import annotations

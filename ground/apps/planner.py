@@ -5,13 +5,13 @@ target, so it hears every observer in range of it), fused into the ground's POI 
 ``ProAssignments`` (every observer's current assignment) on ``ground/planner/assignments`` and
 each information-driven ``AssignmentDecision`` on ``ground/planner/decisions``.
 
-What to fly comes from :class:`ground.planning.mission_plan.MissionPlan`: the scenario's phases, with
-``assign = "information"`` phases chosen by expected information gain and reassigned when the
-set's gain saturates, and -- with ``fdir.recovery`` -- a recovery assignment when the FDIR
+What to fly comes from :class:`ground.planning.mission_plan.MissionPlan`: the scenario's phases,
+with ``assign = "information"`` phases chosen by expected information gain and reassigned when
+the set's gain saturates, and -- with ``fdir.recovery`` -- a recovery assignment when the FDIR
 reports an identified camera or actuator fault (input ``ground/fdir/report``).  An
-assignment is uplinked from ``UPLINK_LEAD_S`` before its departure and repeated every cycle until the next one supersedes it, so a command lost on the
-range-limited, lossy link is simply received later (a spacecraft acts on a new
-``assignment_id`` once).
+assignment is uplinked from ``UPLINK_LEAD_S`` before its departure and repeated every cycle
+until the next one supersedes it, so a command lost on the range-limited, lossy link is simply
+received later (a spacecraft acts on a new ``assignment_id`` once).
 """
 
 from __future__ import annotations

@@ -1,1 +1,2 @@
-"""Run archives: the recorder, the reader, run metadata, the archive CLI (``python -m ground.archive``)."""
+"""Run archives: the recorder, the reader, run metadata, the archive CLI
+(``python -m ground.archive``)."""

@@ -30,7 +30,8 @@ def software_version() -> str:
     return f"{version}+g{commit}" if commit else version
 
 
-def run_metadata(scenario: Scenario, transport: str, scenario_toml: str) -> dict[str, dict[str, str]]:
+def run_metadata(scenario: Scenario, transport: str,
+                 scenario_toml: str) -> dict[str, dict[str, str]]:
     """MCAP metadata records of a run: what ran, with which seed and software."""
     return {
         "run": {"scenario": scenario.name, "seed": str(scenario.seed), "transport": transport,

@@ -28,9 +28,9 @@ and counted in :attr:`McapRecorder.invalid`; payloads are not validated against 
 Crash safety: messages are grouped in zstd chunks of about ``chunk_size`` bytes (uncompressed).
 The file is written without a user-space buffer, so each chunk reaches the operating system the
 moment it is complete: after a SIGKILL every complete chunk is in the file and
-:func:`ground.archive.reader.load_run` recovers it (``truncated=True``).  The chunk in progress (at most
-``chunk_size`` bytes of messages) is lost; call :meth:`McapRecorder.flush` to close it early.
-The recorder does not fsync (a process kill does not need it; a power loss does).
+:func:`ground.archive.reader.load_run` recovers it (``truncated=True``).  The chunk in progress
+(at most ``chunk_size`` bytes of messages) is lost; call :meth:`McapRecorder.flush` to close
+it early.  The recorder does not fsync (a process kill does not need it; a power loss does).
 """
 
 from __future__ import annotations

@@ -46,8 +46,8 @@ def _serve(conn: Connection, path: str, metadata: dict[str, dict[str, str]] | No
 
 
 class RecorderProcess:
-    """An :class:`~ground.archive.recorder.McapRecorder` in a child process (see the module docstring);
-    use as a context manager or call :meth:`close`."""
+    """An :class:`~ground.archive.recorder.McapRecorder` in a child process (see the module
+    docstring); use as a context manager or call :meth:`close`."""
 
     def __init__(self, path: str | Path, metadata: dict[str, dict[str, str]] | None = None,
                  chunk_size: int = 4 * 1024 * 1024) -> None:

@@ -268,8 +268,10 @@ def _write(replay: Replay, run: Path, out: Path | None) -> None:
     dets = ", ".join(f"sc{d['spacecraft']} {d['class'] or 'unidentified'} at {d['time_s']:.0f} s"
                      + ("" if d["faithful"] else " (after divergence)")
                      for d in res["detections"]) or "no detection"
-    print(f"{run}: {dets}; {'matches the live run' if res['matches_live'] else 'differs from the live run'}"
-          f"; faithful until {res['faithful_until_s']:.0f} s; {res['replay_wall_s']:.1f} s -> {dest}")
+    print(f"{run}: {dets}; "
+          f"{'matches the live run' if res['matches_live'] else 'differs from the live run'}"
+          f"; faithful until {res['faithful_until_s']:.0f} s; "
+          f"{res['replay_wall_s']:.1f} s -> {dest}")
 
 
 if __name__ == "__main__":

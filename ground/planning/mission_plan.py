@@ -3,11 +3,13 @@ hierarchical planner of Sec. II.C).
 
 Scenario phases (``assign = "scenario"``) give their PROs directly.  Information phases
 (``assign = "information"``) are decided when they are uplinked, from the ground's fused view of
-the POIs at that moment: the greedy set of :func:`ground.planning.orbit_assignment.greedy_assignment`,
-matched to the observers by :func:`ground.planning.orbit_assignment.match_to_observers`.  While an
+the POIs at that moment: the greedy set of
+:func:`ground.planning.orbit_assignment.greedy_assignment`, matched to the observers by
+:func:`ground.planning.orbit_assignment.match_to_observers`.  While an
 information phase is the latest one, the plan measures how much the fused cost H falls in each
 ``check_period_s`` window after arrival, and when the set's gain saturates
-(:func:`ground.planning.orbit_assignment.gain_saturated`) it chooses a new set; the new set is flown only
+(:func:`ground.planning.orbit_assignment.gain_saturated`) it chooses a new set; the new set is
+flown only
 if its expected gain beats keeping the current one by ``min_improvement`` (a transfer costs
 fuel and time).  Every decision is kept with its figures (expected gain, online bound) for the
 archive.
@@ -314,9 +316,9 @@ class MissionPlan:
         ones keep theirs (untasked); the ``impaired`` ones, then the healthy ones, get the
         greedy set of library PROs (``greedy_assignment``) clear of the keep-out they need and
         separated from the PROs already fixed, matched to the observers by
-        ``match_to_observers``; ``w``, ``phi``: as :meth:`_weights` gives them.  Returns (PROs by observer, library index per observer or -1,
-        expected gain, online bound).  An impaired group with no feasible set falls back to the
-        nominal keep-out (logged)."""
+        ``match_to_observers``; ``w``, ``phi``: as :meth:`_weights` gives them.  Returns (PROs by
+        observer, library index per observer or -1, expected gain, online bound).  An impaired
+        group with no feasible set falls back to the nominal keep-out (logged)."""
         a = self.scenario.assignment
         nominal = self.scenario.guidance.keep_out_m + a.keep_out_margin_m
         cur = self.current

@@ -69,7 +69,8 @@ def table(rows: dict[str, _Row]) -> str:
     lines = [head, "-" * len(head)]
     for k in sorted(rows):
         r = rows[k]
-        lines.append(f"{k:<{kw}}  {r.type_name:<17} {r.seq:>7} {r.t_sim:>10.1f} {r.count:>7}  {r.summary}")
+        lines.append(f"{k:<{kw}}  {r.type_name:<17} {r.seq:>7} {r.t_sim:>10.1f} {r.count:>7}  "
+                     f"{r.summary}")
     return "\n".join(lines)
 
 
@@ -77,7 +78,8 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m ground.tools.tlm", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--filter", default="insp/**", help="Zenoh key expression (default insp/**)")
-    p.add_argument("--connect", default=DEFAULT_ENDPOINT, help="Zenoh endpoint of the constellation")
+    p.add_argument("--connect", default=DEFAULT_ENDPOINT,
+                   help="Zenoh endpoint of the constellation")
     p.add_argument("--stream", action="store_true", help="print every message instead of a table")
     p.add_argument("--duration", type=float, help="quit after this many seconds")
     args = p.parse_args(argv)
