@@ -66,7 +66,8 @@ class CameraSettings(_Section):
 
 
 class Rates(_Section):
-    """Rate groups ω_high / ω_mid / ω_low (Hz) and the FDI period (s)."""
+    """Rate groups ω_high / ω_mid / ω_low (Hz) and the FDI period (s), a whole number of ω_mid
+    periods (``interfaces.fdi_schedule``)."""
 
     high_hz: float = Field(default=10.0, gt=0.0)
     mid_hz: float = Field(default=1.0, gt=0.0)
@@ -83,7 +84,15 @@ class Rates(_Section):
             raise ValueError("rates.low_hz must not exceed rates.mid_hz")
         ratio = self.mid_hz / self.low_hz
         if abs(ratio - round(ratio)) > 1e-9:
-            raise ValueError(f"rates.low_hz = {self.low_hz} must divide rates.mid_hz = {self.mid_hz}")
+            raise ValueError(f"rates.low_hz = {self.low_hz} must divide "
+                             f"rates.mid_hz = {self.mid_hz}")
+        mids = self.fdi_period_s * self.mid_hz
+        if round(mids) < 1 or abs(mids - round(mids)) > 1e-9:
+            raise ValueError(
+                f"rates.fdi_period_s = {self.fdi_period_s} s must be a whole number of ω_mid "
+                f"periods ({1.0 / self.mid_hz:g} s at rates.mid_hz = {self.mid_hz}): the "
+                "observers report H_i and the ground judges at ω_mid steps, so every FDI window "
+                "must end on one")
         return self
 
     @property
@@ -218,8 +227,9 @@ class Phase(_ProFormation):
 
 
 class AssignmentSettings(_Section):
-    """The central agent's information-driven orbit assignment (``ground/planning/orbit_assignment.py``,
-    ``ground/planning/mission_plan.py``), for phases with ``assign = "information"``.
+    """The central agent's information-driven orbit assignment
+    (``ground/planning/orbit_assignment.py``, ``ground/planning/mission_plan.py``), for phases
+    with ``assign = "information"``.
 
     Candidates: every combination of ``rho_x_m`` × ``rho_z_m`` × ``phases`` in-plane phases
     (evenly spread) × ``cross_phase_offsets_deg``; those passing closer than the guidance
@@ -322,13 +332,15 @@ class FdirSettings(_Section):
     ``samples`` pointings within ``eps_deg`` of the planned one, floored at ``floor``; a fault
     is declared after ``persistence`` windows in a row over the threshold (or, with
     ``persistence_window`` = n, on the window that brings the exceedances among the last n
-    decided windows to ``persistence``), and an observer whose observations stay missing for ``silent_windows`` windows is reported as a link fault.
+    decided windows to ``persistence``), and an observer whose observations stay missing for
+    ``silent_windows`` windows is reported as a link fault.
     A reported H_i off the ground's recomputation from the observer's own observations by more
     than ``integrity_tol`` (relative) for ``persistence`` windows is a data-integrity fault,
     and more of its observations lost (sequence gaps) than the links' nominal
     ``comms.packet_loss`` plus ``loss_tol`` (and the window's sampling spread) for
     ``persistence`` windows a link fault.  A window is evaluated ``latency_s`` after it closes
-    (its last images must have arrived).  A declared performance fault is identified (ground/fdir/identify.py)
+    (its last images must have arrived).  A declared performance fault is identified
+    (ground/fdir/identify.py)
     against the nominal bounds ``beta_tol`` (camera health located from the images),
     ``position_tol_m`` (camera from the images vs nav, nav vs plan), ``pointing_tol_deg``
     (reported pointing error), ``overlap_tol`` (seen vs expected POIs), ``explained_min``
@@ -349,7 +361,8 @@ class FdirSettings(_Section):
     settle_s: float = Field(default=30.0, ge=0.0,
                             description="images this soon after a slew are not judged")
     recovery: bool = Field(default=True, description="replan on an identified camera or "
-                                                     "actuator fault (ground/planning/mission_plan.py)")
+                                                     "actuator fault "
+                                                     "(ground/planning/mission_plan.py)")
     integrity_tol: float = Field(
         default=0.2, gt=0.0,
         description="relative difference between a reported H_i and the ground's recomputation "

@@ -1,4 +1,5 @@
-"""The constellation as real OS processes over a real Zenoh network (deploy/run_constellation.py)."""
+"""The constellation as real OS processes over a real Zenoh network
+(deploy/run_constellation.py)."""
 
 from __future__ import annotations
 
@@ -15,7 +16,6 @@ import numpy as np
 
 from deploy.inproc import run_inproc
 from ground.archive.reader import load_run
-from ground.archive.recorder import McapRecorder
 from interfaces import catalogue as cat
 from interfaces import topics
 from interfaces.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry
@@ -48,7 +48,8 @@ def _comparable(path: Path) -> dict[str, list[dict]]:
 
 def test_same_seed_same_messages_on_zenoh_and_inproc(tmp_path: Path, free_port: int) -> None:
     sc = small_scenario("det", duration_s=30.0,
-                        comms={"range_m": 36.0, "packet_loss": 0.25, "burst": {"mean_length_packets": 3.0}},
+                        comms={"range_m": 36.0, "packet_loss": 0.25,
+                               "burst": {"mean_length_packets": 3.0}},
                         phases=[{"name": "move", "start_s": 10.0, "transfer_s": 600.0,
                                  "rho_x_m": 22.0, "rho_z_m": 20.0}])  # an SCP transfer + MPC
     path = write_scenario(tmp_path / "det.toml", sc)
@@ -64,13 +65,16 @@ def test_same_seed_same_messages_on_zenoh_and_inproc(tmp_path: Path, free_port: 
     for key in z:
         assert z[key] == i[key], f"{key} differs between transports"
     # the channel really acted (range and loss) on the compared traffic
-    links = [c for m in z[topics.key("det", "ground", "bus", "link_stats")][-1:] for c in m["links"]]
+    links = [c for m in z[topics.key("det", "ground", "bus", "link_stats")][-1:]
+             for c in m["links"]]
     assert sum(c["dropped_loss"] for c in links) > 0 and sum(c["delivered"] for c in links) > 0
     # the transfer was planned (or refused) identically: compare the plans themselves
     assert any(k.endswith("/guidance/plan") for k in z)
 
 
-def test_killed_fsw_process_fails_the_run_and_keeps_the_archive(tmp_path: Path, free_port: int) -> None:
+def test_killed_fsw_process_fails_the_run_and_keeps_the_archive(
+    tmp_path: Path, free_port: int
+) -> None:
     sc = small_scenario("kill", duration_s=400.0)
     path = write_scenario(tmp_path / "kill.toml", sc)
     out = tmp_path / "out"
@@ -155,6 +159,7 @@ def test_range_limited_link_cuts_and_restores_with_distance() -> None:
                 dist = truth[m.t_sim - 1.0][sc_id - 1]  # sent one tick before delivery
                 if abs(dist - sc.comms.range_m) > 0.05:  # away from the boundary
                     assert (d_dist > 0) == (dist <= sc.comms.range_m), (sc_id, m.t_sim, dist)
+                    assert (d_range > 0) == (dist > sc.comms.range_m), (sc_id, m.t_sim, dist)
                 pattern.append("D" if d_dist > 0 else "R")
             prev = c
         runs = "".join(ch for i, ch in enumerate(pattern) if i == 0 or pattern[i - 1] != ch)

@@ -27,8 +27,11 @@ def test_defaults_and_pro_phasing() -> None:
      "observers.count"),
     ('name = "x"\nduration_s = 10\n[[faults]]\nspacecraft = 1\nkind = "camera_degradation"\n'
      'start_s = 0\nmagnitude = 1.5\n', "(0, 1)"),
-    ('name = "x"\nduration_s = 10\n[[faults]]\nspacecraft = 1\nkind = "melted"\nstart_s = 0\n', "kind"),
+    ('name = "x"\nduration_s = 10\n[[faults]]\nspacecraft = 1\nkind = "melted"\n'
+     'start_s = 0\n', "kind"),
     ('name = "x"\nduration_s = [', "not valid TOML"),
+    ('name = "x"\nduration_s = 10\n[rates]\nfdi_period_s = 2.5\n', "whole number of ω_mid"),
+    ('name = "x"\nduration_s = 10\n[rates]\nfdi_period_s = 0.5\n', "rates.fdi_period_s = 0.5"),
 ])
 def test_invalid_scenarios_name_the_field(text: str, needle: str) -> None:
     with pytest.raises(ScenarioError) as e:
@@ -41,10 +44,15 @@ def test_shipped_scenarios_load() -> None:
         assert load_scenario(path).name
 
 
-def test_launcher_rejects_a_bad_scenario_clearly(tmp_path: Path) -> None:
+@pytest.mark.parametrize("section, key", [
+    ("[comms]\nrange = 5\n", "comms.range"),
+    ("[rates]\nfdi_period_s = 2.5\n", "rates.fdi_period_s = 2.5 s must be a whole number"),
+])
+def test_launcher_rejects_a_bad_scenario_clearly(tmp_path: Path, section: str, key: str) -> None:
     bad = tmp_path / "bad.toml"
-    bad.write_text('name = "x"\nduration_s = 10\n[comms]\nrange = 5\n')
+    bad.write_text('name = "x"\nduration_s = 10\n' + section)
     p = subprocess.run([sys.executable, str(REPO / "deploy" / "run_constellation.py"),
                         "--scenario", str(bad), "--out", str(tmp_path / "o")],
                        capture_output=True, text=True, timeout=60)
-    assert p.returncode == 2 and "comms.range" in p.stderr
+    assert p.returncode == 2 and key in p.stderr
+    assert not (tmp_path / "o").exists(), "refused before anything started"

@@ -1,9 +1,10 @@
 """Information-cost app: the spacecraft's share of the inspection (paper Eq. 8, Sec. III.A).
 
 Rate group mid (ω_mid).  Input: the observations of every observer (its own, and a neighbour's
-only while in communication range: the channel decides).  Output: at every FDI period
-(``rates.fdi_period_s``) the information-cost telemetry to the ground — its contribution H_i,
-the cost H and prior term of its fused view, every contribution H_j as fused here, and counts.
+only while in communication range: the channel decides).  Output: at every FDI window
+boundary (``interfaces.fdi_schedule``, every ``rates.fdi_period_s``) the information-cost
+telemetry to the ground — its contribution H_i, the cost H and prior term of its fused view,
+every contribution H_j as fused here, and counts.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from collections.abc import Callable
 from fsw.lib.poi_map import PoiMap
 from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
+from interfaces.fdi_schedule import FdiSchedule
 from interfaces.messages import InfoCostTelemetry, PoiObservations
 
 
@@ -27,8 +29,9 @@ class InfoCostApp(App):
         sc = ctx.scenario
         self.sc_id = ctx.spacecraft or 0
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
-        self.period = sc.rates.fdi_period_s
-        self.next_report = 0.0
+        self.schedule = FdiSchedule(sc.rates.fdi_period_s)
+        self.last_boundary = -1
+        """the FDI window boundary last reported (``interfaces.fdi_schedule``)"""
         self.images = 0
         self.shared = 0
         self.report_factor: Callable[[float], float] = lambda t: 1.0
@@ -43,12 +46,14 @@ class InfoCostApp(App):
             self.shared += 1
 
     def step(self, t: float) -> None:
-        if t < self.next_report - 1e-9:
+        j = self.schedule.boundary_at(t)
+        if j is None or j <= self.last_boundary:
             return
-        self.next_report = t + self.period
+        self.last_boundary = j
         h_j = self.map.contributions()
         self.publish("telemetry", InfoCostTelemetry(
-            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, h_i=float(h_j[self.sc_id - 1]) * self.report_factor(t),
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id,
+            h_i=float(h_j[self.sc_id - 1]) * self.report_factor(t),
             h_local=self.map.cost(), prior_term=self.map.prior_term(),
             contributions={str(j + 1): float(h) for j, h in enumerate(h_j)},
             pois_seen_own=self.map.seen(self.sc_id), pois_seen_fused=self.map.seen(),

@@ -75,6 +75,7 @@ from ground.fdir.twin import (
 )
 from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
+from interfaces.fdi_schedule import FdiSchedule
 from interfaces.messages import (
     AttitudeEstimate,
     FaultReport,
@@ -212,6 +213,7 @@ class FdirApp(App):
         sc = ctx.scenario
         self.cfg = sc.fdir
         self.period = sc.rates.fdi_period_s
+        self.schedule = FdiSchedule(self.period)
         self.n = mean_motion(sc.orbit.altitude_km * 1e3)
         self.camera = Camera(math.radians(sc.camera.half_angle_deg), sc.camera.max_range_m,
                              sc.camera.k)
@@ -226,8 +228,9 @@ class FdirApp(App):
         self.boresight_body = np.array(sc.attitude.boresight_body, dtype=float)
         self.boresight_body /= np.linalg.norm(self.boresight_body)
         self.tol = Tolerances.of(self.cfg)
-        self._reported: dict[tuple[int, float], float] = {}  # (observer, t) -> reported H_i
-        self.window_start = 0.0
+        self._reported: dict[tuple[int, int], float] = {}  # (observer, boundary) -> H_i
+        self.next_window = 0
+        """the next FDI window to judge (``interfaces.fdi_schedule``)"""
         self.rejected = 0
         self._transfers: dict[tuple[int, int], Transfer] = {}
 
@@ -258,8 +261,9 @@ class FdirApp(App):
             obs.plans[msg.assignment_id] = FlightPlan(plan.t_from_s, plan.pro, tr)
 
     def on_telemetry(self, msg: InfoCostTelemetry) -> None:
-        if msg.spacecraft in self.observers and msg.t_sim >= self.window_start:
-            self._reported[(msg.spacecraft, round(msg.t_sim, 6))] = msg.h_i
+        j = self.schedule.boundary_at(msg.t_sim)
+        if msg.spacecraft in self.observers and j is not None and j > self.next_window:
+            self._reported[(msg.spacecraft, j)] = msg.h_i
 
     def on_attitude(self, msg: AttitudeEstimate) -> None:
         obs = self.observers.get(msg.spacecraft)
@@ -292,13 +296,19 @@ class FdirApp(App):
 
     # --- cycle ----------------------------------------------------------------------------
 
-    def step(self, t: float) -> None:
-        while t >= self.window_start + self.period + self.cfg.latency_s - 1e-9:
-            a = self.window_start
-            self.window_start += self.period  # first: a failing window is not retried forever
-            self._evaluate(a, a + self.period)
+    @property
+    def window_start(self) -> float:
+        """Start of the next window to judge (s): later data is still to come."""
+        return self.schedule.start(self.next_window)
 
-    def _evaluate(self, a: float, b: float) -> None:
+    def step(self, t: float) -> None:
+        while t >= self.schedule.end(self.next_window) + self.cfg.latency_s - 1e-9:
+            k = self.next_window
+            self.next_window += 1  # first: a failing window is not retried forever
+            self._evaluate(k)
+
+    def _evaluate(self, k: int) -> None:
+        a, b = self.schedule.start(k), self.schedule.end(k)
         inside = [m for m in self.pending if a <= m.image_t_s < b]
         psi = self.settled.variance() ** 2
         phi = self.settled.phi
@@ -313,9 +323,9 @@ class FdirApp(App):
         for m in inside:
             self.settled.add(m.spacecraft, *m.arrays())
         self.pending = [m for m in self.pending if m.image_t_s >= b]
-        self._check_reports(b)
+        self._check_reports(k + 1, b)
 
-    def _check_reports(self, b: float) -> None:
+    def _check_reports(self, j: int, b: float) -> None:
         """Data integrity: each observer's H_i reported at b against the contribution the
         ground computes from the observations it received (its map now holds every image
         before b), with every observer's precision scaled up by the share of its observations
@@ -328,7 +338,7 @@ class FdirApp(App):
         scaled = self.settled.F / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS))[:, None]
         ground = agent_contributions(self.settled.phi, self.settled.w_inv, scaled)
         for sc in self.observers:
-            reported = self._reported.pop((sc, round(b, 6)), None)
+            reported = self._reported.pop((sc, j), None)
             mine = float(ground[sc - 1])
             if reported is None or mine <= 0.0 or lost[sc - 1] > MAX_JUDGED_LOSS:
                 continue
@@ -339,7 +349,7 @@ class FdirApp(App):
                 self.publish("report", FaultReport(
                     sender=self.ctx.node, t_sim=b, spacecraft=sc, fault_class="data_integrity",
                     metric=deviation, threshold=self.cfg.integrity_tol, window_end_s=b))
-        self._reported = {k: v for k, v in self._reported.items() if k[1] > b}
+        self._reported = {k: v for k, v in self._reported.items() if k[1] > j}
 
     def _loss_limit(self, sent: int) -> float:
         """Lost share of a window's ``sent`` observations beyond which the link is faulty: the
