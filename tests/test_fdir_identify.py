@@ -137,9 +137,9 @@ def test_classify_without_evidence() -> None:
 def test_dv_rate_counts_only_station_keeping() -> None:
     """The Δv rate is taken over the spans between two consecutive guidance reports that both
     say hold: a transfer's Δv (planned) does not count, and neither does the time."""
-    from ground.apps.fdir import _Observer
+    from ground.fdir.observer import ObserverState
 
-    obs = _Observer()
+    obs = ObserverState()
     for t_s, dv, hold in [(0.0, 0.0, True), (10.0, 0.001, True), (20.0, 0.5, False),
                           (30.0, 0.9, True), (40.0, 0.902, True), (200.0, 5.0, True)]:
         obs.guidance.append((t_s, dv, hold))

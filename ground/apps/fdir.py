@@ -44,35 +44,25 @@ from __future__ import annotations
 
 import bisect
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from fsw.lib import quat
 from fsw.lib.hcw import mean_motion
-from fsw.lib.infocost import Camera, agent_contributions, visibility
+from fsw.lib.infocost import Camera
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
-from ground.fdir.identify import (
-    MIN_FIXES,
-    Evidence,
-    Tolerances,
-    classify,
-    explained_fraction,
-    locate_camera,
-    seen_overlap,
-)
+from ground.fdir.identify import Tolerances, classify, window_evidence
 from ground.fdir.metric import direction, metric
-from ground.planning.mission_plan import pro_of
-from ground.fdir.threshold import Persistence, adaptive_threshold
-from ground.fdir.twin import (
-    FlightPlan,
-    Transfer,
-    centre_boresights,
-    delta_h,
-    perturbed_boresights,
-    predicted_delta_h,
+from ground.fdir.observer import (
+    MAX_JUDGED_LOSS,
+    ObserverState,
+    ground_contributions,
+    loss_limit,
 )
+from ground.fdir.threshold import Persistence, sampled_threshold
+from ground.fdir.twin import FlightPlan, Transfer, TwinModel, delta_h, planned_boresights
+from ground.planning.mission_plan import pro_of
 from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
 from interfaces.fdi_schedule import FdiSchedule
@@ -87,111 +77,6 @@ from interfaces.messages import (
     StateEstimate,
     TransferPlanMsg,
 )
-
-
-class _Series:
-    """A time series of vectors reported by an observer (nav position, attitude), sampled at
-    any time by linear interpolation (held at the ends for at most ``MAX_GAP_S``)."""
-
-    MAX_GAP_S = 5.0
-    """A time farther than this from every sample has no value (stale telemetry), s."""
-
-    def __init__(self) -> None:
-        self.t: list[float] = []
-        self.v: list[np.ndarray] = []
-
-    def add(self, t: float, value: np.ndarray) -> None:
-        i = bisect.bisect_right(self.t, t)
-        self.t.insert(i, t)
-        self.v.insert(i, value)
-
-    def at(self, times: np.ndarray) -> np.ndarray | None:
-        """Values (K, d) at ``times`` (K,), or None unless every time is within ``MAX_GAP_S``
-        of a sample."""
-        if not self.t:
-            return None
-        t = np.array(self.t)
-        j = np.searchsorted(t, times)
-        before = np.abs(times - t[np.clip(j - 1, 0, len(t) - 1)])
-        after = np.abs(t[np.clip(j, 0, len(t) - 1)] - times)
-        if np.any(np.minimum(before, after) > self.MAX_GAP_S):
-            return None
-        v = np.array(self.v)
-        return np.stack([np.interp(times, t, v[:, j]) for j in range(v.shape[1])], axis=1)
-
-    def forget_before(self, t: float) -> None:
-        """Drop samples no later window needs (keep the last one before t)."""
-        i = max(bisect.bisect_left(self.t, t) - 1, 0)
-        del self.t[:i], self.v[:i]
-
-
-@dataclass
-class _Observer:
-    """The FDIR's knowledge of one observer: its plans (by assignment id), the times its
-    attitude mode changed (as reported), and its silence count."""
-
-    plans: dict[int, FlightPlan] = field(default_factory=dict)
-    modes: list[tuple[float, str]] = field(default_factory=list)
-    nav: _Series = field(default_factory=_Series)
-    """reported position (nav estimate), LVLH m"""
-    attitude: _Series = field(default_factory=_Series)
-    """reported camera boresight (LVLH, 3), pointing error (rad) and aim point (LVLH, 3, m)"""
-    guidance: list[tuple[float, float, bool]] = field(default_factory=list)
-    """reported (time s, Δv commanded so far m/s, holding its PRO), in time order"""
-    silent: int = 0
-    link_declared: bool = False
-    last_seq: int = 0
-    """last observation sequence number judged (the Bus numbers from 1)"""
-    received: int = 0
-    lost: int = 0
-    """observations received and missing (sequence gaps) since the start"""
-
-    def lost_fraction(self) -> float:
-        """Share of its observations that never reached the ground, since the start."""
-        total = self.received + self.lost
-        return self.lost / total if total else 0.0
-
-    def forget_modes_before(self, t: float) -> None:
-        """Drop mode changes no later window needs (keep the one in force at t)."""
-        i = bisect.bisect_right(self.modes, (t, "~")) - 1
-        del self.modes[:max(i, 0)]
-
-    def tracking_at(self, t: float, settle_s: float) -> bool:
-        """Whether the last reported attitude mode at or before t is ``track``, entered at
-        least ``settle_s`` before t (the loop's transient after a slew is not predicted)."""
-        i = bisect.bisect_right(self.modes, (t, "~")) - 1
-        return i >= 0 and self.modes[i][1] == "track" and self.modes[i][0] <= t - settle_s
-
-    def dv_rate(self, a: float, b: float) -> float | None:
-        """Commanded Δv per second (m/s²) over the parts of [a, b] between two consecutive
-        guidance reports that both say ``hold``; None without any."""
-        rep = [g for g in self.guidance if a <= g[0] <= b]
-        pairs = [(g0, g1) for g0, g1 in zip(rep, rep[1:]) if g0[2] and g1[2] and g1[0] > g0[0]]
-        if not pairs:
-            return None
-        return (sum(g1[1] - g0[1] for g0, g1 in pairs)
-                / sum(g1[0] - g0[0] for g0, g1 in pairs))
-
-    def forget_guidance_before(self, t: float) -> None:
-        """Drop guidance reports no later window needs (keep the last one before t)."""
-        i = bisect.bisect_left(self.guidance, (t,)) - 1
-        del self.guidance[:max(i, 0)]
-
-    def plan_at(self, t: float) -> FlightPlan | None:
-        valid = [p for p in self.plans.values() if p.t_from_s <= t]
-        return max(valid, key=lambda p: p.t_from_s) if valid else None
-
-
-THRESHOLD_IMAGES = 20
-"""The threshold's pointing samples use at most this many of a window's images (cost)."""
-
-def _sample_stride(images: int) -> int:
-    """Every k-th image, so that at most ``THRESHOLD_IMAGES`` of them are sampled."""
-    return max(1, math.ceil(images / THRESHOLD_IMAGES))
-
-
-MAX_JUDGED_LOSS = 0.9
-"""An observer with a larger share of its observations lost has no data-integrity verdict."""
 
 
 class FdirApp(App):
@@ -215,13 +100,14 @@ class FdirApp(App):
         self.period = sc.rates.fdi_period_s
         self.schedule = FdiSchedule(self.period)
         self.n = mean_motion(sc.orbit.altitude_km * 1e3)
-        self.camera = Camera(math.radians(sc.camera.half_angle_deg), sc.camera.max_range_m,
-                             sc.camera.k)
-        self.poi_pos, self.poi_normal = sphere_pois(sc.target.pois, sc.target.radius_m)
+        camera = Camera(math.radians(sc.camera.half_angle_deg), sc.camera.max_range_m,
+                        sc.camera.k)
+        self.twin = TwinModel(*sphere_pois(sc.target.pois, sc.target.radius_m), camera,
+                              sc.target.radius_m)
         self.settled = PoiMap.uniform(sc.target.pois, sc.target.prior_variance,
                                       sc.observers.count)
         self.pending: list[PoiObservations] = []
-        self.observers = {i: _Observer() for i in range(1, sc.observers.count + 1)}
+        self.observers = {i: ObserverState() for i in range(1, sc.observers.count + 1)}
         self.persistence = Persistence(self.cfg.persistence, self.cfg.persistence_window)
         self.integrity = Persistence(self.cfg.persistence)
         self.loss = Persistence(self.cfg.persistence)
@@ -239,10 +125,10 @@ class FdirApp(App):
     def on_observations(self, msg: PoiObservations) -> None:
         if msg.spacecraft not in self.observers:
             return
-        if msg.poi and (min(msg.poi) < 0 or max(msg.poi) >= len(self.poi_pos)):
+        if msg.poi and (min(msg.poi) < 0 or max(msg.poi) >= len(self.twin.poi_pos)):
             self.rejected += 1
             self.log.error("FDIR: dropped observations of sc%d with POI indices outside the "
-                           "%d of the target (%d dropped)", msg.spacecraft, len(self.poi_pos),
+                           "%d of the target (%d dropped)", msg.spacecraft, len(self.twin.poi_pos),
                            self.rejected)
             return
         if msg.image_t_s >= self.window_start:
@@ -335,8 +221,7 @@ class FdirApp(App):
         ``fdir.integrity_tol`` is an inconsistent report.  An observer with more than
         ``MAX_JUDGED_LOSS`` of its observations missing cannot be judged."""
         lost = np.array([o.lost_fraction() for o in self.observers.values()])
-        scaled = self.settled.F / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS))[:, None]
-        ground = agent_contributions(self.settled.phi, self.settled.w_inv, scaled)
+        ground = ground_contributions(self.settled, lost)
         for sc in self.observers:
             reported = self._reported.pop((sc, j), None)
             mine = float(ground[sc - 1])
@@ -352,18 +237,12 @@ class FdirApp(App):
         self._reported = {k: v for k, v in self._reported.items() if k[1] > j}
 
     def _loss_limit(self, sent: int) -> float:
-        """Lost share of a window's ``sent`` observations beyond which the link is faulty: the
-        nominal loss p (``comms.packet_loss``) plus ``fdir.loss_tol`` plus two standard
-        deviations of the window's loss share, √(p(1−p)(2L−1)/n) for Gilbert-Elliott bursts of
-        mean length L (2L − 1: the variance inflation of a two-state Markov loss process with
-        rare bursts; L = 1 is Bernoulli)."""
+        """The link's loss limit for ``sent`` observations (``observer.loss_limit``)."""
         comms = self.ctx.scenario.comms
-        p = comms.packet_loss
         burst = comms.burst.mean_length_packets if comms.burst else 1.0
-        spread = math.sqrt(p * (1.0 - p) * (2.0 * burst - 1.0) / max(sent, 1))
-        return min(1.0, p + self.cfg.loss_tol + 2.0 * spread)
+        return loss_limit(comms.packet_loss, burst, self.cfg.loss_tol, sent)
 
-    def _check_loss(self, sc: int, obs: _Observer, images: list[PoiObservations],
+    def _check_loss(self, sc: int, obs: ObserverState, images: list[PoiObservations],
                     b: float) -> int:
         """Observations of the window missing by sequence number (the observer numbers every
         message it publishes on its key); more than ``_loss_limit`` of them for
@@ -371,10 +250,7 @@ class FdirApp(App):
         if not images:
             return 0
         seqs = sorted(m.seq for m in images)
-        lost = max(seqs[-1] - obs.last_seq - len(seqs), 0)
-        obs.last_seq = max(seqs[-1], obs.last_seq)
-        obs.received += len(seqs)
-        obs.lost += lost
+        lost = obs.count_observations(seqs)
         if obs.silent:  # the gap is the silence already judged (a link fault), not loss
             return 0
         fraction = lost / (lost + len(seqs))
@@ -387,7 +263,7 @@ class FdirApp(App):
                 metric=fraction, threshold=limit, window_end_s=b))
         return lost
 
-    def _judge(self, sc: int, obs: _Observer, images: list[PoiObservations], a: float,
+    def _judge(self, sc: int, obs: ObserverState, images: list[PoiObservations], a: float,
                b: float, psi: np.ndarray, phi: np.ndarray, lost: int) -> None:
         plan = obs.plan_at(a)
         window = FdirWindow(sender=self.ctx.node, t_sim=b, spacecraft=sc, t_start_s=a,
@@ -403,19 +279,23 @@ class FdirApp(App):
         if not images:
             self.publish("window", window)
             return
-        dh = sum(delta_h(psi[poi], phi[poi], prec) for poi, prec in (m.arrays() for m in images))
+        seen = [m.arrays() for m in images]
+        dh = sum(delta_h(psi[poi], phi[poi], prec) for poi, prec in seen)
         times = np.array([m.image_t_s for m in images])
         pos = plan.positions(self.n, times)
-        bore = self._planned_boresights(obs, times, pos)
-        dh_pred = predicted_delta_h(pos, bore, self.poi_pos, self.poi_normal, self.camera,
-                                    psi, phi)
+        att = obs.attitude.at(times)
+        bore = planned_boresights(att, pos)
+        dh_pred = self.twin.predicted(pos, bore, psi, phi)
         h_prev = float(np.sum(phi * psi * self.settled.F[sc - 1]))
         m_val = metric(dh, dh_pred, h_prev)
-        tau = self._threshold(sc, a, pos, bore, psi, phi, h_prev)
+        rng = np.random.default_rng([self.ctx.scenario.seed, sc, int(round(a))])
+        tau = sampled_threshold(self.twin, pos, bore, psi, phi, h_prev,
+                                math.radians(self.cfg.eps_deg), self.cfg.samples, self.cfg.floor,
+                                rng)
         exceeded = None if m_val is None or tau is None else m_val > tau
         dirn = direction(dh, dh_pred, h_prev)
-        ev = self._evidence(obs, images, times, pos, psi, phi,
-                            (dh, dh_pred) if exceeded else None, (a, b))
+        ev = window_evidence(self.twin, seen, obs.nav.at(times), att, pos, psi, phi,
+                             (dh, dh_pred) if exceeded else None, obs.dv_rate(a, b))
         self.publish("window", window.model_copy(update={
             "dh": dh, "dh_pred": dh_pred, "metric": m_val, "threshold": tau,
             "direction": dirn, "exceeded": exceeded, "evidence": ev.as_dict()}))
@@ -427,82 +307,7 @@ class FdirApp(App):
                 sender=self.ctx.node, t_sim=b, spacecraft=sc, fault_class=cls, direction=dirn,
                 metric=m_val, threshold=tau, window_end_s=b, evidence=ev.as_dict()))
 
-    def _evidence(self, obs: _Observer, images: list[PoiObservations], times: np.ndarray,
-                  planned: np.ndarray, psi: np.ndarray, phi: np.ndarray,
-                  gap: tuple[float, float] | None, span: tuple[float, float]) -> Evidence:
-        """Identification evidence of one window (``identify.Evidence``).  The cheap parts
-        (camera fixes, nav and attitude against the plan) every window, so their nominal spread
-        is in the archive; the twin at the reported pose and the seen-set overlap only when the
-        window exceeded its threshold (``gap`` = (ΔH_i, ΔH_i^pred))."""
-        sc_cfg = self.ctx.scenario
-        fixes = [locate_camera(self.poi_pos[poi], prec, self.camera.k, sc_cfg.target.radius_m)
-                 for poi, prec in (m.arrays() for m in images)]
-        nav = obs.nav.at(times)
-        att = obs.attitude.at(times)
-        located = [(i, f) for i, f in enumerate(fixes) if f is not None]
-        if len(located) < MIN_FIXES:
-            located = []
-        beta = float(np.median([f.beta for _, f in located])) if located else None
-        cam_nav = nav_plan = point = explained = explained_loc = overlap = None
-        if nav is not None:
-            nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
-            if located:
-                d = np.array([f.position_m - nav[i] for i, f in located])
-                cam_nav = float(np.linalg.norm(np.median(d, axis=0)))
-        if att is not None:
-            point = math.degrees(float(np.median(att[:, 3])))
-        if gap is not None and nav is not None and att is not None:
-            bore = att[:, :3] / np.linalg.norm(att[:, :3], axis=1, keepdims=True)
-            dh_rep = predicted_delta_h(nav, bore, self.poi_pos, self.poi_normal, self.camera,
-                                       psi, phi)
-            explained = explained_fraction(gap[0], gap[1], dh_rep)
-            where = nav.copy()
-            for i, f in located:
-                where[i] = f.position_m
-            dh_loc = predicted_delta_h(where, bore, self.poi_pos, self.poi_normal, self.camera,
-                                       psi, phi)
-            explained_loc = explained_fraction(gap[0], gap[1], dh_loc)
-            k = _sample_stride(len(images))
-            vis = visibility(nav[::k], bore[::k], self.poi_pos, self.poi_normal, self.camera)
-            ratios = [seen_overlap(m.poi, np.flatnonzero(v)) for m, v in zip(images[::k], vis)]
-            valid = [r for r in ratios if r is not None]
-            overlap = float(np.median(valid)) if valid else None
-        return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc,
-                        obs.dv_rate(*span))
-
-    def _planned_boresights(self, obs: _Observer, times: np.ndarray, pos: np.ndarray
-                            ) -> np.ndarray:
-        """The twin's pointing: from each planned position to the aim point the observer
-        reports (its camera policy's choice: the target centre by default, the max-variance
-        POI with ``[camera] pointing = "max_variance"``), or to the target centre when the
-        attitude reports are missing.  A pointing or camera fault leaves the aim as intended,
-        so it still shows against this prediction."""
-        att = obs.attitude.at(times)
-        if att is None:
-            return centre_boresights(pos)
-        los = att[:, 4:7] - pos
-        norm = np.linalg.norm(los, axis=1, keepdims=True)
-        if np.any(norm <= 0.0):
-            return centre_boresights(pos)
-        return los / norm
-
-    def _threshold(self, sc: int, a: float, pos: np.ndarray, bore: np.ndarray, psi: np.ndarray,
-                   phi: np.ndarray, h_prev: float) -> float | None:
-        """τ_i (Eq. 11-12) from ``fdir.samples`` ε-cone pointings of (at most
-        ``THRESHOLD_IMAGES``, evenly spread) planned images, each compared with the prediction
-        for the same images; floored at ``fdir.floor``.  Seeded by (seed, observer, window)."""
-        k = _sample_stride(len(pos))
-        pos, bore = pos[::k], bore[::k]
-        ref = predicted_delta_h(pos, bore, self.poi_pos, self.poi_normal, self.camera, psi, phi)
-        rng = np.random.default_rng([self.ctx.scenario.seed, sc, int(round(a))])
-        eps = math.radians(self.cfg.eps_deg)
-        samples = [predicted_delta_h(pos, perturbed_boresights(bore, eps, len(bore), rng),
-                                     self.poi_pos, self.poi_normal, self.camera, psi, phi)
-                   for _ in range(self.cfg.samples)]
-        # the subset holds about 1/k of the window's gain
-        return adaptive_threshold(samples, ref, h_prev / k, self.cfg.floor)
-
-    def _silence(self, sc: int, obs: _Observer, b: float) -> None:
+    def _silence(self, sc: int, obs: ObserverState, b: float) -> None:
         """An observer with a plan sent no image this window: after ``silent_windows`` in a
         row, a link fault (once per episode)."""
         obs.silent += 1

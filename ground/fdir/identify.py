@@ -52,11 +52,14 @@ the reported H_i.)  Pure functions; the app gathers the inputs.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 
 import numpy as np
 import numpy.typing as npt
 
+from fsw.lib.infocost import visibility
+from ground.fdir.twin import TwinModel, sample_stride
 from interfaces.scenario import FdirSettings
 
 FloatArray = npt.NDArray[np.float64]
@@ -199,3 +202,57 @@ def classify(ev: Evidence, tol: Tolerances) -> str | None:
     if ev.seen_overlap is not None and ev.seen_overlap < tol.overlap:
         return "camera"
     return None
+
+
+Observation = tuple[np.ndarray, np.ndarray]
+"""One image's observations: POI indices and their precisions σ⁻¹."""
+
+
+def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndarray | None,
+                    attitude: np.ndarray | None, planned: np.ndarray, psi: np.ndarray,
+                    phi: np.ndarray, gap: tuple[float, float] | None,
+                    dv_rate: float | None) -> Evidence:
+    """Identification evidence of one window.  ``nav``: reported positions at the image times
+    (LVLH, m); ``attitude``: reported boresight, pointing error and aim point rows; ``planned``:
+    the plan's positions.  The cheap parts (camera fixes, nav and attitude against the plan)
+    every window, so their nominal spread is in the archive; the twin at the reported pose and
+    the seen-set overlap only when the window exceeded its threshold (``gap`` = (ΔH_i,
+    ΔH_i^pred))."""
+    fixes = [locate_camera(twin.poi_pos[poi], prec, twin.camera.k, twin.radius_m)
+             for poi, prec in images]
+    located = [(i, f) for i, f in enumerate(fixes) if f is not None]
+    if len(located) < MIN_FIXES:
+        located = []
+    beta = float(np.median([f.beta for _, f in located])) if located else None
+    cam_nav = nav_plan = point = None
+    if nav is not None:
+        nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
+        if located:
+            d = np.array([f.position_m - nav[i] for i, f in located])
+            cam_nav = float(np.linalg.norm(np.median(d, axis=0)))
+    if attitude is not None:
+        point = math.degrees(float(np.median(attitude[:, 3])))
+    explained = explained_loc = overlap = None
+    if gap is not None and nav is not None and attitude is not None:
+        explained, explained_loc, overlap = _gap_evidence(twin, images, nav, attitude, located,
+                                                          psi, phi, gap)
+    return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc, dv_rate)
+
+
+def _gap_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndarray,
+                  attitude: np.ndarray, located: list[tuple[int, CameraFix]], psi: np.ndarray,
+                  phi: np.ndarray, gap: tuple[float, float]
+                  ) -> tuple[float | None, float | None, float | None]:
+    """The gradient test (the twin re-run at the reported pose, and with the located camera
+    positions) and the seen-set overlap of an exceeded window."""
+    bore = attitude[:, :3] / np.linalg.norm(attitude[:, :3], axis=1, keepdims=True)
+    explained = explained_fraction(gap[0], gap[1], twin.predicted(nav, bore, psi, phi))
+    where = nav.copy()
+    for i, f in located:
+        where[i] = f.position_m
+    explained_loc = explained_fraction(gap[0], gap[1], twin.predicted(where, bore, psi, phi))
+    k = sample_stride(len(images))
+    vis = visibility(nav[::k], bore[::k], twin.poi_pos, twin.poi_normal, twin.camera)
+    ratios = [seen_overlap(poi, np.flatnonzero(v)) for (poi, _), v in zip(images[::k], vis)]
+    valid = [r for r in ratios if r is not None]
+    return explained, explained_loc, float(np.median(valid)) if valid else None

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ground.fdir.metric import metric
+from ground.fdir.twin import TwinModel, perturbed_boresights, sample_stride
 
 
 def adaptive_threshold(dh_samples: Sequence[float], dh_pred: float, h_prev: float = 0.0,
@@ -82,3 +83,18 @@ class Persistence:
             return False
         self._declared.add(spacecraft)
         return True
+
+
+def sampled_threshold(twin: TwinModel, positions: np.ndarray, boresights: np.ndarray,
+                      psi: np.ndarray, phi: np.ndarray, h_prev: float, eps_rad: float,
+                      samples: int, floor: float, rng: np.random.Generator) -> float | None:
+    """τ_i (Eq. 11-12) of one window: ``samples`` pointings within ``eps_rad`` of the planned
+    ones for (at most ``SAMPLED_IMAGES``, evenly spread) planned images, each compared with the
+    prediction for the same images; floored at ``floor``."""
+    k = sample_stride(len(positions))
+    pos, bore = positions[::k], boresights[::k]
+    ref = twin.predicted(pos, bore, psi, phi)
+    draws = [twin.predicted(pos, perturbed_boresights(bore, eps_rad, len(bore), rng), psi, phi)
+             for _ in range(samples)]
+    # the subset holds about 1/k of the window's gain
+    return adaptive_threshold(draws, ref, h_prev / k, floor)

@@ -119,3 +119,46 @@ def perturbed_boresights(boresight: npt.ArrayLike, eps_rad: float, count: int,
     e2 = np.cross(b, e1)
     return (cos_t[:, None] * b + sin_t[:, None] * (np.cos(az)[:, None] * e1
                                                   + np.sin(az)[:, None] * e2))
+
+
+@dataclass(frozen=True)
+class TwinModel:
+    """What the twin knows of the target and the cameras: the POIs (positions and outward
+    normals, LVLH, m), the target radius (m) and the nominal camera model."""
+
+    poi_pos: FloatArray
+    poi_normal: FloatArray
+    camera: Camera
+    radius_m: float
+
+    def predicted(self, positions: npt.ArrayLike, boresights: npt.ArrayLike,
+                  psi: npt.ArrayLike, phi: npt.ArrayLike) -> float:
+        """ΔH_i^pred of images taken from ``positions`` along ``boresights``."""
+        return predicted_delta_h(positions, boresights, self.poi_pos, self.poi_normal,
+                                 self.camera, psi, phi)
+
+
+SAMPLED_IMAGES = 20
+"""The costlier twin runs (threshold samples, seen-set overlap) use at most this many of a
+window's images, evenly spread."""
+
+
+def sample_stride(images: int) -> int:
+    """Every k-th image, so that at most ``SAMPLED_IMAGES`` of them are used."""
+    return max(1, math.ceil(images / SAMPLED_IMAGES))
+
+
+def planned_boresights(attitude: FloatArray | None, positions: FloatArray) -> FloatArray:
+    """The twin's pointing: from each planned position to the aim point the observer reports
+    (``attitude`` rows: reported boresight (3), pointing error, aim point (3) LVLH m; its camera
+    policy's choice: the target centre by default, the max-variance POI with
+    ``[camera] pointing = "max_variance"``), or to the target centre when the attitude reports
+    are missing.  A pointing or camera fault leaves the aim as intended, so it still shows
+    against this prediction."""
+    if attitude is None:
+        return centre_boresights(positions)
+    los = attitude[:, 4:7] - positions
+    norm = np.linalg.norm(los, axis=1, keepdims=True)
+    if np.any(norm <= 0.0):
+        return centre_boresights(positions)
+    return los / norm

@@ -1,0 +1,144 @@
+"""The FDIR's knowledge of one observer between windows (DESIGN.md "Information cost and
+FDIR"): its plans, reported attitude modes, nav and attitude series, guidance reports, silence
+and observation-loss counts -- the state the FDIR app keeps per observer, as plain code that
+tests call directly.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fsw.lib.infocost import agent_contributions
+from fsw.lib.poi_map import PoiMap
+from ground.fdir.twin import FlightPlan
+
+
+class TimeSeries:
+    """A time series of vectors reported by an observer (nav position, attitude), sampled at
+    any time by linear interpolation (held at the ends for at most ``MAX_GAP_S``)."""
+
+    MAX_GAP_S = 5.0
+    """A time farther than this from every sample has no value (stale telemetry), s."""
+
+    def __init__(self) -> None:
+        self.t: list[float] = []
+        self.v: list[np.ndarray] = []
+
+    def add(self, t: float, value: np.ndarray) -> None:
+        i = bisect.bisect_right(self.t, t)
+        self.t.insert(i, t)
+        self.v.insert(i, value)
+
+    def at(self, times: np.ndarray) -> np.ndarray | None:
+        """Values (K, d) at ``times`` (K,), or None unless every time is within ``MAX_GAP_S``
+        of a sample."""
+        if not self.t:
+            return None
+        t = np.array(self.t)
+        j = np.searchsorted(t, times)
+        before = np.abs(times - t[np.clip(j - 1, 0, len(t) - 1)])
+        after = np.abs(t[np.clip(j, 0, len(t) - 1)] - times)
+        if np.any(np.minimum(before, after) > self.MAX_GAP_S):
+            return None
+        v = np.array(self.v)
+        return np.stack([np.interp(times, t, v[:, j]) for j in range(v.shape[1])], axis=1)
+
+    def forget_before(self, t: float) -> None:
+        """Drop samples no later window needs (keep the last one before t)."""
+        i = max(bisect.bisect_left(self.t, t) - 1, 0)
+        del self.t[:i], self.v[:i]
+
+
+@dataclass
+class ObserverState:
+    """The FDIR's knowledge of one observer: its plans (by assignment id), the times its
+    attitude mode changed (as reported), and its silence count."""
+
+    plans: dict[int, FlightPlan] = field(default_factory=dict)
+    modes: list[tuple[float, str]] = field(default_factory=list)
+    nav: TimeSeries = field(default_factory=TimeSeries)
+    """reported position (nav estimate), LVLH m"""
+    attitude: TimeSeries = field(default_factory=TimeSeries)
+    """reported camera boresight (LVLH, 3), pointing error (rad) and aim point (LVLH, 3, m)"""
+    guidance: list[tuple[float, float, bool]] = field(default_factory=list)
+    """reported (time s, Δv commanded so far m/s, holding its PRO), in time order"""
+    silent: int = 0
+    link_declared: bool = False
+    last_seq: int = 0
+    """last observation sequence number judged (the Bus numbers from 1)"""
+    received: int = 0
+    lost: int = 0
+    """observations received and missing (sequence gaps) since the start"""
+
+    def count_observations(self, seqs: list[int]) -> int:
+        """Count a window's received observations (their sequence numbers, sorted) and those
+        missing between them and the last judged; returns the number missing."""
+        lost = max(seqs[-1] - self.last_seq - len(seqs), 0)
+        self.last_seq = max(seqs[-1], self.last_seq)
+        self.received += len(seqs)
+        self.lost += lost
+        return lost
+
+    def lost_fraction(self) -> float:
+        """Share of its observations that never reached the ground, since the start."""
+        total = self.received + self.lost
+        return self.lost / total if total else 0.0
+
+    def forget_modes_before(self, t: float) -> None:
+        """Drop mode changes no later window needs (keep the one in force at t)."""
+        i = bisect.bisect_right(self.modes, (t, "~")) - 1
+        del self.modes[:max(i, 0)]
+
+    def tracking_at(self, t: float, settle_s: float) -> bool:
+        """Whether the last reported attitude mode at or before t is ``track``, entered at
+        least ``settle_s`` before t (the loop's transient after a slew is not predicted)."""
+        i = bisect.bisect_right(self.modes, (t, "~")) - 1
+        return i >= 0 and self.modes[i][1] == "track" and self.modes[i][0] <= t - settle_s
+
+    def dv_rate(self, a: float, b: float) -> float | None:
+        """Commanded Δv per second (m/s²) over the parts of [a, b] between two consecutive
+        guidance reports that both say ``hold``; None without any."""
+        rep = [g for g in self.guidance if a <= g[0] <= b]
+        pairs = [(g0, g1) for g0, g1 in zip(rep, rep[1:]) if g0[2] and g1[2] and g1[0] > g0[0]]
+        if not pairs:
+            return None
+        return (sum(g1[1] - g0[1] for g0, g1 in pairs)
+                / sum(g1[0] - g0[0] for g0, g1 in pairs))
+
+    def forget_guidance_before(self, t: float) -> None:
+        """Drop guidance reports no later window needs (keep the last one before t)."""
+        i = bisect.bisect_left(self.guidance, (t,)) - 1
+        del self.guidance[:max(i, 0)]
+
+    def plan_at(self, t: float) -> FlightPlan | None:
+        valid = [p for p in self.plans.values() if p.t_from_s <= t]
+        return max(valid, key=lambda p: p.t_from_s) if valid else None
+
+
+def loss_limit(packet_loss: float, burst_packets: float, loss_tol: float, sent: int) -> float:
+    """Lost share of a window's ``sent`` observations beyond which the link is faulty: the
+    nominal loss p (``comms.packet_loss``) plus ``fdir.loss_tol`` plus two standard deviations
+    of the window's loss share, √(p(1−p)(2L−1)/n) for Gilbert-Elliott bursts of mean length L
+    (2L − 1: the variance inflation of a two-state Markov loss process with rare bursts; L = 1
+    is Bernoulli)."""
+    p = packet_loss
+    spread = math.sqrt(p * (1.0 - p) * (2.0 * burst_packets - 1.0) / max(sent, 1))
+    return min(1.0, p + loss_tol + 2.0 * spread)
+
+
+MAX_JUDGED_LOSS = 0.9
+"""An observer with a larger share of its observations lost has no data-integrity verdict."""
+
+
+def ground_contributions(settled: PoiMap, lost: np.ndarray) -> np.ndarray:
+    """Each observer's contribution H_i as the ground computes it from the observations it
+    received (Eq. 8), with every observer's precision scaled up by the share of its observations
+    lost on the way (``lost``, per observer), so ψ is as consistent as the ground can make it:
+    an observer's own H_i holds all of its images.  Shares above ``MAX_JUDGED_LOSS`` are
+    capped (such an observer is not judged)."""
+    scaled = settled.F / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS))[:, None]
+    return agent_contributions(settled.phi, settled.w_inv, scaled)

@@ -1,0 +1,82 @@
+"""The FDIR's per-observer state and the pure pieces of a window's verdict, called directly:
+loss counting by sequence number and its limit, the ground's own H_i with loss compensation,
+the twin's pointing and the sampled threshold."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fsw.lib.infocost import Camera, agent_contributions
+from fsw.lib.poi import sphere_pois
+from fsw.lib.poi_map import PoiMap
+from ground.fdir.observer import MAX_JUDGED_LOSS, ObserverState, ground_contributions, loss_limit
+from ground.fdir.threshold import sampled_threshold
+from ground.fdir.twin import TwinModel, centre_boresights, planned_boresights
+
+
+def test_losses_are_counted_from_sequence_gaps() -> None:
+    obs = ObserverState()
+    assert obs.count_observations([1, 2, 3]) == 0
+    assert obs.count_observations([5, 8]) == 3  # 4, 6 and 7 never arrived
+    assert (obs.received, obs.lost, obs.last_seq) == (5, 3, 8)
+    assert obs.lost_fraction() == pytest.approx(3 / 8)
+    assert obs.count_observations([7]) == 0, "a late one is not a loss"
+
+
+def test_loss_limit_is_the_nominal_loss_plus_tolerance_and_two_sigma() -> None:
+    # Bernoulli (L = 1): p + tol + 2 sqrt(p (1-p) / n)
+    assert loss_limit(0.1, 1.0, 0.05, 100) == pytest.approx(0.15 + 2 * math.sqrt(0.09 / 100))
+    # bursts of mean length L inflate the variance by 2L - 1
+    assert loss_limit(0.1, 5.0, 0.05, 100) == pytest.approx(0.15 + 2 * math.sqrt(0.81 / 100))
+    assert loss_limit(0.0, 1.0, 0.05, 0) == pytest.approx(0.05)
+    assert loss_limit(0.9, 1.0, 0.5, 1) == 1.0
+
+
+def test_ground_contributions_scale_up_what_was_lost() -> None:
+    rng = np.random.default_rng(2)
+    m = PoiMap.uniform(50, 4.0, 3)
+    for agent in range(1, 4):
+        m.add(agent, rng.choice(50, 20, replace=False), rng.uniform(0.5, 2.0, 20))
+    none = ground_contributions(m, np.zeros(3))
+    assert none == pytest.approx(agent_contributions(m.phi, m.w_inv, m.F))
+    half = ground_contributions(m, np.array([0.5, 0.0, 0.0]))
+    doubled = m.F.copy()
+    doubled[0] *= 2.0
+    assert half == pytest.approx(agent_contributions(m.phi, m.w_inv, doubled))
+    capped = ground_contributions(m, np.array([0.99, 0.0, 0.0]))
+    cap = m.F.copy()
+    cap[0] /= 1.0 - MAX_JUDGED_LOSS
+    assert capped == pytest.approx(agent_contributions(m.phi, m.w_inv, cap))
+
+
+def test_twin_points_at_the_reported_aim_or_the_centre() -> None:
+    pos = np.array([[30.0, 0.0, 0.0], [0.0, 40.0, 0.0]])
+    assert planned_boresights(None, pos) == pytest.approx(centre_boresights(pos))
+    aim = np.zeros((2, 7))
+    aim[:, 4:7] = [[30.0, 0.0, 10.0], [0.0, 40.0, -10.0]]
+    assert planned_boresights(aim, pos) == pytest.approx(np.array([[0, 0, 1.0], [0, 0, -1.0]]))
+    aim[1, 4:7] = pos[1]  # aim point on the spacecraft: no direction, the centre instead
+    assert planned_boresights(aim, pos) == pytest.approx(centre_boresights(pos))
+
+
+def test_sampled_threshold_is_seeded_and_grows_with_the_cone() -> None:
+    # a camera narrower than the target: where it points decides what it sees
+    twin = TwinModel(*sphere_pois(500, 5.0), Camera(math.radians(3.0), 100.0, 0.01), 5.0)
+    m = PoiMap.uniform(500, 4.0, 1)
+    psi, phi = m.variance() ** 2, m.phi
+    t = np.linspace(0.0, 2 * math.pi, 40, endpoint=False)
+    pos = np.stack([20 * np.sin(t), 40 * np.cos(t), 25 * np.sin(t)], axis=1)
+    bore = centre_boresights(pos)
+
+    def tau(eps_deg: float, seed: int = 1) -> float | None:
+        return sampled_threshold(twin, pos, bore, psi, phi, 0.0, math.radians(eps_deg), 10, 0.0,
+                                 np.random.default_rng(seed))
+
+    assert tau(1.0) == tau(1.0) and tau(1.0) != tau(1.0, seed=2)
+    assert 0.0 < tau(0.5) < tau(3.0)
+    floored = sampled_threshold(twin, pos, bore, psi, phi, 0.0, math.radians(0.5), 10, 0.5,
+                                np.random.default_rng(1))
+    assert floored == 0.5
