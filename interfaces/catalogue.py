@@ -73,6 +73,11 @@ class Topic(Generic[M]):
             return self.key(mission)
         return self.every_spacecraft(mission)
 
+    def any_mission(self) -> str:
+        """Key expression of this topic from every publisher of any mission (tools reading an
+        archive before they know its mission)."""
+        return self.every("m").replace(f"{topics.ROOT}/m/", f"{topics.ROOT}/*/", 1)
+
     def every_spacecraft(self, mission: str) -> str:
         """Key expression of this topic for every spacecraft (for SIM_HARDWARE: every
         spacecraft's hardware)."""

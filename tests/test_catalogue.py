@@ -34,6 +34,8 @@ def test_every_topic_round_trips_through_its_keys(topic: Topic[Message]) -> None
     assert cat.topic_of(key) is topic
     assert cat.topic_of(topic.every(M)) is topic
     assert topics.matches(topic.every(M), key)
+    assert topics.matches(topic.any_mission(), key)
+    assert not topics.matches(topic.any_mission(), key.replace(topic.name, "other"))
     if topic.space in (Space.SPACECRAFT, Space.SIM_HARDWARE):
         assert topics.matches(topic.every_spacecraft(M), key)
         assert topics.node_of_key(key) == ("sc2" if topic.space is Space.SPACECRAFT else "sim")

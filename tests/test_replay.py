@@ -16,7 +16,9 @@ from ground.analysis.summary import write_summary
 from ground.archive.metadata import run_metadata
 from ground.archive.reader import ArchiveError, load_run
 from ground.archive.recorder import McapRecorder
-from ground.fdir.replay import GroundOutput, main, replay_run, with_settings
+from ground.fdir.replay import UNREAD, GroundOutput, main, replay_run, with_settings
+from ground.station import APPS as GROUND_APPS
+from interfaces import catalogue as cat
 from interfaces.scenario import Scenario, ScenarioError
 from tests.conftest import small_scenario
 
@@ -93,6 +95,12 @@ def test_another_setting_replays_as_the_live_run_with_it(
             if w.t_sim <= horizon]
     assert mine == [w.model_dump(exclude={"t_wall"}) for w in other_windows
                     if w.t_sim <= horizon]
+
+
+def test_what_a_replay_drops_unread_no_ground_app_reads() -> None:
+    ground_inputs = {i.topic for app in GROUND_APPS for i in app.INPUTS}
+    assert ground_inputs and not ground_inputs & set(UNREAD)
+    assert cat.TRUTH not in UNREAD and cat.TICK not in UNREAD
 
 
 def test_settings_that_change_the_flight_are_refused() -> None:

@@ -194,6 +194,10 @@ class RunArchive:
         keys = self._keys_matching(key_expr)
         return [r for r in self._records if r.key in keys]
 
+    def held(self) -> list[Record]:
+        """Every record held, by log time then file order (those of streamed keys are not)."""
+        return list(self._records)
+
     def of(self, topic: Topic[M], mission: str) -> list[M]:
         """Decoded messages of a catalogued topic from every publisher of ``mission``."""
         return self.messages(topic.every(mission), topic.type)
