@@ -63,6 +63,11 @@ def test_a_sweep_writes_one_table(campaign: tuple[Path, list[str]]) -> None:
         assert int(rows["2"][k]) == live[k], k
     assert int(rows["1"]["detected"]) > int(rows["2"]["detected"]), \
         "declaring on the first exceedance detects within the runs' 150 s"
+    for r in rows.values():
+        assert int(r["false_alarms_faithful"]) <= int(r["false_alarms"])
+        assert int(r["nominal_cycles_faithful"]) <= int(r["nominal_cycles"])
+    assert rows["2"]["nominal_cycles_faithful"] == rows["2"]["nominal_cycles"], \
+        "the live setting's replays are faithful to the end"
     assert "| 1 |" in (dest / "sweep.md").read_text()
     assert (dest / "fdir.persistence=1" / "report.md").exists()
 

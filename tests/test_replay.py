@@ -85,7 +85,10 @@ def test_another_setting_replays_as_the_live_run_with_it(
     assert first_camera(other["detections"]) < first_camera(summary["detections"]), \
         "the setting declares the camera fault sooner"
     assert horizon < 400.0, "and its recovery uplink differs from the live run's"
-    before = [d for d in replay.results()["detections"] if d["time_s"] <= horizon]
+    res = replay.results()
+    assert res["scores_faithful"]["false_alarms"] <= res["scores"]["false_alarms"]
+    assert res["scores_faithful"]["nominal_cycles"] < res["scores"]["nominal_cycles"]
+    before = [d for d in res["detections"] if d["time_s"] <= horizon]
     assert before and all(d["faithful"] for d in before)
     assert [{k: v for k, v in d.items() if k != "faithful"} for d in before] \
         == [d for d in other["detections"] if d["time_s"] <= horizon]

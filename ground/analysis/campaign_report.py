@@ -129,7 +129,8 @@ def _stats(rows: list[dict[str, Any]], hours: float) -> dict[str, Any]:
 def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> dict[str, Any]:
     """One detector's figures over the finished runs ``ids`` of ``out`` (a campaign or its
     replay): faults, detected, isolated, identified (counts), latency median and p90 of the
-    isolated faults (s), false alarms and nominal cycles, runs, and runs whose replay (if any)
+    isolated faults (s), false alarms and nominal cycles (over whole runs, and over each
+    replay's faithful span: ``ground.fdir.replay``), runs, and runs whose replay (if any)
     stayed faithful to the end."""
     runs = _load(out, ids)
     rows = [r for r in _rows(runs) if r["detector"] == detector]
@@ -138,12 +139,23 @@ def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> d
            and r["latency_s"] is not None]
     faithful = sum(s.get("replay", {}).get("faithful_until_s", math.inf) >= s["duration_s"]
                    for s in runs)
+    spans = [_detector_scores(s.get("replay", {}).get("scores_faithful") or s.get("scores", {}),
+                              s, detector) for s in runs]
     return {"faults": st["faults"], "detected": st["detected"], "isolated": st["isolated"],
             "identified": st["identified"],
             "latency_median_s": float(np.median(lat)) if lat else None,
             "latency_p90_s": float(np.quantile(lat, 0.9)) if lat else None,
             "false_alarms": st["false_alarms"], "nominal_cycles": st["nominal_cycles"],
+            "false_alarms_faithful": sum(sc.get("false_alarms", 0) for sc in spans),
+            "nominal_cycles_faithful": sum(sc.get("nominal_cycles", 0) for sc in spans),
             "runs": len(runs), "faithful_runs": int(faithful)}
+
+
+def _detector_scores(main: dict[str, Any], summary: dict[str, Any], detector: str
+                     ) -> dict[str, Any]:
+    """The scores of ``detector`` in a summary: ``main`` for the main detector (the faithful
+    span's, for a replay), else the baseline's."""
+    return main if detector == "main" else summary.get("baselines", {}).get(detector, {})
 
 
 def _cells(detector: str, st: dict[str, Any]) -> str:

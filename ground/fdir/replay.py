@@ -10,7 +10,8 @@ the ground subscribes to, in the lockstep's order: all messages of sim time t, t
 Tick at t.  Its own channel model (the scenario's comms, seed, cuts and link faults) decides
 again, in the same deterministic order, which of them reached it, so losses and range cuts
 replay as they happened.  What it publishes -- FDI windows, fault reports, baseline verdicts --
-is scored as ``summary.json`` scores the live run (``ground.analysis.summary.fdir_results``).
+is scored as ``summary.json`` scores the live run (``ground.analysis.summary.fdir_results``);
+``scores_faithful`` scores only what it declared and judged up to ``faithful_until_s``.
 
 Faithfulness.  With the run's own settings the replay reproduces the live detections, their
 times and classes, and every window and verdict exactly (``matches_live``).  The spacecraft's
@@ -18,7 +19,7 @@ data, however, is what they flew: once an uplink differs from the live one -- a 
 replan after a declaration made at another time, or not made -- the replay judges a
 trajectory that its own uplinks did not command.  ``faithful_until_s`` is the sim time of the
 first such difference (the run's end when there is none); what the replay reports after it is
-kept, and marked.
+kept, and marked, and left out of ``scores_faithful``.
 """
 
 from __future__ import annotations
@@ -112,14 +113,19 @@ class Replay:
 
     def results(self) -> dict[str, Any]:
         """``summary.json``'s FDIR fields for the replay, with its faithfulness."""
-        out = fdir_results(self.replayed.reports, self.replayed.windows, self.replayed.verdicts,
-                           self.scenario)
+        mine = self.replayed
+        out = fdir_results(mine.reports, mine.windows, mine.verdicts, self.scenario)
         horizon = self.faithful_until_s()
         for d in out["detections"]:
             d["faithful"] = d["time_s"] <= horizon
+        faithful = fdir_results([r for r in mine.reports if r.t_sim <= horizon],
+                                [w for w in mine.windows if w.t_end_s <= horizon],
+                                [v for v in mine.verdicts if v.t_end_s <= horizon],
+                                self.scenario)
         return {"scenario": self.scenario.name, "seed": self.scenario.seed,
                 "replay_wall_s": round(self.wall_s, 3), "faithful_until_s": horizon,
-                "matches_live": self.matches_live(), **out}
+                "matches_live": self.matches_live(), **out,
+                "scores_faithful": faithful["scores"]}
 
 
 def _plan(msg: ProAssignments) -> tuple[float, list[dict[str, Any]]]:
