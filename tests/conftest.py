@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
 import socket
-from collections.abc import Callable
+import subprocess
+import sys
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -57,11 +61,16 @@ def _toml(v: object) -> str:
     return repr(v)
 
 
-@pytest.fixture
-def free_port() -> int:
+def a_free_port() -> int:
+    """A TCP port free on loopback now."""
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
+
+
+@pytest.fixture
+def free_port() -> int:
+    return a_free_port()
 
 
 def collector(*types: type[Message], key_prefix: dict[str, str] | None = None,
@@ -96,3 +105,26 @@ def recorded_run(scenario: Scenario, out: Path, *types: type[Message]
 
         run_inproc(scenario, tap=both)
     return got, write_summary(out, scenario, "inproc", 1.0, "completed")
+
+
+@contextlib.contextmanager
+def dask_cluster() -> Iterator[str]:
+    """A real Dask scheduler and one single-threaded worker, separate processes on loopback
+    (importing this repository); yields the scheduler's address and stops both."""
+    port = a_free_port()
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    quiet = {"env": env, "stdout": subprocess.DEVNULL, "stderr": subprocess.DEVNULL}
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler",
+                               "--host", "127.0.0.1", "--port", str(port),
+                               "--dashboard-address", ":0"], **quiet)]
+    try:
+        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker",
+                                       f"tcp://127.0.0.1:{port}", "--nworkers", "1",
+                                       "--nthreads", "1", "--host", "127.0.0.1",
+                                       "--dashboard-address", ":0"], **quiet))
+        yield f"tcp://127.0.0.1:{port}"
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+        for p in procs:
+            p.wait(timeout=30)

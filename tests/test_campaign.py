@@ -7,9 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
-import os
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -20,6 +18,7 @@ import pytest
 from deploy.campaign import CampaignError, load_campaign
 from deploy.run_campaign import main as run_campaign
 from ground.archive.metadata import software_version
+from tests.conftest import dask_cluster
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -103,35 +102,13 @@ def _results(out: Path) -> dict[str, dict[str, object]]:
     return res
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
 def test_local_pool_and_dask_cluster_agree(tmp_path: Path) -> None:
     path = _campaign(tmp_path)
     assert run_campaign(["--campaign", str(path), "--out", str(tmp_path / "local"),
                          "--workers", "2"]) == 0
-    port = _free_port()
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
-    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler",
-                               "--host", "127.0.0.1", "--port", str(port),
-                               "--dashboard-address", ":0"], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
-    try:
-        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker",
-                                       f"tcp://127.0.0.1:{port}", "--nworkers", "1",
-                                       "--nthreads", "1", "--host", "127.0.0.1",
-                                       "--dashboard-address", ":0"], env=env,
-                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+    with dask_cluster() as address:
         assert run_campaign(["--campaign", str(path), "--out", str(tmp_path / "dask"),
-                             "--cluster", f"tcp://127.0.0.1:{port}"]) == 0
-    finally:
-        for p in reversed(procs):
-            p.terminate()
-        for p in procs:
-            p.wait(timeout=30)
+                             "--cluster", address]) == 0
     local, dask = _results(tmp_path / "local"), _results(tmp_path / "dask")
     assert list(local) == ["cam-0000", "cam-0001", "nom-0000"]
     assert local == dask

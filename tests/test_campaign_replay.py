@@ -14,6 +14,7 @@ import pytest
 from deploy.campaign_replay import FDIR_FIELDS
 from deploy.run_campaign import main as run_campaign
 from ground.analysis.campaign_report import detector_figures
+from tests.conftest import dask_cluster
 from tests.test_campaign import BASE, CAMPAIGN
 
 
@@ -49,6 +50,19 @@ def test_own_settings_give_back_the_live_fields(campaign: tuple[Path, list[str]]
         for k in FDIR_FIELDS:
             assert again[k] == live[k], (rid, k)
     assert detector_figures(dest, ids) == detector_figures(out, ids)
+
+
+def test_a_dask_cluster_replays_as_the_local_pool(campaign: tuple[Path, list[str]]) -> None:
+    out, ids = campaign
+    with dask_cluster() as address:
+        assert run_campaign(["--out", str(out), "--replay", "--set", "fdir.persistence=1",
+                             "--cluster", address, "--out-report", str(out / "on-dask")]) == 0
+    assert run_campaign(["--out", str(out), "--replay", "--set", "fdir.persistence=1",
+                         "--workers", "2", "--out-report", str(out / "local")]) == 0
+    for rid in ids:
+        a, b = _summary(out / "on-dask", rid), _summary(out / "local", rid)
+        a["replay"].pop("wall_s"), b["replay"].pop("wall_s")
+        assert a["replay"] == b["replay"] and all(a[k] == b[k] for k in FDIR_FIELDS), rid
 
 
 def test_a_sweep_writes_one_table(campaign: tuple[Path, list[str]]) -> None:
