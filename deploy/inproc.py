@@ -46,7 +46,7 @@ def run_inproc(
     executives: dict[str, Executive] = {}
     for node, build in builders.items():
         bus = Bus(node, mission, net.endpoint(),
-                  channel=ChannelModel(node, scenario.comms, scenario.seed, scenario.faults))
+                  channel=ChannelModel.of(node, scenario))
         executives[node] = build(bus, scenario)
         TickClient(executives[node], synchronous=True)
     sim = SimNode(Bus(topics.SIM, mission, net.endpoint()), scenario, list(builders),

@@ -30,7 +30,7 @@ import numpy as np
 
 from interfaces.messages import LinkCounter
 from interfaces.rng import stream
-from interfaces.scenario import Comms, Fault, LinkCut
+from interfaces.scenario import Comms, Fault, LinkCut, Scenario
 from interfaces.topics import GROUND, spacecraft_of
 
 
@@ -99,6 +99,12 @@ class ChannelModel:
     _truth_pos: list[dict[str, np.ndarray]] = field(default_factory=list)
     _cuts: list[_Cut] = field(default_factory=list)
     _lock: threading.Lock = field(default_factory=threading.Lock)
+
+    @classmethod
+    def of(cls, receiver: str, scenario: Scenario) -> ChannelModel:
+        """The channel model of ``receiver`` in a run of ``scenario`` (every run, transport
+        and replay builds it this way, so its draws are the same)."""
+        return cls(receiver, scenario.comms, scenario.seed, scenario.faults)
 
     def __post_init__(self) -> None:
         self._cuts = [_Cut(c.a, c.b, c.start_s, c.end_s) for c in self.comms.cuts]

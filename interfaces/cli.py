@@ -75,7 +75,7 @@ def run_participant(
     scenario = load_node_scenario(args)
     stop = stop_on_signals()
     bus = Bus(node, mission_of(args, scenario), open_zenoh(args),
-              channel=ChannelModel(node, scenario.comms, scenario.seed, scenario.faults))
+              channel=ChannelModel.of(node, scenario))
     try:
         client = TickClient(build(bus, scenario))
         bus.watch_alive(client.on_liveness)

@@ -145,7 +145,7 @@ def scenario_of(archive: RunArchive) -> Scenario:
     """The scenario a run ran with, from its metadata (written by every run and campaign)."""
     text = archive.metadata.get("scenario", {}).get("resolved_json")
     if not text:
-        raise ArchiveError(f"{archive.path}: no scenario in the archive's metadata")
+        raise ArchiveError("no scenario in the archive's metadata")
     return Scenario.model_validate_json(text)
 
 
@@ -181,22 +181,26 @@ def replay_run(path: Path, settings: dict[str, str] | None = None,
     from the run's."""
     start = time.perf_counter()
     archive = load_run(path, stream={t.any_mission(): _drop for t in UNREAD})
-    run_scenario = scenario or scenario_of(archive)
+    replay_scenario = with_settings(scenario or scenario_of(archive), settings or {})
     mission = _mission_of(archive)
-    replay_scenario = with_settings(run_scenario, settings or {})
-    net = InprocNetwork()
-    bus = Bus(topics.GROUND, mission, net.endpoint(),
-              channel=ChannelModel(topics.GROUND, replay_scenario.comms, replay_scenario.seed,
-                                   replay_scenario.faults))
-    executive = ground_executive(bus, replay_scenario)
-    executive.barrier_timeout_s = 0.0  # everything the archive holds is delivered before a tick
-    TickClient(executive, synchronous=True)
-    replayed = GroundOutput()
-    net.endpoint().subscribe_samples(topics.node_prefix(mission, topics.GROUND) + "/**",
-                                     lambda s: replayed.add(s.message))
-    _play(archive.held(), net.endpoint(), topics.node_prefix(mission, topics.GROUND) + "/")
+    replayed = _run_ground(archive, mission, replay_scenario)
     return Replay(replay_scenario, GroundOutput.of_archive(archive, mission), replayed,
                   time.perf_counter() - start)
+
+
+def _run_ground(archive: RunArchive, mission: str, scenario: Scenario) -> GroundOutput:
+    """The ground station, built as a run builds it, fed the archive; what it published."""
+    net = InprocNetwork()
+    bus = Bus(topics.GROUND, mission, net.endpoint(),
+              channel=ChannelModel.of(topics.GROUND, scenario))
+    executive = ground_executive(bus, scenario)
+    executive.barrier_timeout_s = 0.0  # everything the archive holds is delivered before a tick
+    TickClient(executive, synchronous=True)
+    own = topics.node_prefix(mission, topics.GROUND)
+    out = GroundOutput()
+    net.endpoint().subscribe_samples(own + "/**", lambda s: out.add(s.message))
+    _play(archive.held(), net.endpoint(), own + "/")
+    return out
 
 
 def _drop(_rec: Record) -> None:
@@ -206,7 +210,7 @@ def _drop(_rec: Record) -> None:
 def _mission_of(archive: RunArchive) -> str:
     tick = next((k for k in archive.topics() if cat.topic_of(k) is cat.TICK), None)
     if tick is None:
-        raise ArchiveError(f"{archive.path}: no lockstep ticks archived, nothing to replay")
+        raise ArchiveError("no lockstep ticks archived, nothing to replay")
     return tick.split("/")[1]
 
 
