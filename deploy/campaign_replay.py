@@ -26,8 +26,9 @@ from pathlib import Path
 from typing import Any
 
 from ground.analysis.campaign_report import detector_figures, write_campaign_report
-from ground.archive.reader import ArchiveError, load_run
-from ground.fdir.replay import replay_run, scenario_of, with_settings
+from ground.archive.metadata import archived_scenario
+from ground.archive.reader import ArchiveError
+from ground.fdir.replay import replay_run, with_settings
 from interfaces.scenario import ScenarioError
 
 log = logging.getLogger("insp.campaign")
@@ -44,9 +45,8 @@ def replay_job(run_dir: str, settings: dict[str, str], dest_root: str) -> dict[s
     dest = Path(dest_root) / "runs" / src.name
     dest.mkdir(parents=True, exist_ok=True)
     summary = json.loads((src / "summary.json").read_text())
-    for extra in ("campaign.json",):
-        if (src / extra).exists():
-            shutil.copyfile(src / extra, dest / extra)
+    if (src / "campaign.json").exists():  # the run's group and software version
+        shutil.copyfile(src / "campaign.json", dest / "campaign.json")
     if summary.get("status") == "completed":
         try:
             replay = replay_run(src / "run.mcap", settings)
@@ -106,9 +106,10 @@ def rejudge(out: Path, settings: dict[str, str], dest: Path, workers: int = 1,
 
 
 def _check_settings(run_dir: Path, settings: dict[str, str]) -> None:
-    summary = json.loads((run_dir / "summary.json").read_text())
-    if summary.get("status") == "completed":
-        with_settings(scenario_of(load_run(run_dir / "run.mcap")), settings)
+    """Refuse bad settings before any work, against the run's own scenario (read from its
+    archive's metadata alone)."""
+    if json.loads((run_dir / "summary.json").read_text()).get("status") == "completed":
+        with_settings(archived_scenario(run_dir / "run.mcap"), settings)
 
 
 def sweep(out: Path, name: str, values: Sequence[str], dest: Path, base: dict[str, str],

@@ -10,7 +10,6 @@ report and judge there.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 TOLERANCE = 1e-6
@@ -33,7 +32,3 @@ class FdiSchedule:
         """The boundary j with j·P = ``t_s`` (within ``TOLERANCE`` of a period), else None."""
         j = round(t_s / self.period_s)
         return j if abs(t_s / self.period_s - j) <= TOLERANCE else None
-
-    def window_of(self, t_s: float) -> int:
-        """The window holding time ``t_s`` (a time at a boundary opens the next window)."""
-        return math.floor(t_s / self.period_s + TOLERANCE)

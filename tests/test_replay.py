@@ -13,7 +13,7 @@ import pytest
 
 from deploy.inproc import run_inproc
 from ground.analysis.summary import write_summary
-from ground.archive.metadata import run_metadata
+from ground.archive.metadata import archived_scenario, run_metadata
 from ground.archive.reader import ArchiveError, load_run
 from ground.archive.recorder import McapRecorder
 from ground.fdir.replay import UNREAD, GroundOutput, main, replay_run, with_settings
@@ -132,3 +132,6 @@ def test_command_line_writes_the_replay_and_refuses_an_archive_without_scenario(
     assert "no scenario" in capsys.readouterr().err
     with pytest.raises(ArchiveError, match="no scenario"):
         replay_run(bare)
+    with pytest.raises(ArchiveError, match="no scenario"):
+        archived_scenario(bare)
+    assert archived_scenario(out / "run.mcap") == _scenario()

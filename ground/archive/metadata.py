@@ -9,6 +9,10 @@ import subprocess
 import time
 from pathlib import Path
 
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+
+from ground.archive.reader import ArchiveError
 from interfaces.scenario import Scenario
 
 
@@ -39,3 +43,26 @@ def run_metadata(scenario: Scenario, transport: str,
                 "started_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())},
         "scenario": {"toml": scenario_toml, "resolved_json": scenario.model_dump_json()},
     }
+
+
+def scenario_from_metadata(metadata: dict[str, dict[str, str]],
+                           source: object | None = None) -> Scenario:
+    """The scenario a run ran with, from its ``scenario`` metadata record (every run and
+    campaign writes it).  Raises ArchiveError (prefixed with ``source``) when there is none."""
+    text = metadata.get("scenario", {}).get("resolved_json")
+    if not text:
+        prefix = "" if source is None else f"{source}: "
+        raise ArchiveError(f"{prefix}no scenario in the archive's metadata")
+    return Scenario.model_validate_json(text)
+
+
+def archived_scenario(path: str | Path) -> Scenario:
+    """The scenario of the archive at ``path``, read from its summary section alone (no
+    message is read).  Raises ArchiveError for an archive without a readable summary or
+    without a scenario."""
+    try:
+        with open(path, "rb") as f:
+            metadata = {m.name: dict(m.metadata) for m in make_reader(f).iter_metadata()}
+    except (OSError, McapError, ValueError) as e:
+        raise ArchiveError(f"{path}: metadata unreadable: {e}") from e
+    return scenario_from_metadata(metadata, path)

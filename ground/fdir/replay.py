@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from ground.analysis.summary import fdir_results
+from ground.archive.metadata import scenario_from_metadata
 from ground.archive.reader import ArchiveError, Record, RunArchive, load_run
 from ground.station import ground_executive
 from interfaces import catalogue as cat
@@ -49,8 +50,6 @@ from interfaces.transport import InprocNetwork, Sample
 SETTABLE = ("fdir.", "rates.fdi_period_s")
 """Settings a replay may change: the ground's detector only.  Anything else changes what the
 spacecraft flew, which only a new simulation can tell."""
-
-_GROUND_OUTPUTS = (cat.FDIR_WINDOW, cat.FAULT_REPORT, cat.BASELINE, cat.ASSIGNMENTS)
 
 UNREAD = (cat.CAMERA_IMAGE, cat.RELNAV, cat.ATTITUDE_SENSORS, cat.THRUST, cat.WHEELS,
           cat.POINTING, cat.TICK_DONE, cat.EXEC_STATS, cat.LINK_STATS, cat.DECISIONS,
@@ -76,11 +75,8 @@ class GroundOutput:
 
     @classmethod
     def of_archive(cls, archive: RunArchive, mission: str) -> GroundOutput:
-        out = cls()
-        for topic in _GROUND_OUTPUTS:
-            for msg in archive.of(topic, mission):
-                out.add(msg)
-        return out
+        return cls(archive.of(cat.FDIR_WINDOW, mission), archive.of(cat.FAULT_REPORT, mission),
+                   archive.of(cat.BASELINE, mission), archive.of(cat.ASSIGNMENTS, mission))
 
 
 @dataclass
@@ -143,10 +139,7 @@ def _same(a: list[Any], b: list[Any]) -> bool:
 
 def scenario_of(archive: RunArchive) -> Scenario:
     """The scenario a run ran with, from its metadata (written by every run and campaign)."""
-    text = archive.metadata.get("scenario", {}).get("resolved_json")
-    if not text:
-        raise ArchiveError("no scenario in the archive's metadata")
-    return Scenario.model_validate_json(text)
+    return scenario_from_metadata(archive.metadata)
 
 
 def with_settings(scenario: Scenario, settings: dict[str, str]) -> Scenario:
