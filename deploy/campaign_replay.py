@@ -33,7 +33,8 @@ from interfaces.scenario import ScenarioError
 
 log = logging.getLogger("insp.campaign")
 
-FDIR_FIELDS = ("detections", "scores", "baselines", "fdir_series", "fdir_settings")
+FDIR_FIELDS = ("detections", "scores", "baselines", "fdir_series", "fdir_thresholds",
+               "fdir_settings")
 """The fields of a run's summary.json that a replay rewrites."""
 
 

@@ -134,6 +134,8 @@ DECISIONS = Topic(Space.GROUND, "planner", "decisions", m.AssignmentDecision,
                   "information-driven orbit decisions with their gains")
 FDIR_WINDOW = Topic(Space.GROUND, "fdir", "window", m.FdirWindow, "one FDI window's evidence")
 FAULT_REPORT = Topic(Space.GROUND, "fdir", "report", m.FaultReport, "declared faults")
+CONSTELLATION_WINDOW = Topic(Space.GROUND, "fdir", "constellation", m.ConstellationWindow,
+                             "the global check (Eq. 6) of one FDI window")
 BASELINE = Topic(Space.GROUND, "fdir", "baseline", m.BaselineVerdict, "baseline detectors")
 TLM_STATUS = Topic(Space.GROUND, "tlm", "status", m.TelemetryStatus, "telemetry freshness")
 
@@ -142,7 +144,8 @@ ALL: tuple[Topic[m.Message], ...] = (
     THRUST, WHEELS, NAV_ESTIMATE, ATTITUDE_ESTIMATE, OBSERVATIONS, POINTING, TRANSFER_PLAN,
     GUIDANCE_STATUS, INFO_COST,
     TICK_DONE, HEARTBEAT, EXEC_STATS, LINK_STATS,
-    ASSIGNMENTS, DECISIONS, FDIR_WINDOW, FAULT_REPORT, BASELINE, TLM_STATUS,
+    ASSIGNMENTS, DECISIONS, FDIR_WINDOW, FAULT_REPORT, CONSTELLATION_WINDOW, BASELINE,
+    TLM_STATUS,
 )
 
 

@@ -254,9 +254,9 @@ class ProAssignments(Message):
 class FaultEvent(Message):
     """Truth of an injected fault (sim): ``kind`` on ``spacecraft`` switched on or off at
     ``t_sim``, with the scenario's ``magnitude`` and the realised parameters (``detail``:
-    directions, torques, rotations; see sim/faults.py)."""
+    directions, torques, rotations; see sim/faults.py); spacecraft 0: every observer."""
 
-    spacecraft: int = Field(ge=1)
+    spacecraft: int = Field(ge=0)
     kind: str = Field(max_length=64)
     active: bool
     magnitude: float | None = None
@@ -286,6 +286,41 @@ class FdirWindow(Message):
     direction: Literal["improved", "degraded"] | None = None
     exceeded: bool | None = None
     evidence: dict[str, float] = Field(default_factory=dict, max_length=32)
+    threshold_model: float | None = Field(
+        default=None, description="τ from the hardware's nominal ratio distribution "
+                                  "(ground/fdir/hardware_threshold.py)")
+    threshold_sampled: float | None = Field(
+        default=None, description="τ of Eq. 11-12 (ε-sampled pointings), before the floor")
+    threshold_by: Literal["model", "sampled", "floor"] | None = Field(
+        default=None, description="what set the threshold in force: the selected threshold, "
+                                  "or the floor guard above it")
+    ratio_mean: float | None = Field(default=None, description="nominal mean of ΔH_i/ΔH_i^pred")
+    ratio_std: float | None = Field(default=None, description="nominal 1σ of ΔH_i/ΔH_i^pred")
+    failed: list[Literal["information", "plan", "pointing", "dv_rate"]] = Field(
+        default_factory=list, max_length=4,
+        description="the detector's tests this window failed (ground/fdir/consistency.py)")
+
+
+class ConstellationWindow(Message):
+    """The global check (Eq. 6) over one FDI window (ground/fdir/constellation.py): the
+    constellation ratio ΣΔH_i / ΣΔH_i^pred of the judged observers, its nominal mean and 1σ,
+    the threshold, whether it was exceeded, the observer that alone explains an excess (None:
+    none does, or not exceeded) and whether the excess is common mode; the ground's cost H at
+    the window's start (Eq. 4) and the running shortfall Σ(ΔH^pred − ΔH) (Eq. 6's H − H_nom to
+    first order).  None where fewer than three observers were judged."""
+
+    t_start_s: float
+    t_end_s: float
+    observers: int = Field(ge=0)
+    ratio: float | None = None
+    ratio_mean: float | None = None
+    ratio_std: float | None = None
+    threshold: float | None = None
+    exceeded: bool | None = None
+    explained_by: int | None = None
+    common_mode: bool | None = None
+    cost: float
+    shortfall: float
 
 
 class FaultReport(Message):
@@ -293,8 +328,9 @@ class FaultReport(Message):
     identified), the direction, the metric and threshold of the window that declared it, and
     the evidence behind the class."""
 
-    spacecraft: int = Field(ge=1)
-    fault_class: Literal["actuator", "camera", "state_sensor", "link", "data_integrity"] | None
+    spacecraft: int = Field(ge=0, description="the faulty observer; 0: the constellation")
+    fault_class: Literal["actuator", "camera", "state_sensor", "link", "data_integrity",
+                         "common_mode"] | None
     direction: Literal["improved", "degraded"] | None = None
     metric: float | None = None
     threshold: float | None = None
@@ -502,6 +538,7 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     FaultEvent,
     FdirWindow,
     FaultReport,
+    ConstellationWindow,
     BaselineVerdict,
     TransferPlanMsg,
     GuidanceStatus,

@@ -24,7 +24,12 @@ FaultKind = Literal[
     "link_loss",
     "packet_loss",
     "faulty_data",
+    "camera_calibration",
 ]
+COMMON_MODE_KINDS = frozenset({"camera_calibration"})
+"""Fault kinds that act on every observer at once (``spacecraft = 0``): a camera calibration
+error (the true variance coefficient is k / ``magnitude``: every precision scaled by it) that no
+single observer explains."""
 
 
 class _Section(BaseModel):
@@ -53,7 +58,18 @@ class CameraSettings(_Section):
     """The observers' inspection cameras: σ = k·dist² (Eq. 5) within a conical field of view.
     With the defaults (k = 1, the paper's Eq. 22 value, and w = 1) an image at 20 m adds
     1/400 of the prior's information, so one image a second takes the cost down over an orbit
-    or two rather than in minutes."""
+    or two rather than in minutes.
+
+    What an image measures (sim/camera.py): for every POI visible from the camera's TRUE pose
+    (inside the cone, within ``max_range_m``, on the side facing the camera) a precision
+    σ⁻¹ = β / (k d²) × max(0, 1 + ν ε), with d the TRUE camera-POI distance, β the camera's
+    health (1 nominal; < 1 under ``camera_degradation`` or, on every camera at once,
+    ``camera_calibration``), ν = ``noise_frac`` and ε ~ N(0, 1) independent per POI and image.
+    There is no bias: a nominal camera's precisions are right on average (E[max(0, 1 + ν ε)]
+    exceeds 1 by under 0.5% for ν ≤ 0.5), and a systematic error is a fault kind.  Because d is
+    the true distance, each image pins the true camera position (``ground/fdir/identify.py``
+    locates it to ≈0.25 m at ν = 5%); the ground's hardware threshold and identification take ν
+    from this section."""
 
     half_angle_deg: float = Field(default=20.0, gt=0.0, lt=90.0)
     max_range_m: float = Field(default=200.0, gt=0.0)
@@ -328,34 +344,65 @@ class Nav(_Section):
 class FdirSettings(_Section):
     """The ground FDIR (ground/apps/fdir.py, DESIGN.md "Information cost and FDIR"): every
     FDI window (``rates.fdi_period_s``) each observer's information gain is compared with the
-    nominal twin's prediction (Eq. 9) against the adaptive threshold (Eq. 11-12) from
-    ``samples`` pointings within ``eps_deg`` of the planned one, floored at ``floor``; a fault
-    is declared after ``persistence`` windows in a row over the threshold (or, with
-    ``persistence_window`` = n, on the window that brings the exceedances among the last n
-    decided windows to ``persistence``), and an observer whose observations stay missing for
-    ``silent_windows`` windows is reported as a link fault.
+    nominal twin's prediction (Eq. 9).  The threshold in force (``threshold``) is by default
+    the hardware model's (ground/fdir/hardware_threshold.py): the quantile, for
+    ``false_alarms_per_observer_hour``, of the ratio's distribution under no fault given the
+    camera's noise (``[camera] noise_frac``), the station-keeping accuracy (``track_sigma_m``,
+    ``transfer_sigma_m``) plus the nav's reported 1σ, and the pointing jitter
+    (``pointing_jitter_deg``) plus the reported attitude knowledge, propagated through the twin
+    with ``model_samples`` pose draws; or Eq. 11-12's (``samples`` pointings within
+    ``eps_deg``).  Both are computed and archived every window; ``floor`` is a guard under the
+    one in force.  With ``fuse_guidance`` a window also fails on the nav-vs-plan, pointing and
+    Δv-rate tests (ground/fdir/consistency.py: ``position_tol_m``, ``pointing_tol_deg``,
+    ``dv_rate_tol_mps2``).  A fault is declared after ``persistence`` failed windows in a row
+    (or, with ``persistence_window`` = n, on the window that brings the failures among the last
+    n decided windows to ``persistence``); the constellation's ratio (the global check, Eq. 6)
+    declares a fault no single observer explains; an observer whose observations stay missing
+    for ``silent_windows`` windows is reported as a link fault.
     A reported H_i off the ground's recomputation from the observer's own observations by more
-    than ``integrity_tol`` (relative) for ``persistence`` windows is a data-integrity fault,
-    and more of its observations lost (sequence gaps) than the links' nominal
+    than ``integrity_tol`` (relative) for ``checks_persistence`` windows is a data-integrity
+    fault, and more of its observations lost (sequence gaps) than the links' nominal
     ``comms.packet_loss`` plus ``loss_tol`` (and the window's sampling spread) for
-    ``persistence`` windows a link fault.  A window is evaluated ``latency_s`` after it closes
-    (its last images must have arrived).  A declared performance fault is identified
-    (ground/fdir/identify.py)
+    ``checks_persistence`` windows a link fault.  A window is evaluated ``latency_s`` after it
+    closes (its last images must have arrived).  A declared performance fault is identified
+    (ground/fdir/identify.py), on its window or the next,
     against the nominal bounds ``beta_tol`` (camera health located from the images),
     ``position_tol_m`` (camera from the images vs nav, nav vs plan), ``pointing_tol_deg``
     (reported pointing error), ``overlap_tol`` (seen vs expected POIs), ``explained_min``
     (share of the ΔH gap the reported pose must explain) and ``dv_rate_tol_mps2`` (Δv the
     observer commands while holding its PRO, per second)."""
 
+    threshold: Literal["hardware", "sampled"] = Field(
+        default="hardware",
+        description="the threshold that decides: the quantile of the hardware's nominal ratio "
+                    "distribution, or Eq. 11-12's ε-sampling (both are computed and archived)")
+    false_alarms_per_observer_hour: float = Field(
+        default=0.01, gt=0.0, le=100.0,
+        description="false-alarm budget of the hardware threshold, per observer-hour")
+    track_sigma_m: float = Field(default=0.05, gt=0.0,
+                                 description="station-keeping accuracy on a PRO, 1σ per axis, m")
+    transfer_sigma_m: float = Field(default=0.15, gt=0.0,
+                                    description="tracking accuracy on a transfer, 1σ per axis, m")
+    pointing_jitter_deg: float = Field(default=0.03, gt=0.0, lt=45.0,
+                                       description="attitude loop tracking error, 1σ per axis")
+    model_samples: int = Field(default=16, ge=2, le=1000,
+                               description="pose draws of the hardware threshold per window")
+    fuse_guidance: bool = Field(
+        default=True, description="the detector also fails a window on its nav-vs-plan, "
+                                  "pointing and Δv-rate tests (ground/fdir/consistency.py)")
     samples: int = Field(default=10, ge=1, le=1000)
     eps_deg: float = Field(default=1.0, gt=0.0, lt=45.0)
-    floor: float = Field(default=0.05, ge=0.0)
-    persistence: int = Field(default=2, ge=1)
+    floor: float = Field(default=0.002, ge=0.0,
+                         description="guard under the selected threshold")
+    persistence: int = Field(default=1, ge=1)
     persistence_window: int | None = Field(
         default=None, ge=1,
         description="main detector: declare on ``persistence`` exceedances among the last this "
                     "many windows (None: ``persistence`` in a row); the campaign report "
                     "re-scores its runs under such rules")
+    checks_persistence: int = Field(
+        default=2, ge=1, description="failed windows in a row that declare a data-integrity or "
+                                     "packet-loss link fault")
     silent_windows: int = Field(default=2, ge=1)
     latency_s: float = Field(default=3.0, ge=0.0)
     settle_s: float = Field(default=30.0, ge=0.0,
@@ -409,7 +456,7 @@ class SimSettings(_Section):
 
 
 class Fault(_Section):
-    spacecraft: int = Field(ge=1)
+    spacecraft: int = Field(ge=0, description="the faulty observer; 0 for a common-mode kind")
     kind: FaultKind
     start_s: float = Field(ge=0.0)
     end_s: float | None = None
@@ -419,11 +466,16 @@ class Fault(_Section):
     def _magnitude(self) -> Fault:
         if self.end_s is not None and self.end_s <= self.start_s:
             raise ValueError("fault end_s must be after start_s")
+        if (self.spacecraft == 0) != (self.kind in COMMON_MODE_KINDS):
+            raise ValueError(f"fault kind {self.kind!r} acts on "
+                             + ("every observer: give spacecraft = 0"
+                                if self.kind in COMMON_MODE_KINDS else "one observer (>= 1)"))
         if self.kind == "link_loss":
             return self
         if self.magnitude is None:
             raise ValueError(f"fault kind {self.kind!r} needs a magnitude")
-        if self.kind in ("camera_degradation", "packet_loss") and not 0.0 < self.magnitude < 1.0:
+        if (self.kind in ("camera_degradation", "packet_loss", "camera_calibration")
+                and not 0.0 < self.magnitude < 1.0):
             raise ValueError(f"{self.kind} magnitude must be in (0, 1), got {self.magnitude}")
         return self
 

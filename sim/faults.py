@@ -16,6 +16,9 @@ The sim's kinds act on the truth, as a failing unit would:
   axis perpendicular to it, drawn from the seed; the attitude loop does not know.
 * ``nav_sensor_bias``: the relative-navigation position measurement offset by ``magnitude`` m in
   an LVLH direction drawn from the seed.
+* ``camera_calibration`` (common mode, ``spacecraft = 0``): every observer's precisions scaled
+  by ``magnitude``, as if the true variance coefficient were k / ``magnitude`` while the ground
+  models k: no single observer explains it.
 
 The link kinds (``link_loss``, ``packet_loss``) act in every node's channel model
 (``interfaces.channel``) and ``faulty_data`` in the faulty spacecraft's software
@@ -40,7 +43,7 @@ from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
 
 SIM_KINDS = frozenset({"thruster_bias", "pointing_actuator", "camera_degradation",
-                       "camera_misalignment", "nav_sensor_bias"})
+                       "camera_misalignment", "nav_sensor_bias", "camera_calibration"})
 
 
 @dataclass(frozen=True)
@@ -142,6 +145,8 @@ class FaultInjector:
             self.hardware.wheels.torque_bias_nm = bias
         elif f.kind == "camera_degradation":
             self.cameras.beta[i] = float(f.magnitude or 1.0) if on else 1.0
+        elif f.kind == "camera_calibration":
+            self.cameras.beta[:] = float(f.magnitude or 1.0) if on else 1.0
         elif f.kind == "camera_misalignment":
             self.cameras.misalignment[i] = np.array(d["rotation_xyzw"]) if on \
                 else np.array([0.0, 0.0, 0.0, 1.0])

@@ -72,20 +72,22 @@ def test_report_figures(campaign: Path) -> None:
     assert "3 of 4 runs finished (0 failed;" in report
     assert "Software: unknown (3 runs)." in report  # no version in these campaign.json
     assert "median 60 s, max 60 s, 0.05 worker-hours in all." in report
-    assert "| main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 (1/4) |" in report
+    assert "| main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 (1/4; 95% ≤ " \
+        "0.75) |" in report
     assert "| cusum | 100% (1/1) | 100% (1/1) | - | 100 / 100 / 100 |" in report
-    assert "| camera_degradation (→ camera) | 0 | 1 | 0 | 0 | 0 | 0 |" in report
-    assert "| thruster_bias (→ actuator) | 0 | 0 | 0 | 0 | 0 | 1 |" in report
+    assert "| camera_degradation (→ camera) | 0 | 1 | 0 | 0 | 0 | 0 | 0 |" in report
+    assert "| thruster_bias (→ actuator) | 0 | 0 | 0 | 0 | 0 | 0 | 1 |" in report
     # per campaign group: a and b form "faulty" (its nominal cycles are a's sc1); c, with no
     # campaign.json, is its own group by its id
     assert "| faulty | main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | " \
-        "0.0000 (0/2) |" in report
-    assert "| c | main | - | - | - | - / - / - | 0.5000 (1/2) |" in report
+        "0.0000 (0/2; 95% ≤ 0.78) |" in report
+    assert "| c | main | - | - | - | - / - / - | 0.5000 (1/2; 95% ≤ 0.97) |" in report
     # persistence re-scored: one window in a row declares run a's fault at 100 s, three never
     # do (it has two windows), and c's false alarm needs only two
-    assert "| 1 of 1 | 50% (1/2) | 50% (1/2) | 100 / 100 / 100 | 0.2500 (1/4) |" in report
-    assert "| 2 of 2 (as run) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 (1/4) |" in report
-    assert "| 3 of 3 | 0% (0/2) | 0% (0/2) | - / - / - | 0.0000 (0/4) |" in report
+    fa = "0.2500 (1/4; 95% ≤ 0.75) |"
+    assert "| 1 of 1 | 50% (1/2) | 50% (1/2) | 100 / 100 / 100 | " + fa in report
+    assert "| 2 of 2 (as run) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | " + fa in report
+    assert "| 3 of 3 | 0% (0/2) | 0% (0/2) | - / - / - | 0.0000 (0/4; 95% ≤ 0.53) |" in report
     # margins H_m/τ by the fault active in the window: a's sc1 and c's windows are nominal
     assert "| nominal | 4 | 0.7 | 1.39 | 1.4 | 50% (2/4) |" in report
     assert "| camera_degradation | 2 | 10 | 10 | 10 | 100% (2/2) |" in report

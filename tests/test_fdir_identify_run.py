@@ -39,7 +39,9 @@ def test_each_fault_identified_on_its_spacecraft(run: Run) -> None:
     assert first[1].fault_class == "actuator"
     assert first[1].evidence["pointing_error_deg"] == pytest.approx(5.0, abs=0.5)
     assert first[2].fault_class == "state_sensor"
-    assert first[2].evidence["camera_vs_nav_m"] == pytest.approx(3.0, abs=0.6)
+    # declared while the nav still absorbs the 3 m bias step: the camera is off the nav by
+    # more than the tolerance (0.5 m) and by at most the bias
+    assert 1.0 < first[2].evidence["camera_vs_nav_m"] < 3.6
     assert first[3].fault_class == "link"
     assert first[3].metric == pytest.approx(0.5, abs=0.15)  # the lost share of observations
     assert all(r.fault_class == "link" for r in reports if r.spacecraft == 3)

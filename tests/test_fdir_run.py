@@ -5,6 +5,7 @@ that reports a corrupted H_i as a data-integrity fault."""
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import pytest
@@ -83,7 +84,8 @@ def test_report_plots_metric_against_threshold(fdir_run: Run,
     assert f"False alarms: 0 in {summary['scores']['nominal_cycles']} nominal" in report
     assert "| camera_degradation, faulty_data, link_loss | H_m,i > 0, i = 1, 2, 3 |" in report
     assert "| chi2_nis |" in report and "| cusum |" in report and "| fixed_threshold |" in report
-    assert "| camera |" in report and "beta_hat 0.5" in report  # the class and its evidence
+    assert "| camera |" in report  # the class and its evidence, β located at 0.5 ± 0.04
+    assert re.search(r"beta_hat 0\.(4[6-9]|5[0-4])", report)
 
 
 def test_camera_fault_identified(fdir_run: Run) -> None:

@@ -130,3 +130,21 @@ def test_pointing_actuator_fault_leaves_the_stated_steady_error(degrees: float) 
     error_deg = math.degrees(math.acos(min(1.0, boresight[2])))
     assert error_deg == pytest.approx(degrees, rel=0.02)
     assert np.linalg.norm(truth.w[0]) < 1e-5  # settled, not drifting
+
+
+def test_common_mode_calibration_fault_scales_every_camera() -> None:
+    sc = _scenario({"spacecraft": 0, "kind": "camera_calibration", "start_s": 5.0,
+                    "end_s": 9.0, "magnitude": 0.7})
+    inj = _injector(sc)
+    assert inj.update(0.0) == [] and inj.cameras.beta.tolist() == [1.0, 1.0]
+    (on,) = inj.update(5.0)
+    assert on.active and inj.cameras.beta.tolist() == [0.7, 0.7]
+    inj.update(9.0)
+    assert inj.cameras.beta.tolist() == [1.0, 1.0]
+
+
+@pytest.mark.parametrize("spacecraft, kind", [(0, "camera_degradation"),
+                                              (1, "camera_calibration")])
+def test_common_mode_kinds_and_spacecraft_zero_go_together(spacecraft: int, kind: str) -> None:
+    with pytest.raises(ValueError, match="observer"):
+        _scenario({"spacecraft": spacecraft, "kind": kind, "start_s": 0.0, "magnitude": 0.5})

@@ -31,12 +31,13 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from scipy.stats import beta  # noqa: E402
 
 from ground.analysis.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
 from ground.fdir.threshold import Persistence  # noqa: E402
 from interfaces.scenario import Fault  # noqa: E402
 
-CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", None)
+CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", "common_mode", None)
 SCALES = np.geomspace(0.1, 10.0, 41)
 """Threshold scales of the ROC sweep."""
 
@@ -99,13 +100,15 @@ def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
                              "detected": f["detected"], "isolated": f["isolated"],
                              "latency_s": f["latency_s"],
                              "identified_class": f["identified_class"] if name == "main" else None,
+                             "identification_latency_s": f.get("identification_latency_s")
+                             if name == "main" else None,
                              "expected_class": f["expected_class"]})
     return rows
 
 
-def _latency(faults: Sequence[dict[str, Any]]) -> str:
-    """"median / p90 / max" of the latency of the isolated faults, s."""
-    lat = [f["latency_s"] for f in faults if f["isolated"] and f["latency_s"] is not None]
+def _latency(faults: Sequence[dict[str, Any]], key: str = "latency_s") -> str:
+    """"median / p90 / max" of the latency of the isolated faults (or ``key``), s."""
+    lat = [f[key] for f in faults if f["isolated"] and f.get(key) is not None]
     if not lat:
         return "- / - / -"
     return f"{np.median(lat):.0f} / {np.quantile(lat, 0.9):.0f} / {max(lat):.0f}"
@@ -121,6 +124,9 @@ def _stats(rows: list[dict[str, Any]], hours: float) -> dict[str, Any]:
         "isolated": sum(r["isolated"] for r in faults),
         "identified": sum(r.get("identified_class") == r["expected_class"] for r in faults),
         "latency": _latency(faults),
+        "identification_latency": _latency(
+            [f for f in faults if f.get("identified_class") == f["expected_class"]],
+            "identification_latency_s"),
         "false_alarms": fa, "nominal_cycles": cycles,
         "false_alarms_per_hour": fa / hours if hours > 0 else None,
     }
@@ -168,8 +174,20 @@ def _cells(detector: str, st: dict[str, Any]) -> str:
 
 
 def _rate(false_alarms: int, cycles: int) -> str:
-    """False alarms per nominal cycle, with the counts it comes from."""
-    return "-" if cycles == 0 else f"{false_alarms / cycles:.4f} ({false_alarms}/{cycles})"
+    """False alarms per nominal cycle, with the counts it comes from and its one-sided 95%
+    upper confidence bound (Clopper-Pearson)."""
+    if cycles == 0:
+        return "-"
+    return (f"{false_alarms / cycles:.4f} ({false_alarms}/{cycles}; 95% ≤ "
+            f"{false_alarm_bound(false_alarms, cycles):.2g})")
+
+
+def false_alarm_bound(false_alarms: int, cycles: int, confidence: float = 0.95) -> float:
+    """One-sided upper confidence bound of a per-cycle false-alarm probability from
+    ``false_alarms`` in ``cycles`` (Clopper-Pearson: the beta quantile; 3/n for none)."""
+    if false_alarms >= cycles:
+        return 1.0
+    return float(beta.ppf(confidence, false_alarms + 1, cycles - false_alarms))
 
 
 def _fmt(v: float | None, f: str = ".0f") -> str:
@@ -184,9 +202,9 @@ def _fault_in(window: list[float], faults: list[dict[str, Any]]) -> str | None:
     """The kind of an injected fault active on the window's spacecraft during the window
     [sc, t0, t1, ...], or None (a nominal window)."""
     sc, t0, t1 = window[0], window[1], window[2]
-    for f in faults:
-        if f["spacecraft"] == sc and f["start_s"] < t1 and (f.get("end_s") is None
-                                                            or t0 < f["end_s"]):
+    for f in faults:  # spacecraft 0: a common-mode fault, on every observer
+        if f["spacecraft"] in (0, sc) and f["start_s"] < t1 and (f.get("end_s") is None
+                                                                 or t0 < f["end_s"]):
             return str(f["kind"])
     return None
 
@@ -310,7 +328,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     rows = _rows(runs)
     fields = ["run", "group", "seed", "status", "detector", "kind", "spacecraft", "start_s",
               "magnitude", "detected", "isolated", "latency_s", "identified_class",
-              "expected_class", "false_alarms", "nominal_cycles"]
+              "identification_latency_s", "expected_class", "false_alarms", "nominal_cycles"]
     with open(out / "results.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
@@ -355,7 +373,12 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
                          f"{_pct(st['detected'], st['faults'])} | "
                          f"{st['faults'] - st['detected']} | "
                          f"{_pct(st['isolated'], st['faults'])} | {st['latency']} |")
-    lines += ["", "## Identification (main detector)", "", "![confusion](confusion.png)", ""]
+    main_stats = _stats([r for r in rows if r["detector"] == "main"], hours["main"])
+    lines += ["", "## Identification (main detector)", "",
+              "Identification may come a window after detection: latency from onset to the "
+              f"first report naming the right class, median / p90 / max: "
+              f"{main_stats['identification_latency']} s.", "",
+              "![confusion](confusion.png)", ""]
     lines += _confusion(out, [r for r in rows if r["detector"] == "main" and r["kind"] != "none"])
     lines += ["", "## Latency", "", "![latency](latency.png)", "",
               "## ROC (threshold scale swept, each detector with its persistence)", "",
@@ -364,6 +387,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
               "A fault is declared on the window that brings the exceedances among the last n "
               "windows to m; the threshold as configured.", ""]
     lines += _persistence_table(runs)
+    lines += _threshold_lines(runs)
     margins = _margins(runs)
     lines += ["", "## Margins (main detector, H_m,i / τ_i per window)", "",
               "![margins](margins.png)", ""] + _margin_lines(margins)
@@ -510,3 +534,31 @@ def _margin_plot(out: Path, margins: dict[str, np.ndarray]) -> None:
     fig.tight_layout()
     fig.savefig(out / "margins.png", dpi=100)
     plt.close(fig)
+
+
+def _threshold_lines(runs: list[dict[str, Any]]) -> list[str]:
+    """What decided the main detector's nominal windows, summed over the runs'
+    ``fdir_thresholds`` (summary.json): which threshold was in force, how often the hardware
+    model's and Eq. 11-12's thresholds lay above the floor guard, which tests failed, and how
+    the nominal ratios sat in the hardware model's distribution."""
+    census = [s["fdir_thresholds"] for s in runs if "fdir_thresholds" in s]
+    if not census:
+        return []
+    n = sum(c["nominal_windows"] for c in census)
+
+    def total(section: str, key: str) -> int:
+        return sum(c[section][key] for c in census)
+
+    by = ", ".join(f"{k} {_pct(total('threshold_by', k), n)}"
+                   for k in ("model", "sampled", "floor"))
+    above = sum(c["model_above_floor"] for c in census)
+    sampled = sum(c["sampled_above_floor"] for c in census)
+    failed = ", ".join(f"{k} {total('failed', k)}"
+                       for k in ("information", "plan", "pointing", "dv_rate"))
+    zn = total("model_z", "windows")
+    z = ", ".join(f"|z| > {k}: {_pct(total('model_z', f'over_{k}'), zn)}" for k in (2, 3, 4))
+    return ["", "## Thresholds (main detector, nominal windows)", "",
+            f"{n} nominal windows decided.  Threshold in force: {by}.  The hardware model's "
+            f"threshold above the floor guard in {_pct(above, n)}; Eq. 11-12's sampled "
+            f"threshold in {_pct(sampled, n)}.  Tests failed: {failed}.  Nominal ratios in "
+            f"the hardware model (z = (x − μ)/σ; a Gaussian has 4.6%, 0.27%, 0.006%): {z}."]

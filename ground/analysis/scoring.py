@@ -6,8 +6,10 @@ Definitions (one run):
 * A fault is *detected* when any alarm is raised at or after its onset and before it ends
   (plus ``grace_s``, one FDI window by default: a window closing after the end still holds
   faulty data); its *latency* is the time from onset to the first such alarm.
-* It is *isolated* when such an alarm names its spacecraft; ``latency_s`` is then measured to
-  the first alarm on that spacecraft, and ``identified_class`` is that alarm's class.
+* It is *isolated* when such an alarm names its spacecraft (0 for a common-mode fault: the
+  constellation); ``latency_s`` is then measured to the first alarm on that spacecraft, and
+  ``identified_class`` is the class of the first such alarm that names one (the detector may
+  identify a window after it detects), at ``identification_latency_s`` from onset.
 * A *false alarm* is an alarm on a spacecraft with no fault active at its time (within the
   same grace).  ``nominal_cycles`` counts the FDI windows judged (a decision was possible) that
   do not overlap a fault of their spacecraft; ``false_alarm_rate`` is false alarms per nominal
@@ -25,7 +27,7 @@ EXPECTED_CLASS = {
     "thruster_bias": "actuator", "pointing_actuator": "actuator",
     "camera_degradation": "camera", "camera_misalignment": "camera",
     "nav_sensor_bias": "state_sensor", "link_loss": "link", "packet_loss": "link",
-    "faulty_data": "data_integrity",
+    "faulty_data": "data_integrity", "camera_calibration": "common_mode",
 }
 """The class each fault kind should be identified as (DESIGN.md)."""
 
@@ -52,6 +54,14 @@ def _active(f: Fault, t: float, grace_s: float) -> bool:
     return f.start_s <= t and (f.end_s is None or t <= f.end_s + grace_s)
 
 
+def overlaps_fault(faults: Sequence[Fault], spacecraft: int, t_start_s: float,
+                   t_end_s: float) -> bool:
+    """Whether a fault of ``spacecraft`` (or a common-mode one, spacecraft 0) overlaps the
+    window [t_start_s, t_end_s)."""
+    return any(f.spacecraft in (0, spacecraft) and f.start_s < t_end_s
+               and (f.end_s is None or t_start_s < f.end_s) for f in faults)
+
+
 def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Judged],
           grace_s: float) -> dict[str, object]:
     """The ``scores`` section: ``per_fault`` (in scenario order) and the false-alarm figures."""
@@ -60,21 +70,22 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
         during = sorted((a for a in alarms if _active(f, a.t_s, grace_s)), key=lambda a: a.t_s)
         on_it = [a for a in during if a.spacecraft == f.spacecraft]
         first = on_it[0] if on_it else (during[0] if during else None)
-        identified = on_it[0].fault_class if on_it else None
+        classed = [a for a in on_it if a.fault_class is not None]
+        identified = classed[0].fault_class if classed else None
         per_fault.append({
             "spacecraft": f.spacecraft, "kind": f.kind, "start_s": f.start_s,
             "detected": bool(during), "isolated": bool(on_it),
             "latency_s": None if first is None else first.t_s - f.start_s,
             "identified_class": identified, "expected_class": EXPECTED_CLASS[f.kind],
             "identified_correctly": identified == EXPECTED_CLASS[f.kind],
+            "identification_latency_s": classed[0].t_s - f.start_s if classed else None,
         })
 
-    def faulty(sc: int, t: float) -> bool:
-        return any(f.spacecraft == sc and _active(f, t, grace_s) for f in faults)
+    def faulty(sc: int, t: float) -> bool:  # a common-mode fault (0) acts on every observer
+        return any(f.spacecraft in (0, sc) and _active(f, t, grace_s) for f in faults)
 
     def overlaps(j: Judged) -> bool:
-        return any(f.spacecraft == j.spacecraft and f.start_s < j.t_end_s
-                   and (f.end_s is None or j.t_start_s < f.end_s) for f in faults)
+        return overlaps_fault(faults, j.spacecraft, j.t_start_s, j.t_end_s)
 
     false_alarms = [a for a in alarms if not faulty(a.spacecraft, a.t_s)]
     nominal = [j for j in judged if not overlaps(j)]

@@ -9,7 +9,7 @@ from typing import Any, TypeVar
 
 from ground.analysis.coverage import coverage_summary
 from ground.analysis.digest import RunDigest, digest_run
-from ground.analysis.scoring import Alarm, Judged, score
+from ground.analysis.scoring import Alarm, Judged, overlaps_fault, score
 from ground.analysis.gnc import gnc_summary
 from ground.archive.reader import ArchiveError, RunArchive
 from interfaces import catalogue as cat
@@ -84,8 +84,32 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
         "scores": score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
         "baselines": baseline_scores(verdicts, scenario),
         "fdir_series": _series(windows, verdicts),
+        "fdir_thresholds": threshold_census(windows, scenario),
         "fdir_settings": {"fdi_period_s": scenario.rates.fdi_period_s,
                           **scenario.fdir.model_dump()},
+    }
+
+
+def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> dict[str, Any]:
+    """``fdir_thresholds``: over the nominal windows the main detector decided (no fault of
+    their spacecraft overlapping), what set the threshold in force (the hardware model, Eq.
+    11-12's sampling, or the floor guard), how often each threshold lay above the floor, and
+    which tests failed; with the nominal standardised ratios (x − μ)/σ of the hardware model
+    beyond 2, 3 and 4."""
+    floor = scenario.fdir.floor
+    nominal = [w for w in windows if w.exceeded is not None
+               and not overlaps_fault(scenario.faults, w.spacecraft, w.t_start_s, w.t_end_s)]
+    z = [abs((w.dh / w.dh_pred - w.ratio_mean) / w.ratio_std) for w in nominal
+         if w.dh is not None and w.dh_pred and w.ratio_mean is not None and w.ratio_std]
+    return {
+        "nominal_windows": len(nominal),
+        "threshold_by": {k: sum(w.threshold_by == k for w in nominal)
+                         for k in ("model", "sampled", "floor")},
+        "model_above_floor": sum((w.threshold_model or 0.0) > floor for w in nominal),
+        "sampled_above_floor": sum((w.threshold_sampled or 0.0) > floor for w in nominal),
+        "failed": {k: sum(k in w.failed for w in nominal)
+                   for k in ("information", "plan", "pointing", "dv_rate")},
+        "model_z": {f"over_{k}": sum(v > k for v in z) for k in (2, 3, 4)} | {"windows": len(z)},
     }
 
 

@@ -53,7 +53,7 @@ class MissionPlanner(App):
             self.map.add(msg.spacecraft, *msg.arrays())
 
     def on_fault(self, msg: FaultReport) -> None:
-        if self.ctx.scenario.fdir.recovery:
+        if self.ctx.scenario.fdir.recovery and msg.spacecraft >= 1:  # 0: the constellation's
             self._faults.append(msg)
 
     def step(self, t: float) -> None:

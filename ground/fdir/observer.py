@@ -62,8 +62,11 @@ class ObserverState:
     modes: list[tuple[float, str]] = field(default_factory=list)
     nav: TimeSeries = field(default_factory=TimeSeries)
     """reported position (nav estimate), LVLH m"""
+    nav_sigma: TimeSeries = field(default_factory=TimeSeries)
+    """the nav's reported position 1σ per axis, √(tr P_rr / 3), m"""
     attitude: TimeSeries = field(default_factory=TimeSeries)
-    """reported camera boresight (LVLH, 3), pointing error (rad) and aim point (LVLH, 3, m)"""
+    """reported camera boresight (LVLH, 3), pointing error (rad), aim point (LVLH, 3, m) and
+    attitude knowledge 1σ (rad)"""
     guidance: list[tuple[float, float, bool]] = field(default_factory=list)
     """reported (time s, Δv commanded so far m/s, holding its PRO), in time order"""
     silent: int = 0
@@ -113,6 +116,27 @@ class ObserverState:
         """Drop guidance reports no later window needs (keep the last one before t)."""
         i = bisect.bisect_left(self.guidance, (t,)) - 1
         del self.guidance[:max(i, 0)]
+
+    def planned(self, n: float, times: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """Planned positions (K, 3) at the image ``times`` (K,), whether each falls on a
+        transfer, and whether the plan knows the path there (``FlightPlan.known``), every time
+        under the plan in force at it (a window may straddle a departure; a plan is in force
+        from ``FlightPlan.starts_s``); None when a time precedes every plan."""
+        plans = sorted(self.plans.values(), key=lambda p: p.starts_s)
+        starts = np.array([p.starts_s for p in plans])
+        which = np.searchsorted(starts, times, side="right") - 1
+        if not plans or np.any(which < 0):
+            return None
+        pos = np.empty((len(times), 3))
+        moving = np.zeros(len(times), dtype=bool)
+        known = np.ones(len(times), dtype=bool)
+        for k in np.unique(which):
+            sel = which == k
+            pos[sel] = plans[k].positions(n, times[sel])
+            moving[sel] = plans[k].on_transfer(times[sel])
+            known[sel] = plans[k].known(times[sel])
+        return pos, moving, known
 
     def plan_at(self, t: float) -> FlightPlan | None:
         valid = [p for p in self.plans.values() if p.t_from_s <= t]

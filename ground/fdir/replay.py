@@ -43,7 +43,13 @@ from interfaces import topics
 from interfaces.bus import Bus
 from interfaces.channel import ChannelModel
 from interfaces.executive import TickClient
-from interfaces.messages import BaselineVerdict, FaultReport, FdirWindow, ProAssignments
+from interfaces.messages import (
+    BaselineVerdict,
+    ConstellationWindow,
+    FaultReport,
+    FdirWindow,
+    ProAssignments,
+)
 from interfaces.scenario import Scenario, ScenarioError
 from interfaces.transport import InprocNetwork, Sample
 
@@ -66,17 +72,20 @@ class GroundOutput:
     reports: list[FaultReport] = field(default_factory=list)
     verdicts: list[BaselineVerdict] = field(default_factory=list)
     assignments: list[ProAssignments] = field(default_factory=list)
+    constellation: list[ConstellationWindow] = field(default_factory=list)
 
     def add(self, msg: object) -> None:
         for kind, holder in ((FdirWindow, self.windows), (FaultReport, self.reports),
-                             (BaselineVerdict, self.verdicts), (ProAssignments, self.assignments)):
+                             (BaselineVerdict, self.verdicts), (ProAssignments, self.assignments),
+                             (ConstellationWindow, self.constellation)):
             if type(msg) is kind:
-                holder.append(msg)  # type: ignore[arg-type]
+                holder.append(msg)  # type: ignore[attr-defined]
 
     @classmethod
     def of_archive(cls, archive: RunArchive, mission: str) -> GroundOutput:
         return cls(archive.of(cat.FDIR_WINDOW, mission), archive.of(cat.FAULT_REPORT, mission),
-                   archive.of(cat.BASELINE, mission), archive.of(cat.ASSIGNMENTS, mission))
+                   archive.of(cat.BASELINE, mission), archive.of(cat.ASSIGNMENTS, mission),
+                   archive.of(cat.CONSTELLATION_WINDOW, mission))
 
 
 @dataclass
@@ -103,9 +112,10 @@ class Replay:
     def matches_live(self) -> bool:
         """Every window, report and verdict equal to the live ground's (sender-stamped wall
         times aside)."""
-        return all(_same(a, b) for a, b in ((self.live.windows, self.replayed.windows),
-                                            (self.live.reports, self.replayed.reports),
-                                            (self.live.verdicts, self.replayed.verdicts)))
+        return all(_same(a, b) for a, b in (
+            (self.live.windows, self.replayed.windows), (self.live.reports, self.replayed.reports),
+            (self.live.verdicts, self.replayed.verdicts),
+            (self.live.constellation, self.replayed.constellation)))
 
     def results(self) -> dict[str, Any]:
         """``summary.json``'s FDIR fields for the replay, with its faithfulness."""
@@ -121,6 +131,7 @@ class Replay:
         return {"scenario": self.scenario.name, "seed": self.scenario.seed,
                 "replay_wall_s": round(self.wall_s, 3), "faithful_until_s": horizon,
                 "matches_live": self.matches_live(), **out,
+                "fdir_thresholds": faithful["fdir_thresholds"],  # the census: faithful span
                 "scores_faithful": faithful["scores"]}
 
 

@@ -8,9 +8,11 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
+from ground.fdir.hardware_threshold import RatioModel
 from ground.fdir.metric import metric
 from ground.fdir.twin import TwinModel, perturbed_boresights, sample_stride
 
@@ -98,3 +100,27 @@ def sampled_threshold(twin: TwinModel, positions: np.ndarray, boresights: np.nda
              for _ in range(samples)]
     # the subset holds about 1/k of the window's gain
     return adaptive_threshold(draws, ref, h_prev / k, floor)
+
+
+@dataclass(frozen=True)
+class WindowThreshold:
+    """The thresholds of one observer's window: the hardware model (its ratio distribution and
+    quantile), Eq. 11-12's sampled τ (unfloored), and the one in force, ``tau``, with what set
+    it (``by``: the selected threshold, or the floor guard where the selected one is below it).
+    ``tau`` is None when the selected threshold is undefined (degenerate prediction)."""
+
+    model: RatioModel | None
+    model_tau: float | None
+    sampled: float | None
+    tau: float | None
+    by: Literal["model", "sampled", "floor"] | None
+
+    @classmethod
+    def choose(cls, model: RatioModel | None, model_tau: float | None, sampled: float | None,
+               selected: float | None, name: Literal["model", "sampled"],
+               floor: float) -> WindowThreshold:
+        if selected is None:
+            return cls(model, model_tau, sampled, None, None)
+        if floor > selected:
+            return cls(model, model_tau, sampled, floor, "floor")
+        return cls(model, model_tau, sampled, selected, name)

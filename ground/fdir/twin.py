@@ -49,6 +49,31 @@ class FlightPlan:
     t_from_s: float
     pro: Pro
     transfer: Transfer | None = None
+    t_arrive_s: float | None = None
+    """end of the transfer the assignment asks for (None: no transfer)"""
+
+    @property
+    def starts_s(self) -> float:
+        """When the observer leaves its previous plan for this one: the first node of the
+        transfer it published (it may start later than asked, e.g. after an outage), else
+        ``t_from_s``."""
+        return float(self.transfer.t_s[0]) if self.transfer is not None else self.t_from_s
+
+    def known(self, t: npt.ArrayLike) -> npt.NDArray[np.bool_]:
+        """Whether the plan says where the observer is at each time ``t``: not between the
+        departure and the arrival of a transfer whose plan has not been received (a lost
+        ``TransferPlanMsg``: the path is the spacecraft's own choice)."""
+        tt = np.atleast_1d(np.asarray(t, dtype=float))
+        if self.transfer is not None or self.t_arrive_s is None:
+            return np.ones(tt.shape, dtype=bool)
+        return ~((tt >= self.t_from_s) & (tt < self.t_arrive_s))
+
+    def on_transfer(self, t: npt.ArrayLike) -> npt.NDArray[np.bool_]:
+        """Whether each absolute time ``t`` (s) falls on the planned transfer."""
+        tt = np.atleast_1d(np.asarray(t, dtype=float))
+        if self.transfer is None:
+            return np.zeros(tt.shape, dtype=bool)
+        return (tt >= self.transfer.t_s[0]) & (tt < self.transfer.t_s[-1])
 
     def positions(self, n: float, t: npt.ArrayLike) -> FloatArray:
         """Planned LVLH positions (K, 3), m, at absolute times ``t`` (K,): on the transfer
@@ -59,7 +84,7 @@ class FlightPlan:
         tr = self.transfer
         if tr is None:
             return out
-        inside = (tt >= tr.t_s[0]) & (tt < tr.t_s[-1])
+        inside = self.on_transfer(tt)
         if inside.any():
             k = np.clip(np.searchsorted(tr.t_s, tt[inside], side="right") - 1, 0,
                         len(tr.u) - 1)
@@ -131,6 +156,10 @@ class TwinModel:
     camera: Camera
     radius_m: float
 
+    def precision(self, positions: npt.ArrayLike, boresights: npt.ArrayLike) -> FloatArray:
+        """σ⁻¹ (K, M) of nominal images taken from ``positions`` along ``boresights``."""
+        return precision(positions, boresights, self.poi_pos, self.poi_normal, self.camera)
+
     def predicted(self, positions: npt.ArrayLike, boresights: npt.ArrayLike,
                   psi: npt.ArrayLike, phi: npt.ArrayLike) -> float:
         """ΔH_i^pred of images taken from ``positions`` along ``boresights``."""
@@ -143,9 +172,9 @@ SAMPLED_IMAGES = 20
 window's images, evenly spread."""
 
 
-def sample_stride(images: int) -> int:
-    """Every k-th image, so that at most ``SAMPLED_IMAGES`` of them are used."""
-    return max(1, math.ceil(images / SAMPLED_IMAGES))
+def sample_stride(images: int, at_most: int = SAMPLED_IMAGES) -> int:
+    """Every k-th image, so that at most ``at_most`` of them are used."""
+    return max(1, math.ceil(images / at_most))
 
 
 def planned_boresights(attitude: FloatArray | None, positions: FloatArray) -> FloatArray:

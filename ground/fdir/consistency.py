@@ -1,0 +1,27 @@
+"""The main detector's guidance and attitude tests, fused with the information test (issue 15:
+as the map saturates the information metric alone loses the orbit actuator faults).  Each
+compares one item of a window's identification evidence (``ground/fdir/identify.Evidence``)
+with the nominal bound the scenario states for it (``Tolerances``): the nav estimate's distance
+from the plan, the pointing error the attitude estimate reports while tracking, and the Δv the
+observer commands per second while holding its PRO.  A window fails the detector when the
+information test or any of these fails; the verdict names which.
+"""
+
+from __future__ import annotations
+
+from ground.fdir.identify import Evidence, Tolerances
+
+TESTS = ("plan", "pointing", "dv_rate")
+"""The consistency tests, by the name a window's verdict gives them."""
+
+
+def failed_tests(ev: Evidence, tol: Tolerances) -> tuple[str, ...]:
+    """Names of the consistency tests the window's evidence fails (``TESTS`` order)."""
+    failed = []
+    if (ev.nav_vs_plan_m or 0.0) > tol.position_m:
+        failed.append("plan")
+    if (ev.pointing_error_deg or 0.0) > tol.pointing_deg:
+        failed.append("pointing")
+    if (ev.dv_rate_mps2 or 0.0) > tol.dv_rate_mps2:
+        failed.append("dv_rate")
+    return tuple(failed)

@@ -1,0 +1,173 @@
+"""The threshold that comes from the hardware (the chapter's future work, Sec. III.E; DESIGN.md
+"Information cost and FDIR"): the distribution of the ratio x = ΔH_i / ΔH_i^pred of one
+observer over one FDI window when nothing is faulty, from what the ground knows of the
+observer's hardware, and τ_i as its quantile for a stated false-alarm probability.
+
+Where the nominal ratio departs from 1:
+
+* the camera: every measured precision is β σ⁻¹ max(0, 1 + ν ε), ε ~ N(0, 1) independent per
+  POI and image (``[camera] noise_frac`` = ν).  Over the window's observations, with weights
+  w = φ ψ σ⁻¹ of the predicted images, x has mean m₁ and variance v Σw² / (Σw)², with m₁ and v
+  the mean and variance of the clipped factor (closed form, :func:`clipped_noise_moments`);
+* the position: the observer flies its plan within its station-keeping accuracy
+  (``fdir.track_sigma_m`` holding a PRO, ``fdir.transfer_sigma_m`` on a transfer, 1σ per axis)
+  and its camera aims from the nav estimate, off the truth by the nav's reported 1σ;
+* the pointing: the attitude loop's tracking jitter (``fdir.pointing_jitter_deg``, 1σ per axis)
+  and the attitude knowledge the observer reports (``sigma_att_rad``).
+
+Position and pointing errors vary slowly against a window (orbit and loop time constants), so
+each draw holds one position offset and one small rotation over the whole window (the
+conservative choice: no averaging over images).  The pose part is a small Monte Carlo through the
+twin; the camera part is exact given the weights.  Their sum is summarised as a Gaussian
+x ~ N(μ, σ²) and τ solves P(|1 − x| > τ) = q: the tail beyond the samples is the Gaussian's.
+Pure functions; the FDIR app feeds them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.optimize import brentq
+from scipy.special import ndtr
+
+from ground.fdir.twin import TwinModel, sample_stride
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class HardwareSpec:
+    """The nominal noise of one observer's hardware that the ground knows from the scenario.
+
+    Attributes:
+        camera_noise_frac: ν, 1σ multiplicative noise of each measured precision.
+        track_sigma_m: station-keeping accuracy holding a PRO, 1σ per axis, m.
+        transfer_sigma_m: tracking accuracy on a transfer, 1σ per axis, m.
+        pointing_jitter_rad: attitude loop tracking error, 1σ per axis, rad.
+        samples: pose draws per window.
+    """
+
+    camera_noise_frac: float
+    track_sigma_m: float
+    transfer_sigma_m: float
+    pointing_jitter_rad: float
+    samples: int = 16
+
+
+@dataclass(frozen=True)
+class RatioModel:
+    """x = ΔH_i / ΔH_i^pred under no fault: mean and 1σ, with the parts of the spread that come
+    from the camera's noise and from the pose."""
+
+    mean: float
+    std: float
+    camera_std: float
+    pose_std: float
+
+    def threshold(self, q: float) -> float:
+        """τ with P(|1 − x| > τ) = ``q`` for x ~ N(mean, std²) (0 < q < 1)."""
+        if not 0.0 < q < 1.0:
+            raise ValueError(f"false-alarm probability must be in (0, 1), got {q!r}")
+        offset = abs(1.0 - self.mean)
+        if self.std <= 0.0:
+            return offset
+        return float(brentq(lambda tau: self.exceedance(tau) - q, 0.0, offset + 40.0 * self.std,
+                            xtol=1e-12))
+
+    def exceedance(self, tau: float) -> float:
+        """P(|1 − x| > τ) for x ~ N(mean, std²)."""
+        below = ndtr((1.0 - tau - self.mean) / self.std)
+        above = ndtr((self.mean - 1.0 - tau) / self.std)
+        return float(below + above)
+
+    def z(self, x: float) -> float:
+        """The standardised residual (x − mean) / std of an observed ratio."""
+        return (x - self.mean) / self.std if self.std > 0.0 else math.inf
+
+
+def clipped_noise_moments(nu: float) -> tuple[float, float]:
+    """Mean and variance of Y = max(0, 1 + ν ε), ε ~ N(0, 1) (the sim's measured-precision
+    factor): with a = −1/ν, E[Y] = Φ(−a) + ν φ(a) and E[Y²] = (1 + ν²) Φ(−a) + ν φ(a)."""
+    if nu <= 0.0:
+        return 1.0, 0.0
+    a = -1.0 / nu
+    tail = float(ndtr(-a))
+    dens = math.exp(-0.5 * a * a) / math.sqrt(2.0 * math.pi)
+    m1 = tail + nu * dens
+    m2 = (1.0 + nu * nu) * tail + nu * dens
+    return m1, max(m2 - m1 * m1, 0.0)
+
+
+def small_rotations(vectors: FloatArray, angles: FloatArray) -> FloatArray:
+    """Rotate unit ``vectors`` (K, 3) by one rotation vector ``angles`` (3,) rad (first order,
+    renormalised: the errors are far below a radian)."""
+    out = vectors + np.cross(angles, vectors)
+    return out / np.linalg.norm(out, axis=1, keepdims=True)
+
+
+POSE_IMAGES = 6
+"""The pose draws image at most this many of a window's planned poses, evenly spread (the
+offsets are common to the window, so a few images carry its geometry)."""
+
+
+def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: FloatArray,
+                phi: FloatArray, position_sigma_m: float, pointing_sigma_rad: float,
+                noise_frac: float, samples: int, rng: np.random.Generator,
+                prec: FloatArray | None = None) -> RatioModel | None:
+    """The nominal distribution of x for the window's images taken from the planned
+    ``positions`` (K, 3) with the camera aimed at ``aims`` (K, 3) (LVLH, m); ψ and φ as the
+    prediction holds them.  ``position_sigma_m`` is the truth's 1σ per axis about the plan,
+    ``pointing_sigma_rad`` the boresight's 1σ per axis about the aim; ``prec``: the
+    prediction's precision (K, M) when already computed.  Returns None when the prediction
+    holds no information (no threshold, no decision)."""
+    weight = phi * psi
+    if prec is None:
+        prec = twin.precision(positions, _aimed(aims, positions))
+    w = prec * weight
+    total = float(w.sum())
+    if not total > 0.0:
+        return None
+    m1, v = clipped_noise_moments(noise_frac)
+    camera_var = v * float(np.sum(w * w)) / total**2
+    k = sample_stride(len(positions), POSE_IMAGES)
+    pos, aim = positions[::k], aims[::k]
+    ref = float(np.sum(prec[::k] @ weight))
+    if not ref > 0.0:
+        return None
+    offsets = rng.normal(0.0, position_sigma_m, (samples, 1, 3))
+    tilts = rng.normal(0.0, pointing_sigma_rad, (samples, 1, 3))
+    true_pos = (pos[None, :, :] + offsets).reshape(-1, 3)
+    aimed = _aimed(np.tile(aim, (samples, 1)), true_pos)
+    bore = aimed + np.cross(np.repeat(tilts, len(pos), axis=1).reshape(-1, 3), aimed)
+    bore /= np.linalg.norm(bore, axis=1, keepdims=True)  # small_rotations, one tilt per draw
+    per_image = twin.precision(true_pos, bore) @ weight
+    draws = per_image.reshape(samples, len(pos)).sum(axis=1) / ref
+    pose_mean = float(draws.mean())
+    pose_var = float(draws.var(ddof=1)) if samples > 1 else 0.0
+    mean = m1 * pose_mean
+    var = m1 * m1 * pose_var + camera_var * pose_mean**2
+    return RatioModel(mean, math.sqrt(var), math.sqrt(camera_var) * abs(pose_mean),
+                      m1 * math.sqrt(pose_var))
+
+
+def _aimed(aims: FloatArray, positions: FloatArray) -> FloatArray:
+    """Unit boresights from ``positions`` to ``aims``."""
+    los = aims - positions
+    return los / np.linalg.norm(los, axis=1, keepdims=True)
+
+
+def window_false_alarm(per_observer_hour: float, window_s: float, persistence: int,
+                       tests: int = 1) -> float:
+    """Per-test false-alarm probability q for one observer's window: a budget of
+    ``per_observer_hour`` false alarms per observer-hour spread over its 3600 / ``window_s``
+    windows an hour (the windows correction; the constellation's rate is the budget times the
+    number of observers), split evenly between ``tests`` fused tests (Bonferroni), and with a
+    fault declared on ``persistence`` exceedances in a row, q = (budget per window)^(1/N)
+    (windows treated as independent)."""
+    if not per_observer_hour > 0.0 or not window_s > 0.0:
+        raise ValueError("the false-alarm budget and the window must be positive")
+    per_window = min(per_observer_hour * window_s / 3600.0, 0.5)
+    return min(per_window ** (1.0 / max(persistence, 1)) / max(tests, 1), 0.5)
