@@ -24,7 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib.infocost import Camera, precision
+from fsw.lib.infocost import Camera
+from fsw.lib.infocost_kernels import precision
 from fsw.lib.pro import Pro
 from fsw.lib.scp import zoh_matrices
 

@@ -1,0 +1,58 @@
+"""Compiled kernel of the per-observation precision (Eq. 5, 14) for the ground's nominal twin.
+
+The same test and formula as :func:`fsw.lib.infocost.precision` -- visible ⇔ inside the cone
+(b·(s − p) > 0 and (b·(s − p))² ≥ cos²α d²), 0 < d² ≤ R², front-facing (n·(p − s) > 0) -- with
+d² = |p|² + |s|² − 2 p·s as there, in one compiled pass over cameras × POIs (numba, cached on
+disk) instead of numpy's blocked temporaries: the FDIR's twin, hardware threshold and Eq.
+11-12 sampling image thousands of poses a window, and there numpy's arithmetic on
+temporaries, not the work, set the cost (≈60 ns per camera-POI pair, a few ns compiled).
+
+The numpy version stays the tested reference (``tests/test_infocost_kernels.py``): values equal
+to rounding, a visibility decided differently only on a pair within rounding of the cone, range
+or horizon boundary.  The sim's cameras keep the numpy version.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+from numba import njit
+
+from fsw.lib.infocost import _TINY, Camera, _inputs
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@njit(cache=True)
+def _fill(p: FloatArray, b: FloatArray, s: FloatArray, n: FloatArray, facing: bool,
+          cos2: float, r2: float, inv_k: float, out: FloatArray) -> None:
+    for i in range(p.shape[0]):
+        px, py, pz = p[i, 0], p[i, 1], p[i, 2]
+        bx, by, bz = b[i, 0], b[i, 1], b[i, 2]
+        pp = px * px + py * py + pz * pz
+        bp = bx * px + by * py + bz * pz
+        for j in range(s.shape[0]):
+            out[i, j] = 0.0
+            sx, sy, sz = s[j, 0], s[j, 1], s[j, 2]
+            if facing:  # cheapest test first: it removes the far side of the target
+                nx, ny, nz = n[j, 0], n[j, 1], n[j, 2]
+                if not (px * nx + py * ny + pz * nz) - (nx * sx + ny * sy + nz * sz) > 0.0:
+                    continue
+            proj = (bx * sx + by * sy + bz * sz) - bp
+            if not proj > 0.0:
+                continue
+            d2 = max(pp + (sx * sx + sy * sy + sz * sz) - 2.0 * (px * sx + py * sy + pz * sz),
+                     0.0)
+            if proj * proj >= cos2 * d2 and 0.0 < d2 <= r2:
+                out[i, j] = inv_k / max(d2, _TINY)
+
+
+def precision(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.ArrayLike,
+              poi_normal: npt.ArrayLike | None, camera: Camera) -> FloatArray:
+    """σ⁻¹ (N, M) = 1/(k d²) where visible, else 0: :func:`fsw.lib.infocost.precision`
+    compiled (same arguments, same validation and errors)."""
+    p, b, s, n = _inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
+    out = np.empty((p.shape[0], s.shape[0]))
+    _fill(p, b, s, s if n is None else n, n is not None, float(np.cos(camera.half_angle_rad)) ** 2,
+          camera.max_range_m ** 2, 1.0 / camera.k, out)
+    return out
