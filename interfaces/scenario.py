@@ -88,7 +88,7 @@ class Rates(_Section):
     high_hz: float = Field(default=10.0, gt=0.0)
     mid_hz: float = Field(default=1.0, gt=0.0)
     low_hz: float = Field(default=0.1, gt=0.0)
-    fdi_period_s: float = Field(default=100.0, gt=0.0)
+    fdi_period_s: float = Field(default=30.0, gt=0.0)
 
     @model_validator(mode="after")
     def _integer_ratios(self) -> Rates:

@@ -16,6 +16,7 @@ from fsw.lib.poi import sphere_pois
 from ground.fdir.hardware_threshold import (
     RatioModel,
     clipped_noise_moments,
+    position_sigma,
     ratio_model,
     small_rotations,
     window_false_alarm,
@@ -135,3 +136,11 @@ def test_window_false_alarm_budget() -> None:
     assert window_false_alarm(0.01, 100.0, 1, tests=2) == pytest.approx(0.01 / 72.0)
     with pytest.raises(ValueError):
         window_false_alarm(0.0, 100.0, 1)
+
+
+def test_position_sigma_adds_the_reported_offsets_up_to_the_tolerance() -> None:
+    assert position_sigma(0.05, 0.0, None, 0.5) == pytest.approx(0.05)
+    assert position_sigma(0.03, 0.04, None, 0.5) == pytest.approx(0.05)
+    offsets = np.tile([0.3, 0.0, 0.4], (10, 1))  # 0.5 m off: 0.5/√3 per axis
+    assert position_sigma(0.0, 0.0, offsets, 0.5) == pytest.approx(0.5 / math.sqrt(3.0))
+    assert position_sigma(0.0, 0.0, 10.0 * offsets, 0.5) == pytest.approx(0.5)  # capped

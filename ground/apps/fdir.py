@@ -62,7 +62,7 @@ from fsw.lib.infocost import Camera
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
 from ground.fdir.consistency import failed_tests
-from ground.fdir.hardware_threshold import ratio_model, window_false_alarm
+from ground.fdir.hardware_threshold import position_sigma, ratio_model, window_false_alarm
 from ground.fdir.constellation import ConstellationVerdict, ObserverGain, constellation_check
 from ground.fdir.identify import Evidence, Tolerances, classify, window_evidence
 from ground.fdir.metric import direction, metric
@@ -441,12 +441,13 @@ class FdirApp(App):
                                     math.radians(cfg.eps_deg), cfg.samples, 0.0,
                                     np.random.default_rng([seed, sc, int(round(a))]))
         aims = att[:, 4:7] if att is not None else np.zeros_like(pos)
-        nav_sigma = obs.nav_sigma.at(times)
-        track = cfg.transfer_sigma_m if moving else cfg.track_sigma_m
+        nav_sigma, nav = obs.nav_sigma.at(times), obs.nav.at(times)
         knowledge = float(np.mean(att[:, 7])) if att is not None else 0.0
         model = ratio_model(
             self.twin, pos, aims, psi, phi,
-            math.hypot(track, float(np.mean(nav_sigma)) if nav_sigma is not None else 0.0),
+            position_sigma(cfg.transfer_sigma_m if moving else cfg.track_sigma_m,
+                           float(np.mean(nav_sigma)) if nav_sigma is not None else 0.0,
+                           None if nav is None else nav - pos, cfg.position_tol_m),
             math.hypot(math.radians(cfg.pointing_jitter_deg), knowledge),
             self.ctx.scenario.camera.noise_frac, cfg.model_samples,
             np.random.default_rng([seed, sc, int(round(a)), 1]), prec)

@@ -10,8 +10,10 @@ Where the nominal ratio departs from 1:
   w = φ ψ σ⁻¹ of the predicted images, x has mean m₁ and variance v Σw² / (Σw)², with m₁ and v
   the mean and variance of the clipped factor (closed form, :func:`clipped_noise_moments`);
 * the position: the observer flies its plan within its station-keeping accuracy
-  (``fdir.track_sigma_m`` holding a PRO, ``fdir.transfer_sigma_m`` on a transfer, 1σ per axis)
-  and its camera aims from the nav estimate, off the truth by the nav's reported 1σ;
+  (``fdir.track_sigma_m`` holding a PRO, ``fdir.transfer_sigma_m`` on a transfer, 1σ per axis),
+  widened by the offset from the plan its nav reports (up to the plan test's tolerance:
+  :func:`position_sigma`), and its camera aims from the nav estimate, off the truth by the
+  nav's reported 1σ;
 * the pointing: the attitude loop's tracking jitter (``fdir.pointing_jitter_deg``, 1σ per axis)
   and the attitude knowledge the observer reports (``sigma_att_rad``).
 
@@ -157,6 +159,19 @@ def _aimed(aims: FloatArray, positions: FloatArray) -> FloatArray:
     """Unit boresights from ``positions`` to ``aims``."""
     los = aims - positions
     return los / np.linalg.norm(los, axis=1, keepdims=True)
+
+
+def position_sigma(track_sigma_m: float, nav_sigma_m: float,
+                   nav_offsets_m: FloatArray | None, tolerance_m: float) -> float:
+    """1σ per axis of the truth about the plan over a window: the station-keeping spec
+    (``track_sigma_m``), the nav's reported 1σ, and the per-axis RMS of the offsets from the
+    plan the nav itself reports (K, 3), counted up to ``tolerance_m`` (beyond it the detector's
+    plan test speaks, ``ground/fdir/consistency.py``) -- after a transfer the loop settles onto
+    its PRO for a few minutes, off it by more than the spec, and the ground sees it."""
+    rms = 0.0
+    if nav_offsets_m is not None and len(nav_offsets_m):
+        rms = min(math.sqrt(float(np.mean(np.sum(nav_offsets_m**2, axis=1))) / 3.0), tolerance_m)
+    return math.sqrt(track_sigma_m**2 + nav_sigma_m**2 + rms**2)
 
 
 def window_false_alarm(per_observer_hour: float, window_s: float, persistence: int,
