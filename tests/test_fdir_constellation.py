@@ -59,3 +59,4 @@ def test_two_independent_faults_are_not_common_mode() -> None:
 
 def test_too_few_observers_give_no_verdict() -> None:
     assert constellation_check(_gains([0.8, 0.8]), Q) is None
+

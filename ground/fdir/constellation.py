@@ -9,10 +9,10 @@ hardware model's N(μ_i, σ_i²) (``ground/fdir/hardware_threshold.py``) and the
 are independent, so X ~ N(Σ μ_i P_i / Σ P_i, Σ σ_i² P_i² / (Σ P_i)²), P_i = ΔH_i^pred.
 
 A constellation-level fault is one no single observer explains: X departs from its model by
-more than the quantile τ_X, and one factor common to every observer fits their ratios within
-their nominal spreads (:func:`common_factor_fits`: a common cause scales them alike; otherwise
-the observer farthest from its own model is named as the explanation, and each observer's own
-test judges it).  A camera or
+more than the quantile τ_X, still does with the observer farthest from its own model left
+out, and one factor common to every observer fits their ratios within their nominal spreads
+(:func:`common_factor_fits`: a common cause scales them alike).  Otherwise that observer is
+named as the explanation, and each observer's own test judges it.  A camera or
 target-model error common to every observer (a wrong variance coefficient k, ``camera_calibration``)
 is the example: every x_i moves together, and declaring each observer faulty would re-plan a
 healthy constellation around itself.  Eq. 6's integral form (``metric.global_check``) is kept for
@@ -87,8 +87,11 @@ def constellation_check(gains: Sequence[ObserverGain], q: float) -> Constellatio
         return None
     x, model, tau, exceeded = _exceeds(gains, q)
     explained_by = None
-    if exceeded and not common_factor_fits(gains, q):
-        explained_by = max(gains, key=lambda g: abs(g.model.z(g.dh / g.dh_pred))).spacecraft
+    if exceeded:
+        worst = max(gains, key=lambda g: abs(g.model.z(g.dh / g.dh_pred)))
+        if not (_exceeds([g for g in gains if g is not worst], q)[3]
+                and common_factor_fits(gains, q)):
+            explained_by = worst.spacecraft
     return ConstellationVerdict(x, model, tau, exceeded, explained_by)
 
 
