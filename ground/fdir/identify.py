@@ -30,8 +30,12 @@ evidence (in this order)                                    class
 β̂ off 1 (information short by a uniform factor)             ``camera``
 pointing error reported, and the pose explains the ΔH gap   ``actuator``
 Δv commanded while holding, above ``dv_rate_tol_mps2``      ``actuator``
+camera not where nav says, by more than nav is off plan,
+and nav and camera off the plan the same way                ``actuator``
 camera not where nav says, by more than nav is off plan     ``state_sensor``
 nav off plan (the observer knows it is not on its orbit)    ``actuator``
+nav and camera off the plan the same way, camera off nav
+by more than half the position tolerance                    ``actuator``
 seen set not what the reported pose would see               ``camera``
 ==========================================================  ================
 
@@ -43,7 +47,11 @@ holds near the plan: nav then stays within the filter lag of the plan and the la
 bias (the paper campaign misnamed 1 of its first 32 leaks so).  The Δv the observer spends on
 station tells them apart first: the leak costs ≈4e-3 m/s² per unit of the maximum thrust
 fraction, a nav bias only the transient of moving onto the offset orbit (2.6e-4 in the
-window of a 3 m step, 1e-4 after).
+window of a 3 m step, 1e-4 after).  With short windows the Δv has not built up when a leak is
+declared; the directions separate them then: a leak drags the truth off the plan and the nav
+follows it the same way (``offset_alignment`` > 0.5, the cosine between the located camera's
+and the nav's offsets from the plan), while a biased nav sits on one side of the plan and the
+truth, steered by it, on the other (a negative cosine).
 
 (``link`` and ``data_integrity`` are decided by the FDIR app from missing telemetry and from
 the reported H_i.)  Pure functions; the app gathers the inputs.
@@ -149,6 +157,8 @@ class Evidence:
         explained_located: the same at the located camera positions (reported boresight).
         dv_rate_mps2: commanded Δv per second over the window's time holding the PRO
             (guidance mode ``hold``), m/s².
+        offset_alignment: cosine between the located camera's and the nav's median offsets
+            from the plan (None when either is under ``MIN_OFFSET_M``).
     """
 
     beta_hat: float | None = None
@@ -159,6 +169,7 @@ class Evidence:
     explained_reported: float | None = None
     explained_located: float | None = None
     dv_rate_mps2: float | None = None
+    offset_alignment: float | None = None
 
     def as_dict(self) -> dict[str, float]:
         """The evidence present, by name (for the bus and summary.json)."""
@@ -196,9 +207,11 @@ def classify(ev: Evidence, tol: Tolerances) -> str | None:
         return "actuator"
     camera_nav, nav_plan = ev.camera_vs_nav_m or 0.0, ev.nav_vs_plan_m or 0.0
     if camera_nav > tol.position_m and camera_nav > nav_plan:
-        return "state_sensor"
+        return "actuator" if (ev.offset_alignment or 0.0) > SAME_WAY else "state_sensor"
     if nav_plan > tol.position_m:
         return "actuator"
+    if (ev.offset_alignment or 0.0) > SAME_WAY and camera_nav > tol.position_m / 2.0:
+        return "actuator"  # the truth and the nav dragged off the plan together: a leak
     if ev.seen_overlap is not None and ev.seen_overlap < tol.overlap:
         return "camera"
     return None
@@ -224,19 +237,40 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
     if len(located) < MIN_FIXES:
         located = []
     beta = float(np.median([f.beta for _, f in located])) if located else None
-    cam_nav = nav_plan = point = None
+    cam_nav = nav_plan = point = align = None
     if nav is not None:
         nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
         if located:
             d = np.array([f.position_m - nav[i] for i, f in located])
             cam_nav = float(np.linalg.norm(np.median(d, axis=0)))
+            align = offset_alignment(np.array([f.position_m for _, f in located]),
+                                     nav[[i for i, _ in located]], planned[[i for i, _ in located]])
     if attitude is not None:
         point = math.degrees(float(np.median(attitude[:, 3])))
     explained = explained_loc = overlap = None
     if gap is not None and nav is not None and attitude is not None:
         explained, explained_loc, overlap = _gap_evidence(twin, images, nav, attitude, located,
                                                           psi, phi, gap)
-    return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc, dv_rate)
+    return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc, dv_rate,
+                    align)
+
+
+MIN_OFFSET_M = 0.05
+"""An offset from the plan shorter than this has no direction worth comparing, m."""
+SAME_WAY = 0.5
+"""``offset_alignment`` above this: camera and nav are off the plan the same way."""
+
+
+def offset_alignment(camera: np.ndarray, nav: np.ndarray, planned: np.ndarray) -> float | None:
+    """Cosine between the median offsets from the plan of the located camera positions and of
+    the nav estimates at the same images (K, 3 each); None when either is under
+    ``MIN_OFFSET_M``."""
+    a = np.median(camera - planned, axis=0)
+    b = np.median(nav - planned, axis=0)
+    na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+    if na < MIN_OFFSET_M or nb < MIN_OFFSET_M:
+        return None
+    return float(a @ b) / (na * nb)
 
 
 def _gap_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndarray,
