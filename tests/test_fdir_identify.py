@@ -17,6 +17,7 @@ from ground.fdir.identify import (
     classify,
     explained_fraction,
     locate_camera,
+    offset_alignment,
     seen_overlap,
 )
 from interfaces.scenario import FdirSettings
@@ -121,6 +122,13 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
       "explained_located": 0.98, "dv_rate_mps2": 1.1e-3}, "actuator"),
     # the window of a 3 m nav bias step: moving onto the offset orbit costs 2.6e-4 m/s²
     ({"nav_vs_plan_m": 0.3, "camera_vs_nav_m": 3.0, "dv_rate_mps2": 2.6e-4}, "state_sensor"),
+    # a leak declared in its first 30 s window, before its Δv builds up: the nav lags the
+    # truth, but both are off the plan the same way (paper_fig23, sc4 at 450 s)
+    ({"nav_vs_plan_m": 0.12, "camera_vs_nav_m": 0.56, "offset_alignment": 0.9}, "actuator"),
+    ({"nav_vs_plan_m": 0.10, "camera_vs_nav_m": 0.48, "seen_overlap": 0.78,
+      "offset_alignment": 0.8}, "actuator"),  # the same, the seen set already changing
+    # a biased nav: nav and truth on opposite sides of the plan
+    ({"nav_vs_plan_m": 1.2, "camera_vs_nav_m": 2.3, "offset_alignment": -0.9}, "state_sensor"),
     ({"pointing_error_deg": 5.0, "explained_reported": 0.1, "explained_located": 0.2},
      None),  # reported off target, but that does not explain the loss
     ({}, None),  # nothing stands out
@@ -148,3 +156,12 @@ def test_dv_rate_counts_only_station_keeping() -> None:
     assert obs.dv_rate(12.0, 25.0) is None  # one report: no span
     obs.forget_guidance_before(35.0)
     assert [g[0] for g in obs.guidance] == [30.0, 40.0, 200.0]
+
+
+def test_offset_alignment_is_the_cosine_of_the_two_offsets() -> None:
+    plan = np.zeros((5, 3))
+    cam = np.tile([1.0, 0.0, 0.0], (5, 1))
+    assert offset_alignment(cam, np.tile([0.3, 0.3, 0.0], (5, 1)), plan) == pytest.approx(
+        1.0 / np.sqrt(2.0))
+    assert offset_alignment(cam, -0.5 * cam, plan) == pytest.approx(-1.0)
+    assert offset_alignment(cam, 0.01 * cam, plan) is None  # too short to have a direction
