@@ -101,7 +101,11 @@ class Judgement:
     window: FdirWindow
     evidence: Evidence
     threshold: WindowThreshold
-    decided: bool
+
+    @property
+    def decided(self) -> bool:
+        """Whether the information test could decide (a metric and a threshold)."""
+        return self.window.metric is not None and self.window.threshold is not None
 
 
 class FdirApp(App):
@@ -359,7 +363,7 @@ class FdirApp(App):
             "threshold_by": th.by, "failed": failed,
             "ratio_mean": th.model.mean if th.model else None,
             "ratio_std": th.model.std if th.model else None})
-        return Judgement(window, ev, th, decided=m_val is not None and th.tau is not None)
+        return Judgement(window, ev, th)
 
     def _constellation(self, a: float, b: float, judged: dict[int, Judgement]
                        ) -> ConstellationVerdict | None:

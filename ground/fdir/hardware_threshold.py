@@ -104,8 +104,8 @@ def clipped_noise_moments(nu: float) -> tuple[float, float]:
 
 
 def small_rotations(vectors: FloatArray, angles: FloatArray) -> FloatArray:
-    """Rotate unit ``vectors`` (K, 3) by one rotation vector ``angles`` (3,) rad (first order,
-    renormalised: the errors are far below a radian)."""
+    """Rotate unit ``vectors`` (K, 3) by the rotation vector ``angles`` rad, one (3,) for all
+    or one per row (K, 3) (first order, renormalised: the errors are far below a radian)."""
     out = vectors + np.cross(angles, vectors)
     return out / np.linalg.norm(out, axis=1, keepdims=True)
 
@@ -142,9 +142,8 @@ def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: F
     offsets = rng.normal(0.0, position_sigma_m, (samples, 1, 3))
     tilts = rng.normal(0.0, pointing_sigma_rad, (samples, 1, 3))
     true_pos = (pos[None, :, :] + offsets).reshape(-1, 3)
-    aimed = _aimed(np.tile(aim, (samples, 1)), true_pos)
-    bore = aimed + np.cross(np.repeat(tilts, len(pos), axis=1).reshape(-1, 3), aimed)
-    bore /= np.linalg.norm(bore, axis=1, keepdims=True)  # small_rotations, one tilt per draw
+    bore = small_rotations(_aimed(np.tile(aim, (samples, 1)), true_pos),
+                           np.repeat(tilts, len(pos), axis=1).reshape(-1, 3))  # one per draw
     per_image = twin.precision(true_pos, bore) @ weight
     draws = per_image.reshape(samples, len(pos)).sum(axis=1) / ref
     pose_mean = float(draws.mean())
