@@ -11,6 +11,9 @@ What the Bus guarantees, identically on every transport:
   nothing else happens, the node goes on.  In one process (in-process transport) a subscriber
   of the message's own type receives the publisher's validated, immutable object, with no JSON
   in between; JSON is made only for the transports and raw subscribers that need bytes.
+* **Admission.** A valid message is then held to the plausibility rules of
+  ``interfaces.admission`` (its sender owns the key, a sane sequence number and date, a bounded
+  queue); a refused one is counted in ``refused`` and logged, and never reaches the barrier.
 * **Deterministic delivery.** Deferred subscriptions (the default) are delivered by
   ``dispatch(t_now)`` on the caller's thread, sorted by (send time, key, sequence).  Messages of
   other flight/ground nodes become eligible one tick after they were sent (at the earliest) and
@@ -34,6 +37,7 @@ from typing import TypeVar
 from pydantic import ValidationError
 
 from interfaces import catalogue, topics
+from interfaces.admission import MAX_SEQ_JUMP, Admission
 from interfaces.channel import ChannelModel, Verdict, applies
 from interfaces.messages import Message, TruthState, json_schema, registry, stamp
 from interfaces.transport import LivenessHandler, RawHandler, Sample, Transport
@@ -73,6 +77,7 @@ class BusStats:
     invalid_dropped: int = 0
     handler_errors: int = 0
     channel_dropped: int = 0
+    refused: int = 0
 
 
 @dataclass(eq=False)
@@ -89,7 +94,7 @@ class Bus:
     _raw: dict[str, list[RawHandler]] = field(default_factory=dict)
     _local_cache: dict[str, list[_Sub]] = field(default_factory=dict)
     _pending: list[_Envelope] = field(default_factory=list)
-    _received_seq: dict[str, int] = field(default_factory=dict)
+    admission: Admission = field(default_factory=Admission)
     _await_cache: dict[str, bool] = field(default_factory=dict)
     _key_types: dict[str, object] = field(default_factory=dict)
     """Catalogue type of each key published or subscribed (None: not catalogued)."""
@@ -179,41 +184,60 @@ class Bus:
 
     def _on_sample(self, key_expr: str, sample: Sample) -> None:
         """Transport callback (any thread): validate bytes (an object of the subscribed type is
-        taken as it is), count, queue or call."""
+        taken as it is), admit, count, call or queue.  A message is queued and its sequence
+        number recorded in one step, so the barrier never wakes for a message not yet queued."""
         self.stats.received += 1
-        key, obj = sample.key, sample.message
-        if obj is None and len(sample.payload) > MAX_PAYLOAD_BYTES:
+        key = sample.key
+        if sample.message is None and len(sample.payload) > MAX_PAYLOAD_BYTES:
             self._invalid(key, f"payload of {len(sample.payload)} bytes exceeds "
                                f"{MAX_PAYLOAD_BYTES}")
             return
-        subs = self._groups.get(key_expr, [])
         decoded: dict[type[Message], Message] = {}
         deferred: dict[int, tuple[Message, list[_Sub]]] = {}
-        for sub in subs:
+        for sub in self._groups.get(key_expr, []):
             msg = decoded.get(sub.msg_type)
             if msg is None:
-                if type(obj) is sub.msg_type:
-                    msg = obj
-                else:
-                    try:
-                        msg = sub.msg_type.model_validate_json(sample.payload)
-                    except ValidationError as e:
-                        self._invalid(key, f"not a valid {sub.msg_type.__name__}: "
-                                           f"{_first_error(e)}")
-                        return
+                msg = self._admitted(key, sub.msg_type, sample)
+                if msg is None:
+                    return
                 decoded[sub.msg_type] = msg
-                with self._cond:
-                    if msg.seq > self._received_seq.get(key, 0):
-                        self._received_seq[key] = msg.seq
-                    self._cond.notify_all()
             if sub.immediate:
                 self._call(sub, msg, key)
             else:
                 deferred.setdefault(id(msg), (msg, []))[1].append(sub)
         # One envelope per message, whatever the number of local subscribers: the channel
         # decides once, so every app of the node sees the same messages.
-        for msg, group in deferred.values():
-            self._enqueue(_Envelope(msg, key, topics.node_of_key(key), False, group))
+        src = topics.node_of_key(key)
+        with self._cond:
+            for msg, group in deferred.values():
+                self._pending.append(_Envelope(msg, key, src, False, group))
+            for msg in decoded.values():
+                self.admission.admit(key, msg)
+            self._cond.notify_all()
+
+    def _admitted(self, key: str, msg_type: type[Message], sample: Sample) -> Message | None:
+        """The sample as a ``msg_type`` that passes admission, or None (dropped, counted)."""
+        msg = sample.message
+        if type(msg) is not msg_type:
+            try:
+                msg = msg_type.model_validate_json(sample.payload)
+            except ValidationError as e:
+                self._invalid(key, f"not a valid {msg_type.__name__}: {_first_error(e)}")
+                return None
+        refusal = self.admission.check(key, msg, len(self._pending))
+        if refusal is not None:
+            self.refuse(key, *refusal)
+            return None
+        return msg
+
+    def refuse(self, key: str, kind: str, why: str) -> None:
+        """Count and log (rate-limited) a message refused on ``key`` (see ``Admission``)."""
+        self.admission.refused[kind] += 1
+        self.stats.refused += 1
+        n = self.stats.refused
+        if n <= 5 or n % 1000 == 0:
+            self.log.warning("%s refused message #%d on %s (%s): %s", self.node, n, key, kind,
+                             why)
 
     def _enqueue(self, env: _Envelope) -> None:
         with self._cond:
@@ -245,6 +269,7 @@ class Bus:
         (or at ``t_now`` with ``include_now``) and their channel delay has elapsed; local and sim
         messages once their time is ``<= t_now``.  Returns the number of messages delivered."""
         delay = self.channel.delay_s if self.channel is not None else 0.0
+        self.admission.advance(t_now)
         with self._cond:
             due, keep = [], []
             for env in self._pending:
@@ -272,12 +297,16 @@ class Bus:
 
     def wait_for(self, expect: dict[str, int], timeout_s: float) -> list[str]:
         """Block until every key of ``expect`` that this node subscribes to (and does not own)
-        has arrived up to its sequence number; return the keys still missing at the timeout."""
-        wanted = {k: s for k, s in expect.items() if self._awaits(k)}
+        has arrived up to its sequence number; return the keys still missing at the timeout.
+        An announced number that admission would refuse (``MAX_SEQ_JUMP`` past the highest seen)
+        is not waited for."""
+        seen = self.admission.highest_seq
+        wanted = {k: s for k, s in expect.items()
+                  if self._awaits(k) and s <= seen.get(k, 0) + MAX_SEQ_JUMP}
         deadline = time.monotonic() + timeout_s
         with self._cond:
             while True:
-                missing = [k for k, s in wanted.items() if self._received_seq.get(k, 0) < s]
+                missing = [k for k, s in wanted.items() if seen.get(k, 0) < s]
                 left = deadline - time.monotonic()
                 if not missing or left <= 0:
                     return missing

@@ -113,11 +113,15 @@ class Executive:
             sender=node, t_sim=t, node=node,
             groups={g: s.model_copy() for g, s in self.stats.items()},
             app_errors=self.app_errors + self.bus.stats.handler_errors,
-            invalid_dropped=self.bus.stats.invalid_dropped,
+            invalid_dropped=self.bus.stats.invalid_dropped, refused=self.bus.stats.refused,
             barrier_timeouts=self.barrier_timeouts, ticks=self.ticks))
         if self.bus.channel is not None:
             self.bus.publish(self._keys["links"], LinkStats(
                 sender=node, t_sim=t, node=node, links=self.bus.channel.counters()))
+
+
+MAX_TICK_GAP = 100
+"""Most ticks a node may find skipped between two it receives (none are, on a reliable link)."""
 
 
 @dataclass(eq=False)
@@ -135,6 +139,7 @@ class TickClient:
     _ticks: queue.Queue[Tick | None] = field(default_factory=queue.Queue)
     finished: threading.Event = field(default_factory=threading.Event)
     sim_lost: bool = False
+    _last_k: int = -1
 
     def __post_init__(self) -> None:
         bus = self.executive.bus
@@ -142,10 +147,31 @@ class TickClient:
         bus.subscribe(cat.SIM_STATUS.key(bus.mission), SimStatus, self._on_status, immediate=True)
 
     def _on_tick(self, tick: Tick) -> None:
+        why = self._implausible(tick)
+        if why:
+            bus = self.executive.bus
+            bus.refuse(cat.TICK.key(bus.mission), "tick", f"tick k={tick.k}: {why}")
+            return
+        self._last_k = tick.k
+        self.executive.bus.admission.advance(tick.t_sim)
         if self.synchronous:
             self.executive.run_tick(tick)
         else:
             self._ticks.put(tick)
+
+    def _implausible(self, tick: Tick) -> str:
+        """Why ``tick`` cannot be the sim's next tick ("" if it can): tick numbers only increase,
+        by at most ``MAX_TICK_GAP``, stay within the run, and match the sim's clock t = k·dt."""
+        rates = self.executive.scenario.rates
+        if not 0 <= tick.k < self.executive.scenario.n_ticks:
+            return f"outside the run's {self.executive.scenario.n_ticks} ticks"
+        if tick.k <= self._last_k:
+            return f"not after tick {self._last_k}"
+        if self._last_k >= 0 and tick.k > self._last_k + MAX_TICK_GAP:
+            return f"{tick.k - self._last_k} ticks after tick {self._last_k}"
+        if tick.dt_s != rates.dt_s or abs(tick.t_sim - tick.k * rates.dt_s) > 1e-6:
+            return f"time t={tick.t_sim:.6g} s, dt={tick.dt_s:g} s off the clock k·{rates.dt_s:g} s"
+        return ""
 
     def _on_status(self, status: SimStatus) -> None:
         if status.state in ("finished", "aborted"):

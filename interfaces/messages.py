@@ -12,18 +12,65 @@ one is invalid, is dropped and counted.  Unknown fields are rejected too.
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal
-
 import math
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
-Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
-Vec6 = Annotated[list[float], Field(min_length=6, max_length=6)]
-Quat = Annotated[list[float], Field(min_length=4, max_length=4)]
+# --- physical ranges ----------------------------------------------------------------------
+# What a message may carry, far beyond anything the mission flies and far below what breaks a
+# filter: a value outside is refused where it enters (an invalid message, dropped and counted).
+
+MAX_RANGE_M = 1.0e5
+"""Largest relative position component, m (the HCW model is meaningless long before)."""
+MAX_SPEED_MPS = 1.0e3
+"""Largest relative velocity component, m/s."""
+MAX_ACCEL_MPS2 = 10.0
+"""Largest commanded or planned acceleration component, m/s²."""
+MAX_RATE_RADPS = 10.0
+"""Largest body rate or gyro bias component, rad/s."""
+MAX_FORCE_N = 10.0
+"""Largest thrust command component, N (the thrusters give tens of mN)."""
+MAX_TORQUE_NM = 1.0
+"""Largest torque command component, N·m (the wheels give a few mN·m)."""
+MAX_TIME_S = 1.0e8
+"""Latest simulation time a message may carry, s (three years)."""
+MAX_PRECISION = 1.0e12
+"""Largest per-POI precision (information, 1/m²)."""
+MAX_ANGLE_RAD = math.pi
+"""Largest angle or angular 1σ, rad."""
+
+
+def _vector(n: int, limit: float) -> type[list[float]]:
+    """A list of n floats, each within ±limit."""
+    item = Annotated[float, Field(ge=-limit, le=limit)]
+    return Annotated[list[item], Field(min_length=n, max_length=n)]  # type: ignore[valid-type,return-value]
+
+
+Position = _vector(3, MAX_RANGE_M)
+"""LVLH position, m."""
+Velocity = _vector(3, MAX_SPEED_MPS)
+"""LVLH velocity, m/s."""
+Accel = _vector(3, MAX_ACCEL_MPS2)
+"""LVLH acceleration, m/s²."""
+Rate = _vector(3, MAX_RATE_RADPS)
+"""Body rate, rad/s."""
+Force = _vector(3, MAX_FORCE_N)
+"""Body force, N."""
+Torque = _vector(3, MAX_TORQUE_NM)
+"""Body torque, N·m."""
+State6 = _vector(6, MAX_RANGE_M)
+"""[x y z vx vy vz] (m, m/s); StateEstimate holds the velocity part to MAX_SPEED_MPS."""
+Quat = _vector(4, 1.0 + 1e-9)
 """Quaternion, scalar last [x, y, z, w] (scipy and Foxglove convention)."""
-Mat6 = Annotated[list[Vec6], Field(min_length=6, max_length=6)]
+Mat6 = Annotated[list[_vector(6, MAX_RANGE_M**2)], Field(  # type: ignore[valid-type]
+    min_length=6, max_length=6)]
+"""6x6 covariance (m², m²/s, m²/s²)."""
+Time = Annotated[float, Field(ge=0.0, le=MAX_TIME_S)]
+"""Simulation time, s."""
+Angle = Annotated[float, Field(ge=0.0, le=MAX_ANGLE_RAD)]
+"""Non-negative angle or angular 1σ, rad."""
 RateGroupName = Literal["high", "mid", "low"]
 
 
@@ -37,7 +84,7 @@ class Message(BaseModel):
 
     sender: str = Field(max_length=64, description="node that published the message")
     seq: int = Field(default=0, ge=0, description="per-key sequence count, set by the Bus")
-    t_sim: float = Field(ge=0.0, description="simulation time of the message, s")
+    t_sim: float = Field(ge=0.0, le=MAX_TIME_S, description="simulation time of the message, s")
     t_wall: float = Field(default=0.0,
                           description="publisher wall clock, UNIX s (not reproducible)")
 
@@ -98,10 +145,10 @@ class TruthState(Message):
     """
 
     spacecraft: list[int]
-    r_lvlh_m: list[Vec3]
-    v_lvlh_mps: list[Vec3]
+    r_lvlh_m: list[Position]
+    v_lvlh_mps: list[Velocity]
     q_lvlh_body: list[Quat] = Field(default_factory=list)
-    w_body_radps: list[Vec3] = Field(default_factory=list)
+    w_body_radps: list[Rate] = Field(default_factory=list)
     dv_mps: list[float] = Field(default_factory=list)
 
 
@@ -109,10 +156,10 @@ class RelNavMeasurement(Message):
     """Relative position/velocity sensor of one observer (LVLH, noisy, seeded)."""
 
     spacecraft: int = Field(ge=1)
-    r_m: Vec3
-    v_mps: Vec3
-    sigma_r_m: float = Field(gt=0.0)
-    sigma_v_mps: float = Field(gt=0.0)
+    r_m: Position
+    v_mps: Velocity
+    sigma_r_m: float = Field(gt=0.0, le=MAX_RANGE_M)
+    sigma_v_mps: float = Field(gt=0.0, le=MAX_SPEED_MPS)
 
 
 class AttitudeMeasurement(Message):
@@ -122,10 +169,10 @@ class AttitudeMeasurement(Message):
     axes (rad)."""
 
     spacecraft: int = Field(ge=1)
-    gyro_radps: Vec3
+    gyro_radps: Rate
     star_tracker: Quat | None = None
-    st_sigma_cross_rad: float = Field(default=0.0, ge=0.0)
-    st_sigma_roll_rad: float = Field(default=0.0, ge=0.0)
+    st_sigma_cross_rad: Angle = 0.0
+    st_sigma_roll_rad: Angle = 0.0
 
     @model_validator(mode="after")
     def _fix_is_usable(self) -> AttitudeMeasurement:
@@ -142,7 +189,8 @@ class _PoiPrecisions(Message):
 
     spacecraft: int = Field(ge=1)
     poi: list[Annotated[int, Field(ge=0)]] = Field(max_length=1_000_000)
-    precision: list[Annotated[float, Field(ge=0.0)]] = Field(max_length=1_000_000)
+    precision: list[Annotated[float, Field(ge=0.0, le=MAX_PRECISION)]] = Field(
+        max_length=1_000_000)
 
     _arrays: tuple[list[int], np.ndarray, np.ndarray] | None = PrivateAttr(default=None)
 
@@ -180,7 +228,7 @@ class ThrustCommand(Message):
     minimum impulse bit."""
 
     spacecraft: int = Field(ge=1)
-    force_body_n: Vec3
+    force_body_n: Force
     duration_s: float = Field(gt=0.0, le=3600.0)
 
 
@@ -190,7 +238,7 @@ class WheelCommand(Message):
     limits)."""
 
     spacecraft: int = Field(ge=1)
-    torque_body_nm: Vec3
+    torque_body_nm: Torque
 
 
 # --- flight software -------------------------------------------------------------------------
@@ -202,9 +250,17 @@ class StateEstimate(Message):
     (chi-square, 6 dof), None when the step had none."""
 
     spacecraft: int = Field(ge=1)
-    x: Vec6
+    x: State6
     P: Mat6
-    nis: float | None = None
+    nis: float | None = Field(default=None, ge=0.0)
+    resets: int = Field(default=0, ge=0, description="times the filter has diverged and "
+                        "restarted from a measurement")
+
+    @model_validator(mode="after")
+    def _velocity_in_range(self) -> StateEstimate:
+        if max(abs(v) for v in self.x[3:]) > MAX_SPEED_MPS:
+            raise ValueError(f"velocity beyond {MAX_SPEED_MPS} m/s")
+        return self
 
 
 MAX_PRO_SIZE_M = 1.0e5
@@ -234,8 +290,8 @@ class ProAssignment(BaseModel):
     assignment_id: int = Field(ge=1)
     phase: str = Field(max_length=64)
     pro: ProElements
-    t_depart_s: float = Field(ge=0.0)
-    t_arrive_s: float = Field(ge=0.0)
+    t_depart_s: Time
+    t_arrive_s: Time
 
     @model_validator(mode="after")
     def _times(self) -> ProAssignment:
@@ -379,8 +435,8 @@ class TransferPlanMsg(Message):
     spacecraft: int = Field(ge=1)
     assignment_id: int = Field(ge=1)
     t_s: list[float]
-    x: list[Vec6]
-    u_mps2: list[Vec3]
+    x: list[State6]
+    u_mps2: list[Accel]
     dv_mps: float = Field(ge=0.0, description="planned L1 fuel, Σ|u|·h, m/s")
     status: str
     iterations: int = Field(ge=0)
@@ -401,7 +457,7 @@ class GuidanceStatus(Message):
     phase: str = ""
     pos_error_m: float = Field(default=0.0, ge=0.0)
     vel_error_mps: float = Field(default=0.0, ge=0.0)
-    accel_lvlh_mps2: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    accel_lvlh_mps2: Accel = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     dv_commanded_mps: float = Field(default=0.0, ge=0.0)
     mpc_status: str = ""
     mpc_ms: float = Field(default=0.0, ge=0.0)
@@ -437,9 +493,9 @@ class PointingTarget(Message):
     the attitude app extrapolates it and uses its motion as feed-forward."""
 
     spacecraft: int = Field(ge=1)
-    target_lvlh_m: Vec3
-    target_rate_lvlh_mps: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    target_accel_lvlh_mps2: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    target_lvlh_m: Position
+    target_rate_lvlh_mps: Velocity = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    target_accel_lvlh_mps2: Accel = Field(default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 class AttitudeEstimate(Message):
@@ -451,12 +507,12 @@ class AttitudeEstimate(Message):
     spacecraft: int = Field(ge=1)
     q_eci_body: Quat
     q_lvlh_body: Quat
-    gyro_bias_radps: Vec3
-    sigma_att_rad: float = Field(ge=0.0)
-    target_lvlh_m: Vec3
-    pointing_error_rad: float = Field(ge=0.0)
+    gyro_bias_radps: Rate
+    sigma_att_rad: Angle
+    target_lvlh_m: Position
+    pointing_error_rad: Angle
     mode: Literal["init", "slew", "track"]
-    torque_body_nm: Vec3
+    torque_body_nm: Torque
     nis: float | None = None
 
 
@@ -479,12 +535,15 @@ class GroupStats(BaseModel):
 
 
 class ExecStats(Message):
-    """Executive statistics: cycle slips per rate group, app errors, invalid messages dropped."""
+    """Executive statistics: cycle slips per rate group, app errors, invalid messages dropped,
+    messages refused at admission (``interfaces.admission``: a sender not owning its key, an
+    absurd sequence number or date, a full queue, an implausible tick)."""
 
     node: str
     groups: dict[str, GroupStats]
     app_errors: int = 0
     invalid_dropped: int = 0
+    refused: int = 0
     barrier_timeouts: int = 0
     ticks: int = 0
 
@@ -510,7 +569,8 @@ class LinkStats(Message):
 
 
 class TelemetryStatus(Message):
-    """Ground view of each spacecraft's telemetry: received, sequence gaps, last time seen."""
+    """Ground view of each spacecraft's telemetry: received, sequence gaps, last time seen,
+    navigation filter restarts."""
 
     class Entry(BaseModel):
         model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
@@ -519,6 +579,8 @@ class TelemetryStatus(Message):
         seq_gaps: int = Field(default=0, description="messages missing by sequence count")
         last_t_sim: float | None = None
         stale: bool = False
+        nav_resets: int = Field(default=0, ge=0,
+                                description="navigation filter restarts (StateEstimate.resets)")
 
     entries: list[Entry]
 

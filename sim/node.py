@@ -108,6 +108,7 @@ class SimNode:
             "attitude": [cat.ATTITUDE_SENSORS.key(m, n) for n in nodes],
             "camera": [cat.CAMERA_IMAGE.key(m, n) for n in nodes],
         }
+        self._prefixes = {p: topics.node_prefix(m, p) + "/" for p in self.participants}
         self._cond = threading.Condition()
         self._answers: dict[str, dict[str, int]] = {}
         self._answer_k = -1
@@ -161,9 +162,13 @@ class SimNode:
     # --- lockstep bookkeeping -------------------------------------------------------------
 
     def _on_done(self, msg: TickDone) -> None:
+        """A participant's answer to the current tick (its sender is the owner of the key it
+        came on: the Bus's admission).  Only keys of its own space count as announced."""
         with self._cond:
-            if msg.k == self._answer_k and msg.sender in self.participants:
-                self._answers[msg.sender] = msg.published
+            if msg.k == self._answer_k and msg.sender in self._prefixes:
+                own = self._prefixes[msg.sender]
+                self._answers[msg.sender] = {k: s for k, s in msg.published.items()
+                                             if k.startswith(own)}
                 self._cond.notify_all()
 
     def on_liveness(self, node: str, alive: bool) -> None:

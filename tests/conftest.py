@@ -7,6 +7,7 @@ import os
 import socket
 import subprocess
 import sys
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -61,6 +62,13 @@ def _toml(v: object) -> str:
     return repr(v)
 
 
+def settle(pred: Callable[[], bool], timeout_s: float = 5.0) -> None:
+    """Poll ``pred`` until it holds or ``timeout_s`` (wall) passes (messages in flight)."""
+    deadline = time.monotonic() + timeout_s
+    while not pred() and time.monotonic() < deadline:
+        time.sleep(0.02)
+
+
 def a_free_port() -> int:
     """A TCP port free on loopback now."""
     with socket.socket() as s:
@@ -94,8 +102,8 @@ def recorded_run(scenario: Scenario, out: Path, *types: type[Message]
     those of ``types`` (as :func:`collector`); returns (collected by type name, the run's
     summary.json as written)."""
     from deploy.inproc import run_inproc
-    from ground.archive.recorder import McapRecorder
     from ground.analysis.summary import write_summary
+    from ground.archive.recorder import McapRecorder
 
     tap, got = collector(*types)
     with McapRecorder(out / "run.mcap", {}) as rec:

@@ -372,13 +372,27 @@ def test_damaged_chunk_stops_reading_at_the_previous_chunk(tmp_path: Path) -> No
         for i in range(100):
             rec.record(key, "RelNavMeasurement", _relnav_payload(i))
     data = bytearray(path.read_bytes())
-    data[len(data) // 3] ^= 0xFF  # a byte inside some chunk in the middle
+    chunks = _record_offsets(bytes(data), opcode=0x06)
+    start, length = chunks[len(chunks) // 2]
+    data[start + length // 2] ^= 0xFF  # a byte inside the middle chunk
     damaged = tmp_path / "damaged.mcap"
     damaged.write_bytes(bytes(data))
     run = load_run(damaged)
     assert run.truncated and "damaged" in (run.stop_reason or "")
     seqs = [m.seq for m in run.messages(key, RelNavMeasurement)]
     assert 0 < len(seqs) < 100 and seqs == list(range(len(seqs)))
+
+
+def _record_offsets(data: bytes, opcode: int) -> list[tuple[int, int]]:
+    """(content offset, content length) of each top-level MCAP record with ``opcode``: after
+    the 8-byte magic, records are opcode (1 byte), length (uint64 LE), content."""
+    found, offset = [], 8
+    while offset + 9 <= len(data):
+        op, length = data[offset], int.from_bytes(data[offset + 1:offset + 9], "little")
+        if op == opcode:
+            found.append((offset + 9, length))
+        offset += 9 + length
+    return found
 
 
 _KILLED_WRITER = """

@@ -13,6 +13,7 @@ from interfaces.bus import Bus
 from interfaces.messages import Heartbeat, StateEstimate, json_schema
 from interfaces.transport import InprocNetwork
 from interfaces.zenoh_transport import ZenohSettings, ZenohTransport
+from tests.conftest import settle
 
 M = "bt"
 
@@ -38,12 +39,6 @@ def pair(request: pytest.FixtureRequest, free_port: int) -> Iterator[tuple[Bus, 
         t.close()
 
 
-def _settle(pred, timeout_s: float = 5.0) -> None:  # noqa: ANN001
-    deadline = time.monotonic() + timeout_s
-    while not pred() and time.monotonic() < deadline:
-        time.sleep(0.02)
-
-
 def test_delivery_order_sequence_and_validation(pair) -> None:  # noqa: ANN001
     bus_a, bus_b, raw = pair
     got: list[Heartbeat] = []
@@ -59,7 +54,7 @@ def test_delivery_order_sequence_and_validation(pair) -> None:  # noqa: ANN001
                 b'{"sender":"sc1","seq":9,"t_sim":NaN,"node":"a","apps":[],"k":0}')
     raw.publish(key, "Heartbeat", b" " * (2 << 20))
     bus_a.publish(key, _hb(4.0))
-    _settle(lambda: bus_b.wait_for({key: 4}, 0.01) == [] and bus_b.stats.invalid_dropped == 4)
+    settle(lambda: bus_b.wait_for({key: 4}, 0.01) == [] and bus_b.stats.invalid_dropped == 4)
     assert bus_b.stats.invalid_dropped == 4
     assert bus_b.dispatch(t_now=10.0) == 4
     assert [m.t_sim for m in got] == [1.0, 2.0, 3.0, 4.0]  # sorted by send time
@@ -74,7 +69,7 @@ def test_messages_from_other_nodes_wait_one_tick(pair) -> None:  # noqa: ANN001
     bus_b.subscribe(key, Heartbeat, got.append)
     time.sleep(0.3)
     bus_a.publish(key, _hb(5.0))
-    _settle(lambda: bus_b.wait_for({key: 1}, 0.01) == [])
+    settle(lambda: bus_b.wait_for({key: 1}, 0.01) == [])
     assert bus_b.dispatch(5.0) == 0  # sent in the same tick: not yet due
     assert bus_b.dispatch(5.5) == 1
 

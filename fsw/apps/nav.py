@@ -8,6 +8,10 @@ expm([[A, B], [0, 0]]·dt)), not the truth.  A commanded acceleration u adds pro
 execution error: one error of 1σ ``THRUST_ERROR_FRAC·|u|`` (m/s², thruster noise and thrust
 direction error) held over the command period T acts like white acceleration noise of density
 ``(THRUST_ERROR_FRAC·|u|)²·T`` (m²/s³).
+
+A filter that diverges anyway (a state or variance beyond what its message may carry,
+``interfaces.messages``) restarts from its next measurement, counts it in
+``StateEstimate.resets`` and publishes nothing until then.
 """
 
 from __future__ import annotations
@@ -17,10 +21,18 @@ import numpy as np
 from fsw.lib import hcw, kalman
 from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import GuidanceStatus, RelNavMeasurement, StateEstimate
+from interfaces.messages import (
+    MAX_RANGE_M,
+    MAX_SPEED_MPS,
+    GuidanceStatus,
+    RelNavMeasurement,
+    StateEstimate,
+)
 
 THRUST_ERROR_FRAC = 0.05
 """1σ execution error of a commanded acceleration, as a fraction of it."""
+STATE_BOUNDS = np.array([MAX_RANGE_M] * 3 + [MAX_SPEED_MPS] * 3)
+"""What a StateEstimate may carry, per component (m, m/s)."""
 
 
 class NavApp(App):
@@ -38,6 +50,7 @@ class NavApp(App):
         self.P = np.eye(6)
         self.t_est = 0.0
         self.nis: float | None = None
+        self.resets = 0
         self.cmd_period = 1.0 / sc.rates.low_hz
         self._cmd: tuple[float, np.ndarray] = (0.0, np.zeros(3))  # (start s, LVLH accel m/s²)
         self._meas: RelNavMeasurement | None = None
@@ -68,9 +81,19 @@ class NavApp(App):
                 self.x, self.P, self.nis = kalman.update(
                     self.x, self.P, np.array(meas.r_m + meas.v_mps), np.eye(6), _R(meas))
         self._propagate_to(t)
+        if kalman.diverged(self.x, self.P, STATE_BOUNDS):
+            self._restart(t)
+            return
         self.publish("estimate", StateEstimate(
             sender=self.ctx.node, t_sim=t, spacecraft=self.ctx.spacecraft or 0,
-            x=self.x.tolist(), P=self.P.tolist(), nis=self.nis))
+            x=self.x.tolist(), P=self.P.tolist(), nis=self.nis, resets=self.resets))
+
+    def _restart(self, t: float) -> None:
+        """Drop a diverged estimate: the next measurement starts the filter again."""
+        self.resets += 1
+        self.log.warning("%s nav diverged at t=%.1f s; restarting from the next measurement "
+                         "(reset #%d)", self.ctx.node, t, self.resets)
+        self.x, self.P, self.nis = None, np.eye(6), None
 
     def _propagate_to(self, t: float) -> None:
         dt = round(t - self.t_est, 9)

@@ -44,3 +44,13 @@ def nees(x_est: FloatArray, P: FloatArray, x_true: FloatArray) -> float:
     """Normalized estimation error squared eᵀ P⁻¹ e (chi-square, dim(x) dof if consistent)."""
     e = x_est - x_true
     return float(e @ np.linalg.solve(P, e))
+
+
+def diverged(x: FloatArray, P: FloatArray, bounds: FloatArray) -> bool:
+    """Whether the filter has left what its messages can carry: a non-finite entry, a state
+    component beyond ``bounds`` (per component, the same units as x), a negative variance, or a
+    variance beyond ``bounds²``.  A diverged filter restarts from its next measurement."""
+    if not (np.isfinite(x).all() and np.isfinite(P).all()):
+        return True
+    var = np.diag(P)
+    return bool((np.abs(x) > bounds).any() or (var < 0.0).any() or (var > bounds**2).any())

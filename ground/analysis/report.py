@@ -349,11 +349,11 @@ def _links_section(summary: dict) -> list[str]:
 def _exec_section(summary: dict) -> list[str]:
     rows = ["## Executives", "",
             "| node | cycle slips (high/mid/low) | max exec ms (high/mid/low) | app errors "
-            "| invalid msgs | barrier timeouts |",
-            "|---|---|---|---|---|---|"]
+            "| invalid msgs | refused msgs | barrier timeouts |",
+            "|---|---|---|---|---|---|---|"]
     for node, e in summary.get("exec", {}).items():
         slips = "/".join(str(e["cycle_slips"].get(g, 0)) for g in ("high", "mid", "low"))
         ms = "/".join(f"{e['max_exec_ms'].get(g, 0):.2f}" for g in ("high", "mid", "low"))
         rows.append(f"| {node} | {slips} | {ms} | {e['app_errors']} | {e['invalid_dropped']} | "
-                    f"{e['barrier_timeouts']} |")
+                    f"{e.get('refused', 0)} | {e['barrier_timeouts']} |")
     return rows + [""]

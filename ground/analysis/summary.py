@@ -51,7 +51,7 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[s
         "exec": {node: {"cycle_slips": {g: s.cycle_slips for g, s in m.groups.items()},
                         "max_exec_ms": {g: round(s.max_exec_ms, 3) for g, s in m.groups.items()},
                         "app_errors": m.app_errors, "invalid_dropped": m.invalid_dropped,
-                        "barrier_timeouts": m.barrier_timeouts}
+                        "refused": m.refused, "barrier_timeouts": m.barrier_timeouts}
                  for node, m in sorted(execs.items())},
         "telemetry": [e.model_dump() for e in tlm[-1].entries] if tlm else [],
         "sim": {"rejected_commands": sim[-1].rejected_commands if sim else None},

@@ -2,8 +2,9 @@
 
 Rate group low.  Inputs: every spacecraft's state estimate and heartbeat.  Output: per
 spacecraft the messages received, the messages missing by sequence count (lost on the link or
-out of range) and whether it has gone silent.  Missing telemetry is a fact to report (a link
-problem), never a zero.
+out of range), whether it has gone silent, and how often its navigation filter has diverged and
+restarted (``StateEstimate.resets``, logged as it happens).  Missing telemetry is a fact to
+report (a link problem), never a zero.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from dataclasses import dataclass, field
 from interfaces import topics
 from interfaces import catalogue as cat
 from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import Message, TelemetryStatus
+from interfaces.messages import Message, StateEstimate, TelemetryStatus
 
 
 @dataclass
@@ -21,6 +22,7 @@ class _Track:
     received: int = 0
     gaps: int = 0
     last_t: float | None = None
+    nav_resets: int = 0
     last_seq: dict[str, int] = field(default_factory=dict)
 
 
@@ -51,11 +53,16 @@ class TelemetryMonitor(App):
         track.last_seq[kind] = max(last, msg.seq)
         track.received += 1
         track.last_t = msg.t_sim if track.last_t is None else max(track.last_t, msg.t_sim)
+        if isinstance(msg, StateEstimate) and msg.resets > track.nav_resets:
+            self.log.warning("sc%d reports its navigation filter restarted (%d so far, t=%.1f s)",
+                             sc, msg.resets, msg.t_sim)
+            track.nav_resets = msg.resets
 
     def step(self, t: float) -> None:
         entries = [
             TelemetryStatus.Entry(
                 spacecraft=sc, received=tr.received, seq_gaps=tr.gaps, last_t_sim=tr.last_t,
+                nav_resets=tr.nav_resets,
                 stale=tr.last_t is None or t - tr.last_t > self.STALE_AFTER_S)
             for sc, tr in self.tracks.items()
         ]

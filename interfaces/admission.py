@@ -1,0 +1,91 @@
+"""Admission of received messages: the Bus's plausibility rules, applied after schema validation
+and before a message is queued, waited for or delivered.
+
+A message that passed its schema can still be hostile or broken in ways only the bus can see:
+
+* **Sender.** Who sent a message follows from the key space it came on (only that node may
+  publish there: ``topics.node_of_key``, enforced by access control on a secured network); a
+  body whose ``sender`` names another node is refused.
+* **Sequence.** A key's sequence count grows by one per message.  A first message numbered above
+  ``MAX_FIRST_SEQ`` or a jump of more than ``MAX_SEQ_JUMP`` past the highest seen is refused: it
+  would make the barrier believe that messages arrived which never will.
+* **Time.** Once the bus has a clock (the lockstep's tick time, ``Admission.advance``), a message
+  dated more than ``MAX_AHEAD_S`` after it is refused instead of queued for a future that may
+  never come.
+* **Queue.** At most ``MAX_PENDING`` messages wait for delivery; beyond that new ones are refused.
+
+A refusal is counted by kind (``Admission.refused``) and logged (rate-limited) by the Bus;
+nothing else happens.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+
+from interfaces import topics
+from interfaces.messages import Message
+
+MAX_FIRST_SEQ = 10**9
+"""Highest sequence number a key's first message may carry (10 Hz for three years)."""
+MAX_SEQ_JUMP = 10_000
+"""Largest step of a key's sequence count past the highest seen (a late subscriber, a burst)."""
+MAX_AHEAD_S = 10.0
+"""How far past the bus's clock a message may be dated, s (a tick is 0.1 s)."""
+MAX_PENDING = 100_000
+"""Messages that may wait for delivery at once (a node receives a few hundred per tick)."""
+
+
+Refusal = tuple[str, str]
+"""(kind, detail): kind is one of "sender", "sequence", "time", "queue" (and "tick", from the
+lockstep client)."""
+
+
+@dataclass
+class Admission:
+    """The admission state of one Bus: its clock and each key's highest sequence number."""
+
+    clock_s: float | None = None
+    """Latest lockstep time seen (s); None until the node's first tick (no time rule before)."""
+    highest_seq: dict[str, int] = field(default_factory=dict)
+    refused: Counter[str] = field(default_factory=Counter)
+    """Refusals so far, by kind (counted by ``Bus.refuse``)."""
+    _owner: dict[str, str | None] = field(default_factory=dict)
+
+    def advance(self, t_s: float) -> None:
+        """The lockstep has reached ``t_s`` (a tick arrived or was dispatched)."""
+        if self.clock_s is None or t_s > self.clock_s:
+            self.clock_s = t_s
+
+    def check(self, key: str, msg: Message, pending: int) -> Refusal | None:
+        """Why ``msg`` received on ``key`` must be refused, or None to admit it (the Bus counts
+        a refusal; an admitted message is recorded by ``admit`` once it is queued)."""
+        return self._why(key, msg, pending)
+
+    def _why(self, key: str, msg: Message, pending: int) -> Refusal | None:
+        owner = self._owner.get(key, "")
+        if owner == "":
+            owner = self._owner[key] = topics.node_of_key(key)
+        if msg.sender != owner:
+            return "sender", f"sender {msg.sender!r} does not own the key (owner {owner!r})"
+        last = self.highest_seq.get(key)
+        if last is None and msg.seq > MAX_FIRST_SEQ:
+            return "sequence", f"first sequence number {msg.seq} exceeds {MAX_FIRST_SEQ}"
+        if last is not None and msg.seq > last + MAX_SEQ_JUMP:
+            return "sequence", f"sequence number jumps from {last} to {msg.seq}"
+        if self.clock_s is not None and msg.t_sim > self.clock_s + MAX_AHEAD_S:
+            return "time", (f"dated t={msg.t_sim:.6g} s, more than {MAX_AHEAD_S:g} s after "
+                            f"the clock's t={self.clock_s:g} s")
+        if pending >= MAX_PENDING:
+            return "queue", f"{pending} messages already waiting for delivery"
+        return None
+
+    def admit(self, key: str, msg: Message) -> None:
+        """Record an admitted message's sequence number (the barrier waits on it)."""
+        if msg.seq > self.highest_seq.get(key, 0):
+            self.highest_seq[key] = msg.seq
+
+    @property
+    def total(self) -> int:
+        """Messages refused so far."""
+        return sum(self.refused.values())

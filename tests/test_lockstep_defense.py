@@ -1,0 +1,162 @@
+"""The lockstep defends itself (issue 16): admission rules of the Bus (sender from the key space,
+sane sequence numbers and dates, bounded queue), plausible ticks only, TickDone announcing only
+its own keys, and the barrier never waking for a message not yet queued.
+
+Hostile messages are injected as raw bytes by a foreign endpoint on both transports, the way a
+stranger on the network would send them."""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from interfaces import admission, topics
+from interfaces import catalogue as cat
+from interfaces.admission import Admission
+from interfaces.bus import Bus
+from interfaces.executive import Executive, TickClient
+from interfaces.messages import Heartbeat, Message, Tick, TickDone
+from interfaces.transport import InprocNetwork
+from interfaces.zenoh_transport import ZenohSettings, ZenohTransport
+from sim.node import SimNode
+from tests.conftest import settle, small_scenario
+
+M = "ld"
+HB_KEY = topics.key(M, "sc1", "exec", "heartbeat")
+
+
+def _hb(t: float, seq: int, sender: str = "sc1") -> Heartbeat:
+    return Heartbeat(sender=sender, seq=seq, t_sim=t, node="sc1", apps=[], k=seq)
+
+
+def _bytes(msg: Message) -> bytes:
+    return msg.model_dump_json().encode()
+
+
+# --- the rules, as pure functions -----------------------------------------------------------
+
+
+def test_admission_rules() -> None:
+    a = Admission()
+    assert a.check(HB_KEY, _hb(1.0, 1), pending=0) is None
+    a.admit(HB_KEY, _hb(1.0, 1))
+    assert a.check(HB_KEY, _hb(1.0, 2, sender="sc2"), 0)[0] == "sender"
+    assert a.check(HB_KEY, _hb(1.0, 1 + admission.MAX_SEQ_JUMP), 0) is None
+    assert a.check(HB_KEY, _hb(1.0, 2 + admission.MAX_SEQ_JUMP), 0)[0] == "sequence"
+    other = topics.key(M, "sc1", "exec", "stats")
+    assert a.check(other, _hb(1.0, admission.MAX_FIRST_SEQ + 1), 0)[0] == "sequence"
+    assert a.check(HB_KEY, _hb(1e6, 2), 0) is None  # no clock yet: no time rule
+    a.advance(100.0)
+    a.advance(50.0)  # the clock never goes back
+    assert a.clock_s == 100.0
+    assert a.check(HB_KEY, _hb(100.0 + admission.MAX_AHEAD_S, 2), 0) is None
+    assert a.check(HB_KEY, _hb(100.1 + admission.MAX_AHEAD_S, 2), 0)[0] == "time"
+    assert a.check(HB_KEY, _hb(100.0, 2), admission.MAX_PENDING)[0] == "queue"
+    assert a.highest_seq == {HB_KEY: 1}
+
+
+# --- on a real Bus, both transports --------------------------------------------------------
+
+
+@pytest.fixture(params=["inproc", "zenoh"])
+def receiver(request: pytest.FixtureRequest,
+             free_port: int) -> Iterator[tuple[Bus, object, list[Heartbeat]]]:
+    """sc2's Bus subscribed to sc1's heartbeat, and a foreign raw endpoint."""
+    if request.param == "inproc":
+        net = InprocNetwork()
+        mine, raw = net.endpoint(), net.endpoint()
+    else:
+        ep = f"tcp/127.0.0.1:{free_port}"
+        mine = ZenohTransport(ZenohSettings.hub(ep))
+        raw = ZenohTransport(ZenohSettings(connect=(ep,)))
+    bus = Bus("sc2", M, mine)
+    got: list[Heartbeat] = []
+    bus.subscribe(HB_KEY, Heartbeat, got.append)
+    time.sleep(0.3 if request.param == "zenoh" else 0.0)
+    yield bus, raw, got
+    raw.close()
+    mine.close()
+
+
+def test_forged_and_absurd_messages_are_refused_and_counted(receiver) -> None:  # noqa: ANN001
+    bus, raw, got = receiver
+    bus.dispatch(10.0)  # the bus's clock: t = 10 s
+    raw.publish(HB_KEY, "Heartbeat", _bytes(_hb(10.0, 1)))
+    raw.publish(HB_KEY, "Heartbeat", _bytes(_hb(10.0, 2, sender="sc3")))  # not the owner
+    raw.publish(HB_KEY, "Heartbeat", _bytes(_hb(10.0, 10**30)))  # seq 1e30
+    raw.publish(HB_KEY, "Heartbeat", _bytes(_hb(1e6, 3)))  # far future
+    raw.publish(HB_KEY, "Heartbeat", _bytes(_hb(10.0, 2)))
+    settle(lambda: bus.stats.received == 5)
+    assert bus.stats.refused == 3 and bus.stats.invalid_dropped == 0
+    assert dict(bus.admission.refused) == {"sender": 1, "sequence": 1, "time": 1}
+    assert bus.admission.highest_seq[HB_KEY] == 2  # the barrier saw only the genuine two
+    assert bus.wait_for({HB_KEY: 2}, 0.01) == []
+    assert bus.dispatch(20.0) == 2 and [m.seq for m in got] == [1, 2]
+    assert not bus._pending  # nothing left queued for a future that never comes
+
+
+def test_barrier_never_wakes_before_the_message_is_queued() -> None:
+    """With the interpreter switching threads as often as it can, a message announced by
+    ``wait_for`` is always in the queue that ``dispatch`` reads next (the stale-command race:
+    before the fix about 2% of these deliveries came a tick late)."""
+    net = InprocNetwork()
+    raw, bus = net.endpoint(), Bus("sc2", M, net.endpoint())
+    got: list[Heartbeat] = []
+    bus.subscribe(HB_KEY, Heartbeat, got.append)
+    late, interval = 0, sys.getswitchinterval()
+    sys.setswitchinterval(1e-6)
+    try:
+        for i in range(1, 2001):
+            sender = threading.Thread(target=raw.publish,
+                                      args=(HB_KEY, "Heartbeat", _bytes(_hb(float(i), i))))
+            sender.start()
+            bus.wait_for({HB_KEY: i}, 5.0)
+            late += bus.dispatch(float(i), include_now=True) == 0
+            sender.join()
+            bus.dispatch(float(i), include_now=True)
+    finally:
+        sys.setswitchinterval(interval)
+    assert late == 0 and len(got) == 2000
+
+
+# --- the lockstep client and the sim ---------------------------------------------------------
+
+
+def _tick(k: int, dt: float = 0.5, t: float | None = None) -> Tick:
+    return Tick(sender="sim", t_sim=k * dt if t is None else t, k=k, dt_s=dt)
+
+
+def test_only_plausible_ticks_run() -> None:
+    sc = small_scenario("ld", duration_s=100.0)  # 2 Hz: 201 ticks
+    net = InprocNetwork()
+    bus, raw = Bus("sc1", M, net.endpoint()), net.endpoint()
+    client = TickClient(Executive(bus, sc, []), synchronous=True)
+    tick_key = cat.TICK.key(M)
+    ticks = (_tick(0), _tick(1), _tick(10**6), _tick(1), _tick(0), _tick(2, t=7.0),
+             _tick(2, dt=0.1), _tick(3), _tick(3 + 21), _tick(3 + 20))
+    for seq, tick in enumerate(ticks, start=1):  # numbered as the sim's own ticks would be
+        raw.publish(tick_key, "Tick", _bytes(tick.model_copy(update={"seq": seq})))
+    assert client.executive.ticks == 4  # k = 0, 1, 3, 23 ran
+    # k = 10^6 and k = 24 (10.5 s ahead of t = 1.5 s) by the bus's time rule, the rest by the
+    # lockstep client's (not increasing, off the clock)
+    assert dict(bus.admission.refused) == {"time": 2, "tick": 4} and bus.stats.refused == 6
+    assert bus.admission.clock_s == 23 * 0.5
+    # the tick-gap rule where the time rule does not reach: the first tick sets no clock
+    first = TickClient(Executive(Bus("sc2", M, net.endpoint()), sc, []), synchronous=True)
+    assert first._implausible(_tick(50)) == ""
+    first._last_k = 50
+    assert "ticks after" in first._implausible(_tick(50 + 101))
+
+
+def test_tick_done_announces_only_the_senders_own_keys() -> None:
+    sc = small_scenario("ld", observers={"count": 2})
+    sim = SimNode(Bus("sim", M, InprocNetwork().endpoint()), sc, participants=["sc1", "sc2"])
+    sim._answer_k = 4
+    own, foreign = topics.key(M, "sc1", "nav", "estimate"), topics.key(M, "sc2", "nav", "estimate")
+    sim._on_done(TickDone(sender="sc1", t_sim=2.0, k=4, published={own: 9, foreign: 10**9}))
+    sim._on_done(TickDone(sender="sc2", t_sim=2.0, k=3, published={foreign: 5}))  # old tick
+    assert sim._answers == {"sc1": {own: 9}}
