@@ -3,11 +3,25 @@ recorder as separate OS processes over Zenoh (default), or all in one process (-
 
     python deploy/run_constellation.py [--scenario deploy/scenarios/default.toml] --out runs/x
         [--transport zenoh|inproc] [--seed N] [--duration S] [--realtime SPEED]
-        [--compare-recovery] [--live PORT]
+        [--compare-recovery] [--live PORT] [--endpoint tcp/127.0.0.1:7447|tls/HOST:PORT]
+        [--audit-access] [--external NODE --advertise tls/HOST:PORT --tls-host HOST]
 
 Writes <out>/run.mcap (every bus message, JSON schemas; opens in Foxglove), <out>/summary.json,
-<out>/report.md with PNG plots, and <out>/logs/ (one log per process).  While it runs, any Zenoh
-client can connect to the endpoint (default tcp/127.0.0.1:7447) and subscribe to insp/**.
+<out>/report.md with PNG plots, and <out>/logs/ (one log per process).
+
+Over Zenoh the network is closed (deploy/access.py): the launcher starts the run's router
+(deploy/router.py) on the endpoint (default tcp/127.0.0.1:7447), every process joins it as a
+client with an account of its own, and access-control rules let each publish only in its own key
+space.  The accounts are made for the run in <out>/access/ (owner-only files); the read-only
+telemetry account <out>/access/tlm.json5 lets any Zenoh client watch the run
+(``python -m ground.tlm --zenoh-config <out>/access/tlm.json5``).  A ``tls/`` endpoint serves
+TLS with a certificate made for the run (its authority is <out>/access/tls/authority.pem).
+--audit-access counts the router's refusals (failed logins, denied messages) into
+<out>/logs/access.json and summary.json's ``access``.  Across hosts: listen on all interfaces
+(--endpoint tls/0.0.0.0:7447), give the address the other hosts use (--advertise
+tls/HOST:7447, also put in the certificate), and name the nodes that run elsewhere
+(--external sc3): the launcher does not start them, and prints how to start each on its host
+with its account file.
 With --live PORT the run is streamed to Foxglove (Foxglove WebSocket protocol, loopback;
 ground/tools/live.py): every bus message on a channel named by its key, and the truth poses in 3D.
 With --compare-recovery the same scenario and seed is run a second time, in-process, with the
@@ -19,6 +33,7 @@ Exits 0 on success; non-zero, with the reason, if a process dies or the run cann
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import signal
 import sys
@@ -31,6 +46,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
+from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
 from deploy.processes import Child, Supervisor  # noqa: E402
 from ground.analysis.digest import RunDigest, digest_run  # noqa: E402
 from ground.archive.reader import ArchiveError  # noqa: E402
@@ -63,7 +79,19 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--realtime", type=float, metavar="SPEED",
                    help="pace the sim to the wall clock times SPEED (default: lockstep, max speed)")
     p.add_argument("--endpoint", default=DEFAULT_ENDPOINT,
-                   help=f"Zenoh endpoint the constellation listens on (default {DEFAULT_ENDPOINT})")
+                   help="Zenoh endpoint of the run's router (default %(default)s; tls/HOST:PORT "
+                        "for TLS)")
+    p.add_argument("--advertise", metavar="ENDPOINT",
+                   help="endpoint the clients connect to (default: --endpoint); for nodes on "
+                        "other hosts")
+    p.add_argument("--external", action="append", default=[], metavar="NODE",
+                   help="a node (sc<N> or ground) started by hand on another host; repeatable")
+    p.add_argument("--tls-host", action="append", default=[], metavar="NAME",
+                   help="another name or address of this host in the TLS certificate (for "
+                        "nodes on other hosts); repeatable")
+    p.add_argument("--audit-access", action="store_true",
+                   help="count the router's refusals into logs/access.json and the summary "
+                        "(traces every routed message: slower)")
     p.add_argument("--mission", help="key-space name (default: scenario name)")
     p.add_argument("--no-report", action="store_true", help="skip report.md and plots")
     p.add_argument("--live", type=int, metavar="PORT", default=0,
@@ -90,6 +118,11 @@ def main(argv: list[str] | None = None) -> int:
     except ScenarioError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    known = {*(f"sc{i}" for i in range(1, scenario.observers.count + 1)), topics.GROUND}
+    if set(args.external) - known or (args.external and args.transport == "inproc"):
+        print(f"error: --external takes nodes of a Zenoh run ({', '.join(sorted(known))}), not "
+              f"{', '.join(args.external)}", file=sys.stderr)
+        return 2
     out = args.out or REPO / "runs" / f"{scenario.name}-{time.strftime('%Y%m%d-%H%M%S')}"
     out.mkdir(parents=True, exist_ok=True)
     mission = args.mission or scenario.name
@@ -108,7 +141,8 @@ def main(argv: list[str] | None = None) -> int:
     wall_s = time.monotonic() - wall0
     digest = _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
-                            status=status, error=error, mission=mission, digest=digest)
+                            status=status, error=error, mission=mission, digest=digest,
+                            extra=_access_audit(out))
     if args.compare_recovery and status == "completed":
         summary = _compare_recovery(scenario, mission, out, scenario_text, args, summary)
     if not args.no_report:
@@ -186,9 +220,19 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
 def _run_zenoh(scenario: Scenario, mission: str, out: Path,
                args: argparse.Namespace) -> tuple[str, str | None]:
     try:
-        hub = ZenohTransport(ZenohSettings.hub(args.endpoint))
-    except Exception as e:  # noqa: BLE001 - zenoh raises ZError
-        return "failed", f"cannot listen on {args.endpoint}: {e} (is another run using it?)"
+        access = _write_access(out, mission, scenario, args)
+    except ValueError as e:
+        return "failed", str(e)
+    sup = Supervisor(REPO)
+    audit = ["--audit", str(out / "logs" / "access.json")] if args.audit_access else []
+    router = sup.start(Child("router", ["-m", "deploy.router", "--config",
+                                        str(access.router_config), *audit],
+                             out / "logs" / "router.log"))
+    hub = _join(access, router, timeout_s=30.0)
+    if hub is None:
+        sup.stop_all()
+        return "failed", (f"the router did not start on {args.endpoint} ({router.describe_exit()}; "
+                          f"is another run using it?):\n{router.log_tail()}")
     progress = _Progress(scenario)
     live = None
     try:
@@ -198,38 +242,95 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
         live = _live_view(args)
         if live is not None:
             hub.subscribe(topics.mission_wildcard(mission), live.forward)
-        return _supervise(scenario, mission, out, args, progress, hub)
+        return _supervise(scenario, mission, out, args, progress, hub, sup, access)
     finally:
         hub.close()
         if live is not None:
             live.close()
+        router.stop()
+
+
+def _write_access(out: Path, mission: str, scenario: Scenario,
+                  args: argparse.Namespace) -> RunAccess:
+    """The run's accounts, rules and (for a tls/ endpoint) certificates, in <out>/access/."""
+    tls = None
+    if args.endpoint.startswith("tls/"):
+        from deploy.certificates import write_tls_files
+
+        advertised = _host_of(args.advertise) if args.advertise else None
+        tls = write_tls_files(out / "access" / "tls",
+                              tuple(args.tls_host) + ((advertised,) if advertised else ()))
+    return write_run_access(out / "access", mission, scenario.observers.count, args.endpoint,
+                            tls, clients_connect=args.advertise)
+
+
+def _host_of(endpoint: str) -> str:
+    """``HOST`` of ``proto/HOST:PORT`` (an IPv6 address in brackets loses them)."""
+    host = endpoint.split("/", 1)[-1].rsplit(":", 1)[0]
+    return host.strip("[]")
+
+
+def _join(access: RunAccess, router: Child, timeout_s: float) -> ZenohTransport | None:
+    """The launcher's own session (read-only account), once the router accepts it; None if the
+    router died or never came up."""
+    deadline = time.monotonic() + timeout_s
+    settings = ZenohSettings(config_file=str(access.client_config(TLM_ACCOUNT)))
+    while time.monotonic() < deadline and router.returncode is None:
+        try:
+            return ZenohTransport(settings)
+        except Exception:  # noqa: BLE001 - zenoh raises ZError while the router starts
+            time.sleep(0.1)
+    return None
+
+
+def _access_audit(out: Path) -> dict[str, Any] | None:
+    """``{"access": ...}`` from the router's refusal counts, if the run was audited."""
+    path = out / "logs" / "access.json"
+    if not path.is_file():
+        return None
+    try:
+        return {"access": json.loads(path.read_text(encoding="utf-8"))}
+    except (OSError, ValueError):
+        return None
 
 
 def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
-               progress: _Progress, hub: ZenohTransport) -> tuple[str, str | None]:
+               progress: _Progress, hub: ZenohTransport, sup: Supervisor,
+               access: RunAccess) -> tuple[str, str | None]:
     common = ["--scenario", str(args.scenario.resolve()), "--mission", mission,
-              "--connect", args.endpoint, "--log-level", args.log_level]
+              "--log-level", args.log_level]
     if args.seed is not None:
         common += ["--seed", str(args.seed)]
     if args.duration is not None:
         common += ["--duration", str(args.duration)]
-    sup = Supervisor(REPO)
+
+    def account(name: str) -> list[str]:
+        return [*common, "--zenoh-config", str(access.client_config(name))]
+
     logs = out / "logs"
-    recorder = sup.start(Child("recorder", ["-m", "ground.archive.record", *common, "--out",
-                                            str(out / "run.mcap"), "--transport-name", "zenoh"],
+    recorder = sup.start(Child("recorder", ["-m", "ground.archive.record", *account("recorder"),
+                                            "--out", str(out / "run.mcap"),
+                                            "--transport-name", "zenoh"],
                                logs / "recorder.log"))
     if not _wait_token(hub, topics.recorder_token(mission), recorder, timeout_s=30.0):
-        sup.stop_all()
+        sup.stop_all(exclude={"router"})
         return "failed", (f"recorder did not start ({recorder.describe_exit()}):\n"
                           f"{recorder.log_tail()}")
-    sim_argv = ["-m", "sim", *common] + (["--realtime", str(args.realtime)]
-                                         if args.realtime else [])
+    sim_argv = ["-m", "sim", *account(topics.SIM)] + (["--realtime", str(args.realtime)]
+                                                      if args.realtime else [])
     sup.start(Child("sim", sim_argv, logs / "sim.log"))
     nodes = [f"sc{i}" for i in range(1, scenario.observers.count + 1)]
-    for i, node in enumerate(nodes, start=1):
-        sup.start(Child(node, ["-m", "fsw", "--spacecraft", str(i), *common], logs / f"{node}.log"))
-    sup.start(Child("ground", ["-m", "ground", *common], logs / "ground.log"))
-    participants = [c for c in sup.children if c.name != "recorder"]
+    commands = {node: ["-m", "fsw", "--spacecraft", str(i), *account(node)]
+                for i, node in enumerate(nodes, start=1)}
+    commands[topics.GROUND] = ["-m", "ground", *account(topics.GROUND)]
+    for node, argv in commands.items():
+        if node in args.external:
+            log.info("%s runs elsewhere: on its host, with this run's scenario and %s there, "
+                     "run: python %s", node, access.client_config(node), " ".join(argv[:-2] + [
+                         "--zenoh-config", access.client_config(node).name]))
+        else:
+            sup.start(Child(node, argv, logs / f"{node}.log"))
+    participants = [c for c in sup.children if c.name not in ("recorder", "router")]
     error: str | None = None
     done_since: float | None = None
     try:
@@ -257,7 +358,7 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         error = "interrupted by the user"
     progress.report(final=True)
     # Stop the flight side first, then the recorder, so the archive holds everything sent.
-    sup.stop_all(order=["sim", *nodes, "ground"], exclude={"recorder"})
+    sup.stop_all(order=["sim", *nodes, "ground"], exclude={"recorder", "router"})
     time.sleep(0.2)
     recorder.stop(timeout_s=10.0)
     if recorder.returncode != 0 and error is None:

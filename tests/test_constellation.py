@@ -32,6 +32,20 @@ def _launch(scenario_path: Path, out: Path, port: int, *extra: str) -> subproces
         cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
+def _join(out: Path, account: str, timeout_s: float = 30.0) -> ZenohTransport:
+    """A session on a running launcher's network with one of the run's accounts (written by the
+    launcher to <out>/access/ when it starts)."""
+    config = out / "access" / f"{account}.json5"
+    deadline = time.monotonic() + timeout_s
+    while True:
+        try:
+            return ZenohTransport(ZenohSettings(config_file=str(config)))
+        except Exception:  # noqa: BLE001 - zenoh raises ZError; the file may not exist yet
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.2)
+
+
 def _comparable(path: Path) -> dict[str, list[dict]]:
     """Per key, the payloads without wall-clock fields.  ExecStats is left out: it reports
     execution times, which are wall-clock measurements by nature."""
@@ -81,7 +95,7 @@ def test_killed_fsw_process_fails_the_run_and_keeps_the_archive(
     p = _launch(path, out, free_port, "--realtime", "20")  # 20 s of wall time if undisturbed
     victim = _wait_pid(["fsw", "--spacecraft", "2", "--scenario", str(path)], timeout_s=30.0)
     seen = threading.Semaphore(0)
-    watcher = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",), mode="client"))
+    watcher = _join(out, "tlm")
     try:
         watcher.subscribe(topics.key("kill", "sc1", "nav", "estimate"), lambda *_: seen.release())
         for _ in range(5):  # kill only once the run is demonstrably under way
@@ -106,7 +120,8 @@ def test_malformed_messages_are_dropped_and_the_app_goes_on(tmp_path: Path, free
     out = tmp_path / "out"
     p = _launch(path, out, free_port, "--realtime", "20")
     _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
-    hostile = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",), mode="client"))
+    # the sim's own account (a compromised sim): the router lets it publish on sc1's sensor keys
+    hostile = _join(out, "sim")
     key = cat.RELNAV.key("bad", "sc1")  # what sc1's nav app subscribes to
     running = threading.Semaphore(0)
     try:
@@ -188,8 +203,7 @@ def test_terminated_launcher_stops_every_process(tmp_path: Path, free_port: int)
     p = _launch(path, out, free_port, "--realtime", "20")
     try:
         _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
-        watcher = ZenohTransport(ZenohSettings(connect=(f"tcp/127.0.0.1:{free_port}",),
-                                               mode="client"))
+        watcher = _join(out, "tlm")
         seen = threading.Semaphore(0)
         try:
             watcher.subscribe(topics.key("term", "sc1", "nav", "estimate"),
@@ -203,9 +217,10 @@ def test_terminated_launcher_stops_every_process(tmp_path: Path, free_port: int)
     _, stderr = p.communicate(timeout=60)
     assert p.returncode != 0 and "interrupted" in stderr
     deadline = time.monotonic() + 10.0
-    while _pids_with(str(path)) and time.monotonic() < deadline:
+    router_config = str(out / "access" / "router.json5")
+    while (_pids_with(str(path)) or _pids_with(router_config)) and time.monotonic() < deadline:
         time.sleep(0.1)
-    assert _pids_with(str(path)) == []
+    assert _pids_with(str(path)) == [] and _pids_with(router_config) == []  # the router too
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "failed"
     assert not load_run(out / "run.mcap").truncated

@@ -158,10 +158,12 @@ def _last_of(digest: RunDigest, model: type[M]) -> dict[str, M]:
 
 def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, status: str,
                   error: str | None = None, mission: str | None = None,
-                  digest: RunDigest | None = None) -> dict[str, Any]:
+                  digest: RunDigest | None = None,
+                  extra: dict[str, Any] | None = None) -> dict[str, Any]:
     """Write ``<out>/summary.json`` and return it.  A damaged or missing archive is reported in
     the summary (``archive_error``), never hidden.  ``digest``: the run's archive already read
-    (``ground.analysis.digest``; the report then reuses it), else ``<out>/run.mcap`` is read."""
+    (``ground.analysis.digest``; the report then reuses it), else ``<out>/run.mcap`` is read.
+    ``extra``: sections from outside the archive (the router's ``access`` audit)."""
     summary: dict[str, Any] = {
         "scenario": scenario.name,
         "seed": scenario.seed,
@@ -181,6 +183,7 @@ def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, 
         summary["real_time_factor"] = round(t_final / wall_s, 2) if wall_s > 0 else None
     except (ArchiveError, OSError) as e:
         summary["archive_error"] = str(e)
+    summary.update(extra or {})
     return _write_json(out, summary)
 
 

@@ -1,8 +1,12 @@
-"""Live telemetry: ``python -m ground.tools.tlm [--filter 'insp/**/nav/**'] [--stream]``.
+"""Live telemetry: ``python -m ground.tools.tlm --zenoh-config <run>/access/tlm.json5
+[--filter 'insp/**/nav/**'] [--stream]``.
 
-Joins the constellation's Zenoh network as a client (default ``tcp/127.0.0.1:7447``) and shows
-the latest message of every key matching the filter as a table refreshed once per second, or,
-with ``--stream``, one line per message.  Ctrl-C quits.
+Joins the run's Zenoh network as a client with the run's read-only telemetry account
+(``<out>/access/tlm.json5``, written by deploy/run_constellation.py: endpoint, user, password
+and, over TLS, the certificate authority) and shows the latest message of every key matching the
+filter as a table refreshed once per second, or, with ``--stream``, one line per message.
+Without ``--zenoh-config`` it connects to ``--connect`` with no credentials (a network without
+access control).  Ctrl-C quits.
 """
 
 from __future__ import annotations
@@ -80,6 +84,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--filter", default="insp/**", help="Zenoh key expression (default insp/**)")
     p.add_argument("--connect", default=DEFAULT_ENDPOINT,
                    help="Zenoh endpoint of the constellation")
+    p.add_argument("--zenoh-config", help="client configuration with credentials (the run's "
+                   "access/tlm.json5)")
     p.add_argument("--stream", action="store_true", help="print every message instead of a table")
     p.add_argument("--duration", type=float, help="quit after this many seconds")
     args = p.parse_args(argv)
@@ -95,7 +101,14 @@ def main(argv: list[str] | None = None) -> int:
             prev = rows.get(key)
             rows[key] = _Row(type_name, seq, t, (prev.count if prev else 0) + 1, text)
 
-    transport = ZenohTransport(ZenohSettings(connect=(args.connect,), mode="client"))
+    try:
+        transport = ZenohTransport(ZenohSettings(connect=(args.connect,), mode="client",
+                                                 config_file=args.zenoh_config))
+    except Exception as e:  # noqa: BLE001 - zenoh raises ZError
+        print(f"error: cannot join {args.zenoh_config or args.connect}: {e}\n(a run's network "
+              "needs its read-only account: --zenoh-config <run>/access/tlm.json5)",
+              file=sys.stderr)
+        return 2
     transport.subscribe(args.filter, on_raw)
     deadline = time.monotonic() + args.duration if args.duration else float("inf")
     try:
