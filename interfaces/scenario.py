@@ -361,7 +361,8 @@ class FdirSettings(_Section):
     for ``silent_windows`` windows is reported as a link fault.
     A reported H_i off the ground's recomputation from the observer's own observations by more
     than ``integrity_tol`` (relative) for ``checks_persistence`` windows is a data-integrity
-    fault, and more of its observations lost (sequence gaps) than the links' nominal
+    fault (judged while the ground holds all but ``integrity_max_loss`` of every observer's
+    observations), and more of its observations lost (sequence gaps) than the links' nominal
     ``comms.packet_loss`` plus ``loss_tol`` (and the window's sampling spread) for
     ``checks_persistence`` windows a link fault.  A window is evaluated ``latency_s`` after it
     closes (its last images must have arrived).  A declared performance fault is identified
@@ -414,6 +415,10 @@ class FdirSettings(_Section):
         default=0.2, gt=0.0,
         description="relative difference between a reported H_i and the ground's recomputation "
                     "beyond which the report is inconsistent (data integrity)")
+    integrity_max_loss: float = Field(
+        default=0.1, ge=0.0, le=1.0,
+        description="largest share of any observer's observations the ground may have lost for "
+                    "a reported H_i to be judged (data integrity)")
     loss_tol: float = Field(default=0.2, gt=0.0, le=1.0,
                             description="share of a window's observations lost beyond the "
                                         "nominal comms.packet_loss")
