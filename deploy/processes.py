@@ -94,9 +94,24 @@ class Child:
         return "\n".join(text[-lines:])
 
 
+@dataclass(frozen=True)
+class Incident:
+    """A process that stopped before the end of the run: which, how, when (sim time, s), and
+    whether it was started again."""
+
+    node: str
+    what: str
+    t_sim: float
+    restarted: bool
+
+    def __str__(self) -> str:
+        return (f"{self.node} {self.what} at t≈{self.t_sim:.1f} s"
+                + (" (restarted)" if self.restarted else ""))
+
+
 @dataclass
 class Supervisor:
-    """Starts children and reports the first unexpected death."""
+    """Starts, restarts and stops children."""
 
     cwd: Path
     children: list[Child] = field(default_factory=list)
@@ -105,6 +120,18 @@ class Supervisor:
         child.start(self.cwd)
         self.children.append(child)
         return child
+
+    def restart(self, child: Child, attempt: int) -> Child:
+        """Start ``child``'s command again (its log continues in ``<name>.restart<N>.log``)."""
+        child.close_log()
+        again = Child(child.name, child.argv,
+                      child.log_path.with_name(f"{child.name}.restart{attempt}.log"))
+        self.children[self.children.index(child)] = again
+        again.start(self.cwd)
+        return again
+
+    def named(self, name: str) -> Child:
+        return next(c for c in self.children if c.name == name)
 
     def stop_all(self, order: list[str] | None = None, exclude: set[str] | None = None,
                  timeout_s: float = 5.0) -> None:

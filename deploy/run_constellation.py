@@ -47,7 +47,7 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
-from deploy.processes import Child, Supervisor  # noqa: E402
+from deploy.processes import Child, Incident, Supervisor  # noqa: E402
 from ground.analysis.digest import RunDigest, digest_run  # noqa: E402
 from ground.archive.reader import ArchiveError  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
@@ -89,6 +89,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--tls-host", action="append", default=[], metavar="NAME",
                    help="another name or address of this host in the TLS certificate (for "
                         "nodes on other hosts); repeatable")
+    p.add_argument("--restart-on-crash", action="store_true",
+                   help="start a flight or ground process again if it dies (it rejoins the "
+                        "lockstep)")
     p.add_argument("--audit-access", action="store_true",
                    help="count the router's refusals into logs/access.json and the summary "
                         "(traces every routed message: slower)")
@@ -330,40 +333,99 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
                          "--zenoh-config", access.client_config(node).name]))
         else:
             sup.start(Child(node, argv, logs / f"{node}.log"))
-    participants = [c for c in sup.children if c.name not in ("recorder", "router")]
-    error: str | None = None
-    done_since: float | None = None
-    try:
-        while True:
-            sim_done = progress.finished.is_set() or participants[0].returncode == 0
-            failed = next((c for c in participants if c.returncode is not None
-                           and (c.returncode != 0 or not sim_done)), None)
-            if failed is not None:
-                error = (f"{failed.name} (pid {failed.proc.pid if failed.proc else '?'}) "
-                         f"{failed.describe_exit()} at sim t≈{progress.t_sim:.1f} s; stopping the "
-                         f"constellation.\n--- last lines of {failed.log_path}:\n"
-                         f"{failed.log_tail()}")
-                break
-            if all(c.returncode == 0 for c in participants):
-                break
-            if sim_done:
-                done_since = done_since or time.monotonic()
-                if time.monotonic() - done_since > 15.0:
-                    error = "processes still running 15 s after the run finished: " + ", ".join(
-                        c.name for c in participants if c.returncode is None)
-                    break
-            time.sleep(0.1)
-            progress.report()
-    except KeyboardInterrupt:
-        error = "interrupted by the user"
+    watch = _Watch(sup, progress, flight=[*(n for n in nodes if n not in args.external),
+                                          *([topics.GROUND] if topics.GROUND not in args.external
+                                            else [])],
+                   restart=args.restart_on_crash)
+    error = watch.run()
     progress.report(final=True)
     # Stop the flight side first, then the recorder, so the archive holds everything sent.
     sup.stop_all(order=["sim", *nodes, "ground"], exclude={"recorder", "router"})
     time.sleep(0.2)
-    recorder.stop(timeout_s=10.0)
-    if recorder.returncode != 0 and error is None:
-        error = f"recorder {recorder.describe_exit()}:\n{recorder.log_tail()}"
-    return ("failed", error) if error else ("completed", None)
+    recorder = sup.named("recorder")
+    if recorder.returncode is None:
+        recorder.stop(timeout_s=10.0)
+        if recorder.returncode != 0 and error is None:
+            error = f"recorder {recorder.describe_exit()}:\n{recorder.log_tail()}"
+    if error:
+        return "failed", error
+    lost = progress.lost_participants()
+    if watch.incidents or lost:
+        return "degraded", "; ".join([*(str(i) for i in watch.incidents), *lost])
+    return "completed", None
+
+
+MAX_RESTARTS = 3
+"""Restarts of one process (--restart-on-crash) before it is left down."""
+
+
+class _Watch:
+    """The launcher's watch over a running constellation.  The sim or the recorder stopping
+    early ends the run at once (no time, or no record, without them); a flight or ground process
+    stopping early is an incident: the sim flies on with its last commands, the ground declares
+    the silent spacecraft a link fault, and with ``restart`` the process is started again (up to
+    ``MAX_RESTARTS`` times) and rejoins the lockstep."""
+
+    def __init__(self, sup: Supervisor, progress: _Progress, flight: list[str],
+                 restart: bool) -> None:
+        self.sup, self.progress, self.flight, self.restart = sup, progress, flight, restart
+        self.incidents: list[Incident] = []
+        self.restarts: dict[str, int] = {}
+        self.down: set[str] = set()
+
+    def run(self) -> str | None:
+        """Watch until every process has finished; the error that ended the run, or None."""
+        done_since: float | None = None
+        try:
+            while True:
+                error = self._essential_stopped()
+                if error is not None:
+                    return error
+                sim_done = self.progress.finished.is_set() or self.sup.named("sim").returncode == 0
+                self._flight_stopped(sim_done)
+                running = [n for n in self.flight
+                           if n not in self.down and self.sup.named(n).returncode is None]
+                if sim_done and not running:
+                    return None
+                if sim_done:
+                    done_since = done_since or time.monotonic()
+                    if time.monotonic() - done_since > 15.0:
+                        return ("processes still running 15 s after the run finished: "
+                                + ", ".join(running))
+                time.sleep(0.1)
+                self.progress.report()
+        except KeyboardInterrupt:
+            return "interrupted by the user"
+
+    def _essential_stopped(self) -> str | None:
+        sim, recorder = self.sup.named("sim"), self.sup.named("recorder")
+        for child, consequence in ((recorder, "nothing after it is recorded; stopping the run"),
+                                   (sim, "no time without it; stopping the constellation")):
+            if child.returncode is not None and (child is recorder or child.returncode != 0):
+                return (f"{child.name} (pid {child.proc.pid if child.proc else '?'}) "
+                        f"{child.describe_exit()} at sim t≈{self.progress.t_sim:.1f} s: "
+                        f"{consequence}.\n--- last lines of {child.log_path}:\n"
+                        f"{child.log_tail()}")
+        return None
+
+    def _flight_stopped(self, sim_done: bool) -> None:
+        for name in self.flight:
+            child = self.sup.named(name)
+            if name in self.down or child.returncode is None:
+                continue
+            if sim_done and child.returncode == 0:
+                continue
+            n = self.restarts.get(name, 0)
+            again = self.restart and not sim_done and n < MAX_RESTARTS
+            incident = Incident(name, child.describe_exit(), self.progress.t_sim, again)
+            self.incidents.append(incident)
+            log.error("%s; %s", incident, "starting it again" if again else
+                      "the constellation flies on without it")
+            if again:
+                self.restarts[name] = n + 1
+                self.sup.restart(child, n + 1)
+            else:
+                self.down.add(name)
 
 
 def _wait_token(hub: ZenohTransport, token: str, child: Child, timeout_s: float) -> bool:
@@ -386,6 +448,7 @@ class _Progress:
         self.t_sim = 0.0
         self.k = 0
         self.finished = threading.Event()
+        self.final: SimStatus | None = None
         self._wall0 = time.monotonic()
         self._last = 0.0
 
@@ -403,7 +466,15 @@ class _Progress:
         except Exception:  # noqa: BLE001
             return
         if status.state in ("finished", "aborted"):
+            self.final = status
             self.finished.set()
+
+    def lost_participants(self) -> list[str]:
+        """What the sim's final status says of participants lost from the lockstep."""
+        if self.final is None:
+            return []
+        return [f"{node} " + ", ".join(f"{e.what} at t≈{e.t_sim:.1f} s" for e in events)
+                for node, events in self.final.participants.items()]
 
     def report(self, final: bool = False) -> None:
         now = time.monotonic()

@@ -80,6 +80,14 @@ class Admission:
             return "queue", f"{pending} messages already waiting for delivery"
         return None
 
+    def forget(self, prefix: str = "") -> None:
+        """Forget the sequence numbers of the keys under ``prefix`` (all, by default) and, for
+        all, the clock: their publisher restarted, or this node rejoins the lockstep."""
+        self.highest_seq = {k: s for k, s in self.highest_seq.items()
+                            if prefix and not k.startswith(prefix)}
+        if not prefix:
+            self.clock_s = None
+
     def admit(self, key: str, msg: Message) -> None:
         """Record an admitted message's sequence number (the barrier waits on it)."""
         if msg.seq > self.highest_seq.get(key, 0):

@@ -130,7 +130,12 @@ class TickClient:
 
     ``synchronous`` (in-process transport): a tick runs inside the sim's publish call.
     Otherwise ticks queue up and ``serve()`` runs them on the calling (main) thread until the sim
-    reports the run finished, or the sim's liveliness token disappears."""
+    reports the run finished, or the sim's liveliness token has been gone for
+    ``rejoin_grace_s`` (wall).  A node cut off from the sim (its process stalled, its link
+    lost) that sees the sim again within that time rejoins: it forgets its tick count, clock
+    and sequence numbers and runs the next tick it receives.  A node whose token comes back
+    (a restarted process numbers its messages from 1 again) has its sequence numbers
+    forgotten."""
 
     SUBSCRIBES: ClassVar[tuple[Topic, ...]] = (cat.TICK, cat.SIM_STATUS)
 
@@ -139,7 +144,10 @@ class TickClient:
     _ticks: queue.Queue[Tick | None] = field(default_factory=queue.Queue)
     finished: threading.Event = field(default_factory=threading.Event)
     sim_lost: bool = False
+    rejoin_grace_s: float = 60.0
+    rejoins: int = 0
     _last_k: int = -1
+    _lost_at: float = 0.0
 
     def __post_init__(self) -> None:
         bus = self.executive.bus
@@ -179,20 +187,33 @@ class TickClient:
             self._ticks.put(None)
 
     def on_liveness(self, node: str, alive: bool) -> None:
-        """Liveliness handler: losing the sim ends the node's loop (nothing waits forever)."""
+        """Liveliness handler: the sim lost (see the class docstring), the sim back (rejoin),
+        another node back (its sequence numbers start again)."""
+        bus = self.executive.bus
         if node == topics.SIM and not alive:
-            self.sim_lost = True
+            self.sim_lost, self._lost_at = True, time.monotonic()
             self._ticks.put(None)
+        elif node == topics.SIM and self.sim_lost:
+            self.sim_lost, self._last_k = False, -1
+            bus.admission.forget()
+            self.rejoins += 1
+            self.executive.log.warning("%s: the sim is back; rejoining the lockstep",
+                                       bus.node)
+        elif alive and node != bus.node:
+            bus.admission.forget(topics.node_prefix(bus.mission, node) + "/")
 
     def serve(self, stop: threading.Event | None = None) -> None:
-        """Run ticks until finished, the sim is lost, or ``stop`` is set."""
+        """Run ticks until finished, the sim is lost for good, or ``stop`` is set."""
         while not (stop is not None and stop.is_set()):
             try:
                 tick = self._ticks.get(timeout=0.5)
             except queue.Empty:
-                continue
-            if tick is None:
-                if self.finished.is_set() or self.sim_lost:
-                    return
-                continue
-            self.executive.run_tick(tick)
+                tick = None
+            if tick is not None:  # every tick queued before the end is run
+                self.executive.run_tick(tick)
+            elif self.finished.is_set() or self._gone():
+                return
+
+    def _gone(self) -> bool:
+        """Whether the sim has been lost for longer than ``rejoin_grace_s``."""
+        return self.sim_lost and time.monotonic() - self._lost_at > self.rejoin_grace_s

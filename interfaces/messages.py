@@ -122,13 +122,21 @@ class TickDone(Message):
 
 
 class SimStatus(Message):
-    """Lifecycle of the run, from the sim: ``running`` then ``finished`` (nodes then exit)."""
+    """Lifecycle of the run, from the sim: ``running`` then ``finished`` (nodes then exit);
+    ``participants``: the nodes lost from the lockstep (process died, stalled, disconnected) and
+    rejoined, with their sim times."""
+
+    class Event(BaseModel):
+        model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+        what: Literal["lost", "rejoined"]
+        t_sim: float = Field(ge=0.0, le=MAX_TIME_S)
 
     state: Literal["waiting", "running", "finished", "aborted"]
     k: int = Field(default=0, ge=0)
     reason: str = ""
     rejected_commands: int = Field(
         default=0, ge=0, description="actuator commands refused (stale, future or wrong sender)")
+    participants: dict[str, list[Event]] = Field(default_factory=dict, max_length=64)
 
 
 # --- sim truth and sensors -------------------------------------------------------------------
@@ -331,8 +339,8 @@ class FdirWindow(Message):
     (sequence gaps)."""
 
     spacecraft: int = Field(ge=1)
-    t_start_s: float
-    t_end_s: float
+    t_start_s: Time
+    t_end_s: Time
     images: int = Field(ge=0)
     lost: int = Field(default=0, ge=0, description="observations missing by sequence number")
     dh: float | None = None
@@ -365,8 +373,8 @@ class ConstellationWindow(Message):
     the window's start (Eq. 4) and the running shortfall Σ(ΔH^pred − ΔH) (Eq. 6's H − H_nom to
     first order).  None where fewer than three observers were judged."""
 
-    t_start_s: float
-    t_end_s: float
+    t_start_s: Time
+    t_end_s: Time
     observers: int = Field(ge=0)
     ratio: float | None = None
     ratio_mean: float | None = None
@@ -390,7 +398,7 @@ class FaultReport(Message):
     direction: Literal["improved", "degraded"] | None = None
     metric: float | None = None
     threshold: float | None = None
-    window_end_s: float
+    window_end_s: Time
     evidence: dict[str, float] = Field(default_factory=dict, max_length=32)
 
 
@@ -401,8 +409,8 @@ class BaselineVerdict(Message):
 
     detector: Literal["chi2_nis", "cusum", "fixed_threshold"]
     spacecraft: int = Field(ge=1)
-    t_start_s: float
-    t_end_s: float
+    t_start_s: Time
+    t_end_s: Time
     statistic: float | None = None
     threshold: float | None = None
     exceeded: bool | None = None
@@ -434,7 +442,7 @@ class TransferPlanMsg(Message):
 
     spacecraft: int = Field(ge=1)
     assignment_id: int = Field(ge=1)
-    t_s: list[float]
+    t_s: list[Time]
     x: list[State6]
     u_mps2: list[Accel]
     dv_mps: float = Field(ge=0.0, description="planned L1 fuel, Σ|u|·h, m/s")
@@ -467,7 +475,7 @@ class PoiObservations(_PoiPrecisions):
     """The observations of one image of ``spacecraft`` (taken at ``image_t_s``) as shared with
     the other observers and the ground.  Received only within range."""
 
-    image_t_s: float = Field(ge=0.0)
+    image_t_s: Time
 
 
 class InfoCostTelemetry(Message):
@@ -581,6 +589,9 @@ class TelemetryStatus(Message):
         stale: bool = False
         nav_resets: int = Field(default=0, ge=0,
                                 description="navigation filter restarts (StateEstimate.resets)")
+        outages: list[Annotated[list[float], Field(min_length=2, max_length=2)]] = Field(
+            default_factory=list, max_length=100,
+            description="[last heard, heard again] (sim s) of each silence that ended")
 
     entries: list[Entry]
 

@@ -114,6 +114,8 @@ class SimNode:
         self._answer_k = -1
         self._alive: set[str] = set()
         self._dead: set[str] = set()
+        self.events: dict[str, list[tuple[str, float]]] = {}
+        """Per participant, ("lost" | "rejoined", sim time s) in order."""
         self.missed_answers = 0
         self.rejected_commands = 0
         self._t_now = 0.0
@@ -172,15 +174,25 @@ class SimNode:
                 self._cond.notify_all()
 
     def on_liveness(self, node: str, alive: bool) -> None:
-        """Liveliness handler: a participant that disappears is not waited for any more."""
+        """Liveliness handler: a participant that disappears is not waited for any more (its
+        last commands are held by the hardware, within their own limits); one that comes back
+        (a stalled process resumed, a crashed one restarted) is waited for again from the next
+        tick.  Both are recorded with their sim time for the final status."""
         with self._cond:
+            t = self._t_now
             if alive:
                 self._alive.add(node)
+                if node in self._dead:
+                    self._dead.discard(node)
+                    self.events.setdefault(node, []).append(("rejoined", t))
+                    self.log.warning("participant %s rejoined at t=%.1f s", node, t)
             elif node in self.participants and node in self._alive:
                 self._alive.discard(node)
                 if self._answer_k < self.scenario.n_ticks - 1:
                     self._dead.add(node)
-                    self.log.error("participant %s lost (process died or disconnected)", node)
+                    self.events.setdefault(node, []).append(("lost", t))
+                    self.log.error("participant %s lost at t=%.1f s (process died, stalled or "
+                                   "disconnected); flying on with its last commands", node, t)
             self._cond.notify_all()
 
     def wait_for_participants(self, timeout_s: float) -> None:
@@ -299,9 +311,13 @@ class SimNode:
 
     def _status(self, state: str, k: int, reason: str = "") -> None:
         t = k * self.scenario.rates.dt_s
+        with self._cond:
+            events = {n: [SimStatus.Event(what=w, t_sim=s) for w, s in e]
+                      for n, e in self.events.items()}
         self.bus.publish(self._keys["status"], SimStatus(
             sender=topics.SIM, t_sim=t, state=state, k=k, reason=reason,
-            rejected_commands=self.rejected_commands), announce=False)  # type: ignore[arg-type]
+            rejected_commands=self.rejected_commands,
+            participants=events), announce=False)  # type: ignore[arg-type]
 
 
 def _sleep_until(wall: float) -> None:

@@ -48,7 +48,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     lines += _gnc_section(out, digest.gnc_series(scenario, mission), summary)
     lines += _coverage_section(out, digest.coverage, summary)
     lines += _fdir_section(out, archive, mission, summary)
-    lines += _links_section(summary) + _exec_section(summary)
+    lines += _links_section(summary) + _exec_section(summary) + _incidents_section(summary)
     return _write(out, lines)
 
 
@@ -343,6 +343,24 @@ def _links_section(summary: dict) -> list[str]:
     for c in summary.get("links", []):
         rows.append(f"| {c['src']} → {c['dst']} | {c['sent']} | {c['delivered']} | "
                     f"{c['dropped_range']} | {c['dropped_loss']} | {c['dropped_cut']} |")
+    return rows + [""]
+
+
+def _incidents_section(summary: dict) -> list[str]:
+    """Processes lost from the lockstep and telemetry outages (a degraded run)."""
+    lost = summary.get("sim", {}).get("participants", {})
+    outages = {e["spacecraft"]: e.get("outages", []) for e in summary.get("telemetry", [])}
+    if not lost and not any(outages.values()):
+        return []
+    rows = ["## Incidents", "", f"Run status: **{summary.get('status')}**"
+            + (f" ({summary['error']})" if summary.get("error") else ""), "",
+            "| node | lockstep (sim s) | telemetry outages (sim s) |", "|---|---|---|"]
+    nodes = sorted(set(lost) | {f"sc{sc}" for sc, o in outages.items() if o})
+    for node in nodes:
+        events = ", ".join(f"{e['what']} {e['t_sim']:.1f}" for e in lost.get(node, []))
+        sc = int(node[2:]) if node.startswith("sc") else None
+        gaps = ", ".join(f"{a:.1f}-{b:.1f}" for a, b in outages.get(sc, []))
+        rows.append(f"| {node} | {events or '-'} | {gaps or '-'} |")
     return rows + [""]
 
 

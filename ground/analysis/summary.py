@@ -54,7 +54,9 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[s
                         "refused": m.refused, "barrier_timeouts": m.barrier_timeouts}
                  for node, m in sorted(execs.items())},
         "telemetry": [e.model_dump() for e in tlm[-1].entries] if tlm else [],
-        "sim": {"rejected_commands": sim[-1].rejected_commands if sim else None},
+        "sim": {"rejected_commands": sim[-1].rejected_commands if sim else None,
+                "participants": ({n: [e.model_dump() for e in ev]
+                                  for n, ev in sim[-1].participants.items()} if sim else {})},
         "fault_events": [e.model_dump(exclude={"sender", "seq", "t_wall"})
                          for e in archive.of(cat.FAULT_EVENTS, mission)],
         **fdir_summary(archive, scenario, mission),

@@ -51,6 +51,10 @@ class BaselinesApp(App):
     def step(self, t: float) -> None:
         windows, self.windows = self.windows, []
         for w in sorted(windows, key=lambda w: (w.t_end_s, w.spacecraft)):
+            if not 1 <= w.spacecraft <= self.count or w.t_end_s < w.t_start_s:
+                self.log.warning("baseline: window of sc%d [%.1f, %.1f) s ignored", w.spacecraft,
+                                 w.t_start_s, w.t_end_s)
+                continue
             self._chi2(w)
             self._information(w)
 

@@ -2,9 +2,10 @@
 
 Rate group low.  Inputs: every spacecraft's state estimate and heartbeat.  Output: per
 spacecraft the messages received, the messages missing by sequence count (lost on the link or
-out of range), whether it has gone silent, and how often its navigation filter has diverged and
-restarted (``StateEstimate.resets``, logged as it happens).  Missing telemetry is a fact to
-report (a link problem), never a zero.
+out of range), whether it has gone silent and when it was silent before (outages longer than
+``STALE_AFTER_S``: a stalled, crashed or unreachable spacecraft), and how often its navigation
+filter has diverged and restarted (``StateEstimate.resets``, logged as it happens).  Missing
+telemetry is a fact to report (a link problem), never a zero.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ class _Track:
     gaps: int = 0
     last_t: float | None = None
     nav_resets: int = 0
+    outages: list[tuple[float, float]] = field(default_factory=list)
     last_seq: dict[str, int] = field(default_factory=dict)
 
 
@@ -52,6 +54,10 @@ class TelemetryMonitor(App):
             track.gaps += msg.seq - last - 1
         track.last_seq[kind] = max(last, msg.seq)
         track.received += 1
+        if track.last_t is not None and msg.t_sim - track.last_t > self.STALE_AFTER_S:
+            track.outages.append((track.last_t, msg.t_sim))
+            self.log.warning("sc%d heard again at t=%.1f s after %.1f s of silence", sc,
+                             msg.t_sim, msg.t_sim - track.last_t)
         track.last_t = msg.t_sim if track.last_t is None else max(track.last_t, msg.t_sim)
         if isinstance(msg, StateEstimate) and msg.resets > track.nav_resets:
             self.log.warning("sc%d reports its navigation filter restarted (%d so far, t=%.1f s)",
@@ -62,7 +68,7 @@ class TelemetryMonitor(App):
         entries = [
             TelemetryStatus.Entry(
                 spacecraft=sc, received=tr.received, seq_gaps=tr.gaps, last_t_sim=tr.last_t,
-                nav_resets=tr.nav_resets,
+                nav_resets=tr.nav_resets, outages=[list(o) for o in tr.outages[-100:]],
                 stale=tr.last_t is None or t - tr.last_t > self.STALE_AFTER_S)
             for sc, tr in self.tracks.items()
         ]
