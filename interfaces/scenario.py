@@ -451,7 +451,12 @@ class FdirSettings(_Section):
 
 
 class SimSettings(_Section):
-    lockstep_timeout_s: float = Field(default=5.0, gt=0.0, description="per-tick answer timeout")
+    lockstep_timeout_s: float = Field(
+        default=60.0, gt=0.0,
+        description="per-tick answer timeout, s (wall): a participant alive but slow (a kernel "
+                    "compiled on first use, a loaded machine) is waited for, so results stay "
+                    "deterministic; a dead or stalled one is dropped as soon as the network "
+                    "notices (at once, or after the 10 s Zenoh lease)")
     startup_timeout_s: float = Field(default=60.0, gt=0.0)
     substeps: int = Field(default=1, ge=1, description="RK4 steps per tick")
     cycle_budget_scale: float = Field(

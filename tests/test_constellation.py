@@ -172,7 +172,7 @@ def test_recorder_death_stops_the_run_at_once(tmp_path: Path, free_port: int) ->
     out = tmp_path / "out"
     p = _launch(path, out, free_port, "--realtime", "10")
     try:
-        _under_way(out, "norec")
+        _under_way(out, "norec", estimates=40)  # 4 s of wall: the recorder has flushed
         os.kill(_wait_pid(["ground.archive.record"], 10.0), signal.SIGKILL)
         killed = time.monotonic()
     finally:
