@@ -31,5 +31,4 @@ def spacecraft_executive(bus: Bus, scenario: Scenario, spacecraft: int) -> Execu
     for app in apps:
         if isinstance(app, InfoCostApp):  # software fault injection (faulty_data), if any
             app.report_factor = reported_h_factor(scenario, spacecraft)
-    return Executive(bus, scenario, apps, log=log,
-                     barrier_timeout_s=scenario.sim.lockstep_timeout_s)
+    return Executive(bus, scenario, apps, log=log)

@@ -22,5 +22,4 @@ def ground_executive(bus: Bus, scenario: Scenario) -> Executive:
     log = logging.getLogger("insp.ground")
     ctx = AppContext(bus=bus, scenario=scenario, node=topics.GROUND, spacecraft=None,
                      rng=stream(scenario.seed, "ground"), log=log)
-    return Executive(bus, scenario, [a(ctx) for a in APPS], log=log,
-                     barrier_timeout_s=scenario.sim.lockstep_timeout_s)
+    return Executive(bus, scenario, [a(ctx) for a in APPS], log=log)

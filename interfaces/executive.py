@@ -49,6 +49,9 @@ class Executive:
     apps: list[App]
     log: logging.Logger = field(default_factory=lambda: logging.getLogger("insp.exec"))
     barrier_timeout_s: float = 5.0
+    """How long a tick waits for the messages it announces (s, wall).  They were all sent before
+    the sim sent the tick, so they arrive in milliseconds; only a message lost in a reconnection
+    (a node rejoining) is waited for this long."""
 
     def __post_init__(self) -> None:
         rates = self.scenario.rates
