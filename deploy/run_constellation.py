@@ -27,7 +27,8 @@ ground/tools/live.py): every bus message on a channel named by its key, and the 
 With --compare-recovery the same scenario and seed is run a second time, in-process, with the
 ground's fault recovery switched the other way ([fdir] recovery), into <out>/counterfactual/,
 and summary.json's ``recovery`` section compares the final H of the two.
-Exits 0 on success; non-zero, with the reason, if a process dies or the run cannot start.
+Exits 0 when the run completed; 1, with the reason, when it ended degraded (a flight or ground
+process lost, see _Watch) or failed (the sim or recorder died, the run could not start).
 """
 
 from __future__ import annotations

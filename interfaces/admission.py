@@ -62,10 +62,15 @@ class Admission:
         a refusal; an admitted message is recorded by ``admit`` once it is queued)."""
         return self._why(key, msg, pending)
 
-    def _why(self, key: str, msg: Message, pending: int) -> Refusal | None:
+    def owner(self, key: str) -> str | None:
+        """The node whose key space ``key`` is in (``topics.node_of_key``, cached per key)."""
         owner = self._owner.get(key, "")
         if owner == "":
             owner = self._owner[key] = topics.node_of_key(key)
+        return owner
+
+    def _why(self, key: str, msg: Message, pending: int) -> Refusal | None:
+        owner = self.owner(key)
         if msg.sender != owner:
             return "sender", f"sender {msg.sender!r} does not own the key (owner {owner!r})"
         last = self.highest_seq.get(key)
@@ -92,8 +97,3 @@ class Admission:
         """Record an admitted message's sequence number (the barrier waits on it)."""
         if msg.seq > self.highest_seq.get(key, 0):
             self.highest_seq[key] = msg.seq
-
-    @property
-    def total(self) -> int:
-        """Messages refused so far."""
-        return sum(self.refused.values())

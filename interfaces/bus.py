@@ -207,7 +207,7 @@ class Bus:
                 deferred.setdefault(id(msg), (msg, []))[1].append(sub)
         # One envelope per message, whatever the number of local subscribers: the channel
         # decides once, so every app of the node sees the same messages.
-        src = topics.node_of_key(key)
+        src = self.admission.owner(key)
         with self._cond:
             for msg, group in deferred.values():
                 self._pending.append(_Envelope(msg, key, src, False, group))

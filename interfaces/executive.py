@@ -148,7 +148,6 @@ class TickClient:
     finished: threading.Event = field(default_factory=threading.Event)
     sim_lost: bool = False
     rejoin_grace_s: float = 60.0
-    rejoins: int = 0
     _last_k: int = -1
     _lost_at: float = 0.0
 
@@ -199,7 +198,6 @@ class TickClient:
         elif node == topics.SIM and self.sim_lost:
             self.sim_lost, self._last_k = False, -1
             bus.admission.forget()
-            self.rejoins += 1
             self.executive.log.warning("%s: the sim is back; rejoining the lockstep",
                                        bus.node)
         elif alive and node != bus.node:

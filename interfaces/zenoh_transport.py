@@ -1,11 +1,11 @@
 """Zenoh transport of the Bus (eclipse-zenoh 1.x).
 
-Default network: every process is a Zenoh *peer* on loopback with multicast scouting off.  One
-process (the launcher, ``deploy/run_constellation.py``) listens on the well-known endpoint
-(``tcp/127.0.0.1:7447`` by default); every other process listens on a free loopback port and
-connects to it, and gossip scouting completes the peer mesh.  Any Zenoh client can connect to the
-well-known endpoint and subscribe to ``insp/**``.  For several hosts, pass a Zenoh JSON5 config
-file (router, endpoints) instead.
+A run's network (``deploy/run_constellation.py``): the run's router on the endpoint
+(``tcp/127.0.0.1:7447`` by default) and every process a client of it with its own account, from
+a Zenoh JSON5 config file (``config_file``: ``<out>/access/<account>.json5``, see
+``deploy/access.py``).  Without a config file the settings make an open network of *peers* on
+loopback (multicast scouting off; one listens on the endpoint, the others connect to it): tests
+and benchmarks of the bus alone.
 
 Messages are JSON with encoding ``application/json;<MessageType>``; publications use the BLOCK
 congestion control so that nothing is dropped under pressure (the channel model, not the
