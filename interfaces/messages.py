@@ -13,7 +13,7 @@ one is invalid, is dropped and counted.  Unknown fields are rejected too.
 from __future__ import annotations
 
 import math
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, ClassVar, Literal, get_args
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
@@ -329,6 +329,14 @@ class FaultEvent(Message):
     detail: dict[str, list[float] | float] = Field(default_factory=dict)
 
 
+WindowTest = Literal["information", "plan", "pointing", "dv_rate", "nis"]
+"""The main detector's tests of an observer's window: the information test (Eq. 9 against the
+threshold), the guidance and attitude consistency tests and the nav's NIS test
+(ground/fdir/consistency.py)."""
+
+WINDOW_TESTS: tuple[str, ...] = get_args(WindowTest)
+
+
 class FdirWindow(Message):
     """The FDIR's verdict on one observer over one FDI window [t_start_s, t_end_s): the
     information gained by the images that reached the ground (ΔH_i, ψ held at the window start)
@@ -360,8 +368,13 @@ class FdirWindow(Message):
                                   "or the floor guard above it")
     ratio_mean: float | None = Field(default=None, description="nominal mean of ΔH_i/ΔH_i^pred")
     ratio_std: float | None = Field(default=None, description="nominal 1σ of ΔH_i/ΔH_i^pred")
-    failed: list[Literal["information", "plan", "pointing", "dv_rate"]] = Field(
-        default_factory=list, max_length=4,
+    nis_sum: float | None = Field(
+        default=None, ge=0.0,
+        description="Σ NIS of the observer's nav updates in the window (fdir.fuse_nis)")
+    nis_limit: float | None = Field(
+        default=None, description="its χ²(6N) quantile at the window's false-alarm probability")
+    failed: list[WindowTest] = Field(
+        default_factory=list, max_length=len(WINDOW_TESTS),
         description="the detector's tests this window failed (ground/fdir/consistency.py)")
 
 

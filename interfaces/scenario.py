@@ -354,7 +354,8 @@ class FdirSettings(_Section):
     ``eps_deg``).  Both are computed and archived every window; ``floor`` is a guard under the
     one in force.  With ``fuse_guidance`` a window also fails on the nav-vs-plan, pointing and
     Δv-rate tests (ground/fdir/consistency.py: ``position_tol_m``, ``pointing_tol_deg``,
-    ``dv_rate_tol_mps2``).  A fault is declared after ``persistence`` failed windows in a row
+    ``dv_rate_tol_mps2``); with ``fuse_nis`` on the nav's normalized innovations.  A fault is
+    declared after ``persistence`` failed windows in a row
     (or, with ``persistence_window`` = n, on the window that brings the failures among the last
     n decided windows to ``persistence``); the constellation's ratio (the global check, Eq. 6)
     declares a fault no single observer explains; an observer whose observations stay missing
@@ -366,7 +367,7 @@ class FdirSettings(_Section):
     ``comms.packet_loss`` plus ``loss_tol`` (and the window's sampling spread) for
     ``checks_persistence`` windows a link fault.  A window is evaluated ``latency_s`` after it
     closes (its last images must have arrived).  A declared performance fault is identified
-    (ground/fdir/identify.py), on its window or the next,
+    (ground/fdir/identify.py), on its window or a later one of the episode,
     against the nominal bounds ``beta_tol`` (camera health located from the images),
     ``position_tol_m`` (camera from the images vs nav, nav vs plan), ``pointing_tol_deg``
     (reported pointing error), ``overlap_tol`` (seen vs expected POIs), ``explained_min``
@@ -391,6 +392,11 @@ class FdirSettings(_Section):
     fuse_guidance: bool = Field(
         default=True, description="the detector also fails a window on its nav-vs-plan, "
                                   "pointing and Δv-rate tests (ground/fdir/consistency.py)")
+    fuse_nis: bool = Field(
+        default=True, description="the detector also fails a window when the Σ NIS of the "
+                                  "observer's nav updates in it exceeds its χ² quantile at the "
+                                  "window's false-alarm probability (the budget is split "
+                                  "between this and the information test)")
     samples: int = Field(default=10, ge=1, le=1000)
     eps_deg: float = Field(default=1.0, gt=0.0, lt=45.0)
     floor: float = Field(default=0.002, ge=0.0,

@@ -35,6 +35,7 @@ from scipy.stats import beta  # noqa: E402
 
 from ground.analysis.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
 from ground.fdir.threshold import Persistence  # noqa: E402
+from interfaces.messages import WINDOW_TESTS  # noqa: E402
 from interfaces.scenario import Fault  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", "common_mode", None)
@@ -547,14 +548,13 @@ def _threshold_lines(runs: list[dict[str, Any]]) -> list[str]:
     n = sum(c["nominal_windows"] for c in census)
 
     def total(section: str, key: str) -> int:
-        return sum(c[section][key] for c in census)
+        return sum(c[section].get(key, 0) for c in census)  # older archives lack newer tests
 
     by = ", ".join(f"{k} {_pct(total('threshold_by', k), n)}"
                    for k in ("model", "sampled", "floor"))
     above = sum(c["model_above_floor"] for c in census)
     sampled = sum(c["sampled_above_floor"] for c in census)
-    failed = ", ".join(f"{k} {total('failed', k)}"
-                       for k in ("information", "plan", "pointing", "dv_rate"))
+    failed = ", ".join(f"{k} {total('failed', k)}" for k in WINDOW_TESTS)
     zn = total("model_z", "windows")
     z = ", ".join(f"|z| > {k}: {_pct(total('model_z', f'over_{k}'), zn)}" for k in (2, 3, 4))
     return ["", "## Thresholds (main detector, nominal windows)", "",

@@ -21,6 +21,7 @@ from interfaces.messages import (
     FdirWindow,
     LinkStats,
     Tick,
+    WINDOW_TESTS,
 )
 from interfaces.scenario import Scenario
 
@@ -110,7 +111,7 @@ def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> dict[str,
         "model_above_floor": sum((w.threshold_model or 0.0) > floor for w in nominal),
         "sampled_above_floor": sum((w.threshold_sampled or 0.0) > floor for w in nominal),
         "failed": {k: sum(k in w.failed for w in nominal)
-                   for k in ("information", "plan", "pointing", "dv_rate")},
+                   for k in WINDOW_TESTS},
         "model_z": {f"over_{k}": sum(v > k for v in z) for k in (2, 3, 4)} | {"windows": len(z)},
     }
 

@@ -21,7 +21,8 @@ closes.  For observer i, with ψ the squared fused variance of the ground's map 
   model's quantile (``ground/fdir/hardware_threshold.py``), else Eq. 11-12's (``fdir.samples``
   pointings within ``fdir.eps_deg``), both archived, with the floor guard ``fdir.floor``;
   direction by Table 3; with ``fdir.fuse_guidance`` the window also fails on the nav-vs-plan,
-  pointing and Δv-rate tests (``ground/fdir/consistency.py``);
+  pointing and Δv-rate tests, and with ``fdir.fuse_nis`` on the Σ NIS of the observer's nav
+  updates in the window against its χ² quantile (``ground/fdir/consistency.py``);
 * the global check (Eq. 6, ``ground/fdir/constellation.py``): the constellation's ratio
   against its model; an information excess no single observer explains is declared once on the
   constellation (spacecraft 0, ``common_mode``) and not held against any observer;
@@ -29,7 +30,7 @@ closes.  For observer i, with ψ the squared fused variance of the ground's map 
   observer with a plan whose images stay missing for ``fdir.silent_windows`` windows is
   declared a link fault — missing data is never read as zero information gain;
 * a declared performance fault is identified (``ground/fdir/identify.py``), on the declaring
-  window or, when that shows no class, the next: the camera's
+  window or, when that shows no class, a later one of the episode: the camera's
   position and health located from the images themselves, the nav estimate and the reported
   attitude against the plan, the twin re-run at the reported pose (the gradient test), the
   seen POIs against those that pose would see, and the Δv it commands on station;
@@ -61,7 +62,7 @@ from fsw.lib.hcw import mean_motion
 from fsw.lib.infocost import Camera
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
-from ground.fdir.consistency import failed_tests
+from ground.fdir.consistency import failed_tests, nis_test
 from ground.fdir.hardware_threshold import position_sigma, ratio_model, window_false_alarm
 from ground.fdir.constellation import ConstellationVerdict, ObserverGain, constellation_check
 from ground.fdir.identify import Evidence, Tolerances, classify, window_evidence
@@ -145,8 +146,8 @@ class FdirApp(App):
         self.boresight_body /= np.linalg.norm(self.boresight_body)
         self.tol = Tolerances.of(self.cfg)
         self.q_window = window_false_alarm(self.cfg.false_alarms_per_observer_hour, self.period,
-                                           self.cfg.persistence)
-        """per-window false-alarm probability of the hardware threshold"""
+                                           self.cfg.persistence, 2 if self.cfg.fuse_nis else 1)
+        """per-window false-alarm probability of the hardware threshold and of the NIS test"""
         self._reported: dict[tuple[int, int], float] = {}  # (observer, boundary) -> H_i
         self.next_window = 0
         """the next FDI window to judge (``interfaces.fdi_schedule``)"""
@@ -206,6 +207,8 @@ class FdirApp(App):
             obs.nav.add(msg.t_sim, np.array(msg.x[:3]))
             obs.nav_sigma.add(msg.t_sim, np.array([math.sqrt(max(
                 (msg.P[0][0] + msg.P[1][1] + msg.P[2][2]) / 3.0, 0.0))]))
+            if msg.nis is not None:
+                obs.nis.append((msg.t_sim, msg.nis))
 
     def on_guidance(self, msg: GuidanceStatus) -> None:
         obs = self.observers.get(msg.spacecraft)
@@ -252,11 +255,7 @@ class FdirApp(App):
         for sc, j in judged.items():
             self._declare(sc, j, common)
         for obs in self.observers.values():
-            obs.forget_modes_before(b)
-            obs.nav.forget_before(b)
-            obs.nav_sigma.forget_before(b)
-            obs.attitude.forget_before(b)
-            obs.forget_guidance_before(b)
+            obs.forget_before(b)
         for m in inside:
             self.settled.add(m.spacecraft, *m.arrays())
         self.pending = [m for m in self.pending if m.image_t_s >= b]
@@ -372,6 +371,9 @@ class FdirApp(App):
         failed = [] if m_val is None or th.tau is None or m_val <= th.tau else ["information"]
         if self.cfg.fuse_guidance:
             failed += failed_tests(ev, self.tol)
+        nis = nis_test(obs.nis_between(a, b), self.q_window) if self.cfg.fuse_nis else None
+        if nis is not None and nis[0] > nis[1]:
+            failed.append("nis")
         if failed or sc in self._unidentified:
             ev = window_evidence(self.twin, seen, nav, att, pos, psi, phi, (dh, dh_pred), dv_rate)
         window = window.model_copy(update={
@@ -379,6 +381,7 @@ class FdirApp(App):
             "direction": direction(dh, dh_pred, h_prev), "evidence": ev.as_dict(),
             "threshold_model": th.model_tau, "threshold_sampled": th.sampled,
             "threshold_by": th.by, "failed": failed,
+            "nis_sum": nis[0] if nis else None, "nis_limit": nis[1] if nis else None,
             "ratio_mean": th.model.mean if th.model else None,
             "ratio_std": th.model.std if th.model else None})
         return Judgement(window, ev, th)
@@ -422,7 +425,8 @@ class FdirApp(App):
         """Publish the window's verdict and declare a fault on the observer after
         ``fdir.persistence`` failed windows.  An information test failed by every observer
         together is the constellation's (common mode), not this observer's.  A fault declared
-        without a class is identified on the next window when its evidence shows one."""
+        without a class is identified on a later window of the episode (while its windows fail,
+        and on the first that passes) when its evidence shows one."""
         failed = [f for f in j.window.failed
                   if not (f == "information" and common is not None and common.common_mode)]
         exceeded = bool(failed) if failed or j.decided else None
@@ -430,7 +434,7 @@ class FdirApp(App):
         self.publish("window", w)
         b = w.t_end_s
         if self.persistence.update(sc, exceeded):
-            cls = classify(j.evidence, self.tol)
+            cls = classify(j.evidence, self.tol, failed)
             self.log.warning("FDIR: fault declared on sc%d at %.0f s (failed %s; H_m %s, τ %s, "
                              "%s): %s", sc, b, "+".join(failed), _g(w.metric), _g(w.threshold),
                              w.direction, cls or "unidentified")
@@ -438,8 +442,9 @@ class FdirApp(App):
             if cls is None:
                 self._unidentified.add(sc)
         elif sc in self._unidentified:
-            self._unidentified.discard(sc)
-            cls = classify(j.evidence, self.tol)
+            cls = classify(j.evidence, self.tol, failed)
+            if cls is not None or not exceeded:
+                self._unidentified.discard(sc)
             if cls is not None:
                 self.log.warning("FDIR: sc%d identified at %.0f s: %s", sc, b, cls)
                 self._report(sc, cls, w, j.evidence)

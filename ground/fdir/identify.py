@@ -53,6 +53,14 @@ follows it the same way (``offset_alignment`` > 0.5, the cosine between the loca
 and the nav's offsets from the plan), while a biased nav sits on one side of the plan and the
 truth, steered by it, on the other (a negative cosine).
 
+A window that fails only the nav's NIS test (ground/fdir/consistency.py) is not called
+``state_sensor``: the NIS sees an orbit actuator fault's unmodelled force as soon as a biased
+sensor's step, often before the truth has moved off the plan by more than the camera fixes'
+noise, and with the nav still near the plan the camera-off-nav fallback would name the sensor.
+Such a fault is declared unidentified and identified on a later window of the episode, when its
+other tests or its geometry speak (a leak: Δv spent, offsets the same way; a bias: the nav off
+the plan).
+
 (``link`` and ``data_integrity`` are decided by the FDIR app from missing telemetry and from
 the reported H_i.)  Pure functions; the app gathers the inputs.
 """
@@ -194,9 +202,17 @@ class Tolerances:
                    fdir.explained_min, fdir.dv_rate_tol_mps2)
 
 
-def classify(ev: Evidence, tol: Tolerances) -> str | None:
+def classify(ev: Evidence, tol: Tolerances, failed: Sequence[str] = ()) -> str | None:
     """The fault class the evidence points to (module docstring table), or None when nothing
-    stands out."""
+    stands out.  ``failed``: the detector's tests the window failed; a window failed by the
+    nav's NIS test alone is not called ``state_sensor`` (module docstring)."""
+    cls = _evidence_class(ev, tol)
+    if cls == "state_sensor" and list(failed) == ["nis"]:
+        return None
+    return cls
+
+
+def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
     if ev.beta_hat is not None and abs(ev.beta_hat - 1.0) > tol.beta:
         return "camera"
     explained = [e for e in (ev.explained_reported, ev.explained_located) if e is not None]

@@ -69,6 +69,8 @@ class ObserverState:
     attitude knowledge 1σ (rad)"""
     guidance: list[tuple[float, float, bool]] = field(default_factory=list)
     """reported (time s, Δv commanded so far m/s, holding its PRO), in time order"""
+    nis: list[tuple[float, float]] = field(default_factory=list)
+    """the nav's reported (time s, NIS of that step's measurement update), in arrival order"""
     silent: int = 0
     link_declared: bool = False
     last_seq: int = 0
@@ -90,6 +92,19 @@ class ObserverState:
         """Share of its observations that never reached the ground, since the start."""
         total = self.received + self.lost
         return self.lost / total if total else 0.0
+
+    def nis_between(self, a: float, b: float) -> list[float]:
+        """The NIS of the nav updates in [a, b)."""
+        return [v for t, v in self.nis if a <= t < b]
+
+    def forget_before(self, t: float) -> None:
+        """Drop every report no window from ``t`` on needs."""
+        self.forget_modes_before(t)
+        self.nav.forget_before(t)
+        self.nav_sigma.forget_before(t)
+        self.attitude.forget_before(t)
+        self.forget_guidance_before(t)
+        self.nis = [(s, v) for s, v in self.nis if s >= t]
 
     def forget_modes_before(self, t: float) -> None:
         """Drop mode changes no later window needs (keep the one in force at t)."""
