@@ -127,8 +127,20 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     ({"nav_vs_plan_m": 0.12, "camera_vs_nav_m": 0.56, "offset_alignment": 0.9}, "actuator"),
     ({"nav_vs_plan_m": 0.10, "camera_vs_nav_m": 0.48, "seen_overlap": 0.78,
       "offset_alignment": 0.8}, "actuator"),  # the same, the seen set already changing
+    # a 3 m nav bias 15-45 s after its step (hard campaign, late-nav-bias-0000): the nav
+    # absorbing the step has walked off the plan, the camera is still on it
+    ({"nav_vs_plan_m": 0.55, "camera_vs_nav_m": 0.52, "camera_vs_plan_m": 0.04},
+     "state_sensor"),
+    ({"nav_vs_plan_m": 3.0, "camera_vs_nav_m": 1.5, "camera_vs_plan_m": 4.0},
+     "actuator"),  # a leak: the camera farther off the plan than the nav
     # a biased nav: nav and truth on opposite sides of the plan
     ({"nav_vs_plan_m": 1.2, "camera_vs_nav_m": 2.3, "offset_alignment": -0.9}, "state_sensor"),
+    # misaligned in its mount (hard campaign, late-misaligned-0001: 5.2°): the seen set
+    # differs little (0.94), the boresight it shows is 5° off the reported one
+    ({"seen_overlap": 0.94, "camera_offset_deg": 5.0}, "camera"),
+    ({"camera_offset_deg": 1.5}, None),  # within the fit's spread
+    ({"pointing_error_deg": 5.0, "explained_reported": 0.99, "camera_offset_deg": 0.7},
+     "actuator"),  # a wheel fault: the attitude knows where it points
     ({"pointing_error_deg": 5.0, "explained_reported": 0.1, "explained_located": 0.2},
      None),  # reported off target, but that does not explain the loss
     ({}, None),  # nothing stands out

@@ -29,10 +29,12 @@ evidence (in this order)                                    class
 ==========================================================  ================
 β̂ off 1 (information short by a uniform factor)             ``camera``
 pointing error reported, and the pose explains the ΔH gap   ``actuator``
+the seen POIs show a boresight > 2 × pointing_tol_deg off    ``camera``
 Δv commanded while holding, above ``dv_rate_tol_mps2``      ``actuator``
 camera not where nav says, by more than nav is off plan,
 and nav and camera off the plan the same way                ``actuator``
 camera not where nav says, by more than nav is off plan     ``state_sensor``
+nav off plan, the camera on it (within half the tolerance)  ``state_sensor``
 nav off plan (the observer knows it is not on its orbit)    ``actuator``
 nav and camera off the plan the same way, camera off nav
 by more than half the position tolerance                    ``actuator``
@@ -51,7 +53,9 @@ window of a 3 m step, 1e-4 after).  With short windows the Δv has not built up 
 declared; the directions separate them then: a leak drags the truth off the plan and the nav
 follows it the same way (``offset_alignment`` > 0.5, the cosine between the located camera's
 and the nav's offsets from the plan), while a biased nav sits on one side of the plan and the
-truth, steered by it, on the other (a negative cosine).
+truth, steered by it, on the other (a negative cosine).  In a bias's first tens of seconds the
+filter is still absorbing the step: the nav walks off the plan while the spacecraft, steered
+by it only slowly, is still on it, so the camera located from the images sits on the plan.
 
 A window that fails only the nav's NIS test (ground/fdir/consistency.py) is not called
 ``state_sensor``: the NIS sees an orbit actuator fault's unmodelled force as soon as a biased
@@ -75,6 +79,7 @@ import numpy as np
 import numpy.typing as npt
 
 from fsw.lib.infocost import visibility
+from ground.fdir.boresight import boresight_offset
 from ground.fdir.twin import TwinModel, sample_stride
 from interfaces.scenario import FdirSettings
 
@@ -167,6 +172,9 @@ class Evidence:
             (guidance mode ``hold``), m/s².
         offset_alignment: cosine between the located camera's and the nav's median offsets
             from the plan (None when either is under ``MIN_OFFSET_M``).
+        camera_vs_plan_m: length of the located camera's median offset from the plan, m.
+        camera_offset_deg: median angle between the reported boresight and the one the seen
+            POIs show, from the located camera positions (``ground/fdir/boresight.py``), deg.
     """
 
     beta_hat: float | None = None
@@ -178,6 +186,8 @@ class Evidence:
     explained_located: float | None = None
     dv_rate_mps2: float | None = None
     offset_alignment: float | None = None
+    camera_vs_plan_m: float | None = None
+    camera_offset_deg: float | None = None
 
     def as_dict(self) -> dict[str, float]:
         """The evidence present, by name (for the bus and summary.json)."""
@@ -219,11 +229,15 @@ def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
     pose_explains = not explained or max(explained) >= tol.explained
     if (ev.pointing_error_deg or 0.0) > tol.pointing_deg and pose_explains:
         return "actuator"
+    if (ev.camera_offset_deg or 0.0) > 2.0 * tol.pointing_deg:  # beyond the fit's spread
+        return "camera"  # it looks elsewhere than its attitude says: misaligned in its mount
     if (ev.dv_rate_mps2 or 0.0) > tol.dv_rate_mps2:
         return "actuator"
     camera_nav, nav_plan = ev.camera_vs_nav_m or 0.0, ev.nav_vs_plan_m or 0.0
     if camera_nav > tol.position_m and camera_nav > nav_plan:
         return "actuator" if (ev.offset_alignment or 0.0) > SAME_WAY else "state_sensor"
+    if nav_plan > tol.position_m and (ev.camera_vs_plan_m or math.inf) < tol.position_m / 2.0:
+        return "state_sensor"  # the nav left the plan, the spacecraft did not
     if nav_plan > tol.position_m:
         return "actuator"
     if (ev.offset_alignment or 0.0) > SAME_WAY and camera_nav > tol.position_m / 2.0:
@@ -253,7 +267,9 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
     if len(located) < MIN_FIXES:
         located = []
     beta = float(np.median([f.beta for _, f in located])) if located else None
-    cam_nav = nav_plan = point = align = None
+    cam_nav = nav_plan = point = align = offset = None
+    cam_plan = (float(np.linalg.norm(np.median([f.position_m - planned[i] for i, f in located],
+                                               axis=0))) if located else None)
     if nav is not None:
         nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
         if located:
@@ -267,8 +283,25 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
     if gap is not None and nav is not None and attitude is not None:
         explained, explained_loc, overlap = _gap_evidence(twin, images, nav, attitude, located,
                                                           psi, phi, gap)
+    if gap is not None and attitude is not None and located:
+        offset = camera_offset_deg(twin, images, attitude, located)
     return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc, dv_rate,
-                    align)
+                    align, cam_plan, offset)
+
+
+OFFSET_IMAGES = 5
+"""Located images of a window whose boresight is fitted (evenly spread)."""
+
+
+def camera_offset_deg(twin: TwinModel, images: Sequence[Observation], attitude: np.ndarray,
+                      located: list[tuple[int, CameraFix]]) -> float | None:
+    """Median over up to ``OFFSET_IMAGES`` located images of the angle between the reported
+    boresight and the one the seen POIs show (``ground/fdir/boresight.py``), deg."""
+    k = sample_stride(len(located), OFFSET_IMAGES)
+    angles = [boresight_offset(f.position_m, attitude[i, :3], images[i][0], twin.poi_pos,
+                               twin.poi_normal, twin.camera) for i, f in located[::k]]
+    valid = [a for a in angles if a is not None]
+    return math.degrees(float(np.median(valid))) if valid else None
 
 
 MIN_OFFSET_M = 0.05
