@@ -17,7 +17,9 @@ window, all from telemetry it already receives:
   motion alone explains.  The twin carries this to all orders: it re-evaluates ΔH_i at the
   reported pose, and at the located camera positions, and :func:`explained_fraction` says how
   much of the gap ΔH_i − ΔH_i^pred each pose accounts for.
-* **The seen set**: the POIs an image saw against those the reported pose would see.
+* **The seen set**: the POIs an image saw against those the reported pose would see, and the
+  boresight they show (``ground/fdir/boresight.py``: the edge of the field of view across the
+  target, from the located camera), against the one the attitude estimate reports.
 * **The Δv it commands while holding its PRO**: a PRO is natural motion, so a healthy
   observer on station spends almost nothing (≈1e-5 m/s² of commanded Δv per second); one that
   fights a force it does not model (a thruster leak) spends what the force costs.
