@@ -50,6 +50,9 @@ def test_a_camera_seeing_the_whole_target_shows_no_offset() -> None:
 def test_nothing_seen_gives_no_offset_and_the_grid_starts_at_the_reported_boresight() -> None:
     cam = Camera(math.radians(8.0), 200.0, 1.0)
     assert boresight_offset(CAMERA_AT, np.array([0.0, 1.0, 0.0]), [], POS, NORMAL, cam) is None
-    bores, angle = candidate_boresights(np.array([0.0, 0.0, 2.0]))
-    assert np.allclose(bores[0], [0.0, 0.0, 1.0]) and angle[0] == 0.0
-    assert np.all(np.diff(angle) >= 0.0) and np.allclose(np.linalg.norm(bores, axis=1), 1.0)
+    bores = candidate_boresights(np.array([0.0, 0.0, 2.0]), 4.0, 2.0)
+    assert len(bores) == 25 and np.allclose(np.linalg.norm(bores, axis=1), 1.0)
+    assert np.allclose(bores[12], [0.0, 0.0, 1.0])  # the grid's centre: no tilt
+    assert math.degrees(max(np.arccos(np.clip(bores[:, 2], -1, 1)))) == pytest.approx(
+        math.degrees(math.atan(math.hypot(math.tan(math.radians(4.0)),
+                                          math.tan(math.radians(4.0))))))

@@ -375,7 +375,9 @@ class FdirApp(App):
         if nis is not None and nis[0] > nis[1]:
             failed.append("nis")
         if failed or sc in self._unidentified:
-            ev = window_evidence(self.twin, seen, nav, att, pos, psi, phi, (dh, dh_pred), dv_rate)
+            naming = sc in self._unidentified or not self.persistence.declared(sc)
+            ev = window_evidence(self.twin, seen, nav, att, pos, psi, phi, (dh, dh_pred), dv_rate,
+                                 fit_boresight=naming)
         window = window.model_copy(update={
             "dh": dh, "dh_pred": dh_pred, "metric": m_val, "threshold": th.tau,
             "direction": direction(dh, dh_pred, h_prev), "evidence": ev.as_dict(),

@@ -256,13 +256,14 @@ Observation = tuple[np.ndarray, np.ndarray]
 def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndarray | None,
                     attitude: np.ndarray | None, planned: np.ndarray, psi: np.ndarray,
                     phi: np.ndarray, gap: tuple[float, float] | None,
-                    dv_rate: float | None) -> Evidence:
+                    dv_rate: float | None, fit_boresight: bool = True) -> Evidence:
     """Identification evidence of one window.  ``nav``: reported positions at the image times
     (LVLH, m); ``attitude``: reported boresight, pointing error and aim point rows; ``planned``:
     the plan's positions.  The cheap parts (camera fixes, nav and attitude against the plan)
     every window, so their nominal spread is in the archive; the twin at the reported pose and
     the seen-set overlap only when the window exceeded its threshold (``gap`` = (ΔH_i,
-    ΔH_i^pred))."""
+    ΔH_i^pred)), and of those the boresight fit only with ``fit_boresight`` (a window that
+    must name a class)."""
     fixes = [locate_camera(twin.poi_pos[poi], prec, twin.camera.k, twin.radius_m)
              for poi, prec in images]
     located = [(i, f) for i, f in enumerate(fixes) if f is not None]
@@ -285,7 +286,7 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
     if gap is not None and nav is not None and attitude is not None:
         explained, explained_loc, overlap = _gap_evidence(twin, images, nav, attitude, located,
                                                           psi, phi, gap)
-    if gap is not None and attitude is not None and located:
+    if gap is not None and fit_boresight and attitude is not None and located:
         offset = camera_offset_deg(twin, images, attitude, located)
     return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc, dv_rate,
                     align, cam_plan, offset)

@@ -71,6 +71,10 @@ class Persistence:
     _hits: dict[int, list[bool]] = field(default_factory=dict)
     _declared: set[int] = field(default_factory=set)
 
+    def declared(self, spacecraft: int) -> bool:
+        """Whether a fault of ``spacecraft`` is declared and its episode still going on."""
+        return spacecraft in self._declared
+
     def update(self, spacecraft: int, exceeded: bool | None) -> bool:
         if exceeded is None:
             return False
