@@ -462,7 +462,11 @@ class FdirApp(App):
                    state: tuple[np.ndarray, np.ndarray, float], a: float) -> WindowThreshold:
         """Both thresholds of the window -- Eq. 11-12's ε-sampling and the hardware model's
         quantile -- and the one in force: the selected one (``fdir.threshold``), raised to the
-        floor guard where it is below."""
+        floor guard where it is below.  The model's pointing spread is the loop's jitter, the
+        reported attitude knowledge and the pointing error the observer reports in the window
+        (up to ``fdir.pointing_tol_deg``, beyond which the pointing test decides): the first
+        window after the initial acquisition still holds the loop's transient (0.13° against
+        0.01° later), which the jitter alone does not cover."""
         cfg, seed = self.cfg, self.ctx.scenario.seed
         psi, phi, h_prev = state
         bore = planned_boresights(att, pos)
@@ -472,12 +476,14 @@ class FdirApp(App):
         aims = att[:, 4:7] if att is not None else np.zeros_like(pos)
         nav_sigma, nav = obs.nav_sigma.at(times), obs.nav.at(times)
         knowledge = float(np.mean(att[:, 7])) if att is not None else 0.0
+        tracking = min(float(np.median(att[:, 3])) if att is not None else 0.0,
+                       math.radians(cfg.pointing_tol_deg))  # beyond: the pointing test's
         model = ratio_model(
             self.twin, pos, aims, psi, phi,
             position_sigma(cfg.transfer_sigma_m if moving else cfg.track_sigma_m,
                            float(np.mean(nav_sigma)) if nav_sigma is not None else 0.0,
                            None if nav is None else nav - pos, cfg.position_tol_m),
-            math.hypot(math.radians(cfg.pointing_jitter_deg), knowledge),
+            math.hypot(math.radians(cfg.pointing_jitter_deg), knowledge, tracking),
             self.ctx.scenario.camera.noise_frac, cfg.model_samples,
             np.random.default_rng([seed, sc, int(round(a)), 1]), prec)
         model_tau = model.threshold(self.q_window) if model is not None else None
