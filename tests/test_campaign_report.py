@@ -15,6 +15,7 @@ from ground.analysis.campaign_report import (
     _alarms_at,
     _magnitude_bins,
     _roc,
+    detector_figures,
     write_campaign_report,
 )
 
@@ -159,3 +160,20 @@ def test_m_of_n_persistence() -> None:
     assert [a.t_s for a in _alarms_at(gappy, 1.0, 2, 3)] == [300.0, 1100.0]
     assert [a.t_s for a in _alarms_at(gappy, 1.0, 1, 1)] == [100.0, 300.0, 900.0, 1100.0]
     assert _alarms_at(gappy, 3.0, 1, 1) == []  # threshold scaled above every level
+
+
+def test_a_replays_main_detector_is_scored_over_its_faithful_span(tmp_path: Path) -> None:
+    """A replay's declarations after its uplinks left the flown run's judge a trajectory nobody
+    commanded: the report's main detector counts the faithful span's false alarms (0 here), the
+    replay table's whole-run column the whole run's (2)."""
+    whole = {"per_fault": [], "false_alarms": 2, "nominal_cycles": 10}
+    faithful = {"per_fault": [], "false_alarms": 0, "nominal_cycles": 8}
+    _write(tmp_path, "r", {"injected_faults": [], "duration_s": 100.0, "scores": whole,
+                           "replay": {"faithful_until_s": 80.0, "scores_faithful": faithful},
+                           "fdir_series": {"main": []}})
+    write_campaign_report(tmp_path, "x", ["r"])
+    main = [r for r in csv.DictReader(open(tmp_path / "results.csv"))
+            if r["detector"] == "main"]
+    assert [(r["false_alarms"], r["nominal_cycles"]) for r in main] == [("0", "8")]
+    figures = detector_figures(tmp_path, ["r"])
+    assert (figures["false_alarms"], figures["false_alarms_faithful"]) == (2, 0)

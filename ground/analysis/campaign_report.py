@@ -84,7 +84,7 @@ def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """results.csv rows: per run, detector and fault (or one nominal row per detector)."""
     rows = []
     for s in runs:
-        detectors = {"main": s.get("scores", {}), **s.get("baselines", {})}
+        detectors = {"main": _main_scores(s), **s.get("baselines", {})}
         for name, sc in detectors.items():
             common = {"run": s["_id"], "group": s["_group"], "seed": s.get("seed"),
                       "status": s.get("status"),
@@ -146,16 +146,24 @@ def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> d
            and r["latency_s"] is not None]
     faithful = sum(s.get("replay", {}).get("faithful_until_s", math.inf) >= s["duration_s"]
                    for s in runs)
-    spans = [_detector_scores(s.get("replay", {}).get("scores_faithful") or s.get("scores", {}),
-                              s, detector) for s in runs]
+    spans = [_detector_scores(_main_scores(s), s, detector) for s in runs]
+    whole = [_detector_scores(s.get("scores", {}), s, detector) for s in runs]
     return {"faults": st["faults"], "detected": st["detected"], "isolated": st["isolated"],
             "identified": st["identified"],
             "latency_median_s": float(np.median(lat)) if lat else None,
             "latency_p90_s": float(np.quantile(lat, 0.9)) if lat else None,
-            "false_alarms": st["false_alarms"], "nominal_cycles": st["nominal_cycles"],
+            "false_alarms": sum(sc.get("false_alarms", 0) for sc in whole),
+            "nominal_cycles": sum(sc.get("nominal_cycles", 0) for sc in whole),
             "false_alarms_faithful": sum(sc.get("false_alarms", 0) for sc in spans),
             "nominal_cycles_faithful": sum(sc.get("nominal_cycles", 0) for sc in spans),
             "runs": len(runs), "faithful_runs": int(faithful)}
+
+
+def _main_scores(summary: dict[str, Any]) -> dict[str, Any]:
+    """The main detector's scores of a run: over the faithful span for a replay (what the
+    replay declared after its uplinks diverged from the flown run judges a trajectory nobody
+    commanded; ``ground.fdir.replay``), else the run's own."""
+    return summary.get("replay", {}).get("scores_faithful") or summary.get("scores", {})
 
 
 def _detector_scores(main: dict[str, Any], summary: dict[str, Any], detector: str
