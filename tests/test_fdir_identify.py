@@ -133,6 +133,9 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
      "state_sensor"),
     ({"nav_vs_plan_m": 3.0, "camera_vs_nav_m": 1.5, "camera_vs_plan_m": 4.0},
      "actuator"),  # a leak: the camera farther off the plan than the nav
+    # a 4.6 m step (late-nav-bias-0001): moving onto the biased orbit spends Δv at a leak's rate
+    ({"nav_vs_plan_m": 1.19, "camera_vs_nav_m": 1.26, "camera_vs_plan_m": 0.13,
+      "offset_alignment": -0.999, "dv_rate_mps2": 1e-3}, "state_sensor"),
     # a biased nav: nav and truth on opposite sides of the plan
     ({"nav_vs_plan_m": 1.2, "camera_vs_nav_m": 2.3, "offset_alignment": -0.9}, "state_sensor"),
     # misaligned in its mount (hard campaign, late-misaligned-0001: 5.2°): the seen set

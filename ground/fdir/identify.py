@@ -32,11 +32,11 @@ evidence (in this order)                                    class
 β̂ off 1 (information short by a uniform factor)             ``camera``
 pointing error reported, and the pose explains the ΔH gap   ``actuator``
 the seen POIs show a boresight > 2 × pointing_tol_deg off    ``camera``
+nav off plan, the camera on it (within half the tolerance)  ``state_sensor``
 Δv commanded while holding, above ``dv_rate_tol_mps2``      ``actuator``
 camera not where nav says, by more than nav is off plan,
 and nav and camera off the plan the same way                ``actuator``
 camera not where nav says, by more than nav is off plan     ``state_sensor``
-nav off plan, the camera on it (within half the tolerance)  ``state_sensor``
 nav off plan (the observer knows it is not on its orbit)    ``actuator``
 nav and camera off the plan the same way, camera off nav
 by more than half the position tolerance                    ``actuator``
@@ -58,6 +58,10 @@ and the nav's offsets from the plan), while a biased nav sits on one side of the
 truth, steered by it, on the other (a negative cosine).  In a bias's first tens of seconds the
 filter is still absorbing the step: the nav walks off the plan while the spacecraft, steered
 by it only slowly, is still on it, so the camera located from the images sits on the plan.
+That comes before the Δv spent: the guidance moving the observer onto the biased orbit spent
+1e-3 m/s² in the window of a 4.6 m step (hard campaign, late-nav-bias-0001), above the
+bound a leak is named by; a leak never leaves the truth on the plan with the nav off it (the
+nav lags the truth).
 
 A window that fails only the nav's NIS test (ground/fdir/consistency.py) is not called
 ``state_sensor``: the NIS sees an orbit actuator fault's unmodelled force as soon as a biased
@@ -233,13 +237,13 @@ def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
         return "actuator"
     if (ev.camera_offset_deg or 0.0) > 2.0 * tol.pointing_deg:  # beyond the fit's spread
         return "camera"  # it looks elsewhere than its attitude says: misaligned in its mount
+    camera_nav, nav_plan = ev.camera_vs_nav_m or 0.0, ev.nav_vs_plan_m or 0.0
+    if nav_plan > tol.position_m and (ev.camera_vs_plan_m or math.inf) < tol.position_m / 2.0:
+        return "state_sensor"  # the nav left the plan, the spacecraft did not (yet)
     if (ev.dv_rate_mps2 or 0.0) > tol.dv_rate_mps2:
         return "actuator"
-    camera_nav, nav_plan = ev.camera_vs_nav_m or 0.0, ev.nav_vs_plan_m or 0.0
     if camera_nav > tol.position_m and camera_nav > nav_plan:
         return "actuator" if (ev.offset_alignment or 0.0) > SAME_WAY else "state_sensor"
-    if nav_plan > tol.position_m and (ev.camera_vs_plan_m or math.inf) < tol.position_m / 2.0:
-        return "state_sensor"  # the nav left the plan, the spacecraft did not
     if nav_plan > tol.position_m:
         return "actuator"
     if (ev.offset_alignment or 0.0) > SAME_WAY and camera_nav > tol.position_m / 2.0:
