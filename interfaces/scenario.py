@@ -349,9 +349,9 @@ class FdirSettings(_Section):
     ``false_alarms_per_observer_hour``, of the ratio's distribution under no fault given the
     camera's noise (``[camera] noise_frac``), the station-keeping accuracy (``track_sigma_m``,
     ``transfer_sigma_m``) plus the nav's reported 1σ, and the pointing jitter
-    (``pointing_jitter_deg``) plus the reported attitude knowledge, propagated through the twin
-    with ``model_samples`` pose draws; or Eq. 11-12's (``samples`` pointings within
-    ``eps_deg``).  Both are computed and archived every window; ``floor`` is a guard under the
+    (``pointing_jitter_deg``) plus the reported attitude knowledge and pointing error (up to
+    ``pointing_tol_deg``), propagated through the twin with ``model_samples`` pose draws; or
+    Eq. 11-12's (``samples`` pointings within ``eps_deg``).  Both are computed and archived every window; ``floor`` is a guard under the
     one in force.  With ``fuse_guidance`` a window also fails on the nav-vs-plan, pointing and
     Δv-rate tests (ground/fdir/consistency.py: ``position_tol_m``, ``pointing_tol_deg``,
     ``dv_rate_tol_mps2``); with ``fuse_nis`` on the nav's normalized innovations.  A fault is
