@@ -351,11 +351,12 @@ class FdirSettings(_Section):
     ``transfer_sigma_m``) plus the nav's reported 1σ, and the pointing jitter
     (``pointing_jitter_deg``) plus the reported attitude knowledge and pointing error (up to
     ``pointing_tol_deg``), propagated through the twin with ``model_samples`` pose draws; or
-    Eq. 11-12's (``samples`` pointings within ``eps_deg``).  Both are computed and archived every window; ``floor`` is a guard under the
-    one in force.  With ``fuse_guidance`` a window also fails on the nav-vs-plan, pointing and
-    Δv-rate tests (ground/fdir/consistency.py: ``position_tol_m``, ``pointing_tol_deg``,
-    ``dv_rate_tol_mps2``); with ``fuse_nis`` on the nav's normalized innovations.  A fault is
-    declared after ``persistence`` failed windows in a row
+    Eq. 11-12's (``samples`` pointings within ``eps_deg``).  Both are computed and archived
+    every window; ``floor`` is a guard under the one in force.  With ``fuse_guidance`` a window
+    also fails on the nav-vs-plan, pointing and Δv-rate tests (ground/fdir/consistency.py:
+    ``position_tol_m``, ``pointing_tol_deg``, ``dv_rate_tol_mps2``); with ``fuse_nis`` on the
+    nav's normalized innovations.  A fault is declared after ``persistence`` failed windows in
+    a row
     (or, with ``persistence_window`` = n, on the window that brings the failures among the last
     n decided windows to ``persistence``); the constellation's ratio (the global check, Eq. 6)
     declares a fault no single observer explains; an observer whose observations stay missing
