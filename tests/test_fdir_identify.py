@@ -136,6 +136,18 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     # a 4.6 m step (late-nav-bias-0001): moving onto the biased orbit spends Δv at a leak's rate
     ({"nav_vs_plan_m": 1.19, "camera_vs_nav_m": 1.26, "camera_vs_plan_m": 0.13,
       "offset_alignment": -0.999, "dv_rate_mps2": 1e-3}, "state_sensor"),
+    # its identifying window in full: the attitude loop, aiming from the jumped nav, reports a
+    # pointing error, and the pose explains half the ΔH gap; the nav is off the plan, the
+    # camera on it (late-nav-bias-0001 and -0003, replayed)
+    ({"nav_vs_plan_m": 1.19, "camera_vs_nav_m": 1.26, "camera_vs_plan_m": 0.126,
+      "pointing_error_deg": 1.23, "explained_reported": -2.47, "explained_located": 0.5004,
+      "seen_overlap": 0.68, "offset_alignment": -0.999, "dv_rate_mps2": 7.1e-4}, "state_sensor"),
+    ({"nav_vs_plan_m": 0.95, "camera_vs_nav_m": 0.96, "camera_vs_plan_m": 0.044,
+      "pointing_error_deg": 1.59, "explained_reported": 0.155, "explained_located": 0.94,
+      "seen_overlap": 0.49, "dv_rate_mps2": 4.5e-4}, "state_sensor"),
+    # a wheel fault: the nav on its plan, the camera located near it
+    ({"pointing_error_deg": 3.76, "explained_reported": 0.87, "explained_located": 0.85,
+      "nav_vs_plan_m": 0.018, "camera_vs_plan_m": 0.14}, "actuator"),
     # a biased nav: nav and truth on opposite sides of the plan
     ({"nav_vs_plan_m": 1.2, "camera_vs_nav_m": 2.3, "offset_alignment": -0.9}, "state_sensor"),
     # misaligned in its mount (hard campaign, late-misaligned-0001: 5.2°): the seen set
