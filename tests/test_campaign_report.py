@@ -177,3 +177,28 @@ def test_a_replays_main_detector_is_scored_over_its_faithful_span(tmp_path: Path
     assert [(r["false_alarms"], r["nominal_cycles"]) for r in main] == [("0", "8")]
     figures = detector_figures(tmp_path, ["r"])
     assert (figures["false_alarms"], figures["false_alarms_faithful"]) == (2, 0)
+
+
+def test_faults_before_the_first_judged_window_are_reported_apart(tmp_path: Path) -> None:
+    """A fault injected at 10 s on an observer whose first judged window opens at 150 s and
+    declared at 180 s: 170 s from onset, 30 s from the first window that could judge it; a
+    fault at 400 s on a judged observer counts among the later ones."""
+    _write(tmp_path, "e", {
+        "injected_faults": [{"spacecraft": 2, "kind": "pointing_actuator", "start_s": 10.0,
+                             "end_s": None, "magnitude": 4.0},
+                            {"spacecraft": 1, "kind": "thruster_bias", "start_s": 400.0,
+                             "end_s": None, "magnitude": 0.3}],
+        "scores": {"per_fault": [_fault(2, "pointing_actuator", 10.0, True, 170.0, "actuator",
+                                        "actuator"),
+                                 _fault(1, "thruster_bias", 400.0, True, 40.0, "actuator",
+                                        "actuator")],
+                   "false_alarms": 0, "nominal_cycles": 4},
+        "fdir_series": {"main": [[1, 60, 90, 0.01, 0.05], [2, 150, 180, 0.5, 0.05],
+                                 [2, 180, 210, 0.5, 0.05]]}})
+    report = write_campaign_report(tmp_path, "x", ["e"]).read_text()
+    assert ("| began before their observer's first judged window | 1 | 170 / 170 / 170 | "
+            "30 / 30 / 30 |") in report
+    assert "| began later | 1 | 40 / 40 / 40 | - |" in report
+    main = [r for r in csv.DictReader(open(tmp_path / "results.csv"))
+            if r["detector"] == "main"]
+    assert [float(r["judgeable_s"]) for r in main] == [150.0, 400.0]
