@@ -17,6 +17,7 @@ from ground.fdir.identify import (
     classify,
     explained_fraction,
     locate_camera,
+    median_se,
     offset_alignment,
     seen_overlap,
 )
@@ -75,6 +76,30 @@ def test_noisy_narrow_images_locate_within_their_spread() -> None:
         betas.append(fix.beta)
     assert np.median(errors) < 0.6
     assert np.median(betas) == pytest.approx(0.7, abs=0.02)
+
+
+@pytest.mark.parametrize("half_angle_deg, beta, pos_tol_m", [(20.0, 0.7, 0.5), (12.0, 1.0, 2.0)])
+def test_very_noisy_images_locate_without_bias(half_angle_deg: float, beta: float,
+                                               pos_tol_m: float) -> None:
+    """50% precision noise: a POI whose noise drew its precision near 0 must not throw the fix
+    off (fitted as d²/β = 1/(kσ⁻¹), such images put β at 0.1-0.3); over a window's 30
+    images the median β is the camera's and the median position within the images' spread."""
+    rng = np.random.default_rng(8)
+    c = np.array([3.0, -18.0, 5.0])
+    fixes = [locate_camera(*_image(c, beta, half_angle_deg, noise=0.5, rng=rng), k=1.0,
+                           radius_m=R, noise_frac=0.5) for _ in range(30)]
+    assert all(f is not None for f in fixes)
+    betas = np.array([f.beta for f in fixes if f is not None])
+    assert abs(np.median(betas) - beta) < 3.0 * median_se(betas)
+    offsets = np.median([f.position_m - c for f in fixes if f is not None], axis=0)
+    assert np.linalg.norm(offsets) < pos_tol_m
+
+
+def test_median_se_is_the_spread_of_the_median() -> None:
+    rng = np.random.default_rng(2)
+    draws = rng.normal(1.0, 0.2, size=(4000, 30))
+    spread = float(np.std(np.median(draws, axis=1)))
+    assert np.median([median_se(d) for d in draws]) == pytest.approx(spread, rel=0.1)
 
 
 def test_too_few_pois_give_no_fix() -> None:
@@ -154,11 +179,27 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     # differs little (0.94), the boresight it shows is 5° off the reported one
     ({"seen_overlap": 0.94, "camera_offset_deg": 5.0}, "camera"),
     ({"camera_offset_deg": 1.5}, None),  # within the fit's spread
+    # a 6.7° fit from a camera located 2 m off by 50% precision noise (12° camera, nav bias)
+    ({"camera_offset_deg": 6.7, "camera_se_deg": 2.64}, None),
+    ({"camera_offset_deg": 6.7, "camera_se_deg": 0.3}, "camera"),
+    # the same window's located camera 1.75 m off the nav, the same way as the nav's 0.14 m
+    # off the plan: within three of its 0.69 m standard errors, it says nothing
+    ({"camera_vs_nav_m": 1.75, "nav_vs_plan_m": 0.14, "offset_alignment": 0.66,
+      "camera_se_m": 0.69}, None),
+    ({"camera_vs_nav_m": 1.75, "nav_vs_plan_m": 0.14, "offset_alignment": 0.66,
+      "camera_se_m": 0.1}, "actuator"),
+    # a leak's first window at 5% noise (paper_fig23, sc2 at 450 s): 0.46 m off the nav, the
+    # same way, with a 0.11 m standard error, is a leak, not the seen set's 0.78
+    ({"camera_vs_nav_m": 0.456, "nav_vs_plan_m": 0.1, "offset_alignment": 0.97,
+      "seen_overlap": 0.784, "camera_se_m": 0.111, "camera_se_deg": 0.49}, "actuator"),
     ({"pointing_error_deg": 5.0, "explained_reported": 0.99, "camera_offset_deg": 0.7},
      "actuator"),  # a wheel fault: the attitude knows where it points
     ({"pointing_error_deg": 5.0, "explained_reported": 0.1, "explained_located": 0.2},
      None),  # reported off target, but that does not explain the loss
     ({}, None),  # nothing stands out
+    # β̂ off by more than beta_tol, but within the scatter of a noisy narrow camera's images
+    ({"beta_hat": 0.85, "beta_se": 0.05}, None),
+    ({"beta_hat": 0.85, "beta_se": 0.01}, "camera"),
 ])
 def test_classify_table(change: dict[str, float], expected: str | None) -> None:
     assert classify(Evidence(**{**NOMINAL, **change}), TOL) == expected

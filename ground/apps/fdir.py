@@ -133,7 +133,7 @@ class FdirApp(App):
         camera = Camera(math.radians(sc.camera.half_angle_deg), sc.camera.max_range_m,
                         sc.camera.k)
         self.twin = TwinModel(*sphere_pois(sc.target.pois, sc.target.radius_m), camera,
-                              sc.target.radius_m)
+                              sc.target.radius_m, sc.camera.noise_frac)
         self.settled = PoiMap.uniform(sc.target.pois, sc.target.prior_variance,
                                       sc.observers.count)
         self.pending: list[PoiObservations] = []

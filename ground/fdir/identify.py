@@ -5,9 +5,9 @@ Once H_m,i has isolated observer i, the ground weighs four pieces of evidence fr
 window, all from telemetry it already receives:
 
 * **Where the camera really was.**  Each image measures every visible POI with precision
-  σ⁻¹ = β / (k d²) (Eq. 5 with the camera health β of Eq. 21), so q = 1/(k σ⁻¹) = d²/β.  On a
+  σ⁻¹ = β / (k d²) (Eq. 5 with the camera health β of Eq. 21), so d²/β = 1/(k σ⁻¹).  On a
   spherical target of radius R, d² = |c|² + R² − 2 c·s is affine in the POI position s, so a
-  least-squares fit q ≈ a + g·s gives g = −2c/β and a = (|c|² + R²)/β, hence
+  fit k σ⁻¹ (a + g·s) ≈ 1 gives g = −2c/β and a = (|c|² + R²)/β, hence
   β²|g|²/4 − aβ + R² = 0: two roots, one camera outside the sphere (the answer) and its
   inverse point inside it (:func:`locate_camera`).  The camera's position and β come out of
   the image itself, independent of the observer's navigation.
@@ -29,13 +29,16 @@ window, all from telemetry it already receives:
 ==========================================================  ================
 evidence (in this order)                                    class
 ==========================================================  ================
-β̂ off 1 (information short by a uniform factor)             ``camera``
+β̂ off 1 (information short by a uniform factor), by more   ``camera``
+than beta_tol and ``BETA_SE_MARGIN`` standard errors
 nav off plan, the camera on it (within half the tolerance)  ``state_sensor``
 pointing error reported, and the pose explains the ΔH gap   ``actuator``
 the seen POIs show a boresight > 2 × pointing_tol_deg off    ``camera``
+(and ``SE_MARGIN`` standard errors of the located camera)
 Δv commanded while holding, above ``dv_rate_tol_mps2``      ``actuator``
-camera not where nav says, by more than nav is off plan,
-and nav and camera off the plan the same way                ``actuator``
+camera not where nav says (beyond ``SE_MARGIN`` standard
+errors too), by more than nav is off plan, and nav and
+camera off the plan the same way                            ``actuator``
 camera not where nav says, by more than nav is off plan     ``state_sensor``
 nav off plan (the observer knows it is not on its orbit)    ``actuator``
 nav and camera off the plan the same way, camera off nav
@@ -90,6 +93,7 @@ import numpy.typing as npt
 
 from fsw.lib.infocost import visibility
 from ground.fdir.boresight import boresight_offset
+from ground.fdir.hardware_threshold import clipped_noise_moments
 from ground.fdir.twin import TwinModel, sample_stride
 from interfaces.scenario import FdirSettings
 
@@ -97,6 +101,20 @@ FloatArray = npt.NDArray[np.float64]
 
 MIN_POIS = 12
 """Fewer POIs in an image than this give no camera fix (4 unknowns, noisy precisions)."""
+
+BETA_SE_MARGIN = 5.0
+"""β̂ is called off 1 only beyond this many standard errors of its median too
+(``Evidence.beta_se``).  With a 12° camera and 50% precision noise the images' β scatter so
+much that healthy windows' medians fall 0.8-1.17, outside ``beta_tol``; in 360 synthetic
+healthy windows (12° and 20° cameras, noise 5-50%) the median was at most 3.8 of them off."""
+
+SE_MARGIN = 3.0
+"""The located camera's position counts only beyond this many standard errors of its median
+too (``Evidence.camera_se_m``, ``camera_se_deg``): against the nav, and through the boresight
+its seen POIs show from it.  With a 12° camera and 50% precision noise it is 1.4 m off (p90),
+which turns that boresight by several degrees.  In the 360 synthetic healthy windows it was
+at most 3.3 standard errors off; more than 3 would lose the first window of a leak at 5%
+noise (paper_fig23: the camera 0.46 m off the nav with a 0.135 m standard error)."""
 
 MIN_FIXES = 5
 """Fewer located images than this in a window give no camera evidence (one fix is noisy:
@@ -112,8 +130,16 @@ class CameraFix:
 
 
 def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
-                  radius_m: float) -> CameraFix | None:
+                  radius_m: float, noise_frac: float = 0.0) -> CameraFix | None:
     """Trilaterate the camera from one image of a spherical target (module docstring).
+
+    The measured σ⁻¹_j = β w_j / (k d_j²) carries the camera's multiplicative noise
+    w_j = max(0, 1 + ν ε_j), so the rows k σ⁻¹_j [1, s_j] regressed on 1 leave the residuals
+    1 − w_j: zero-mean, of one spread.  (Fitting d²/β = 1/(k σ⁻¹) itself does not: a POI whose
+    w came out near 0 gives a value without bound; at ν = 50% that fit put the camera metres
+    off and β at 0.1-0.3.)  The noise in the regressors shrinks the fit by
+    f = E[w] / E[w²] (errors in variables); dividing it out leaves β unbiased, and the
+    position, which is a ratio of the fitted terms, does not depend on it.
 
     Args:
         poi_pos: positions (n, 3) of the POIs the image saw, target frame (LVLH), m, on the
@@ -121,6 +147,8 @@ def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
         precision: their measured σ⁻¹ (n,), > 0.
         k: the camera's variance coefficient (σ = k d², Eq. 5), m⁻².
         radius_m: the target's radius R, m.
+        noise_frac: ν, the 1σ multiplicative noise of a measured precision (the camera's
+            spec, ``[camera] noise_frac``).
 
     Returns:
         The fix, or None when the image saw fewer than ``MIN_POIS`` POIs or the fit is
@@ -131,10 +159,13 @@ def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
     good = p > 0.0
     if good.sum() < MIN_POIS:
         return None
-    s, q = s[good], 1.0 / (k * p[good])
-    coef, _, rank, _ = np.linalg.lstsq(np.c_[np.ones(len(q)), s], q, rcond=None)
+    s, kp = s[good], k * p[good]
+    coef, _, rank, _ = np.linalg.lstsq(kp[:, None] * np.c_[np.ones(len(kp)), s],
+                                       np.ones(len(kp)), rcond=None)
     if rank < 4:
         return None
+    m1, var = clipped_noise_moments(noise_frac)
+    coef = coef * (m1 * m1 + var) / m1
     a, g = float(coef[0]), coef[1:]
     gg = float(g @ g)
     if not (gg > 0.0 and a > 0.0):
@@ -185,6 +216,11 @@ class Evidence:
         camera_vs_plan_m: length of the located camera's median offset from the plan, m.
         camera_offset_deg: median angle between the reported boresight and the one the seen
             POIs show, from the located camera positions (``ground/fdir/boresight.py``), deg.
+        beta_se: standard error of ``beta_hat`` from the spread of the images' own β
+            (:func:`median_se`).
+        camera_se_m: standard error of the located camera's median position (per axis,
+            :func:`median_se`), m.
+        camera_se_deg: the same as the angle it subtends at the target's near surface, deg.
     """
 
     beta_hat: float | None = None
@@ -198,6 +234,9 @@ class Evidence:
     offset_alignment: float | None = None
     camera_vs_plan_m: float | None = None
     camera_offset_deg: float | None = None
+    beta_se: float | None = None
+    camera_se_m: float | None = None
+    camera_se_deg: float | None = None
 
     def as_dict(self) -> dict[str, float]:
         """The evidence present, by name (for the bus and summary.json)."""
@@ -233,7 +272,8 @@ def classify(ev: Evidence, tol: Tolerances, failed: Sequence[str] = ()) -> str |
 
 
 def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
-    if ev.beta_hat is not None and abs(ev.beta_hat - 1.0) > tol.beta:
+    if ev.beta_hat is not None and abs(ev.beta_hat - 1.0) > max(
+            tol.beta, BETA_SE_MARGIN * (ev.beta_se or 0.0)):
         return "camera"
     nav_plan = ev.nav_vs_plan_m or 0.0
     if nav_plan > tol.position_m and (ev.camera_vs_plan_m or math.inf) < tol.position_m / 2.0:
@@ -242,16 +282,19 @@ def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
     pose_explains = not explained or max(explained) >= tol.explained
     if (ev.pointing_error_deg or 0.0) > tol.pointing_deg and pose_explains:
         return "actuator"
-    if (ev.camera_offset_deg or 0.0) > 2.0 * tol.pointing_deg:  # beyond the fit's spread
+    if (ev.camera_offset_deg or 0.0) > (2.0 * tol.pointing_deg  # beyond the fit's spread
+                                        + SE_MARGIN * (ev.camera_se_deg or 0.0)):
         return "camera"  # it looks elsewhere than its attitude says: misaligned in its mount
     camera_nav = ev.camera_vs_nav_m or 0.0
+    located = SE_MARGIN * (ev.camera_se_m or 0.0)  # how far the located camera can be wrong
     if (ev.dv_rate_mps2 or 0.0) > tol.dv_rate_mps2:
         return "actuator"
-    if camera_nav > tol.position_m and camera_nav > nav_plan:
+    if camera_nav > max(tol.position_m, located) and camera_nav > nav_plan:
         return "actuator" if (ev.offset_alignment or 0.0) > SAME_WAY else "state_sensor"
     if nav_plan > tol.position_m:
         return "actuator"
-    if (ev.offset_alignment or 0.0) > SAME_WAY and camera_nav > tol.position_m / 2.0:
+    if (ev.offset_alignment or 0.0) > SAME_WAY and camera_nav > max(tol.position_m / 2.0,
+                                                                     located):
         return "actuator"  # the truth and the nav dragged off the plan together: a leak
     if ev.seen_overlap is not None and ev.seen_overlap < tol.overlap:
         return "camera"
@@ -273,12 +316,15 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
     the seen-set overlap only when the window exceeded its threshold (``gap`` = (ΔH_i,
     ΔH_i^pred)), and of those the boresight fit only with ``fit_boresight`` (a window that
     must name a class)."""
-    fixes = [locate_camera(twin.poi_pos[poi], prec, twin.camera.k, twin.radius_m)
-             for poi, prec in images]
+    fixes = [locate_camera(twin.poi_pos[poi], prec, twin.camera.k, twin.radius_m,
+                           twin.noise_frac) for poi, prec in images]
     located = [(i, f) for i, f in enumerate(fixes) if f is not None]
     if len(located) < MIN_FIXES:
         located = []
-    beta = float(np.median([f.beta for _, f in located])) if located else None
+    betas = np.array([f.beta for _, f in located])
+    beta, beta_se = (float(np.median(betas)), median_se(betas)) if located else (None, None)
+    camera_se = (_camera_se(np.array([f.position_m for _, f in located]), planned,
+                            twin.radius_m) if located else (None, None))
     cam_nav = nav_plan = point = align = offset = None
     cam_plan = (float(np.linalg.norm(np.median([f.position_m - planned[i] for i, f in located],
                                                axis=0))) if located else None)
@@ -298,7 +344,24 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
     if gap is not None and fit_boresight and attitude is not None and located:
         offset = camera_offset_deg(twin, images, attitude, located)
     return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc, dv_rate,
-                    align, cam_plan, offset)
+                    align, cam_plan, offset, beta_se, *camera_se)
+
+
+def _camera_se(located: np.ndarray, planned: np.ndarray, radius_m: float
+               ) -> tuple[float, float]:
+    """The standard error of the located camera's median position (K, 3), m, and the angle it
+    subtends from the target's near surface (the plan's median range less the radius), deg."""
+    se = math.hypot(*(median_se(located[:, j]) for j in range(3)))
+    near = float(np.median(np.linalg.norm(planned, axis=1))) - radius_m
+    return se, math.degrees(math.atan2(se, max(near, radius_m)))
+
+
+def median_se(values: npt.ArrayLike) -> float:
+    """Standard error of the median of ``values``, from their spread: 1.2533 σ / √n, with σ
+    the median absolute deviation × 1.4826 (robust to the odd wild fix)."""
+    v = np.asarray(values, dtype=float)
+    mad = float(np.median(np.abs(v - np.median(v))))
+    return 1.2533 * 1.4826 * mad / math.sqrt(len(v))
 
 
 OFFSET_IMAGES = 5

@@ -150,12 +150,14 @@ def perturbed_boresights(boresight: npt.ArrayLike, eps_rad: float, count: int,
 @dataclass(frozen=True)
 class TwinModel:
     """What the twin knows of the target and the cameras: the POIs (positions and outward
-    normals, LVLH, m), the target radius (m) and the nominal camera model."""
+    normals, LVLH, m), the target radius (m), the nominal camera model and the 1σ
+    multiplicative noise ν of a measured precision (``[camera] noise_frac``)."""
 
     poi_pos: FloatArray
     poi_normal: FloatArray
     camera: Camera
     radius_m: float
+    noise_frac: float = 0.0
 
     def precision(self, positions: npt.ArrayLike, boresights: npt.ArrayLike) -> FloatArray:
         """σ⁻¹ (K, M) of nominal images taken from ``positions`` along ``boresights``."""
