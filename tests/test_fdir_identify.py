@@ -182,16 +182,10 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     # a 6.7° fit from a camera located 2 m off by 50% precision noise (12° camera, nav bias)
     ({"camera_offset_deg": 6.7, "camera_se_deg": 2.64}, None),
     ({"camera_offset_deg": 6.7, "camera_se_deg": 0.3}, "camera"),
-    # the same window's located camera 1.75 m off the nav, the same way as the nav's 0.14 m
-    # off the plan: within three of its 0.69 m standard errors, it says nothing
-    ({"camera_vs_nav_m": 1.75, "nav_vs_plan_m": 0.14, "offset_alignment": 0.66,
-      "camera_se_m": 0.69}, None),
-    ({"camera_vs_nav_m": 1.75, "nav_vs_plan_m": 0.14, "offset_alignment": 0.66,
-      "camera_se_m": 0.1}, "actuator"),
     # a leak's first window at 5% noise (paper_fig23, sc2 at 450 s): 0.46 m off the nav, the
-    # same way, with a 0.11 m standard error, is a leak, not the seen set's 0.78
+    # same way, is a leak, not the seen set's 0.78, whatever the spread of the fixes
     ({"camera_vs_nav_m": 0.456, "nav_vs_plan_m": 0.1, "offset_alignment": 0.97,
-      "seen_overlap": 0.784, "camera_se_m": 0.111, "camera_se_deg": 0.49}, "actuator"),
+      "seen_overlap": 0.784, "camera_se_m": 0.2, "camera_se_deg": 0.8}, "actuator"),
     ({"pointing_error_deg": 5.0, "explained_reported": 0.99, "camera_offset_deg": 0.7},
      "actuator"),  # a wheel fault: the attitude knows where it points
     ({"pointing_error_deg": 5.0, "explained_reported": 0.1, "explained_located": 0.2},
