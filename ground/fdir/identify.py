@@ -219,8 +219,8 @@ class Evidence:
             POIs show, from the located camera positions (``ground/fdir/boresight.py``), deg.
         beta_se: standard error of ``beta_hat`` from the spread of the images' own β
             (:func:`median_se`).
-        camera_se_m: standard error of the located camera's median position (per axis,
-            :func:`median_se`), m.
+        camera_se_m: standard error of the located camera's median offset from the plan
+            (per axis, :func:`median_se`), m.
         camera_se_deg: the same as the angle it subtends at the target's near surface, deg.
     """
 
