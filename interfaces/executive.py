@@ -150,6 +150,7 @@ class TickClient:
     rejoin_grace_s: float = 60.0
     _last_k: int = -1
     _lost_at: float = 0.0
+    _rejoin: threading.Event = field(default_factory=threading.Event)
 
     def __post_init__(self) -> None:
         bus = self.executive.bus
@@ -197,7 +198,8 @@ class TickClient:
             self._ticks.put(None)
         elif node == topics.SIM and self.sim_lost:
             self.sim_lost, self._last_k = False, -1
-            bus.admission.forget()
+            self._rejoin.set()  # the serving thread forgets the lost epoch (_rejoin_lockstep)
+            self._ticks.put(None)
             self.executive.log.warning("%s: the sim is back; rejoining the lockstep",
                                        bus.node)
         elif alive and node != bus.node:
@@ -206,6 +208,8 @@ class TickClient:
     def serve(self, stop: threading.Event | None = None) -> None:
         """Run ticks until finished, the sim is lost for good, or ``stop`` is set."""
         while not (stop is not None and stop.is_set()):
+            if self._rejoin.is_set():
+                self._rejoin_lockstep()
             try:
                 tick = self._ticks.get(timeout=0.5)
             except queue.Empty:
@@ -214,6 +218,20 @@ class TickClient:
                 self.executive.run_tick(tick)
             elif self.finished.is_set() or self._gone():
                 return
+
+    def _rejoin_lockstep(self) -> None:
+        """Forget the epoch lost with the sim, on the thread that runs ticks: drop the ticks
+        still queued from it, then the bus's clock and sequence numbers.  (Forgotten on the
+        liveliness thread, a stale tick run afterwards set the clock back to its own time, and
+        every message of the sim's present was then refused as dated too far ahead: the node
+        never rejoined.)"""
+        self._rejoin.clear()
+        while True:
+            try:
+                self._ticks.get_nowait()
+            except queue.Empty:
+                break
+        self.executive.bus.admission.forget()
 
     def _gone(self) -> bool:
         """Whether the sim has been lost for longer than ``rejoin_grace_s``."""

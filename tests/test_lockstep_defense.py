@@ -152,6 +152,43 @@ def test_only_plausible_ticks_run() -> None:
     assert "ticks after" in first._implausible(_tick(50 + 101))
 
 
+def test_a_node_cut_off_from_the_sim_rejoins_at_the_sims_present() -> None:
+    """Ticks queued before the node lost the sim belong to a lost epoch: after the sim is back
+    they are dropped, not run, so they cannot set the bus's clock back behind the sim's
+    present (which would refuse every later message as dated too far ahead)."""
+    sc = small_scenario("ld", duration_s=400.0)  # 2 Hz
+    net = InprocNetwork()
+    bus, raw = Bus("sc1", M, net.endpoint()), net.endpoint()
+    client = TickClient(Executive(bus, sc, []), synchronous=False)
+    tick_key = cat.TICK.key(M)
+
+    def send(seq: int, k: int) -> None:
+        raw.publish(tick_key, "Tick", _bytes(_tick(k).model_copy(update={"seq": seq})))
+
+    for k in range(4):  # queued, not yet run: the node stalls before serving them
+        send(k + 1, k)
+    client.on_liveness(topics.SIM, False)
+    client.on_liveness(topics.SIM, True)
+    stop = threading.Event()
+    serving = threading.Thread(target=client.serve, args=(stop,))
+    serving.start()
+    try:
+        deadline = time.monotonic() + 5.0
+        while not client._ticks.empty() and time.monotonic() < deadline:
+            time.sleep(0.01)  # what was queued is served (or dropped)
+        time.sleep(0.1)
+        send(301, 300)  # the sim's present, 150 s on
+        send(302, 301)
+        while client.executive.ticks < 2 and time.monotonic() < deadline:
+            time.sleep(0.01)
+    finally:
+        stop.set()
+        serving.join(timeout=5.0)
+    assert client.executive.ticks == 2  # the stale ticks 0-3 were not run
+    assert bus.admission.clock_s == 301 * 0.5
+    assert bus.admission.refused["time"] == 0
+
+
 def test_tick_done_announces_only_the_senders_own_keys() -> None:
     sc = small_scenario("ld", observers={"count": 2})
     sim = SimNode(Bus("sim", M, InprocNetwork().endpoint()), sc, participants=["sc1", "sc2"])
