@@ -185,7 +185,7 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     # a leak's first window at 5% noise (paper_fig23, sc2 at 450 s): 0.46 m off the nav, the
     # same way, is a leak, not the seen set's 0.78, whatever the spread of the fixes
     ({"camera_vs_nav_m": 0.456, "nav_vs_plan_m": 0.1, "offset_alignment": 0.97,
-      "seen_overlap": 0.784, "camera_se_m": 0.2, "camera_se_deg": 0.8}, "actuator"),
+      "seen_overlap": 0.784, "camera_se_deg": 0.8}, "actuator"),
     ({"pointing_error_deg": 5.0, "explained_reported": 0.99, "camera_offset_deg": 0.7},
      "actuator"),  # a wheel fault: the attitude knows where it points
     ({"pointing_error_deg": 5.0, "explained_reported": 0.1, "explained_located": 0.2},

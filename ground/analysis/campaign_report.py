@@ -130,9 +130,10 @@ def _judgeable_s(fault: dict[str, Any], first: dict[int, float]) -> float | None
 def _onset_lines(faults: list[dict[str, Any]]) -> list[str]:
     """Latency from onset against the targets, with the faults that began before their
     observer's first judged window apart (main detector's rows)."""
-    early = [f for f in faults if f.get("judgeable_s") is not None
-             and f["judgeable_s"] > f["start_s"]]
-    late = [f for f in faults if f not in early]
+    early, late = [], []
+    for f in faults:
+        began_early = f.get("judgeable_s") is not None and f["judgeable_s"] > f["start_s"]
+        (early if began_early else late).append(f)
     from_window = [{**f, "latency_s": f["latency_s"] - (f["judgeable_s"] - f["start_s"])}
                    for f in early if f["latency_s"] is not None]
     return ["", "## Latency from onset (main detector)", "",

@@ -89,6 +89,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 import numpy.typing as npt
+from scipy.stats import median_abs_deviation
 
 from fsw.lib.infocost import visibility
 from ground.fdir.boresight import boresight_offset
@@ -219,9 +220,9 @@ class Evidence:
             POIs show, from the located camera positions (``ground/fdir/boresight.py``), deg.
         beta_se: standard error of ``beta_hat`` from the spread of the images' own β
             (:func:`median_se`).
-        camera_se_m: standard error of the located camera's median offset from the plan
-            (per axis, :func:`median_se`), m.
-        camera_se_deg: the same as the angle it subtends at the target's near surface, deg.
+        camera_se_deg: standard error of the located camera's median offset from the plan
+            (per axis, :func:`median_se`), as the angle it subtends at the target's near
+            surface, deg.
     """
 
     beta_hat: float | None = None
@@ -236,7 +237,6 @@ class Evidence:
     camera_vs_plan_m: float | None = None
     camera_offset_deg: float | None = None
     beta_se: float | None = None
-    camera_se_m: float | None = None
     camera_se_deg: float | None = None
 
     def as_dict(self) -> dict[str, float]:
@@ -323,11 +323,11 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
     betas = np.array([f.beta for _, f in located])
     beta, beta_se = (float(np.median(betas)), median_se(betas)) if located else (None, None)
     cam_nav = nav_plan = point = align = offset = cam_plan = None
-    camera_se: tuple[float | None, float | None] = (None, None)
+    camera_se = None
     if located:
         off_plan = np.array([f.position_m - planned[i] for i, f in located])
         cam_plan = float(np.linalg.norm(np.median(off_plan, axis=0)))
-        camera_se = _camera_se(off_plan, planned, twin.radius_m)
+        camera_se = _camera_se_deg(off_plan, planned, twin.radius_m)
     if nav is not None:
         nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
         if located:
@@ -344,26 +344,24 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
     if gap is not None and fit_boresight and attitude is not None and located:
         offset = camera_offset_deg(twin, images, attitude, located)
     return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc, dv_rate,
-                    align, cam_plan, offset, beta_se, *camera_se)
+                    align, cam_plan, offset, beta_se, camera_se)
 
 
-def _camera_se(off_plan: np.ndarray, planned: np.ndarray, radius_m: float
-               ) -> tuple[float, float]:
-    """The standard error of the located camera's median offset from the plan (K, 3), m
-    (offsets, not positions: the camera moves along its orbit during the window), and the
-    angle it subtends from the target's near surface (the plan's median range less the
-    radius), deg."""
+def _camera_se_deg(off_plan: np.ndarray, planned: np.ndarray, radius_m: float) -> float:
+    """The standard error of the located camera's median offset from the plan (K, 3; offsets,
+    not positions: the camera moves along its orbit during the window), as the angle it
+    subtends from the target's near surface (the plan's median range less the radius), deg."""
     se = math.hypot(*(median_se(off_plan[:, j]) for j in range(3)))
     near = float(np.median(np.linalg.norm(planned, axis=1))) - radius_m
-    return se, math.degrees(math.atan2(se, max(near, radius_m)))
+    return math.degrees(math.atan2(se, max(near, radius_m)))
 
 
 def median_se(values: npt.ArrayLike) -> float:
-    """Standard error of the median of ``values``, from their spread: 1.2533 σ / √n, with σ
-    the median absolute deviation × 1.4826 (robust to the odd wild fix)."""
+    """Standard error of the median of ``values``, from their spread: √(π/2) σ / √n, with σ
+    the median absolute deviation scaled to a normal's (robust to the odd wild fix)."""
     v = np.asarray(values, dtype=float)
-    mad = float(np.median(np.abs(v - np.median(v))))
-    return 1.2533 * 1.4826 * mad / math.sqrt(len(v))
+    sigma = float(median_abs_deviation(v, scale="normal"))
+    return math.sqrt(math.pi / 2.0) * sigma / math.sqrt(len(v))
 
 
 OFFSET_IMAGES = 5
