@@ -162,6 +162,28 @@ def test_m_of_n_persistence() -> None:
     assert _alarms_at(gappy, 3.0, 1, 1) == []  # threshold scaled above every level
 
 
+def test_windows_failed_on_other_tests_count_at_every_threshold_scale() -> None:
+    """A main-detector window failed by the plan, pointing, Δv or NIS test (sixth value 1) is
+    exceeded whatever the information threshold's scale; a five-value row (a summary written
+    before the flag) is judged on H_m alone."""
+    nis_only = [[1, 0.0, 30.0, 0.001, 0.05, 1.0], [1, 30.0, 60.0, 0.001, 0.05, 0.0]]
+    assert [a.t_s for a in _alarms_at(nis_only, 1.0, 1, 1)] == [30.0]
+    assert [a.t_s for a in _alarms_at(nis_only, 100.0, 1, 1)] == [30.0]
+    assert _alarms_at([w[:5] for w in nis_only], 1.0, 1, 1) == []
+
+
+def test_the_report_says_when_summaries_lack_the_other_tests(tmp_path: Path) -> None:
+    """Re-scoring from five-value rows undercounts the main detector: the report says so."""
+    base = {"injected_faults": [], "duration_s": 60.0,
+            "scores": {"per_fault": [], "false_alarms": 0, "nominal_cycles": 2}}
+    _write(tmp_path, "old", base | {"fdir_series": {"main": [[1, 0, 30, 0.01, 0.05]]}})
+    _write(tmp_path, "new", base | {"fdir_series": {"main": [[1, 0, 30, 0.01, 0.05, 0.0]]}})
+    write_campaign_report(tmp_path, "x", ["old", "new"])
+    assert "1 of 2 runs' summaries predate" in (tmp_path / "report.md").read_text()
+    write_campaign_report(tmp_path, "x", ["new"])
+    assert "predate" not in (tmp_path / "report.md").read_text()
+
+
 def test_a_replays_main_detector_is_scored_over_its_faithful_span(tmp_path: Path) -> None:
     """A replay's declarations after its uplinks left the flown run's judge a trajectory nobody
     commanded: the report's main detector counts the faithful span's false alarms (0 here), the

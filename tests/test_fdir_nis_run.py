@@ -9,6 +9,7 @@ from __future__ import annotations
 import pytest
 
 from deploy.inproc import run_inproc
+from ground.analysis.summary import _series
 from interfaces.messages import FaultReport, FdirWindow
 from tests.conftest import collector, small_scenario
 
@@ -44,3 +45,14 @@ def test_healthy_observers_nis_within_its_quantile(
     healthy = [w for w in run[0] if w.spacecraft != 1 and w.nis_sum is not None]
     assert len(healthy) >= 4
     assert all(w.nis_sum < w.nis_limit and not w.exceeded for w in healthy)  # type: ignore[operator]
+
+
+def test_the_campaign_series_records_a_window_failed_on_its_nis(
+        run: tuple[list[FdirWindow], list[FaultReport]]) -> None:
+    """summary.json's ``fdir_series`` marks the leak's first window as failed on another test:
+    its H_m is under τ, so a re-scoring from H_m alone would miss it."""
+    first = next(w for w in run[0] if w.spacecraft == 1 and w.exceeded is not None)
+    row = next(r for r in _series(run[0], [])["main"] if r[0] == 1 and r[1] == first.t_start_s)
+    assert row[3] < row[4] and row[5] == 1.0
+    healthy = [r for r in _series(run[0], [])["main"] if r[0] != 1]
+    assert healthy and all(r[5] == 0.0 for r in healthy)

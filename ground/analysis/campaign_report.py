@@ -297,11 +297,19 @@ def _persistence(run: dict[str, Any], detector: str) -> tuple[int, int]:
 def _alarms_at(series: list[list[float]], scale: float, m: int, n: int) -> list[Alarm]:
     """The alarms a detector raises on its windows with its threshold scaled, under the
     detector's own rule (``threshold.Persistence``: ``m`` exceedances among the last ``n``
-    windows, once per episode)."""
+    windows, once per episode).  A main-detector window that failed one of its other tests
+    (the row's sixth value) counts as exceeded at every scale."""
     rule = Persistence(m, n)
     return [Alarm(int(w[0]), w[2], None)
             for w in sorted(series, key=lambda w: (w[0], w[2]))
-            if rule.update(int(w[0]), w[3] > scale * w[4])]
+            if rule.update(int(w[0]), w[3] > scale * w[4] or (len(w) > 5 and w[5] > 0.0))]
+
+
+def _information_only(runs: list[dict[str, Any]]) -> int:
+    """How many runs' main-detector series predate the other-tests flag (five values a row):
+    their re-scoring sees the information test alone."""
+    return sum(1 for s in runs
+               if any(len(w) < 6 for w in s.get("fdir_series", {}).get("main", [])))
 
 
 @dataclass
@@ -438,8 +446,15 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
               "![roc](roc.png)", "",
               "## Persistence (main detector re-scored from its windows)", "",
               "A fault is declared on the window that brings the exceedances among the last n "
-              "windows to m; the threshold as configured.", ""]
-    lines += _persistence_table(runs)
+              "windows to m; the threshold as configured.  A main-detector window counts as "
+              "exceeded when H_m passes τ or it failed one of the other tests (plan, pointing, "
+              "Δv rate, NIS), which the ROC's scale does not move."]
+    old_rows = _information_only(runs)
+    if old_rows:
+        lines.append(f"**{old_rows} of {len(runs)} runs' summaries predate the other tests' "
+                     "record: in them the main detector's ROC and this table see the "
+                     "information test alone, and undercount what it detected.**")
+    lines += [""] + _persistence_table(runs)
     lines += _threshold_lines(runs)
     margins = _margins(runs)
     lines += ["", "## Margins (main detector, H_m,i / τ_i per window)", "",

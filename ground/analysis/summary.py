@@ -120,9 +120,12 @@ def _series(windows: list[FdirWindow], verdicts: list[BaselineVerdict]
             ) -> dict[str, list[list[float]]]:
     """``fdir_series``: every decided window of each detector as [spacecraft, t_start_s,
     t_end_s, statistic, threshold] -- what a campaign needs to re-score at other threshold
-    scales (ROC) without the archives."""
+    scales (ROC) without the archives.  The main detector's rows carry a sixth value, 1 when
+    the window failed a test other than the information test (plan, pointing, Δv rate, NIS:
+    ``FdirWindow.failed``), which no threshold scale moves."""
     out: dict[str, list[list[float]]] = {"main": [
-        [w.spacecraft, w.t_start_s, w.t_end_s, w.metric, w.threshold] for w in windows
+        [w.spacecraft, w.t_start_s, w.t_end_s, w.metric, w.threshold,
+         float(any(t != "information" for t in w.failed))] for w in windows
         if w.metric is not None and w.threshold is not None]}
     for v in verdicts:
         if v.statistic is not None and v.threshold is not None:
