@@ -186,6 +186,19 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     # same way, is a leak, not the seen set's 0.78, whatever the spread of the fixes
     ({"camera_vs_nav_m": 0.456, "nav_vs_plan_m": 0.1, "offset_alignment": 0.97,
       "seen_overlap": 0.784, "camera_se_deg": 0.8}, "actuator"),
+    # a 12° camera misaligned 5.5° at 50% precision noise, its first failed window (beyond
+    # campaign, noise50-misaligned-0001): located 0.91 m off its nav, but the fixes' median
+    # has a 0.62 m standard error, and the boresight fit (6.7°) is within its own spread: no
+    # class yet; its next window's seen set (0.40) names the camera
+    ({"camera_vs_nav_m": 0.91, "nav_vs_plan_m": 0.028, "camera_vs_plan_m": 0.885,
+      "explained_reported": -0.015, "explained_located": 0.697, "camera_offset_deg": 6.668,
+      "camera_se_m": 0.621, "camera_se_deg": 2.729, "seen_overlap": 0.986}, None),
+    ({"camera_vs_nav_m": 0.636, "nav_vs_plan_m": 0.031, "camera_vs_plan_m": 0.609,
+      "explained_reported": -0.002, "explained_located": 0.716, "camera_offset_deg": 4.469,
+      "camera_se_m": 0.549, "camera_se_deg": 2.411, "seen_overlap": 0.396}, "camera"),
+    # the same distance with a 5% noise camera's spread is a biased nav
+    ({"camera_vs_nav_m": 0.91, "nav_vs_plan_m": 0.028, "camera_vs_plan_m": 0.885,
+      "explained_located": 0.697, "camera_se_m": 0.03, "seen_overlap": 0.986}, "state_sensor"),
     ({"pointing_error_deg": 5.0, "explained_reported": 0.99, "camera_offset_deg": 0.7},
      "actuator"),  # a wheel fault: the attitude knows where it points
     ({"pointing_error_deg": 5.0, "explained_reported": 0.1, "explained_located": 0.2},
