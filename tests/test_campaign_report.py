@@ -14,6 +14,7 @@ from ground.analysis.campaign_report import (
     SCALES,
     _alarms_at,
     _magnitude_bins,
+    _rescore,
     _roc,
     detector_figures,
     write_campaign_report,
@@ -182,6 +183,21 @@ def test_the_report_says_when_summaries_lack_the_other_tests(tmp_path: Path) -> 
     assert "1 of 2 runs' summaries predate" in (tmp_path / "report.md").read_text()
     write_campaign_report(tmp_path, "x", ["new"])
     assert "predate" not in (tmp_path / "report.md").read_text()
+
+
+def test_the_global_checks_declaration_counts_in_the_rescoring() -> None:
+    """A common-mode fault (spacecraft 0) is isolated by the global check, which has no rows in
+    ``fdir_series`` (hard campaign, late-common-mode-0000: H 0.33 against 0.031 at 3,300 s):
+    the re-scoring keeps it while its statistic passes the scaled threshold."""
+    run = {"injected_faults": [{"spacecraft": 0, "kind": "camera_calibration",
+                                "start_s": 3274.1, "magnitude": 0.6}],
+           "fdir_settings": {"fdi_period_s": 30.0, "persistence": 1},
+           "detections": [{"spacecraft": 0, "time_s": 3300.0, "class": "common_mode",
+                           "metric": 0.33, "threshold": 0.031}],
+           "fdir_series": {"main": [[1, 3270.0, 3300.0, 0.01, 0.05, 0.0]]}}
+    for scale, isolated in ((1.0, True), (10.0, True), (11.0, False)):
+        (fault,) = _rescore([run], "main", scale).per_fault
+        assert fault["isolated"] is isolated, scale
 
 
 def test_a_replays_main_detector_is_scored_over_its_faithful_span(tmp_path: Path) -> None:

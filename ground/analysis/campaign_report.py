@@ -326,7 +326,9 @@ def _rescore(runs: list[dict[str, Any]], detector: str, scale: float,
     """Re-score each run's windows of ``detector`` with its threshold times ``scale`` and the
     persistence ``rule`` (m of the last n windows; None: the run's own, n in a row) exactly as
     summary.json is scored (``scoring.score``); the main detector's link and data-integrity
-    declarations, which no threshold scales, are kept as they were."""
+    declarations, which no threshold scales, are kept as they were, and the global check's
+    (``common_mode``, Eq. 6) where its statistic passes its threshold times ``scale`` (its
+    windows are not in ``fdir_series``: one it did not declare cannot be added)."""
     total = Rescored()
     for s in runs:
         if detector not in s.get("fdir_series", {}):
@@ -335,7 +337,7 @@ def _rescore(runs: list[dict[str, Any]], detector: str, scale: float,
         injected = [Fault.model_validate(f) for f in s.get("injected_faults", [])]
         grace = float(s.get("fdir_settings", {}).get("fdi_period_s", 0.0))
         fixed = [Alarm(d["spacecraft"], d["time_s"], d["class"]) for d in s.get("detections", [])
-                 if detector == "main" and d["class"] in ("link", "data_integrity")]
+                 if detector == "main" and _kept(d, scale)]
         judged = [Judged(int(w[0]), w[1], w[2]) for w in series]
         m, n = rule or _persistence(s, detector)
         sc = score(injected, fixed + _alarms_at(series, scale, m, n), judged, grace)
@@ -343,6 +345,16 @@ def _rescore(runs: list[dict[str, Any]], detector: str, scale: float,
         total.nominal_cycles += int(sc["nominal_cycles"])  # type: ignore[call-overload]
         total.per_fault += sc["per_fault"]  # type: ignore[arg-type]
     return total
+
+
+def _kept(declared: dict[str, Any], scale: float) -> bool:
+    """Whether a main-detector declaration that is not an observer window's stands in a
+    re-scoring at ``scale`` (``_rescore``)."""
+    if declared["class"] in ("link", "data_integrity"):
+        return True
+    return (declared["class"] == "common_mode" and declared.get("metric") is not None
+            and declared.get("threshold") is not None
+            and declared["metric"] > scale * declared["threshold"])
 
 
 def _roc(runs: list[dict[str, Any]], detector: str) -> tuple[np.ndarray, np.ndarray]:
