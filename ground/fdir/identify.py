@@ -115,9 +115,9 @@ located camera's median offset too (``Evidence.camera_se_deg``): with a 12° cam
 precision noise the camera is located 1.4 m off (p90), which turns the boresight fitted from
 it by several degrees.  In 360 synthetic healthy windows the located camera was at most 3.3
 standard errors off.  The camera-off-nav rule's ``state_sensor`` verdict is guarded so too:
-a 12° camera misaligned by 4-10° at 50% noise is located 0.7-1.1 m off its nav, within 3
-standard errors (0.6-1.1 m), and 13 of the 16 such faults of the beyond campaign were named
-``state_sensor``.  The ``actuator`` verdicts read from the same distances are not guarded: a
+a 12° camera misaligned by 4-10° at 50% noise is located 0.5-2.5 m off its nav, within 3
+standard errors (0.6-1.7 m each), and 13 of the 16 such faults of the beyond campaign were
+named ``state_sensor``.  The ``actuator`` verdicts read from the same distances are not guarded: a
 leak drags the camera during the window, which widens the spread of its offsets, and a guard
 of 3 standard errors lost the first window of 8 of 32 paper_fig23 leaks at 5% noise."""
 
