@@ -1,7 +1,9 @@
 """The whole constellation in one process on the in-process transport (tests, campaigns).
 
 Same apps, messages, channel model and lockstep as the multi-process run; ticks run
-synchronously inside the sim's publish, so no threads are involved.
+synchronously inside the sim's publish, so no threads are involved.  The lean runtime: routes
+resolved once per key, messages made in this process not re-admitted, one truth feed for every
+node's channel stage, no barrier wait (every announced message was delivered before the tick).
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from fsw.spacecraft import spacecraft_executive
 from ground.station import ground_executive
 from interfaces import topics
 from interfaces.bus import Bus
-from interfaces.channel import ChannelModel
+from interfaces.channel import ChannelModel, history_for
 from interfaces.executive import Executive, TickClient
 from interfaces.scenario import Scenario
 from interfaces.transport import InprocNetwork, RawHandler, SampleHandler
@@ -44,9 +46,10 @@ def run_inproc(
     if ground:
         builders[topics.GROUND] = ground_executive
     executives: dict[str, Executive] = {}
+    truth = history_for(scenario)  # one truth feed for every node's channel
     for node, build in builders.items():
         bus = Bus(node, mission, net.endpoint(),
-                  channel=ChannelModel.of(node, scenario))
+                  channel=ChannelModel.of(node, scenario, truth))
         executives[node] = build(bus, scenario)
         TickClient(executives[node], synchronous=True)
     sim = SimNode(Bus(topics.SIM, mission, net.endpoint()), scenario, list(builders),

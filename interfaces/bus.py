@@ -57,17 +57,37 @@ class _Sub:
     immediate: bool
 
 
-@dataclass
 class _Envelope:
-    msg: Message
-    key: str
-    src: str | None
-    local: bool
-    subs: list[_Sub]
+    """A message waiting in a node's inbox for its subscribers ``subs``; ``order`` is its place
+    in the delivery order, (send time, key, sequence)."""
 
-    @property
-    def order(self) -> tuple[float, str, int]:
-        return (self.msg.t_sim, self.key, self.msg.seq)
+    __slots__ = ("msg", "key", "src", "local", "subs", "order")
+
+    def __init__(self, msg: Message, key: str, src: str | None, local: bool,
+                 subs: list[_Sub]) -> None:
+        self.msg, self.key, self.src, self.local, self.subs = msg, key, src, local, subs
+        self.order = (msg.t_sim, key, msg.seq)
+
+
+def _order(env: _Envelope) -> tuple[float, str, int]:
+    return env.order
+
+
+@dataclass
+class _Group:
+    """The subscriptions of one key expression, split for delivery of a message of ``kind``
+    (the type all of them take, or None when they take different types)."""
+
+    subs: list[_Sub]
+    kind: type[Message] | None
+    immediate: list[_Sub]
+    deferred: list[_Sub]
+
+    @classmethod
+    def of(cls, subs: list[_Sub]) -> _Group:
+        kinds = {s.msg_type for s in subs}
+        return cls(subs, kinds.pop() if len(kinds) == 1 else None,
+                   [s for s in subs if s.immediate], [s for s in subs if not s.immediate])
 
 
 @dataclass
@@ -93,6 +113,12 @@ class Bus:
     _groups: dict[str, list[_Sub]] = field(default_factory=dict)
     _raw: dict[str, list[RawHandler]] = field(default_factory=dict)
     _local_cache: dict[str, list[_Sub]] = field(default_factory=dict)
+    _split: dict[str, _Group] = field(default_factory=dict)
+    _routes: dict[str, tuple[type[Message] | None, list[_Sub]]] = field(default_factory=dict)
+    """Per key published: its catalogue type (None: not catalogued) and this node's own
+    subscribers of it (resolved once per key)."""
+    _crosses: dict[str | None, bool] = field(default_factory=dict)
+    """Per source node: whether its messages to this node cross a modelled link."""
     _pending: list[_Envelope] = field(default_factory=list)
     admission: Admission = field(default_factory=Admission)
     _await_cache: dict[str, bool] = field(default_factory=dict)
@@ -104,9 +130,9 @@ class Bus:
         self.prefix = topics.node_prefix(self.mission, self.node)
         if self.log is None:
             self.log = logging.getLogger(f"insp.bus.{self.node}")
-        if self.channel is not None:
-            self.subscribe(catalogue.TRUTH.key(self.mission), TruthState, self._on_truth,
-                           immediate=True)
+        if self.channel is not None and self.channel.truth.claim_feed():
+            self.subscribe(catalogue.TRUTH.key(self.mission), TruthState,
+                           self.channel.truth.observe, immediate=True)
 
     # --- publishing ------------------------------------------------------------------------
 
@@ -116,26 +142,44 @@ class Bus:
         Sets ``sender``, ``seq`` and ``t_wall``.  Treat a published message as immutable.
         ``announce=False`` leaves the key out of ``published_since_last`` (lockstep control
         messages that nobody must wait for)."""
-        if not key.startswith(self.prefix + "/"):
-            raise ValueError(f"node {self.node} may not publish on {key!r} "
-                             f"(own space: {self.prefix})")
-        self._check_type(key, type(msg))
+        route = self._routes.get(key)
+        if route is None:
+            route = self._route(key)
+        expected, local = route
+        if expected is not None and type(msg) is not expected:
+            raise TypeError(f"{key} carries {expected.__name__}, not {type(msg).__name__}")
         seq = self._seq.get(key, 0) + 1
         self._seq[key] = seq
         if announce:
             self._published_since[key] = seq
         stamp(msg, self.node, seq, time.time())
         self.stats.published += 1
-        for sub in self._local_subs(key):
-            self._enqueue(_Envelope(msg, key, self.node, True, [sub]))
+        if local:
+            with self._cond:
+                for sub in local:
+                    self._pending.append(_Envelope(msg, key, self.node, True, [sub]))
         self.transport.send(Sample(key, type(msg).__name__, message=msg))
 
-    def _check_type(self, key: str, msg_type: type[Message]) -> None:
-        """A catalogued key carries its catalogue type only (``interfaces.catalogue``)."""
+    def _route(self, key: str) -> tuple[type[Message] | None, list[_Sub]]:
+        """What publishing on ``key`` needs, checked and resolved once: the key is in this
+        node's space, its catalogue type, this node's own subscribers of it."""
+        if not key.startswith(self.prefix + "/"):
+            raise ValueError(f"node {self.node} may not publish on {key!r} "
+                             f"(own space: {self.prefix})")
+        route = self._routes[key] = (self._catalogue_type(key), self._local_subs(key))
+        return route
+
+    def _catalogue_type(self, key: str) -> type[Message] | None:
+        """The message type the catalogue gives ``key`` (None: not catalogued), cached."""
         expected = self._key_types.get(key, _UNKNOWN)
         if expected is _UNKNOWN:
             topic = catalogue.topic_of(key)
             self._key_types[key] = expected = None if topic is None else topic.type
+        return expected  # type: ignore[return-value]
+
+    def _check_type(self, key: str, msg_type: type[Message]) -> None:
+        """A catalogued key carries its catalogue type only (``interfaces.catalogue``)."""
+        expected = self._catalogue_type(key)
         if expected is not None and msg_type is not expected:
             raise TypeError(f"{key} carries {expected.__name__}, not {msg_type.__name__}")
 
@@ -160,10 +204,13 @@ class Bus:
         group = self._groups.get(key_expr)
         if group is None:
             self._groups[key_expr] = group = []
-            self.transport.subscribe_samples(key_expr,
-                                             lambda smp, e=key_expr: self._on_sample(e, smp))
+            self.transport.subscribe_samples(
+                key_expr, lambda smp, e=key_expr: self._on_sample(e, smp),
+                made_here=lambda key, msg, e=key_expr: self._on_made_here(e, key, msg))
         group.append(sub)
+        self._split[key_expr] = _Group.of(group)
         self._local_cache.clear()
+        self._routes.clear()
         self._await_cache.clear()
 
     def subscriptions(self) -> dict[str, list[type[Message]]]:
@@ -215,6 +262,25 @@ class Bus:
                 self.admission.admit(key, msg)
             self._cond.notify_all()
 
+    def _on_made_here(self, key_expr: str, key: str, msg: Message) -> None:
+        """In-process callback: a message another Bus of this process published.  It was
+        made valid and its publisher's Bus set its sender and sequence number, so the admission
+        checks cannot fail it and are skipped; it is delivered, queued and recorded for the
+        barrier exactly as an admitted sample (``_on_sample``)."""
+        group = self._split[key_expr]
+        if type(msg) is not group.kind:  # subscribed as other types: validate from JSON
+            self._on_sample(key_expr, Sample(key, type(msg).__name__, message=msg))
+            return
+        self.stats.received += 1
+        for sub in group.immediate:
+            self._call(sub, msg, key)
+        with self._cond:
+            if group.deferred:
+                self._pending.append(_Envelope(msg, key, self.admission.owner(key), False,
+                                               group.deferred))
+            self.admission.admit(key, msg)
+            self._cond.notify_all()
+
     def _admitted(self, key: str, msg_type: type[Message], sample: Sample) -> Message | None:
         """The sample as a ``msg_type`` that passes admission, or None (dropped, counted)."""
         msg = sample.message
@@ -239,10 +305,6 @@ class Bus:
             self.log.warning("%s refused message #%d on %s (%s): %s", self.node, n, key, kind,
                              why)
 
-    def _enqueue(self, env: _Envelope) -> None:
-        with self._cond:
-            self._pending.append(env)
-
     def _invalid(self, key: str, why: str) -> None:
         self.stats.invalid_dropped += 1
         n = self.stats.invalid_dropped
@@ -256,10 +318,6 @@ class Bus:
             self.stats.handler_errors += 1
             self.log.exception("%s: handler for %s failed", self.node, key)
 
-    def _on_truth(self, msg: TruthState) -> None:
-        assert self.channel is not None
-        self.channel.observe_truth(msg.t_sim, msg.spacecraft, msg.r_lvlh_m)
-
     # --- delivery --------------------------------------------------------------------------
 
     def dispatch(self, t_now: float, include_now: bool = False) -> int:
@@ -271,14 +329,16 @@ class Bus:
         delay = self.channel.delay_s if self.channel is not None else 0.0
         self.admission.advance(t_now)
         with self._cond:
+            if not self._pending:
+                return 0
             due, keep = [], []
             for env in self._pending:
                 (due if self._is_due(env, t_now, include_now, delay) else keep).append(env)
             self._pending = keep
-        due.sort(key=lambda e: e.order)
+        due.sort(key=_order)
         delivered = 0
         for env in due:
-            if not env.local and self.channel is not None and applies(env.src, self.node):
+            if not env.local and self.channel is not None and self._crosses_link(env.src):
                 if self.channel.decide(env.src or "", env.msg.t_sim) is not Verdict.DELIVER:
                     self.stats.channel_dropped += 1
                     continue
@@ -291,9 +351,16 @@ class Bus:
         t = env.msg.t_sim
         if env.local or env.src == topics.SIM:
             return t <= t_now + _EPS_S
-        link_delay = delay if applies(env.src, self.node) else 0.0
+        link_delay = delay if self._crosses_link(env.src) else 0.0
         sent_before = t <= t_now + _EPS_S if include_now else t < t_now - _EPS_S
         return sent_before and t + link_delay <= t_now + _EPS_S
+
+    def _crosses_link(self, src: str | None) -> bool:
+        """Whether messages from node ``src`` cross a modelled link to this node (cached)."""
+        hit = self._crosses.get(src)
+        if hit is None:
+            hit = self._crosses[src] = applies(src, self.node)
+        return hit
 
     def wait_for(self, expect: dict[str, int], timeout_s: float) -> list[str]:
         """Block until every key of ``expect`` that this node subscribes to (and does not own)

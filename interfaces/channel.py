@@ -15,6 +15,12 @@ transport or on arrival order:
   Bernoulli loss (its ``magnitude``) on every link of its spacecraft, from a separate stream.
 * delay: a fixed ``comms.delay_s``; the Bus holds a message until the receiver's time reaches
   send time + delay (and at least one tick).
+
+The channel is a stage of its own between sender and receivers: the receiving Bus asks its
+``decide`` for every cross-link message, in delivery order.  The truth it reads is a
+:class:`TruthHistory`, one per process, fed by the sim's TruthState through a single
+subscription however many nodes the process hosts; positions are made from a truth message only
+for the times a delivery is decided.
 """
 
 from __future__ import annotations
@@ -28,7 +34,7 @@ from enum import Enum
 
 import numpy as np
 
-from interfaces.messages import LinkCounter
+from interfaces.messages import LinkCounter, TruthState
 from interfaces.rng import stream
 from interfaces.scenario import Comms, Fault, LinkCut, Scenario
 from interfaces.topics import GROUND, spacecraft_of
@@ -84,6 +90,62 @@ def _end_matches(pattern: str, node: str) -> bool:
     return pattern == "*" or pattern == node
 
 
+@dataclass(eq=False)
+class TruthHistory:
+    """The sim's truth positions (LVLH, m) of the last ``horizon_s`` seconds, by sim time, as the
+    channel models of one process read them (thread-safe).  The first Bus whose channel reads it
+    feeds it (``claim_feed``), with the TruthState messages as they come; a time's positions are
+    converted when a delivery first asks for them."""
+
+    horizon_s: float = 60.0
+    """History kept behind the newest truth (s): at least the link delay and a margin."""
+    _t: list[float] = field(default_factory=list)
+    _pos: list[dict[str, np.ndarray] | tuple[list[int], list[list[float]]]] = field(
+        default_factory=list)
+    _fed: bool = False
+    _lock: threading.Lock = field(default_factory=threading.Lock)
+
+    def claim_feed(self) -> bool:
+        """True for the first caller only: it subscribes ``observe`` to the sim's truth."""
+        with self._lock:
+            first, self._fed = not self._fed, True
+        return first
+
+    def observe(self, msg: TruthState) -> None:
+        """Bus handler of the sim's TruthState."""
+        self.record(msg.t_sim, msg.spacecraft, msg.r_lvlh_m)
+
+    def record(self, t_sim: float, spacecraft: list[int], r_lvlh_m: list[list[float]]) -> None:
+        """Record the true positions (m) of ``spacecraft`` at ``t_sim`` (s)."""
+        with self._lock:
+            i = bisect.bisect_right(self._t, t_sim)
+            if i > 0 and self._t[i - 1] == t_sim:
+                self._pos[i - 1] = (spacecraft, r_lvlh_m)
+                return
+            self._t.insert(i, t_sim)
+            self._pos.insert(i, (spacecraft, r_lvlh_m))
+            old = bisect.bisect_left(self._t, self._t[-1] - self.horizon_s)
+            if old > 0:
+                del self._t[:old]
+                del self._pos[:old]
+
+    def positions_at(self, t: float) -> dict[str, np.ndarray] | None:
+        """Positions by node (the ground at the origin) at the latest truth time <= t
+        (+1 µs tolerance), or None if there is none."""
+        with self._lock:
+            i = bisect.bisect_right(self._t, t + 1e-6)
+            if i == 0:
+                return None
+            pos = self._pos[i - 1]
+            if isinstance(pos, tuple):
+                spacecraft, r_lvlh_m = pos
+                pos = {f"sc{sc}": np.asarray(r, dtype=float)
+                       for sc, r in zip(spacecraft, r_lvlh_m)}
+                pos[GROUND] = np.zeros(3)
+                self._pos[i - 1] = pos
+            return pos
+
+
 @dataclass
 class ChannelModel:
     """The channel as seen by one receiving node (``receiver``: "sc<N>" or "ground")."""
@@ -94,17 +156,19 @@ class ChannelModel:
     faults: Sequence[Fault] = ()
     """The scenario's faults: ``link_loss`` cuts every link of its spacecraft, ``packet_loss``
     adds a loss probability (``magnitude``) on them, each over [start_s, end_s)."""
+    truth: TruthHistory = field(default_factory=TruthHistory)
+    """Where the true positions come from (shared by the channel models of one process)."""
     _links: dict[str, _Link] = field(default_factory=dict)
-    _truth_t: list[float] = field(default_factory=list)
-    _truth_pos: list[dict[str, np.ndarray]] = field(default_factory=list)
     _cuts: list[_Cut] = field(default_factory=list)
-    _lock: threading.Lock = field(default_factory=threading.Lock)
 
     @classmethod
-    def of(cls, receiver: str, scenario: Scenario) -> ChannelModel:
+    def of(cls, receiver: str, scenario: Scenario,
+           truth: TruthHistory | None = None) -> ChannelModel:
         """The channel model of ``receiver`` in a run of ``scenario`` (every run, transport
-        and replay builds it this way, so its draws are the same)."""
-        return cls(receiver, scenario.comms, scenario.seed, scenario.faults)
+        and replay builds it this way, so its draws are the same), reading ``truth`` (shared
+        by the nodes of one process; a history of its own by default)."""
+        return cls(receiver, scenario.comms, scenario.seed, scenario.faults,
+                   truth if truth is not None else history_for(scenario))
 
     def __post_init__(self) -> None:
         self._cuts = [_Cut(c.a, c.b, c.start_s, c.end_s) for c in self.comms.cuts]
@@ -130,16 +194,8 @@ class ChannelModel:
 
     def observe_truth(self, t_sim: float, spacecraft: list[int],
                       r_lvlh_m: list[list[float]]) -> None:
-        """Record true positions at ``t_sim`` (from the sim's TruthState); thread-safe."""
-        pos = {f"sc{sc}": np.asarray(r, dtype=float) for sc, r in zip(spacecraft, r_lvlh_m)}
-        pos[GROUND] = np.zeros(3)
-        with self._lock:
-            i = bisect.bisect_right(self._truth_t, t_sim)
-            if i > 0 and self._truth_t[i - 1] == t_sim:
-                self._truth_pos[i - 1] = pos
-                return
-            self._truth_t.insert(i, t_sim)
-            self._truth_pos.insert(i, pos)
+        """Record true positions (m) at ``t_sim`` (s) in this model's truth history."""
+        self.truth.record(t_sim, spacecraft, r_lvlh_m)
 
     def cut(self, a: str, b: str = "*", start_s: float = 0.0, end_s: float = math.inf) -> None:
         """Inject a link cut (e.g. a ``link_loss`` fault)."""
@@ -196,26 +252,13 @@ class ChannelModel:
         return lost
 
     def _in_range(self, src: str, t_send: float) -> bool:
-        pos = self._positions_at(t_send)
+        pos = self.truth.positions_at(t_send)
         if pos is None:
             return False
         a, b = pos.get(src), pos.get(self.receiver)
         if a is None or b is None:
             return False
         return float(np.linalg.norm(a - b)) <= self.comms.range_m
-
-    def _positions_at(self, t: float) -> dict[str, np.ndarray] | None:
-        """Truth at the latest time <= t (+1 µs tolerance); prunes history older than needed."""
-        with self._lock:
-            i = bisect.bisect_right(self._truth_t, t + 1e-6)
-            if i == 0:
-                return None
-            pos = self._truth_pos[i - 1]
-            keep_from = max(0, i - 1 - 4)  # messages are decided in time order: keep a margin
-            if keep_from > 0:
-                del self._truth_t[:keep_from]
-                del self._truth_pos[:keep_from]
-            return pos
 
     def _link(self, src: str) -> _Link:
         link = self._links.get(src)
@@ -228,6 +271,11 @@ class ChannelModel:
     def counters(self) -> list[LinkCounter]:
         """Copies of the per-link counters, sorted by source."""
         return [self._links[s].counter.model_copy() for s in sorted(self._links)]
+
+
+def history_for(scenario: Scenario) -> TruthHistory:
+    """A truth history long enough for ``scenario``'s link delay."""
+    return TruthHistory(horizon_s=scenario.comms.delay_s + 60.0)
 
 
 def applies(src: str | None, dst: str) -> bool:

@@ -8,6 +8,12 @@ messages to its own subscribers itself, identically on every transport.
 JSON is made only where bytes are needed: on the wire (Zenoh) and for raw subscribers (the
 recorder, the live view), once per message however many of them there are.  In one process a
 Bus subscriber of the message's own type receives the publisher's (immutable) object.
+
+The in-process network is the lean runtime of one-process runs: each (publisher, key) pair's
+receivers are resolved once and cached, and a message another Bus of this process made
+(``send``) goes to each receiving Bus's ``made_here`` handler, which skips the admission checks
+that message cannot fail.  Raw bytes (``publish``: tools, tests, a hostile publisher) take the
+full path of validation and admission, as everything arriving over Zenoh does.
 """
 
 from __future__ import annotations
@@ -47,6 +53,8 @@ class Sample:
 
 SampleHandler = Callable[[Sample], None]
 """Receives a Sample (the Bus); may run on a transport thread."""
+MadeHereHandler = Callable[[str, "Message"], None]
+"""Receives (key, message) for a message a Bus of this process published (in-process only)."""
 RawHandler = Callable[[str, str, bytes], None]
 """Receives (key, message type name, JSON payload); may run on a transport thread."""
 Responder = Callable[[str], bytes | None]
@@ -55,9 +63,17 @@ LivenessHandler = Callable[[str, bool], None]
 """Receives (node, alive) when a node's liveliness token appears or disappears."""
 
 
+_Route = tuple[Callable[..., None], bool, "MadeHereHandler | None"]
+"""A receiver of a key: (handler, raw, made_here), as subscribed."""
+
+
 class Transport(Protocol):
+    synchronous: bool
+    """Whether ``send`` delivers to every receiver before it returns (the in-process network)."""
+
     def send(self, sample: Sample) -> None:
-        """Publish a sample (the Bus's path: bytes only if this transport needs them)."""
+        """Publish a sample a Bus made (the Bus's path: bytes only if this transport needs
+        them)."""
 
     def publish(self, key: str, type_name: str, payload: bytes) -> None:
         """Publish raw bytes (tools, tests: a hostile or foreign publisher)."""
@@ -65,8 +81,11 @@ class Transport(Protocol):
     def subscribe(self, key_expr: str, handler: RawHandler) -> None:
         """Raw samples as (key, type name, JSON bytes)."""
 
-    def subscribe_samples(self, key_expr: str, handler: SampleHandler) -> None:
-        """Samples as they come: the object where the transport has it (the Bus's path)."""
+    def subscribe_samples(self, key_expr: str, handler: SampleHandler,
+                          made_here: MadeHereHandler | None = None) -> None:
+        """Samples as they come: the object where the transport has it (the Bus's path).
+        ``made_here``, where the transport can tell, receives instead the messages that another
+        Bus of this process published (``send``)."""
 
     def serve(self, key_expr: str, responder: Responder) -> None: ...
 
@@ -82,13 +101,12 @@ class Transport(Protocol):
 @dataclass
 class InprocNetwork:
     """The shared medium of in-process transports: synchronous delivery in subscription order.
-    The handlers of each (publisher, key) pair are resolved once and cached until a subscription
-    or an endpoint changes."""
+    The receivers of each (publisher, key) pair are resolved once and cached until a
+    subscription or an endpoint changes."""
 
     _endpoints: list[InprocTransport] = field(default_factory=list)
     _lock: threading.RLock = field(default_factory=threading.RLock)
-    _routes: dict[tuple[int, str], list[tuple[Callable[..., None], bool]]] = field(
-        default_factory=dict)
+    _routes: dict[tuple[int, str], list[_Route]] = field(default_factory=dict)
 
     def endpoint(self) -> InprocTransport:
         t = InprocTransport(self)
@@ -102,21 +120,24 @@ class InprocNetwork:
         with self._lock:
             self._routes.clear()
 
-    def _deliver(self, origin: InprocTransport, sample: Sample) -> None:
-        key = sample.key
-        with self._lock:
-            targets = self._routes.get((id(origin), key))
-            if targets is None:
-                targets = [
-                    (h, raw) for ep in self._endpoints if ep is not origin and not ep.closed
-                    for expr, h, raw in ep.subs if matches(expr, key)
-                ]
+    def _targets(self, origin: InprocTransport, key: str) -> list[_Route]:
+        targets = self._routes.get((id(origin), key))
+        if targets is None:
+            with self._lock:
+                targets = [sub[1:] for ep in self._endpoints if ep is not origin and not ep.closed
+                           for sub in ep.subs if matches(sub[0], key)]
                 self._routes[(id(origin), key)] = targets
-        for h, raw in targets:
+        return targets
+
+    def _deliver(self, origin: InprocTransport, sample: Sample, made_here: bool) -> None:
+        key = sample.key
+        for handler, raw, made in self._targets(origin, key):
             if raw:
-                h(key, sample.type_name, sample.payload)
+                handler(key, sample.type_name, sample.payload)
+            elif made is not None and made_here:
+                made(key, sample.message)
             else:
-                h(sample)
+                handler(sample)
 
     def _query(self, selector: str) -> list[tuple[str, bytes]]:
         with self._lock:
@@ -141,25 +162,29 @@ class InprocTransport:
     """In-process transport: one process, no network; same API and semantics as Zenoh's."""
 
     network: InprocNetwork
-    subs: list[tuple[str, Callable[..., None], bool]] = field(default_factory=list)
-    """(key expression, handler, raw): raw handlers get bytes, the others the Sample."""
+    subs: list[tuple[str, Callable[..., None], bool, MadeHereHandler | None]] = field(
+        default_factory=list)
+    """(key expression, handler, raw, made_here): raw handlers get bytes, the others the
+    Sample, or (key, message) through ``made_here`` for what a Bus of this process made."""
     servers: list[tuple[str, Responder]] = field(default_factory=list)
     watchers: list[LivenessHandler] = field(default_factory=list)
     alive: list[str] = field(default_factory=list)
     closed: bool = False
+    synchronous: bool = True
 
     def send(self, sample: Sample) -> None:
-        self.network._deliver(self, sample)
+        self.network._deliver(self, sample, made_here=sample.message is not None)
 
     def publish(self, key: str, type_name: str, payload: bytes) -> None:
-        self.network._deliver(self, Sample(key, type_name, payload=payload))
+        self.network._deliver(self, Sample(key, type_name, payload=payload), made_here=False)
 
     def subscribe(self, key_expr: str, handler: RawHandler) -> None:
-        self.subs.append((key_expr, handler, True))
+        self.subs.append((key_expr, handler, True, None))
         self.network.invalidate()
 
-    def subscribe_samples(self, key_expr: str, handler: SampleHandler) -> None:
-        self.subs.append((key_expr, handler, False))
+    def subscribe_samples(self, key_expr: str, handler: SampleHandler,
+                          made_here: MadeHereHandler | None = None) -> None:
+        self.subs.append((key_expr, handler, False, made_here))
         self.network.invalidate()
 
     def serve(self, key_expr: str, responder: Responder) -> None:

@@ -23,7 +23,14 @@ from typing import Any, Literal
 
 import zenoh
 
-from interfaces.transport import LivenessHandler, RawHandler, Responder, Sample, SampleHandler
+from interfaces.transport import (
+    LivenessHandler,
+    MadeHereHandler,
+    RawHandler,
+    Responder,
+    Sample,
+    SampleHandler,
+)
 
 DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
 
@@ -68,6 +75,8 @@ class ZenohTransport:
     _entities: list[Any] = field(default_factory=list)
     _lock: threading.Lock = field(default_factory=threading.Lock)
     _closed: bool = False
+    synchronous: bool = False
+    """Delivery happens on Zenoh's threads, after ``send`` returns."""
 
     def __post_init__(self) -> None:
         self._session = zenoh.open(self.settings.config())
@@ -102,7 +111,10 @@ class ZenohTransport:
         )
         self._entities.append(sub)
 
-    def subscribe_samples(self, key_expr: str, handler: SampleHandler) -> None:
+    def subscribe_samples(self, key_expr: str, handler: SampleHandler,
+                          made_here: MadeHereHandler | None = None) -> None:
+        """Every sample comes from another process: bytes, validated and admitted by the Bus
+        (``made_here`` is never called)."""
         self.subscribe(key_expr, lambda k, t, p: handler(Sample(k, t, payload=p)))
 
     def serve(self, key_expr: str, responder: Responder) -> None:

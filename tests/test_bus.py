@@ -92,3 +92,28 @@ def test_local_delivery_same_tick() -> None:
     bus.subscribe(key, Heartbeat, got.append)
     bus.publish(key, _hb(1.0))
     assert bus.dispatch(1.0) == 1 and got[0].seq == 1
+
+
+def test_in_process_messages_skip_admission_raw_bytes_do_not() -> None:
+    """The lean in-process path: a message another Bus of the process made is delivered without
+    the admission checks (it cannot fail them); raw bytes on the same network are still
+    validated and admitted, and a forged one is refused."""
+    net = InprocNetwork()
+    bus_a, bus_b, raw = Bus("sc1", M, net.endpoint()), Bus("sc2", M, net.endpoint()), \
+        net.endpoint()
+    got: list[Heartbeat] = []
+    key = topics.key(M, "sc1", "exec", "heartbeat")
+    bus_b.subscribe(key, Heartbeat, got.append)
+    checked: list[str] = []
+    check = bus_b.admission.check
+    bus_b.admission.check = lambda k, m, p: checked.append(k) or check(k, m, p)  # type: ignore
+    bus_a.publish(key, _hb(1.0))
+    forged = _hb(1.5).model_dump() | {"sender": "sc3", "seq": 2}
+    raw.publish(key, "Heartbeat", json.dumps(forged).encode())  # another node's name: refused
+    genuine = _hb(2.0).model_dump() | {"sender": "sc1", "seq": 2}
+    raw.publish(key, "Heartbeat", json.dumps(genuine).encode())
+    assert checked == [key, key]  # only the two raw samples were held to admission
+    assert bus_b.stats.received == 3 and bus_b.stats.refused == 1
+    assert dict(bus_b.admission.refused) == {"sender": 1}
+    assert bus_b.admission.highest_seq[key] == 2  # the barrier saw both genuine messages
+    assert bus_b.dispatch(10.0) == 2 and [m.t_sim for m in got] == [1.0, 2.0]

@@ -7,7 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from interfaces.channel import ChannelModel, Verdict, applies, gilbert_elliott_rates
+from interfaces.channel import (
+    ChannelModel,
+    TruthHistory,
+    Verdict,
+    applies,
+    gilbert_elliott_rates,
+)
 from interfaces.scenario import Burst, Comms, Fault, LinkCut
 
 
@@ -121,3 +127,21 @@ def test_link_faults_cut_and_add_loss_only_on_the_faulty_spacecraft() -> None:
         for _ in range(50):
             ch_.decide("sc3", 0.0)
     assert [a.decide("sc1", 0.0) for _ in range(300)] == [b.decide("sc1", 0.0) for _ in range(300)]
+
+
+def test_one_truth_history_serves_every_channel_of_a_process() -> None:
+    """The nodes of one process share one truth feed: the first Bus claims it, every channel
+    model reads it, and history older than its horizon is forgotten (a message that old is
+    dropped for range, as before the first truth)."""
+    truth = TruthHistory(horizon_s=10.0)
+    assert truth.claim_feed() and not truth.claim_feed()
+    a = ChannelModel("sc1", Comms(range_m=50.0), seed=7, truth=truth)
+    b = ChannelModel("sc2", Comms(range_m=50.0), seed=7, truth=truth)
+    for t in range(0, 31):
+        truth.record(float(t), [1, 2, 3], [[0, 0, 0], [40.0, 0, 0], [0, 60.0, 0]])
+    assert a.decide("sc2", 30.0) is Verdict.DELIVER and a.decide("sc3", 30.0) is Verdict.RANGE
+    assert b.decide("sc1", 25.5) is Verdict.DELIVER  # truth at 25 s
+    assert b.decide("sc1", 19.0) is Verdict.RANGE  # older than the horizon: no truth kept
+    pos = truth.positions_at(20.0)
+    assert pos is not None and np.array_equal(pos["sc3"], [0.0, 60.0, 0.0])
+    assert np.array_equal(pos["ground"], np.zeros(3))
