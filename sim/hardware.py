@@ -20,6 +20,7 @@ from scipy.spatial.transform import Rotation
 from fsw.lib import quat
 from interfaces.rng import stream
 from interfaces.scenario import Scenario
+from sim import kernels
 from sim.actuators import ThrusterBank, WheelArray
 from sim.attitude import AttitudeTruth
 from sim.sensors import Gyro, StarTracker
@@ -45,10 +46,13 @@ def initial_attitudes(scenario: Scenario, r_eci_lvlh: Rotation) -> tuple[np.ndar
 
 
 class ObserverHardware:
-    """Thrusters, wheels, attitude truth and attitude sensors of all observers."""
+    """Thrusters, wheels, attitude truth and attitude sensors of all observers.  ``compiled``:
+    the frame and thrust glue of the 10 Hz tick run on :mod:`sim.kernels` (the same bits as the
+    numpy reference, which ``compiled=False`` runs)."""
 
-    def __init__(self, scenario: Scenario, r_eci_lvlh: Rotation) -> None:
+    def __init__(self, scenario: Scenario, r_eci_lvlh: Rotation, compiled: bool = True) -> None:
         sc = scenario
+        self.compiled = compiled
         n = sc.observers.count
         ids = range(1, n + 1)
         act, sen = sc.actuators, sc.sensors
@@ -97,9 +101,13 @@ class ObserverHardware:
     def accel_lvlh(self, t_s: float, q_lvlh_eci: np.ndarray) -> np.ndarray:
         """Thrust acceleration in LVLH over the tick starting at ``t_s`` (N, 3), m/s², given the
         true ECI -> LVLH rotation as a quaternion (4,)."""
+        q_lvlh_body = self.q_lvlh_body(q_lvlh_eci)
+        if self.compiled:
+            return kernels.thrust_accel_lvlh(q_lvlh_body, self.force_body, self.force_until,
+                                             self.force_bias_body, float(t_s), self.mass_kg)
         active = (t_s < self.force_until - 1e-9)[:, None]
         f = np.where(active, self.force_body, 0.0) + self.force_bias_body
-        out: np.ndarray = quat.rotate(self.q_lvlh_body(q_lvlh_eci), f) / self.mass_kg
+        out: np.ndarray = quat.rotate(q_lvlh_body, f) / self.mass_kg
         return out
 
     def step(self, t_s: float, dt_s: float) -> None:
@@ -124,4 +132,7 @@ class ObserverHardware:
     def q_lvlh_body(self, q_lvlh_eci: np.ndarray) -> np.ndarray:
         """True attitudes with respect to LVLH (N, 4), scalar last, given the true ECI -> LVLH
         rotation as a quaternion (4,)."""
+        if self.compiled:
+            return kernels.lvlh_attitudes(np.asarray(q_lvlh_eci, dtype=float),
+                                          self.attitude.q)
         return quat.mul(np.broadcast_to(q_lvlh_eci, (self.n, 4)), self.attitude.q)

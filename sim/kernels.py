@@ -4,7 +4,11 @@
   (same equations, same stage order, quaternions renormalised after each substep), with the
   integral of the body rate the gyro senses;
 * :func:`relative_rk4` — the chief + deputies RK4 of :class:`sim.dynamics.RelativeTruth`
-  (Battin's differential gravity, optional J2, LVLH acceleration rotated into ECI at each stage).
+  (Battin's differential gravity, optional J2, LVLH acceleration rotated into ECI at each stage);
+* :func:`lvlh_attitudes` and :func:`thrust_accel_lvlh` — the frame and thrust glue of
+  :class:`sim.hardware.ObserverHardware` (the attitudes in LVLH, the thrust acceleration in
+  LVLH), the same floating-point operations in the same order as its numpy reference, so the
+  results are the same bits.
 
 The numpy implementations in those classes stay the reference; ``tests/test_sim_kernels.py``
 checks these against them on random states.  Inputs are float64 arrays, already validated by
@@ -159,3 +163,42 @@ def relative_rk4(y0: np.ndarray, a_lvlh: np.ndarray, has_accel: bool, mu: float,
         s += k4
         y = y + (h / 6.0) * s
     return y
+
+
+@njit(cache=True)
+def lvlh_attitudes(q_lvlh_eci: np.ndarray, q_eci_body: np.ndarray) -> np.ndarray:
+    """R_lvlh_body = R_lvlh_eci R_eci_body per spacecraft (N, 4), scalar last: the Hamilton
+    product of :func:`fsw.lib.quat.mul` with the frame quaternion (4,) on every row."""
+    n = q_eci_body.shape[0]
+    out = np.empty((n, 4))
+    px, py, pz, pw = q_lvlh_eci[0], q_lvlh_eci[1], q_lvlh_eci[2], q_lvlh_eci[3]
+    for i in range(n):
+        qx, qy, qz, qw = q_eci_body[i, 0], q_eci_body[i, 1], q_eci_body[i, 2], q_eci_body[i, 3]
+        out[i, 0] = pw * qx + qw * px + py * qz - pz * qy
+        out[i, 1] = pw * qy + qw * py + pz * qx - px * qz
+        out[i, 2] = pw * qz + qw * pz + px * qy - py * qx
+        out[i, 3] = pw * qw - px * qx - py * qy - pz * qz
+    return out
+
+
+@njit(cache=True)
+def thrust_accel_lvlh(q_lvlh_body: np.ndarray, force_body: np.ndarray, force_until: np.ndarray,
+                      force_bias_body: np.ndarray, t_s: float, mass_kg: float) -> np.ndarray:
+    """Thrust acceleration in LVLH (N, 3), m/s²: the commanded force while its command runs
+    (``t_s`` before ``force_until`` less 1 ns) plus the continuous bias, body axes (N), rotated
+    by R(q_lvlh_body) (:func:`fsw.lib.quat.rotate`) and divided by the mass (kg)."""
+    n = force_body.shape[0]
+    out = np.empty((n, 3))
+    for i in range(n):
+        active = t_s < force_until[i] - 1e-9
+        vx = (force_body[i, 0] if active else 0.0) + force_bias_body[i, 0]
+        vy = (force_body[i, 1] if active else 0.0) + force_bias_body[i, 1]
+        vz = (force_body[i, 2] if active else 0.0) + force_bias_body[i, 2]
+        qx, qy, qz, qw = q_lvlh_body[i, 0], q_lvlh_body[i, 1], q_lvlh_body[i, 2], q_lvlh_body[i, 3]
+        tx = 2.0 * (qy * vz - qz * vy)
+        ty = 2.0 * (qz * vx - qx * vz)
+        tz = 2.0 * (qx * vy - qy * vx)
+        out[i, 0] = (vx + qw * tx + qy * tz - qz * ty) / mass_kg
+        out[i, 1] = (vy + qw * ty + qz * tx - qx * tz) / mass_kg
+        out[i, 2] = (vz + qw * tz + qx * ty - qy * tx) / mass_kg
+    return out

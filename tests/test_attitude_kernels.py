@@ -113,3 +113,36 @@ def test_tracking_torque_matches_reference(seed: int) -> None:
     np.testing.assert_allclose(tau, ref_tau, rtol=1e-11, atol=1e-15)
     assert angle == pytest.approx(ref_angle, abs=1e-12)
     assert np.abs(tau).max() <= tau_max * (1 + 1e-12)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_track_cycle_is_the_kernels_called_one_by_one(seed: int) -> None:
+    """The fused tracking cycle gives the same bits as the separate kernels, and names a slew
+    beyond the threshold and a line of sight that vanishes."""
+    rng = np.random.default_rng(seed)
+    n, incl, t, h = 1.1e-3, math.radians(51.6), float(rng.uniform(0.0, 5000.0)), 1.0
+    x_est = np.concatenate([rng.normal(size=3) * 40.0, rng.normal(size=3) * 0.05])
+    target, rate, accel = rng.normal(size=3), rng.normal(size=3) * 0.01, rng.normal(size=3) * 1e-4
+    q_est, w_est, h_w = _unit_quat(rng), rng.normal(size=3) * 1e-3, rng.normal(size=3) * 1e-3
+    J, bore = np.diag(rng.uniform(0.5, 2.0, size=3)), np.array([0.0, 0.0, 1.0])
+    threshold = math.radians(5.0) if seed % 3 == 0 else math.pi
+    los = [kern.los_eci(t + d, n, incl, x_est, t - 0.4, target, rate, accel, t - 0.7)
+           for d in (-h, 0.0, h)]
+    q_des, w_des, wdot_des = kern.pointing_reference(q_est, *los, bore, h)
+    angle = kern.angle_between(q_des, q_est)
+    status, _, q_got, angle_got, tau_got = kern.track_cycle(
+        t, h, n, incl, x_est, t - 0.4, target, rate, accel, t - 0.7, q_est, q_est, w_est, bore,
+        J, h_w, 0.05, 0.4, 0.02, 0.01, threshold)
+    assert np.array_equal(q_got, q_des) and angle_got == angle
+    if angle > threshold:
+        assert status == kern.SLEW and not tau_got.any()
+    else:
+        tau, _ = kern.tracking_torque(q_est, w_est, q_des, w_des, wdot_des, J, h_w, 0.05, 0.4,
+                                      0.02, 0.01)
+        assert status == kern.TRACKED and np.array_equal(tau_got, tau)
+    on_target = x_est.copy()  # the spacecraft at the target, not moving: no line of sight
+    on_target[:3], on_target[3:] = target, 0.0
+    status, t_bad, *_ = kern.track_cycle(
+        t, h, n, incl, on_target, t, target, np.zeros(3), np.zeros(3), t, q_est, q_est, w_est,
+        bore, J, h_w, 0.05, 0.4, 0.02, 0.01, threshold)
+    assert status == kern.NO_LINE_OF_SIGHT and t_bad == t - h

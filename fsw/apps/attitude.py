@@ -73,6 +73,7 @@ class AttitudeApp(App):
         self.w_max = math.radians(sc.attitude.slew_rate_max_dps)
         self.gains = gains_for(sc.attitude.settling_time_s, w_max_radps=self.w_max)
         self._w_limit = -1.0 if self.gains.w_max_radps is None else self.gains.w_max_radps
+        self._slew_threshold_rad = math.radians(sc.attitude.slew_threshold_deg)
         self.tau_max = sc.actuators.wheel_max_torque_nm
         s = sc.sensors
         self.sigma_v, self.sigma_u = s.gyro_arw_rad_rts, s.gyro_bias_rw_rad_s15
@@ -174,28 +175,31 @@ class AttitudeApp(App):
 
     def _control(self, t: float) -> np.ndarray:
         """Wheel torque tracking the slew plan, or the pointing attitude (quaternions R_eci_body,
-        scalar last: no scipy Rotation on the 10 Hz path)."""
-        assert self.q is not None
+        scalar last: no scipy Rotation on the 10 Hz path; the tracking cycle is one compiled
+        call, :func:`fsw.lib.attitude_kernels.track_cycle`)."""
+        assert self.q is not None and self._est is not None
         if self.mode == "slew" and self.slew is not None and t - self.slew_t0 <= self.slew_end:
             r_des, w_des, wdot_des = self.slew.at_quat(t - self.slew_t0)
         else:
-            h = DESIRED_RATE_STEP_S
-            q_des, w_des, wdot_des = kern.pointing_reference(
-                self.q if self.q_point is None else self.q_point, self._los_eci(t - h),
-                self._los_eci(t), self._los_eci(t + h), self.boresight, h)
-            angle = kern.angle_between(q_des, self.q)
-            if angle > math.radians(self.cfg.slew_threshold_deg):
-                self._plan_slew(t, angle)
-                self.q_point = None
-                r_des, w_des, wdot_des = self.slew.at_quat(0.0)
-            else:
-                self.mode, self.q_point, r_des = "track", q_des, q_des
+            status, t_bad, q_des, angle, tau = kern.track_cycle(
+                t, DESIRED_RATE_STEP_S, self.n, self.incl, self._x_est, self._est.t_sim,
+                self.target, self.target_rate, self.target_accel, self.target_t,
+                self.q if self.q_point is None else self.q_point, self.q, self.w_est,
+                self.boresight, self.J, self.h_wheels, self.gains.kp, self.gains.kd,
+                self._w_limit, self.tau_max, self._slew_threshold_rad)
+            if status == kern.NO_LINE_OF_SIGHT:
+                raise ValueError(f"no line of sight to the pointing target at t={t_bad:.1f} s "
+                                 f"(target on the spacecraft, or non-finite)")
+            if status == kern.TRACKED:
+                self.mode, self.q_point = "track", q_des
+                return _finite(tau)
+            self._plan_slew(t, angle)
+            self.q_point = None
+            r_des, w_des, wdot_des = self.slew.at_quat(0.0)  # type: ignore[union-attr]
         tau, _ = kern.tracking_torque(self.q, self.w_est, r_des, w_des, wdot_des, self.J,
                                       self.h_wheels, self.gains.kp, self.gains.kd,
                                       self._w_limit, self.tau_max)
-        if not np.isfinite(tau).all():
-            raise ValueError(f"non-finite torque command {tau.tolist()} (safe mode: zero torque)")
-        return tau
+        return _finite(tau)
 
     def _plan_slew(self, t: float, angle: float) -> None:
         """Plan a rate-limited slew (SCP, slerp as fallback) onto the pointing attitude."""
@@ -226,6 +230,13 @@ class AttitudeApp(App):
             sigma_att_rad=float(math.sqrt(max(0.0, np.trace(self.P[:3, :3])))),
             target_lvlh_m=self._target_at(t).tolist(), pointing_error_rad=error,
             mode=self.mode, torque_body_nm=self.tau.tolist(), nis=self.nis))  # type: ignore[arg-type]
+
+
+def _finite(tau: np.ndarray) -> np.ndarray:
+    """The torque command, or the error that sends the app to safe mode (zero torque)."""
+    if not np.isfinite(tau).all():
+        raise ValueError(f"non-finite torque command {tau.tolist()} (safe mode: zero torque)")
+    return tau
 
 
 def _saturate(tau: np.ndarray, tau_max: float) -> np.ndarray:

@@ -10,7 +10,10 @@ set the cost (≈0.5 ms per spacecraft step with numpy, tens of µs compiled):
 * :func:`pointing_reference` — the desired attitude by :func:`fsw.lib.attitude.repoint` onto the
   line of sight, and its rate and acceleration by central differences of the repointed attitudes
   ``h`` before and after (the attitude app's feed-forward);
-* :func:`tracking_torque` — :func:`fsw.lib.attitude_control.tracking_torque`.
+* :func:`tracking_torque` — :func:`fsw.lib.attitude_control.tracking_torque`;
+* :func:`track_cycle` — the attitude app's whole tracking cycle in one call: the lines of sight,
+  the pointing reference, its distance from the estimate and, below the slew threshold, the
+  tracking torque (the kernels above composed, so the same bits as calling them one by one).
 
 Inputs are float64 arrays already validated (finite, unit quaternions where stated): the
 attitude app feeds them from validated messages and its own state.  The numpy versions stay
@@ -284,3 +287,47 @@ def tracking_torque(q_est: np.ndarray, w_est: np.ndarray, q_des: np.ndarray, w_d
     if ratio > 1.0:
         tau = tau / ratio
     return tau, err_angle
+
+
+TRACKED = 0
+""":func:`track_cycle` status: the pointing attitude is tracked (the torque is computed)."""
+SLEW = 1
+""":func:`track_cycle` status: the estimate is beyond the slew threshold (no torque: plan a
+slew)."""
+NO_LINE_OF_SIGHT = 2
+""":func:`track_cycle` status: a line of sight is zero or not finite (its time is returned)."""
+
+
+@njit(cache=True)
+def track_cycle(t: float, h: float, n: float, inclination_rad: float, x_est: np.ndarray,
+                t_est: float, target: np.ndarray, target_rate: np.ndarray,
+                target_accel: np.ndarray, target_t: float, q_seed: np.ndarray,
+                q_est: np.ndarray, w_est: np.ndarray, boresight: np.ndarray, J: np.ndarray,
+                h_wheels: np.ndarray, kp: float, kd: float, w_max: float, tau_max: float,
+                slew_threshold_rad: float
+                ) -> tuple[int, float, np.ndarray, float, np.ndarray]:
+    """One tracking cycle at time ``t`` (s): the lines of sight (:func:`los_eci`) ``h`` seconds
+    before, at and after ``t``; the pointing reference repointed from ``q_seed``
+    (:func:`pointing_reference`); its angle from the estimate ``q_est`` (rad); and, when that
+    angle is within ``slew_threshold_rad``, the tracking torque (:func:`tracking_torque`, N·m).
+
+    Returns (status, time s of a bad line of sight, desired attitude, angle rad, torque N·m):
+    status :data:`TRACKED`, :data:`SLEW` (torque zero) or :data:`NO_LINE_OF_SIGHT`."""
+    zero4, zero3 = np.zeros(4), np.zeros(3)
+    lines = np.empty((3, 3))
+    for j in range(3):
+        tj = t + (j - 1) * h
+        los = los_eci(tj, n, inclination_rad, x_est, t_est, target, target_rate, target_accel,
+                      target_t)
+        n2 = los[0] * los[0] + los[1] * los[1] + los[2] * los[2]
+        if not (n2 > 0.0 and math.isfinite(n2)):
+            return NO_LINE_OF_SIGHT, tj, zero4, 0.0, zero3
+        lines[j] = los
+    q_des, w_des, wdot_des = pointing_reference(q_seed, lines[0], lines[1], lines[2],
+                                                boresight, h)
+    angle = angle_between(q_des, q_est)
+    if angle > slew_threshold_rad:
+        return SLEW, t, q_des, angle, zero3
+    tau, _ = tracking_torque(q_est, w_est, q_des, w_des, wdot_des, J, h_wheels, kp, kd, w_max,
+                             tau_max)
+    return TRACKED, t, q_des, angle, tau

@@ -289,10 +289,12 @@ def from_matrix(m: npt.ArrayLike) -> FloatArray:
     Markley & Crassidis 2014, Ch. 2), then the result is normalised.  This is the algorithm
     of scipy's ``from_matrix`` and gives the same sign: the largest-magnitude component positive.
     The input must be a proper rotation matrix to rounding (scipy would first orthogonalise a
-    grossly non-orthogonal one).  Vectorised numpy, no float fast path: not meant for the inner
-    loop (build quaternions directly there).
+    grossly non-orthogonal one).  A single (3, 3) matrix is done on Python floats (the sim's
+    10 Hz frame), a stack in vectorised numpy; both give the same bits.
     """
     ma = np.asarray(m, dtype=float)
+    if ma.shape == (3, 3):
+        return _from_matrix_floats(ma.tolist())
     m00, m01, m02 = ma[..., 0, 0], ma[..., 0, 1], ma[..., 0, 2]
     m10, m11, m12 = ma[..., 1, 0], ma[..., 1, 1], ma[..., 1, 2]
     m20, m21, m22 = ma[..., 2, 0], ma[..., 2, 1], ma[..., 2, 2]
@@ -306,3 +308,21 @@ def from_matrix(m: npt.ArrayLike) -> FloatArray:
     choice = np.argmax(np.stack([m00, m11, m22, tr], axis=-1), axis=-1)
     q = np.take_along_axis(candidates, choice[..., None, None], axis=-2)[..., 0, :]
     return normalize(q)
+
+
+def _from_matrix_floats(rows: list[list[float]]) -> FloatArray:
+    """:func:`from_matrix` of one matrix, the same operations on floats (ties go to the first
+    candidate, as ``np.argmax``)."""
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = rows
+    tr = m00 + m11 + m22
+    diag = [m00, m11, m22, tr]
+    choice = diag.index(max(diag))
+    if choice == 0:
+        q = [1.0 + m00 - m11 - m22, m01 + m10, m02 + m20, m21 - m12]
+    elif choice == 1:
+        q = [m01 + m10, 1.0 - m00 + m11 - m22, m12 + m21, m02 - m20]
+    elif choice == 2:
+        q = [m02 + m20, m12 + m21, 1.0 - m00 - m11 + m22, m10 - m01]
+    else:
+        q = [m21 - m12, m02 - m20, m10 - m01, 1.0 + tr]
+    return normalize(np.array(q))
