@@ -23,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
+from interfaces.encoding import encode
 from interfaces.topics import matches
 
 if TYPE_CHECKING:
@@ -47,7 +48,7 @@ class Sample:
         """The message's JSON bytes (encoded once)."""
         if self._payload is None:
             assert self.message is not None
-            self._payload = self.message.model_dump_json().encode()
+            self._payload = encode(self.message)
         return self._payload
 
 

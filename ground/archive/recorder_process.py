@@ -25,6 +25,10 @@ from interfaces.transport import Sample
 
 BATCH = 1024
 """Samples per message on the pipe (about 0.3 MB of JSON at the default scenario's mix)."""
+PIPE_BYTES = 1 << 20
+"""Capacity asked for the pipe (Linux ``F_SETPIPE_SZ``; 1 MiB is the default ceiling): a whole
+batch fits, so sending it is a copy, not a wait for the child to read (64 KiB by default)."""
+_F_SETPIPE_SZ = 1031
 
 
 class RecorderDied(RuntimeError):
@@ -45,6 +49,16 @@ def _serve(conn: Connection, path: str, metadata: dict[str, dict[str, str]] | No
             rec.record_prepared(pickle.loads(data))
 
 
+def _widen(fd: int) -> None:
+    """Ask for a pipe of ``PIPE_BYTES`` (Linux; elsewhere, or when refused, it stays as it is)."""
+    try:
+        import fcntl
+
+        fcntl.fcntl(fd, _F_SETPIPE_SZ, PIPE_BYTES)
+    except (ImportError, OSError):
+        pass
+
+
 class RecorderProcess:
     """An :class:`~ground.archive.recorder.McapRecorder` in a child process (see the module
     docstring); use as a context manager or call :meth:`close`."""
@@ -57,6 +71,7 @@ class RecorderProcess:
                                  name="recorder", daemon=True)
         self._proc.start()
         child_conn.close()
+        _widen(self._conn.fileno())
         self._batch: list[Pending] = []
         self._closed = False
 

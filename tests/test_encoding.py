@@ -1,0 +1,64 @@
+"""Message bytes (interfaces/encoding.py): the JSON pydantic writes, for every message type."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from deploy.inproc import run_inproc
+from interfaces.encoding import encode
+from interfaces.messages import (
+    AssignmentDecision,
+    CameraImage,
+    FaultReport,
+    Message,
+    SimStatus,
+    registry,
+)
+from interfaces.transport import Sample
+from tests.conftest import small_scenario
+
+
+def _pydantic(msg: Message) -> bytes:
+    return msg.model_dump_json().encode()
+
+
+def test_every_message_type_of_a_run_is_encoded_as_pydantic_does() -> None:
+    """A short run with faults and FDIR windows: every message it publishes, then the two
+    types it does not (a fault report, an assignment decision)."""
+    scenario = small_scenario(
+        "enc", duration_s=100.0, rates={"fdi_period_s": 10.0},
+        faults=[{"spacecraft": 1, "kind": "pointing_actuator", "start_s": 5.0, "magnitude": 20.0},
+                {"spacecraft": 2, "kind": "thruster_bias", "start_s": 5.0, "magnitude": 0.5}],
+        phases=[{"name": "p", "start_s": 1.0, "transfer_s": 30.0}])
+    samples: list[Sample] = []
+    run_inproc(scenario, sample_tap=samples.append)
+    extra: list[Message] = [
+        FaultReport(sender="ground", t_sim=40.0, spacecraft=2, fault_class="actuator",
+                    direction="degraded", metric=0.3, threshold=0.01, window_end_s=40.0,
+                    evidence={"dv_rate": 1.5e-5, "beta": 0.98}),
+        AssignmentDecision(sender="ground", t_sim=900.0, phase="inspection", reason="saturated",
+                           library_indices=[3, -1, 17], expected_gain=0.25, upper_bound=0.5,
+                           ratio_bound=0.5, current_gain=None, measured_gains=[0.1, 2e-9],
+                           switched=True),
+    ]
+    messages = [s.message for s in samples if s.message is not None] + extra
+    assert {type(m).__name__ for m in messages} == set(registry())  # every type is here
+    for msg in messages:
+        assert encode(msg) == _pydantic(msg), type(msg).__name__
+    assert all(s.payload == _pydantic(s.message) for s in samples[:2000])  # the Bus's bytes
+
+
+def test_floats_strings_and_fallback() -> None:
+    rng = np.random.default_rng(5)
+    values = [0.0, -0.0, 5e-324, 1.7976931348623157e308, 1e15, 1e16, 1e21, 1e22, 1e-5, 1e-7,
+              0.1, 1.0 / 3.0, 123456789012345678.0]
+    values += (rng.standard_normal(20_000) * 10.0 ** rng.uniform(-300, 300, 20_000)).tolist()
+    image = CameraImage.model_construct(sender="sim", seq=1, t_sim=1.0, t_wall=0.0, spacecraft=1,
+                                        poi=list(range(len(values))), precision=values)
+    assert encode(image) == _pydantic(image)
+    text = "".join(chr(i) for i in range(300)) + "é漢字\u2028\u2029😀\x7f"
+    status = SimStatus(sender="sim", t_sim=0.0, state="aborted", k=0, reason=text)
+    assert encode(status) == _pydantic(status)
+    huge = CameraImage.model_construct(sender="sim", seq=1, t_sim=1.0, t_wall=0.0, spacecraft=1,
+                                       poi=[2**70], precision=[1.0])  # beyond orjson's ints
+    assert encode(huge) == _pydantic(huge)
