@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy.stats import median_abs_deviation
 
 from fsw.lib.infocost import Camera, precision
 from fsw.lib.poi import sphere_pois
@@ -100,6 +101,10 @@ def test_median_se_is_the_spread_of_the_median() -> None:
     draws = rng.normal(1.0, 0.2, size=(4000, 30))
     spread = float(np.std(np.median(draws, axis=1)))
     assert np.median([median_se(d) for d in draws]) == pytest.approx(spread, rel=0.1)
+    # its MAD is scipy's, to the bit (odd and even counts, ties, a wild value)
+    for v in (*draws[:200], draws[0][:7], np.r_[draws[1][:9], 50.0], np.ones(4)):
+        mad = float(median_abs_deviation(v, scale="normal"))
+        assert median_se(v) == math.sqrt(math.pi / 2.0) * mad / math.sqrt(len(v))
 
 
 def test_too_few_pois_give_no_fix() -> None:

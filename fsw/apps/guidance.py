@@ -214,11 +214,12 @@ class GuidanceApp(App):
         plan = self.plan
         if plan is not None:
             tau = times - self.plan_t0
-            inside = tau <= plan.t_s[-1]
-            for j in np.flatnonzero(inside):
-                refs[j] = plan.state_at(tau[j])
-                if j < h:
-                    u_ref[j] = plan.u[min(int(tau[j] // plan.t_s[1]), len(plan.u) - 1)]
+            inside = np.flatnonzero(tau <= plan.t_s[-1])
+            if inside.size:
+                refs[inside] = plan.states_at(tau[inside])  # one vectorised propagation
+                fed = inside[inside < h]
+                step = np.minimum((tau[fed] // plan.t_s[1]).astype(int), len(plan.u) - 1)
+                u_ref[fed] = plan.u[step]
         return refs, u_ref
 
     def _command(self, t: float, u_lvlh: np.ndarray) -> np.ndarray:

@@ -90,7 +90,6 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.stats import median_abs_deviation
 
 from fsw.lib.infocost import visibility
 from ground.fdir.boresight import boresight_offset
@@ -364,11 +363,18 @@ def _camera_se(off_plan: np.ndarray, planned: np.ndarray, radius_m: float
     return se, math.degrees(math.atan2(se, max(near, radius_m)))
 
 
+NORMAL_MAD = 0.6744897501960817
+"""The median absolute deviation of a standard normal, Φ⁻¹(3/4): MAD / this estimates σ (the
+constant and division of ``scipy.stats.median_abs_deviation(scale="normal")``)."""
+
+
 def median_se(values: npt.ArrayLike) -> float:
     """Standard error of the median of ``values``, from their spread: √(π/2) σ / √n, with σ
-    the median absolute deviation scaled to a normal's (robust to the odd wild fix)."""
+    the median absolute deviation scaled to a normal's (robust to the odd wild fix).  The MAD
+    is scipy's ``median_abs_deviation(scale="normal")`` written out (the same operations, so
+    the same bits, tested): scipy's call costs ~0.4 ms, four of them a window."""
     v = np.asarray(values, dtype=float)
-    sigma = float(median_abs_deviation(v, scale="normal"))
+    sigma = float(np.median(np.abs(v - np.median(v)))) / NORMAL_MAD
     return math.sqrt(math.pi / 2.0) * sigma / math.sqrt(len(v))
 
 
