@@ -329,8 +329,10 @@ def _chunk_items(chunk: Chunk) -> list[_ChunkItem]:
     return items
 
 
-class _Loader:
-    """The state of one archive read: channels, schemas, kept records and streamed counts."""
+class RecordLoader:
+    """The state of one archive read: channels, schemas, kept records and streamed counts
+    (fed record by record from the file here, or sample by sample as a run is recorded:
+    ``ground.archive.live``)."""
 
     def __init__(self, sinks: Mapping[str, RecordSink]) -> None:
         self.sinks = dict(sinks)
@@ -349,14 +351,33 @@ class _Loader:
         channel = self.channels.get(channel_id)
         if channel is None:  # a message before its channel: not MCAP-conformant
             return f"message on unknown channel {channel_id}"
-        record = Record(channel[0], channel[1], log_time, publish_time, data)
-        sink = channel[2]
+        self.take(Record(channel[0], channel[1], log_time, publish_time, data), channel[2])
+        return None
+
+    def take(self, record: Record, sink: RecordSink | None) -> None:
+        """Keep ``record``, or hand it to its key's ``sink`` (counted, not kept)."""
         if sink is None:
             self.records.append(record)
         else:
             self.streamed[record.key] = self.streamed.get(record.key, 0) + 1
             sink(record)
-        return None
+
+    def sink_of(self, key: str) -> RecordSink | None:
+        """The sink of ``key`` (the first matching expression), or None to keep its records."""
+        return next((f for e, f in self.sinks.items() if matches(e, key)), None)
+
+    def archive(self, path: Path, truncated: bool, stop_reason: str | None
+                ) -> RunArchive:
+        """The archive read so far (records put in log-time order, ties in file order)."""
+        self.records.sort(key=attrgetter("log_time_ns"))
+        schemas = {s.name: SchemaInfo(s.name, s.encoding, s.data)
+                   for s in self.schemas_by_id.values()}
+        header = self.header
+        return RunArchive(
+            path=path, records=self.records, channel_types=self.channel_types,
+            metadata=self.metadata, schemas=schemas, truncated=truncated,
+            stop_reason=stop_reason, library=header.library if header is not None else "",
+            profile=header.profile if header is not None else "", streamed=self.streamed)
 
     def item(self, rec: object) -> str | None:
         """Take one record or chunk item; a stop reason if reading must stop."""
@@ -369,8 +390,7 @@ class _Loader:
             type_name = schema.name if schema is not None else ""
             if rec.id not in self.channels:
                 self.channel_types.setdefault(rec.topic, []).append(type_name)
-            sink = next((f for e, f in self.sinks.items() if matches(e, rec.topic)), None)
-            self.channels[rec.id] = (rec.topic, type_name, sink)
+            self.channels[rec.id] = (rec.topic, type_name, self.sink_of(rec.topic))
         elif isinstance(rec, Schema):
             self.schemas_by_id[rec.id] = rec
         elif isinstance(rec, Metadata):
@@ -382,7 +402,7 @@ class _Loader:
         return None
 
 
-def _read_records(reader: StreamReader, loader: _Loader) -> str | None:
+def _read_records(reader: StreamReader, loader: RecordLoader) -> str | None:
     """Feed every record of the file to ``loader``; the reason reading stopped early, if it
     did (a chunk is taken whole or not at all)."""
     stream = iter(reader.records)
@@ -411,7 +431,7 @@ def load_run(path: str | Path, stream: Mapping[str, RecordSink] | None = None) -
     Raises :class:`ArchiveError` if the file is not MCAP, ``OSError`` if it cannot be read.
     """
     path = Path(path)
-    loader = _Loader(stream or {})
+    loader = RecordLoader(stream or {})
     with open(path, "rb") as file:
         head = file.read(len(MCAP_MAGIC))
         if head != MCAP_MAGIC:
@@ -431,23 +451,8 @@ def load_run(path: str | Path, stream: Mapping[str, RecordSink] | None = None) -
     truncated = stop_reason is not None or not loader.footer_seen
     if truncated and stop_reason is None:  # pragma: no cover - StreamReader stops at the footer
         stop_reason = "no footer"
-    loader.records.sort(key=attrgetter("log_time_ns"))  # stable: ties keep file order
-    schemas = {s.name: SchemaInfo(s.name, s.encoding, s.data)
-               for s in loader.schemas_by_id.values()}
-    header = loader.header
-    return RunArchive(
-        path=path,
-        records=loader.records,
-        channel_types=loader.channel_types,
-        metadata=loader.metadata,
-        schemas=schemas,
-        truncated=truncated,
-        stop_reason=stop_reason,
-        library=header.library if header is not None else "",
-        profile=header.profile if header is not None else "",
-        streamed=loader.streamed,
-    )
+    return loader.archive(path, truncated, stop_reason)
 
 
-__all__ = ["ArchiveError", "MCAP_MAGIC", "Record", "RecordSink", "RunArchive", "SchemaInfo",
-           "load_run"]
+__all__ = ["ArchiveError", "MCAP_MAGIC", "Record", "RecordLoader", "RecordSink", "RunArchive",
+           "SchemaInfo", "load_run"]
