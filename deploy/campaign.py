@@ -328,8 +328,9 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
 
     from deploy.inproc import run_inproc
     from ground.archive.metadata import run_metadata
-    from ground.archive.recorder import McapRecorder
+    from ground.analysis.digest import LiveDigest, RunDigest
     from ground.analysis.summary import write_summary
+    from ground.archive.recorder import McapRecorder
 
     handler = logging.FileHandler(out / "run.log")
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
@@ -339,10 +340,14 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     root.setLevel(logging.INFO)  # the run's log keeps its INFO lines (slews, assignments...)
     t0 = time.monotonic()
     status, error = "completed", None
+    digest: RunDigest | None = None  # a failed run's summary reads what its archive holds
     try:
         note = f"# campaign run {spec.id} (group {spec.group}, seed {spec.seed}): resolved_json\n"
-        with McapRecorder(out / "run.mcap", run_metadata(spec.scenario, "inproc", note)) as rec:
-            run_inproc(spec.scenario, sample_tap=rec.record_sample)
+        metadata = run_metadata(spec.scenario, "inproc", note)
+        live = LiveDigest(spec.scenario, spec.scenario.name, out / "run.mcap", metadata)
+        with McapRecorder(out / "run.mcap", metadata) as rec:
+            run_inproc(spec.scenario, sample_tap=live.tap(rec))
+        digest = live.finish()
     except Exception as e:  # noqa: BLE001 - a crashed run is a result, not the campaign's end
         status, error = "failed", f"{type(e).__name__}: {e}\n{traceback.format_exc()}"
         logging.getLogger("insp.campaign").error("run %s failed: %s", spec.id, error)
@@ -350,7 +355,8 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
         root.removeHandler(handler)
         root.setLevel(level)
         handler.close()
-    return write_summary(out, spec.scenario, "inproc", time.monotonic() - t0, status, error)
+    return write_summary(out, spec.scenario, "inproc", time.monotonic() - t0, status, error,
+                         digest=digest)
 
 
 def _zenoh_run(spec: RunSpec, out: Path) -> dict[str, Any]:

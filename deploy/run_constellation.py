@@ -49,7 +49,7 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
 
 from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor  # noqa: E402
-from ground.analysis.digest import RunDigest, digest_run  # noqa: E402
+from ground.analysis.digest import LiveDigest, RunDigest, digest_run  # noqa: E402
 from ground.archive.reader import ArchiveError  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
@@ -132,8 +132,9 @@ def main(argv: list[str] | None = None) -> int:
     mission = args.mission or scenario.name
     scenario_text = args.scenario.read_text(encoding="utf-8")
     wall0 = time.monotonic()
+    digest: RunDigest | None = None
     if args.transport == "inproc":
-        status, error = _run_inproc(scenario, mission, out, scenario_text, args)
+        status, error, digest = _run_inproc(scenario, mission, out, scenario_text, args)
     else:
         main_thread = threading.current_thread() is threading.main_thread()
         previous = signal.signal(signal.SIGTERM, _interrupt) if main_thread else None
@@ -143,7 +144,7 @@ def main(argv: list[str] | None = None) -> int:
             if main_thread:
                 signal.signal(signal.SIGTERM, previous)
     wall_s = time.monotonic() - wall0
-    digest = _read_archive(out, scenario, mission)
+    digest = digest or _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
                             status=status, error=error, mission=mission, digest=digest,
                             extra=_access_audit(out))
@@ -172,15 +173,21 @@ def _read_archive(out: Path, scenario: Scenario, mission: str) -> RunDigest | No
 
 
 def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
-                args: argparse.Namespace) -> tuple[str, str | None]:
+                args: argparse.Namespace) -> tuple[str, str | None, RunDigest]:
+    """Run in this process, recording into ``<out>/run.mcap`` (the recorder in a child
+    process) and digesting the run for its summary as it goes."""
     from deploy.inproc import run_inproc
 
     if args.realtime:
         log.warning("--realtime is ignored with --transport inproc (lockstep only)")
     live = _live_view(args)
-    with RecorderProcess(out / "run.mcap", run_metadata(scenario, "inproc", scenario_text)) as rec:
+    metadata = run_metadata(scenario, "inproc", scenario_text)
+    digest = LiveDigest(scenario, mission, out / "run.mcap", metadata)
+    with RecorderProcess(out / "run.mcap", metadata) as rec:
+        record = digest.tap(rec)
+
         def tap(sample: Sample) -> None:
-            rec.record_sample(sample)
+            record(sample)
             if live is not None:
                 live.forward(sample.key, sample.type_name, sample.payload)
 
@@ -189,7 +196,7 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
         finally:
             if live is not None:
                 live.close()
-    return "completed", None
+    return "completed", None, digest.finish()
 
 
 def _live_view(args: argparse.Namespace) -> LiveView | None:
@@ -211,13 +218,14 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
     log.info("counterfactual run: recovery %s", "on" if flipped.fdir.recovery else "off")
     wall0 = time.monotonic()
     note = f"\n# counterfactual run: [fdir] recovery = {str(flipped.fdir.recovery).lower()}\n"
+    digest: RunDigest | None = None
     try:
-        status, error = _run_inproc(flipped, mission, other, scenario_text + note, args)
+        status, error, digest = _run_inproc(flipped, mission, other, scenario_text + note, args)
     except Exception as e:  # noqa: BLE001 - the primary run's results must still be written
         log.exception("counterfactual run failed")
         status, error = "failed", f"{type(e).__name__}: {e}"
     counter = write_summary(other, flipped, transport="inproc", wall_s=time.monotonic() - wall0,
-                            status=status, error=error, mission=mission)
+                            status=status, error=error, mission=mission, digest=digest)
     return add_recovery_comparison(out, summary, counter, scenario.fdir.recovery)
 
 

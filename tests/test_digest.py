@@ -4,11 +4,18 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from mcap.reader import make_reader
 
 from deploy.inproc import run_inproc
-from ground.analysis.digest import digest_archive, digest_run, unread_keys
+from ground.analysis.digest import (
+    LiveDigest,
+    RunDigest,
+    digest_archive,
+    digest_run,
+    unread_keys,
+)
 from ground.archive.reader import ArchiveError, Record, load_run
 from ground.archive.recorder import McapRecorder
 from ground.analysis.summary import build_summary
@@ -18,13 +25,20 @@ REPO = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Scenario]:
-    """A 40 s nominal run recorded through the in-process fast path, in small chunks."""
+def recorded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Scenario, RunDigest]:
+    """A 40 s nominal run recorded through the in-process fast path, in small chunks, and
+    digested as it went."""
     sc = load_scenario(REPO / "deploy" / "scenarios" / "nominal.toml").with_overrides(None, 40.0)
     path = tmp_path_factory.mktemp("digest") / "run.mcap"
-    with McapRecorder(path, {}, chunk_size=64 * 1024) as rec:
-        run_inproc(sc, sample_tap=rec.record_sample)
-    return path, sc
+    live = LiveDigest(sc, sc.name, path, {"run": {"note": "digest test"}})
+    with McapRecorder(path, {"run": {"note": "digest test"}}, chunk_size=64 * 1024) as rec:
+        run_inproc(sc, sample_tap=live.tap(rec))
+    return path, sc, live.finish()
+
+
+@pytest.fixture(scope="module")
+def run(recorded: tuple[Path, Scenario, RunDigest]) -> tuple[Path, Scenario]:
+    return recorded[0], recorded[1]
 
 
 def test_chunk_reader_matches_the_mcap_library(run: tuple[Path, Scenario]) -> None:
@@ -65,3 +79,22 @@ def test_digest_gives_the_summary_of_the_whole_archive(run: tuple[Path, Scenario
     assert streamed.coverage.h[-1] < streamed.coverage.h_initial  # the cameras saw something
     assert streamed.counters.counts == whole.counters.counts
     assert build_summary(streamed, sc, sc.name) == build_summary(whole, sc, sc.name)
+
+
+def test_the_digest_built_as_the_run_went_is_the_files(
+        recorded: tuple[Path, Scenario, RunDigest]) -> None:
+    """What a one-process run digests as it goes is what a read of its finished archive gives:
+    the same records, counts, metadata, coverage, truth and summary."""
+    path, sc, live = recorded
+    read = digest_run(path, sc, sc.name)
+    assert [(r.key, r.type_name, r.log_time_ns, r.payload) for r in live.archive.held()] == [
+        (r.key, r.type_name, r.log_time_ns, r.payload) for r in read.archive.held()]
+    assert live.archive.topics() == read.archive.topics()
+    assert live.archive.metadata == read.archive.metadata
+    assert set(live.archive.schemas) == set(read.archive.schemas)
+    assert not live.archive.truncated and len(live.archive) == len(read.archive) > 1000
+    assert live.coverage.h == read.coverage.h and live.coverage.t_s == read.coverage.t_s
+    for field in ("t_s", "r_m", "v_mps", "q_lvlh_body", "dv_mps"):
+        assert np.array_equal(getattr(live.truth, field), getattr(read.truth, field))
+    assert live.counters.counts == read.counters.counts
+    assert build_summary(live, sc, sc.name) == build_summary(read, sc, sc.name)

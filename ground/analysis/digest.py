@@ -8,17 +8,27 @@ counters (ticks, executive and link statistics) keep their last record, the trut
 arrays (:class:`ground.analysis.truth_table.TruthTable`), and the bulk neither reads
 (observations, attitude sensors, wheel commands, lockstep answers, heartbeats) is counted and
 dropped.
+
+A one-process run builds the same digest as it goes (:class:`LiveDigest`, fed the samples the
+recorder is given): no second read of the file, and the images fused from the message objects
+rather than their JSON.  ``tests/test_digest.py`` checks that both give the same summary.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Protocol
 
 from ground.analysis.coverage import Coverage, CoverageFuser, camera_images, coverage
 from ground.analysis.nav import NavErrors, nav_errors
 from ground.analysis.gnc import GncSeries, gnc_series
-from ground.archive.reader import Record, RunArchive, load_run
+from ground.archive.live import LiveArchive
+from ground.archive.reader import Record, RecordSink, RunArchive, load_run
+from ground.archive.recorder import Pending, prepare_raw, prepare_sample
+from interfaces.messages import Message
+from interfaces.transport import Sample
 from ground.analysis.truth_table import TruthTable, TruthTableBuilder
 from interfaces import catalogue as cat
 from interfaces.scenario import Scenario
@@ -76,16 +86,61 @@ def _drop(_rec: Record) -> None:
     """Sink of the records nobody reads (they are still counted by the archive)."""
 
 
-def digest_run(path: Path, scenario: Scenario, mission: str) -> RunDigest:
-    """Read ``path`` once for the summary and report (see the module docstring)."""
+def _sinks(scenario: Scenario, mission: str
+           ) -> tuple[CoverageFuser, LastRecords, TruthTableBuilder, dict[str, RecordSink]]:
+    """The digest's builders and the key expressions streamed to them."""
     fuser = CoverageFuser(scenario)
     counters = LastRecords()
     truth = TruthTableBuilder()
     stream = {camera_images(mission): fuser.add_record, cat.TRUTH.key(mission): truth.add_record,
               **dict.fromkeys(counter_keys(mission), counters),
               **dict.fromkeys(unread_keys(mission), _drop)}
+    return fuser, counters, truth, stream
+
+
+def digest_run(path: Path, scenario: Scenario, mission: str) -> RunDigest:
+    """Read ``path`` once for the summary and report (see the module docstring)."""
+    fuser, counters, truth, stream = _sinks(scenario, mission)
     archive = load_run(path, stream=stream)
     return RunDigest(archive, fuser.finish(archive, mission), counters, truth.finish())
+
+
+class Recorder(Protocol):
+    """What takes a prepared sample for the file (McapRecorder, RecorderProcess)."""
+
+    def take(self, pending: Pending) -> None: ...
+
+
+class LiveDigest:
+    """:func:`digest_run`'s digest built as a one-process run goes: give it every sample the
+    recorder writes (``take``, prepared once for both), in the same order; ``finish`` after the
+    run.  ``path`` and ``metadata``: the archive's file and the metadata written into it."""
+
+    def __init__(self, scenario: Scenario, mission: str, path: Path,
+                 metadata: dict[str, dict[str, str]]) -> None:
+        self._fuser, self._counters, self._truth, stream = _sinks(scenario, mission)
+        self._archive = LiveArchive(path, metadata, stream)
+        self._mission = mission
+
+    def take(self, pending: Pending, message: Message | None) -> None:
+        self._archive.take(pending, message)
+
+    def tap(self, recorder: Recorder) -> Callable[[Sample], None]:
+        """A sample handler giving each sample to ``recorder`` and to this digest, prepared
+        once for both."""
+        def handler(sample: Sample) -> None:
+            pending = prepare_sample(sample)
+            if pending is None:
+                pending = prepare_raw(sample.key, sample.type_name, sample.payload)
+            recorder.take(pending)
+            self._archive.take(pending, sample.message)
+
+        return handler
+
+    def finish(self) -> RunDigest:
+        archive = self._archive.finish()
+        return RunDigest(archive, self._fuser.finish(archive, self._mission), self._counters,
+                         self._truth.finish())
 
 
 def digest_archive(archive: RunArchive, scenario: Scenario, mission: str) -> RunDigest:

@@ -311,6 +311,11 @@ class McapRecorder:
         self._pending.append(pending)
         self._drain()
 
+    def take(self, pending: Pending) -> None:
+        """Record one sample already prepared by :func:`prepare_sample`."""
+        self._pending.append(pending)
+        self._drain()
+
     def record_prepared(self, batch: list[Pending]) -> None:
         """Record samples already prepared by :func:`prepare_sample` (the recorder process)."""
         self._pending.extend(batch)

@@ -78,8 +78,12 @@ class RecorderProcess:
     def record_sample(self, sample: Sample) -> None:
         """Queue one bus sample for the archive."""
         pending = prepare_sample(sample)
-        self._batch.append(pending if pending is not None
-                           else prepare_raw(sample.key, sample.type_name, sample.payload))
+        self.take(pending if pending is not None
+                  else prepare_raw(sample.key, sample.type_name, sample.payload))
+
+    def take(self, pending: Pending) -> None:
+        """Queue one sample already prepared (:func:`prepare_sample`)."""
+        self._batch.append(pending)
         if len(self._batch) >= BATCH:
             self._send()
 
