@@ -16,6 +16,7 @@ import math
 from typing import Annotated, ClassVar, Literal, get_args
 
 import numpy as np
+import numpy.typing as npt
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
 # --- physical ranges ----------------------------------------------------------------------
@@ -213,18 +214,35 @@ class _PoiPrecisions(Message):
         per message: in one process every subscriber of the same message shares them."""
         cached = self._arrays
         if cached is None or cached[0] is not self.poi:  # a model_copy may carry another list
-            idx = np.asarray(self.poi, dtype=np.int64)
-            prec = np.asarray(self.precision, dtype=np.float64)
-            idx.setflags(write=False)
-            prec.setflags(write=False)
-            cached = (self.poi, idx, prec)
-            self.__pydantic_private__["_arrays"] = cached  # type: ignore[index]
+            self._keep_arrays(self.poi, self.precision)
+            cached = self._arrays
+            assert cached is not None
         return cached[1], cached[2]
+
+    def _keep_arrays(self, poi: npt.ArrayLike, precision: npt.ArrayLike) -> None:
+        """Keep read-only copies of ``poi`` (int64) and ``precision`` (float64), equal to the
+        lists, as what :meth:`arrays` returns."""
+        idx = np.array(poi, dtype=np.int64)
+        prec = np.array(precision, dtype=np.float64)
+        idx.setflags(write=False)
+        prec.setflags(write=False)
+        self.__pydantic_private__["_arrays"] = (self.poi, idx, prec)  # type: ignore[index]
 
 
 class CameraImage(_PoiPrecisions):
     """One inspection image of an observer (ω_mid): the POIs it saw (ascending) and the
     precision of each measurement (Eq. 5: 1/(k·dist²), with the camera's noise and health)."""
+
+    @classmethod
+    def of_arrays(cls, sender: str, t_sim: float, spacecraft: int, poi: np.ndarray,
+                  precision: np.ndarray) -> CameraImage:
+        """The image of ``poi`` (int) and ``precision`` (float) arrays, validated from their
+        lists, which keeps copies of the arrays as :meth:`arrays` (the same values: no
+        conversion back from the lists in its subscribers)."""
+        msg = cls(sender=sender, t_sim=t_sim, spacecraft=spacecraft, poi=poi.tolist(),
+                  precision=precision.tolist())
+        msg._keep_arrays(poi, precision)
+        return msg
 
 
 # --- commands (flight software -> hardware) --------------------------------------------------
@@ -489,6 +507,19 @@ class PoiObservations(_PoiPrecisions):
     the other observers and the ground.  Received only within range."""
 
     image_t_s: Time
+
+    @classmethod
+    def of_image(cls, image: CameraImage, sender: str, t_sim: float) -> PoiObservations:
+        """The observations of ``image``, sent by ``sender`` at ``t_sim`` (s): the image's own
+        validated, immutable lists, not validated again (``model_construct`` of valid parts;
+        a 2,500-POI image's lists cost ~0.1 ms to validate)."""
+        if not 0.0 <= t_sim <= MAX_TIME_S:
+            raise ValueError(f"t_sim must be in [0, {MAX_TIME_S:g}] s, got {t_sim!r}")
+        msg = cls.model_construct(sender=sender, t_sim=t_sim, spacecraft=image.spacecraft,
+                                  image_t_s=image.t_sim, poi=image.poi,
+                                  precision=image.precision)
+        msg.__pydantic_private__["_arrays"] = image._arrays  # type: ignore[index]
+        return msg
 
 
 class InfoCostTelemetry(Message):

@@ -279,9 +279,8 @@ class SimNode:
                 st_sigma_cross_rad=hw.st_sigma_rad[0], st_sigma_roll_rad=hw.st_sigma_rad[1]))
         if k % self.scenario.rates.ticks_per("mid") == 0:
             for i, img in enumerate(self.cameras.images(rel[:, :3], q_lvlh_body)):
-                self.bus.publish(self._keys["camera"][i], CameraImage(
-                    sender=topics.SIM, t_sim=t, spacecraft=self.ids[i], poi=img.poi.tolist(),
-                    precision=img.precision.tolist()))
+                self.bus.publish(self._keys["camera"][i], CameraImage.of_arrays(
+                    topics.SIM, t, self.ids[i], img.poi, img.precision))
             for i, sensor in enumerate(self.sensors):
                 r, v = sensor.measure(rel[i, :3], rel[i, 3:])
                 self.bus.publish(self._keys["relnav"][i], RelNavMeasurement(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from deploy.inproc import run_inproc
 from interfaces.encoding import encode
@@ -11,6 +12,7 @@ from interfaces.messages import (
     CameraImage,
     FaultReport,
     Message,
+    PoiObservations,
     SimStatus,
     registry,
 )
@@ -62,3 +64,33 @@ def test_floats_strings_and_fallback() -> None:
     huge = CameraImage.model_construct(sender="sim", seq=1, t_sim=1.0, t_wall=0.0, spacecraft=1,
                                        poi=[2**70], precision=[1.0])  # beyond orjson's ints
     assert encode(huge) == _pydantic(huge)
+
+
+def test_observations_of_an_image_are_the_validated_message() -> None:
+    """The camera app shares an image's validated lists without validating them again: the
+    same message, the same bytes; a time outside the schema is still refused."""
+    image = CameraImage(sender="sim", t_sim=3.0, spacecraft=2, poi=[1, 5, 9],
+                        precision=[0.5, 1e-3, 2.0])
+    shared = PoiObservations.of_image(image, "sc2", 3.0)
+    checked = PoiObservations(sender="sc2", t_sim=3.0, spacecraft=2, image_t_s=3.0,
+                              poi=[1, 5, 9], precision=[0.5, 1e-3, 2.0])
+    assert shared == checked and encode(shared) == encode(checked) == _pydantic(checked)
+    assert shared.arrays()[0].tolist() == [1, 5, 9]
+    with pytest.raises(ValueError, match="t_sim"):
+        PoiObservations.of_image(image, "sc2", float("nan"))
+
+
+def test_an_image_of_arrays_keeps_them_for_its_subscribers() -> None:
+    """The sim's image keeps copies of its arrays (equal to its lists, read-only), and the
+    observations shared from it carry the same arrays; a copy with other lists converts its
+    own."""
+    poi, precision = np.array([1, 5, 9]), np.array([0.5, 1e-3, 2.0])
+    image = CameraImage.of_arrays("sim", 3.0, 2, poi, precision)
+    poi[0] = 7  # the caller's array may change afterwards
+    idx, prec = image.arrays()
+    assert idx.tolist() == image.poi == [1, 5, 9] and prec.tolist() == image.precision
+    assert not idx.flags.writeable and not prec.flags.writeable
+    shared = PoiObservations.of_image(image, "sc2", 3.0)
+    assert shared.arrays()[0] is idx and shared.arrays()[1] is prec
+    other = image.model_copy(update={"poi": [2, 3, 4]})
+    assert other.arrays()[0].tolist() == [2, 3, 4]

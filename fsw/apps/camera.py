@@ -83,9 +83,7 @@ class CameraApp(App):
     def step(self, t: float) -> None:
         images, self._images = self._images, []
         for img in images:
-            self.publish("observations", PoiObservations(
-                sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, image_t_s=img.t_sim,
-                poi=img.poi, precision=img.precision))
+            self.publish("observations", PoiObservations.of_image(img, self.ctx.node, t))
         if self.max_variance and t >= self.next_retarget - 1e-9 and self._est is not None \
                 and self._tracking:
             self.next_retarget = t + RETARGET_S
