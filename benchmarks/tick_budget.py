@@ -15,18 +15,28 @@ with the default mission's work, by rate group.
   10 Hz work, and what a 1 Hz and a 0.1 Hz tick add to it on average (means, since a run's
   wall time is their sum; medians beside them).
 
-Targets (DESIGN.md "Targets"): bare ≤ 50 µs, 10 Hz-only ≤ 0.5 ms, a 1 Hz tick adds ≤ 3 ms,
-a 0.1 Hz tick adds ≤ 10 ms.
+* **the slower work per call**, in the same run: the sim's camera images (one call images
+  every observer), the nav step, the infocost fusion of one observations message, the ground
+  FDIR's work per observer-window (hardware threshold and identification evidence included)
+  and an MPC solve.  Each is timed around the real call (the method wrapped for the run,
+  restored after).
+
+Targets (DESIGN.md "Targets", issue 25): bare ≤ 50 µs, 10 Hz-only ≤ 0.5 ms, a 1 Hz tick adds
+≤ 3 ms, a 0.1 Hz tick adds ≤ 10 ms; per call: camera image ≤ 0.3 ms, fusion ≤ 0.3 ms, nav
+≤ 0.1 ms, FDIR ≤ 5 ms per observer-window, MPC solve ≤ 1 ms.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import importlib
 import json
 import multiprocessing
 import sys
 import threading
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +58,15 @@ from interfaces.transport import InprocNetwork, Sample  # noqa: E402
 
 DEFAULT = REPO / "deploy" / "scenarios" / "default.toml"
 TARGETS_MS = {"bare": 0.05, "high": 0.5, "mid": 3.0, "low": 10.0}
+CALLS: tuple[tuple[str, str, str, float], ...] = (
+    # (module, attribute path, what, target ms per call)
+    ("sim.camera", "TruthCameras.images", "sim camera, every observer's image", 0.3),
+    ("fsw.apps.nav", "NavApp.step", "nav step", 0.1),
+    ("fsw.apps.infocost", "InfoCostApp.on_observations", "infocost fusion, one image", 0.3),
+    ("ground.apps.fdir", "FdirApp._judge", "ground FDIR, one observer-window", 5.0),
+    ("fsw.lib.mpc", "MpcTracker.solve", "MPC solve", 1.0),
+)
+"""The slower work timed per call, with its target per call (ms)."""
 
 
 def bare_lockstep(scenario: Scenario, ticks: int) -> float:
@@ -80,6 +99,36 @@ def bare_lockstep(scenario: Scenario, ticks: int) -> float:
         bus.wait_for(expect, 1.0)
         bus.dispatch(k * dt, include_now=True)
     return (time.perf_counter() - start) / ticks
+
+
+@contextlib.contextmanager
+def timed_calls(calls: tuple[tuple[str, str, str, float], ...]
+                ) -> Iterator[dict[str, list[float]]]:
+    """Time every call of the named methods while inside (wall s per call, by method)."""
+    times: dict[str, list[float]] = {name: [] for _, name, _, _ in calls}
+    saved = []
+    for module, name, _, _ in calls:
+        cls_name, method = name.split(".")
+        cls = getattr(importlib.import_module(module), cls_name)
+        original = getattr(cls, method)
+        saved.append((cls, method, original))
+        setattr(cls, method, _timer(original, times[name]))
+    try:
+        yield times
+    finally:
+        for cls, method, original in saved:
+            setattr(cls, method, original)
+
+
+def _timer(fn: Callable[..., object], sink: list[float]) -> Callable[..., object]:
+    def wrapped(*args: object, **kwargs: object) -> object:
+        start = time.perf_counter()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            sink.append(time.perf_counter() - start)
+
+    return wrapped
 
 
 def mission_ticks(scenario: Scenario, out: Path) -> tuple[np.ndarray, float]:
@@ -142,6 +191,8 @@ def main() -> None:
     run_inproc(scenario.with_overrides(None, 5.0))  # imports and compiled kernels loaded
     tick_s, wall = mission_ticks(scenario, args.out)
     table = by_rate(tick_s, scenario)
+    with timed_calls(CALLS) as calls:
+        mission_ticks(scenario, args.out)
     rows = [("bare lockstep, 6 nodes", 1e3 * bare, None, "bare"),
             ("10 Hz-only tick", table["high"]["mean"], table["high"]["median"], "high"),
             ("a 1 Hz tick adds", table["mid"]["mean"], table["mid"]["median"], "mid"),
@@ -154,9 +205,20 @@ def main() -> None:
         r = target / max(mean, 1e-9)
         print(f"{name:<24} {mean:>9.3f} {'' if med is None else f'{med:.3f}':>10} "
               f"{target:>10.2f}  {r:5.2f} {'✓' if r >= 1 else '✗'}")
+    print(f"\n{'per call (a second run, timed)':<36} {'calls':>7} {'mean ms':>9} "
+          f"{'median ms':>10} {'target ms':>10}  ratio")
+    per_call = {}
+    for _, name, what, target in CALLS:
+        ms = 1e3 * np.array(calls[name] or [np.nan])
+        per_call[name] = {"calls": len(calls[name]), "mean": float(ms.mean()),
+                          "median": float(np.median(ms))}
+        r = target / max(float(ms.mean()), 1e-9)
+        print(f"{what:<36} {len(calls[name]):>7} {ms.mean():>9.3f} {np.median(ms):>10.3f} "
+              f"{target:>10.2f}  {r:5.2f} {'✓' if r >= 1 else '✗'}")
     if args.json:
         args.json.write_text(json.dumps({"bare_ms": 1e3 * bare, "rtf": args.duration / wall,
-                                         "by_rate_ms": table}, indent=1))
+                                         "by_rate_ms": table, "per_call_ms": per_call},
+                                        indent=1))
 
 
 if __name__ == "__main__":
