@@ -12,7 +12,10 @@ Measures, with the real commands a user runs (``deploy/run_constellation.py``,
   simulated hour;
 * ``scaling``: the nominal set-up (FDIR on) with 5/10/20 observers × 5,000/50,000 POIs,
   in-process: real-time factor;
-* ``campaign``: wall time per run of ``deploy/campaigns/paper.toml`` with ``--workers 2``.
+* ``campaign``: wall time per run of ``deploy/campaigns/paper.toml`` with ``--workers 2``;
+* ``budget``: the per-tick and per-call budgets in one process (``benchmarks/tick_budget.py``:
+  the bare lockstep, the default mission's 10 Hz-only tick and what a 1 Hz and a 0.1 Hz tick
+  add, the slower work per call).
 
 ``--quick`` shortens every workload (reference 1,200 s, scaling 60 s, 4 campaign runs) so the
 whole set runs in a few minutes; its ratios are indicative (start-up weighs more in short runs).
@@ -39,6 +42,7 @@ if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
 from benchmarks.lockstep_limit import free_port, measure as lockstep_rate  # noqa: E402
+from benchmarks.tick_budget import CALLS, TARGETS_MS as TICK_TARGETS_MS  # noqa: E402
 from interfaces.scenario import load_scenario  # noqa: E402
 
 TWO_ORBITS_S = 11354.0
@@ -193,8 +197,25 @@ def bench_campaign(quick: bool, tmp: Path, rows: list, res: dict) -> None:
                  ratio(per_run, TARGETS["campaign_s_per_run"], False)))
 
 
+def bench_budget(quick: bool, tmp: Path, rows: list, res: dict) -> None:
+    out = tmp / "budget.json"
+    run_tree([sys.executable, "benchmarks/tick_budget.py", "--duration",
+              "300" if quick else "1200", "--out", str(tmp / "budget"), "--json", str(out)])
+    budget = res["budget"] = json.loads(out.read_text())
+    rows.append(("bare lockstep in one process, 6 nodes", f"{budget['bare_ms']:.3f} ms per tick",
+                 ratio(budget["bare_ms"], TICK_TARGETS_MS["bare"], False)))
+    for key, what in (("high", "10 Hz-only tick"), ("mid", "a 1 Hz tick adds"),
+                      ("low", "a 0.1 Hz tick adds")):
+        ms = budget["by_rate_ms"][key]["mean"]
+        rows.append((f"  default mission: {what}", f"{ms:.3f} ms (mean)",
+                     ratio(ms, TICK_TARGETS_MS[key], False)))
+    for _, name, what, target in CALLS:
+        ms = budget["per_call_ms"][name]["mean"]
+        rows.append((f"  per call: {what}", f"{ms:.3f} ms (mean)", ratio(ms, target, False)))
+
+
 BENCHES = {"lockstep": bench_lockstep, "reference": bench_reference, "scaling": bench_scaling,
-           "campaign": bench_campaign}
+           "campaign": bench_campaign, "budget": bench_budget}
 
 
 def main() -> None:

@@ -125,6 +125,8 @@ class Bus:
     _key_types: dict[str, object] = field(default_factory=dict)
     """Catalogue type of each key published or subscribed (None: not catalogued)."""
     _cond: threading.Condition = field(default_factory=threading.Condition)
+    _waiting: int = 0
+    """Threads inside ``wait_for`` (changed and read under ``_cond``)."""
 
     def __post_init__(self) -> None:
         self.prefix = topics.node_prefix(self.mission, self.node)
@@ -260,7 +262,8 @@ class Bus:
                 self._pending.append(_Envelope(msg, key, src, False, group))
             for msg in decoded.values():
                 self.admission.admit(key, msg)
-            self._cond.notify_all()
+            if self._waiting:
+                self._cond.notify_all()
 
     def _on_made_here(self, key_expr: str, key: str, msg: Message) -> None:
         """In-process callback: a message another Bus of this process published.  It was
@@ -275,11 +278,14 @@ class Bus:
         for sub in group.immediate:
             self._call(sub, msg, key)
         with self._cond:
+            highest = self.admission.highest_seq
             if group.deferred:
                 self._pending.append(_Envelope(msg, key, self.admission.owner(key), False,
                                                group.deferred))
-            self.admission.admit(key, msg)
-            self._cond.notify_all()
+            if msg.seq > highest.get(key, 0):  # Admission.admit, inlined
+                highest[key] = msg.seq
+            if self._waiting:
+                self._cond.notify_all()
 
     def _admitted(self, key: str, msg_type: type[Message], sample: Sample) -> Message | None:
         """The sample as a ``msg_type`` that passes admission, or None (dropped, counted)."""
@@ -372,12 +378,16 @@ class Bus:
                   if self._awaits(k) and s <= seen.get(k, 0) + MAX_SEQ_JUMP}
         deadline = time.monotonic() + timeout_s
         with self._cond:
-            while True:
-                missing = [k for k, s in wanted.items() if seen.get(k, 0) < s]
-                left = deadline - time.monotonic()
-                if not missing or left <= 0:
-                    return missing
-                self._cond.wait(left)
+            self._waiting += 1  # receivers notify only while someone waits
+            try:
+                while True:
+                    missing = [k for k, s in wanted.items() if seen.get(k, 0) < s]
+                    left = deadline - time.monotonic()
+                    if not missing or left <= 0:
+                        return missing
+                    self._cond.wait(left)
+            finally:
+                self._waiting -= 1
 
     def _awaits(self, key: str) -> bool:
         """Whether ``key`` is another node's key that a deferred/immediate subscription covers."""

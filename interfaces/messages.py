@@ -193,13 +193,23 @@ class AttitudeMeasurement(Message):
         return self
 
 
+_MAX_POIS = 1_000_000
+"""Most POIs one image or observations message may carry."""
+
+
+def _header_ok(sender: object, t_sim: object) -> bool:
+    """Whether ``sender`` and ``t_sim`` pass :class:`Message`'s rules."""
+    return (type(sender) is str and len(sender) <= 64 and type(t_sim) is float
+            and 0.0 <= t_sim <= MAX_TIME_S)
+
+
 class _PoiPrecisions(Message):
     """POI indices (into the target's POI list) and the precision σ⁻¹ measured on each."""
 
     spacecraft: int = Field(ge=1)
-    poi: list[Annotated[int, Field(ge=0)]] = Field(max_length=1_000_000)
+    poi: list[Annotated[int, Field(ge=0)]] = Field(max_length=_MAX_POIS)
     precision: list[Annotated[float, Field(ge=0.0, le=MAX_PRECISION)]] = Field(
-        max_length=1_000_000)
+        max_length=_MAX_POIS)
 
     _arrays: tuple[list[int], np.ndarray, np.ndarray] | None = PrivateAttr(default=None)
 
@@ -236,12 +246,23 @@ class CameraImage(_PoiPrecisions):
     @classmethod
     def of_arrays(cls, sender: str, t_sim: float, spacecraft: int, poi: np.ndarray,
                   precision: np.ndarray) -> CameraImage:
-        """The image of ``poi`` (int) and ``precision`` (float) arrays, validated from their
-        lists, which keeps copies of the arrays as :meth:`arrays` (the same values: no
-        conversion back from the lists in its subscribers)."""
-        msg = cls(sender=sender, t_sim=t_sim, spacecraft=spacecraft, poi=poi.tolist(),
-                  precision=precision.tolist())
-        msg._keep_arrays(poi, precision)
+        """The image of ``poi`` (int) and ``precision`` (float) arrays, which keeps copies of
+        them as :meth:`arrays` (the same values: its subscribers convert no list back).
+
+        Validated on the arrays: the schema's rules checked with numpy (POIs integers ≥ 0,
+        precisions finite in [0, MAX_PRECISION], equal lengths within the bound, the header's
+        ranges), ~20× cheaper than pydantic on a 2,500-POI image; whatever those checks do not
+        pass is validated by pydantic, which raises (``tests/test_encoding.py``)."""
+        idx, prec = np.asarray(poi), np.asarray(precision)
+        fields = {"sender": sender, "t_sim": t_sim, "spacecraft": spacecraft,
+                  "poi": idx.tolist(), "precision": prec.tolist()}
+        ok = (_header_ok(sender, t_sim) and type(spacecraft) is int and spacecraft >= 1
+              and idx.ndim == prec.ndim == 1 and len(idx) == len(prec) <= _MAX_POIS
+              and np.issubdtype(idx.dtype, np.integer) and bool((idx >= 0).all())
+              and np.issubdtype(prec.dtype, np.floating) and bool(np.isfinite(prec).all())
+              and bool(((prec >= 0.0) & (prec <= MAX_PRECISION)).all()))
+        msg = cls.model_construct(**fields) if ok else cls(**fields)
+        msg._keep_arrays(idx, prec)
         return msg
 
 
@@ -513,8 +534,9 @@ class PoiObservations(_PoiPrecisions):
         """The observations of ``image``, sent by ``sender`` at ``t_sim`` (s): the image's own
         validated, immutable lists, not validated again (``model_construct`` of valid parts;
         a 2,500-POI image's lists cost ~0.1 ms to validate)."""
-        if not 0.0 <= t_sim <= MAX_TIME_S:
-            raise ValueError(f"t_sim must be in [0, {MAX_TIME_S:g}] s, got {t_sim!r}")
+        if not _header_ok(sender, t_sim):
+            raise ValueError(f"sender {sender!r} or t_sim {t_sim!r} outside the message's "
+                             f"rules (t_sim in [0, {MAX_TIME_S:g}] s)")
         msg = cls.model_construct(sender=sender, t_sim=t_sim, spacecraft=image.spacecraft,
                                   image_t_s=image.t_sim, poi=image.poi,
                                   precision=image.precision)

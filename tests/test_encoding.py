@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from pydantic import ValidationError
 
 from deploy.inproc import run_inproc
 from interfaces.encoding import encode
@@ -94,3 +95,30 @@ def test_an_image_of_arrays_keeps_them_for_its_subscribers() -> None:
     assert shared.arrays()[0] is idx and shared.arrays()[1] is prec
     other = image.model_copy(update={"poi": [2, 3, 4]})
     assert other.arrays()[0].tolist() == [2, 3, 4]
+
+
+def test_an_image_of_arrays_is_checked_as_pydantic_would() -> None:
+    """The sim's image checks its arrays with numpy; it equals the message pydantic validates,
+    and what pydantic refuses is refused (by pydantic: the fast path passes it on)."""
+    rng = np.random.default_rng(3)
+    poi = np.sort(rng.choice(5000, 2500, replace=False))
+    precision = rng.uniform(0.0, 50.0, 2500)
+    fast = CameraImage.of_arrays("sim", 12.5, 3, poi, precision)
+    checked = CameraImage(sender="sim", t_sim=12.5, spacecraft=3, poi=poi.tolist(),
+                          precision=precision.tolist())
+    assert fast.model_dump() == checked.model_dump() and encode(fast) == _pydantic(checked)
+    assert type(fast.poi[0]) is int and type(fast.precision[0]) is float
+    bad_precision = [np.nan, -1.0, 2e12, np.inf]
+    for value in bad_precision:
+        p = precision.copy()
+        p[7] = value
+        with pytest.raises(ValidationError):
+            CameraImage.of_arrays("sim", 12.5, 3, poi, p)
+    with pytest.raises(ValidationError):
+        CameraImage.of_arrays("sim", 12.5, 3, np.r_[-1, poi[1:]], precision)
+    with pytest.raises(ValidationError):
+        CameraImage.of_arrays("sim", 12.5, 3, poi[:-1], precision)
+    with pytest.raises(ValidationError):
+        CameraImage.of_arrays("sim", 12.5, 0, poi, precision)
+    with pytest.raises(ValidationError):
+        CameraImage.of_arrays("sim", -1.0, 3, poi, precision)
