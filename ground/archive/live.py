@@ -75,9 +75,13 @@ class LiveArchive:
         else:
             self._loader.channel_types.setdefault(key, []).append(type_name)
             sink = self._channels[channel] = self._loader.sink_of(key)
-        record = (Record(key, type_name, log_ns, publish_ns, payload)
-                  if sink is None or message is None
-                  else HeldRecord(key, type_name, log_ns, publish_ns, payload, message))
+        if sink is None:  # kept to the end of the run: a copy of its own size (an encoder's
+            # bytes can sit in a larger block: orjson's hold 4 KiB whatever their length)
+            record = Record(key, type_name, log_ns, publish_ns, memoryview(payload).tobytes())
+        elif message is None:
+            record = Record(key, type_name, log_ns, publish_ns, payload)
+        else:
+            record = HeldRecord(key, type_name, log_ns, publish_ns, payload, message)
         self._loader.take(record, sink)
 
     def finish(self) -> RunArchive:
