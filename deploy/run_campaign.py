@@ -122,11 +122,14 @@ def _interrupt(signum: int, _frame: object) -> None:
 
 def _local(todo: list[RunSpec], out: Path, workers: int, transport: str
            ) -> Iterator[dict[str, Any]]:
-    """Run on a spawn process pool.  A job that dies outside its run is recorded as failed;
+    """Run on a spawn process pool, one worker per core asked, each running its runs one after
+    another with its imports and compiled kernels loaded once, and one BLAS thread
+    (:func:`one_blas_thread`).  A job that dies outside its run is recorded as failed;
     a pool broken by a dead worker (killed, out of memory) is replaced and its pending runs
     resubmitted once (a run that breaks the pool twice is recorded as failed)."""
     queue = list(reversed(todo))
     broke: set[str] = set()
+    one_blas_thread()
     while queue:
         pool = ProcessPoolExecutor(max_workers=max(1, workers), mp_context=get_context("spawn"))
         pending: dict[Future[dict[str, Any]], RunSpec] = {}
@@ -155,6 +158,18 @@ def _local(todo: list[RunSpec], out: Path, workers: int, transport: str
             for proc in list(getattr(pool, "_processes", {}).values()):
                 proc.terminate()  # an interrupted run is abandoned: redone next time
             pool.shutdown(wait=True, cancel_futures=True)
+
+
+BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+"""The thread counts of the BLAS libraries numpy and scipy may load."""
+
+
+def one_blas_thread() -> None:
+    """One BLAS thread in each worker the pool starts from now (they inherit the environment;
+    a run's matrices are small, and the workers already fill the cores: threads only contend).
+    A count the user set is kept."""
+    for name in BLAS_THREADS:
+        os.environ.setdefault(name, "1")
 
 
 def _dask(todo: list[RunSpec], out: Path, address: str, transport: str

@@ -21,6 +21,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
+from sim import kernels
 from sim.sensors import as_generators
 
 __all__ = ["ThrusterBank", "WheelArray", "accel_lvlh"]
@@ -195,14 +196,18 @@ class WheelArray:
     tick), ``|h|`` therefore never exceeds ``h_max`` on an axis that started within it.
     """
 
-    def __init__(self, n: int, tau_max_nm: npt.ArrayLike, h_max_nms: npt.ArrayLike) -> None:
+    def __init__(self, n: int, tau_max_nm: npt.ArrayLike, h_max_nms: npt.ArrayLike,
+                 compiled: bool = True) -> None:
         """Create the wheel arrays.
 
         Args:
             n: number of spacecraft N (>= 1).
             tau_max_nm: motor torque limit per wheel, N·m (scalar or (3,)).
             h_max_nms: momentum limit per wheel, N·m·s (scalar or (3,)).
+            compiled: :meth:`realise` on :func:`sim.kernels.realise_wheel_torque` (the same
+                bits); False runs the numpy reference.
         """
+        self.compiled = compiled
         if int(n) != n or n < 1:
             raise ValueError(f"n must be a positive integer, got {n!r}")
         self._n = int(n)
@@ -256,9 +261,13 @@ class WheelArray:
             The realised torque on the body (N, 3), N·m, constant over the tick.
         """
         _check_dt(dt)
-        tau = self._scale * _rows("tau_cmd_body", tau_cmd_body, self._n) + self._bias
+        cmd, h0 = _rows("tau_cmd_body", tau_cmd_body, self._n), _rows("h", h, self._n)
+        if self.compiled:
+            out_fast: FloatArray = kernels.realise_wheel_torque(
+                cmd, h0, self._scale, self._bias, self._tau_max, self._h_max, float(dt))
+            return out_fast
+        tau = self._scale * cmd + self._bias
         tau = np.clip(tau, -self._tau_max, self._tau_max)
-        h0 = _rows("h", h, self._n)
         h_end = h0 - tau * dt
         h_lim = np.clip(h_end, np.minimum(-self._h_max, h0), np.maximum(self._h_max, h0))
         # Recompute only the limited axes, so unlimited torques pass bit-exact.

@@ -63,7 +63,8 @@ class ObserverHardware:
         self.thrusters = [ThrusterBank(act.thruster_max_force_n, act.thruster_min_impulse_ns,
                                        act.thruster_noise_frac, [stream(sc.seed, "thruster", i)])
                           for i in ids]
-        self.wheels = WheelArray(n, act.wheel_max_torque_nm, act.wheel_max_momentum_nms)
+        self.wheels = WheelArray(n, act.wheel_max_torque_nm, act.wheel_max_momentum_nms,
+                                 compiled=compiled)
         axis = int(np.argmax(np.abs(sc.attitude.boresight_body)))
         self.gyro = Gyro([stream(sc.seed, "gyro", i) for i in ids], sen.gyro_arw_rad_rts,
                          sen.gyro_bias_rw_rad_s15, sen.gyro_bias_sigma_radps)
@@ -114,10 +115,15 @@ class ObserverHardware:
         """Advance the attitude (wheel torques held) and the Δv bookkeeping by one tick."""
         # Propellant proxy: commanded and leaked force are spent separately (a leak on one
         # thruster of an axis is not refunded by firing the opposite one).
-        active = (t_s < self.force_until - 1e-9)[:, None]
-        spent = np.abs(np.where(active, self.force_body, 0.0)) + np.abs(self.force_bias_body)
-        self.dv_mps += spent.sum(axis=1) * dt_s / self.mass_kg
-        held = np.where((t_s < self.tau_until - 1e-9)[:, None], self.tau_cmd, 0.0)
+        if self.compiled:
+            held = kernels.spend_and_hold(self.dv_mps, self.force_body, self.force_until,
+                                          self.force_bias_body, self.tau_cmd, self.tau_until,
+                                          float(t_s), float(dt_s), self.mass_kg)
+        else:
+            active = (t_s < self.force_until - 1e-9)[:, None]
+            spent = np.abs(np.where(active, self.force_body, 0.0)) + np.abs(self.force_bias_body)
+            self.dv_mps += spent.sum(axis=1) * dt_s / self.mass_kg
+            held = np.where((t_s < self.tau_until - 1e-9)[:, None], self.tau_cmd, 0.0)
         tau = self.wheels.realise(held, self.attitude.h, dt_s)
         self.attitude.step(dt_s, tau)
 

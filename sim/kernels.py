@@ -5,10 +5,12 @@
   integral of the body rate the gyro senses;
 * :func:`relative_rk4` — the chief + deputies RK4 of :class:`sim.dynamics.RelativeTruth`
   (Battin's differential gravity, optional J2, LVLH acceleration rotated into ECI at each stage);
-* :func:`lvlh_attitudes` and :func:`thrust_accel_lvlh` — the frame and thrust glue of
-  :class:`sim.hardware.ObserverHardware` (the attitudes in LVLH, the thrust acceleration in
-  LVLH), the same floating-point operations in the same order as its numpy reference, so the
-  results are the same bits.
+* :func:`lvlh_attitudes`, :func:`thrust_accel_lvlh` and :func:`spend_and_hold` — the frame,
+  thrust and Δv glue of :class:`sim.hardware.ObserverHardware` (the attitudes in LVLH, the
+  thrust acceleration in LVLH, the Δv spent and the wheel torques held), and
+  :func:`realise_wheel_torque`, :meth:`sim.actuators.WheelArray.realise`: the same
+  floating-point operations in the same order as their numpy references, so the results are
+  the same bits (numpy's clip, minimum and maximum written out as it computes them).
 
 The numpy implementations in those classes stay the reference; ``tests/test_sim_kernels.py``
 checks these against them on random states.  Inputs are float64 arrays, already validated by
@@ -201,4 +203,51 @@ def thrust_accel_lvlh(q_lvlh_body: np.ndarray, force_body: np.ndarray, force_unt
         out[i, 0] = (vx + qw * tx + qy * tz - qz * ty) / mass_kg
         out[i, 1] = (vy + qw * ty + qz * tx - qx * tz) / mass_kg
         out[i, 2] = (vz + qw * tz + qx * ty - qy * tx) / mass_kg
+    return out
+
+
+@njit(cache=True)
+def spend_and_hold(dv_mps: np.ndarray, force_body: np.ndarray, force_until: np.ndarray,
+                   force_bias_body: np.ndarray, tau_cmd: np.ndarray, tau_until: np.ndarray,
+                   t_s: float, dt_s: float, mass_kg: float) -> np.ndarray:
+    """Add this tick's Δv (m/s; commanded force while it runs and the leak, each spent in
+    full) to ``dv_mps`` in place, and return the wheel torques held (N·m, zero once a command
+    is older than its hold)."""
+    n = force_body.shape[0]
+    held = np.empty((n, 3))
+    for i in range(n):
+        active = t_s < force_until[i] - 1e-9
+        spent = 0.0
+        for k in range(3):
+            f = abs(force_body[i, k] if active else 0.0) + abs(force_bias_body[i, k])
+            spent = f if k == 0 else spent + f
+        dv_mps[i] += spent * dt_s / mass_kg
+        holding = t_s < tau_until[i] - 1e-9
+        for k in range(3):
+            held[i, k] = tau_cmd[i, k] if holding else 0.0
+    return held
+
+
+@njit(cache=True)
+def realise_wheel_torque(tau_cmd: np.ndarray, h: np.ndarray, scale: np.ndarray,
+                         bias: np.ndarray, tau_max: np.ndarray, h_max: np.ndarray, dt: float
+                         ) -> np.ndarray:
+    """The torque the wheels realise on the body over a tick (N, 3), N·m: the command scaled
+    and biased, clipped to the torque limit, then recomputed on the axes whose momentum
+    (N·m·s) would cross its limit (:meth:`sim.actuators.WheelArray.realise`)."""
+    n = tau_cmd.shape[0]
+    out = np.empty((n, 3))
+    for i in range(n):
+        for k in range(3):
+            tau = scale[i, k] * tau_cmd[i, k] + bias[i, k]
+            lo, hi = -tau_max[k], tau_max[k]
+            tau = tau if tau > lo else lo  # np.clip: max first, then min
+            tau = tau if tau < hi else hi
+            h0 = h[i, k]
+            h_end = h0 - tau * dt
+            lo = -h_max[k] if -h_max[k] <= h0 else h0  # np.minimum(-h_max, h0)
+            hi = h_max[k] if h_max[k] >= h0 else h0  # np.maximum(h_max, h0)
+            h_lim = h_end if h_end > lo else lo
+            h_lim = h_lim if h_lim < hi else hi
+            out[i, k] = (h0 - h_lim) / dt if h_lim != h_end else tau
     return out

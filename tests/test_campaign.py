@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -219,3 +220,15 @@ def test_one_campaign_per_directory(tmp_path: Path) -> None:
         fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
         assert run_campaign(["--campaign", str(path), "--out", str(out)]) == 2
     assert not list((out / "runs").iterdir())
+
+
+def test_campaign_workers_get_one_blas_thread(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pool's workers inherit one BLAS thread each; a count the user set is kept."""
+    from deploy.run_campaign import BLAS_THREADS, one_blas_thread
+
+    for name in BLAS_THREADS:
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    one_blas_thread()
+    assert {n: os.environ[n] for n in BLAS_THREADS} == {
+        "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "3", "MKL_NUM_THREADS": "1"}
