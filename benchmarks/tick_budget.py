@@ -21,7 +21,7 @@ with the default mission's work, by rate group.
   and an MPC solve.  Each is timed around the real call (the method wrapped for the run,
   restored after).
 
-Targets (DESIGN.md "Targets", issue 25): bare ≤ 50 µs, 10 Hz-only ≤ 0.5 ms, a 1 Hz tick adds
+Targets (issue 25): bare ≤ 50 µs, 10 Hz-only ≤ 0.5 ms, a 1 Hz tick adds
 ≤ 3 ms, a 0.1 Hz tick adds ≤ 10 ms; per call: camera image ≤ 0.3 ms, fusion ≤ 0.3 ms, nav
 ≤ 0.1 ms, FDIR ≤ 5 ms per observer-window, MPC solve ≤ 1 ms.
 """
