@@ -78,7 +78,6 @@ class _Group:
     """The subscriptions of one key expression, split for delivery of a message of ``kind``
     (the type all of them take, or None when they take different types)."""
 
-    subs: list[_Sub]
     kind: type[Message] | None
     immediate: list[_Sub]
     deferred: list[_Sub]
@@ -86,7 +85,7 @@ class _Group:
     @classmethod
     def of(cls, subs: list[_Sub]) -> _Group:
         kinds = {s.msg_type for s in subs}
-        return cls(subs, kinds.pop() if len(kinds) == 1 else None,
+        return cls(kinds.pop() if len(kinds) == 1 else None,
                    [s for s in subs if s.immediate], [s for s in subs if not s.immediate])
 
 

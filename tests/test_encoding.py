@@ -77,7 +77,7 @@ def test_observations_of_an_image_are_the_validated_message() -> None:
                               poi=[1, 5, 9], precision=[0.5, 1e-3, 2.0])
     assert shared == checked and encode(shared) == encode(checked) == _pydantic(checked)
     assert shared.arrays()[0].tolist() == [1, 5, 9]
-    with pytest.raises(ValueError, match="t_sim"):
+    with pytest.raises(ValidationError, match="t_sim"):
         PoiObservations.of_image(image, "sc2", float("nan"))
 
 

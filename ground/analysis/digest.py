@@ -26,8 +26,7 @@ from ground.analysis.nav import NavErrors, nav_errors
 from ground.analysis.gnc import GncSeries, gnc_series
 from ground.archive.live import LiveArchive
 from ground.archive.reader import Record, RecordSink, RunArchive, load_run
-from ground.archive.recorder import Pending, prepare_raw, prepare_sample
-from interfaces.messages import Message
+from ground.archive.recorder import Pending, prepared
 from interfaces.transport import Sample
 from ground.analysis.truth_table import TruthTable, TruthTableBuilder
 from interfaces import catalogue as cat
@@ -122,16 +121,11 @@ class LiveDigest:
         self._archive = LiveArchive(path, metadata, stream)
         self._mission = mission
 
-    def take(self, pending: Pending, message: Message | None) -> None:
-        self._archive.take(pending, message)
-
     def tap(self, recorder: Recorder) -> Callable[[Sample], None]:
         """A sample handler giving each sample to ``recorder`` and to this digest, prepared
         once for both."""
         def handler(sample: Sample) -> None:
-            pending = prepare_sample(sample)
-            if pending is None:
-                pending = prepare_raw(sample.key, sample.type_name, sample.payload)
+            pending = prepared(sample)
             recorder.take(pending)
             self._archive.take(pending, sample.message)
 

@@ -25,8 +25,7 @@ from ground.archive.recorder import (
     PROFILE,
     SCHEMA_ENCODING,
     Pending,
-    prepare_raw,
-    prepare_sample,
+    prepared,
 )
 from interfaces.messages import Message, json_schema, registry
 from interfaces.transport import Sample
@@ -59,9 +58,7 @@ class LiveArchive:
 
     def record_sample(self, sample: Sample) -> None:
         """Take one bus sample (prepared here; see :meth:`take` to share the preparation)."""
-        pending = prepare_sample(sample)
-        self.take(pending if pending is not None
-                  else prepare_raw(sample.key, sample.type_name, sample.payload), sample.message)
+        self.take(prepared(sample), sample.message)
 
     def take(self, pending: Pending, message: Message | None = None) -> None:
         """Take one prepared sample (and its message object, if the sample carried one)."""

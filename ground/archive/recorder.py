@@ -89,6 +89,14 @@ def prepare_sample(sample: Sample) -> Pending | None:
             None, True, round(msg.t_sim * 1e9), msg.seq, time.time_ns())
 
 
+def prepared(sample: Sample) -> Pending:
+    """``sample`` ready to write: :func:`prepare_sample`'s, or :func:`prepare_raw`'s for bytes
+    alone."""
+    pending = prepare_sample(sample)
+    return pending if pending is not None else prepare_raw(sample.key, sample.type_name,
+                                                           sample.payload)
+
+
 def prepare_raw(key: str, type_name: str, payload: bytes) -> Pending:
     """A raw sample ready to write (its payload parsed for t_sim and seq, never trusted)."""
     is_object, t_ns, sequence = _parse_payload(payload)
@@ -529,4 +537,4 @@ class McapRecorder:
 
 
 __all__ = ["LIBRARY", "McapRecorder", "MESSAGE_ENCODING", "Pending", "SCHEMA_ENCODING",
-           "prepare_raw", "prepare_sample"]
+           "prepare_raw", "prepare_sample", "prepared"]

@@ -20,7 +20,7 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from types import TracebackType
 
-from ground.archive.recorder import McapRecorder, Pending, prepare_raw, prepare_sample
+from ground.archive.recorder import McapRecorder, Pending, prepared
 from interfaces.transport import Sample
 
 BATCH = 1024
@@ -77,9 +77,7 @@ class RecorderProcess:
 
     def record_sample(self, sample: Sample) -> None:
         """Queue one bus sample for the archive."""
-        pending = prepare_sample(sample)
-        self.take(pending if pending is not None
-                  else prepare_raw(sample.key, sample.type_name, sample.payload))
+        self.take(prepared(sample))
 
     def take(self, pending: Pending) -> None:
         """Queue one sample already prepared (:func:`prepare_sample`)."""
