@@ -14,6 +14,10 @@ A message that passed its schema can still be hostile or broken in ways only the
   never come.
 * **Queue.** At most ``MAX_PENDING`` messages wait for delivery; beyond that new ones are refused.
 
+The lockstep's tick is exempt from the sequence and time rules (``Admission.judged_by_subscriber``):
+it defines the clock the time rule reads, and its subscriber judges it by rules of its own
+(``interfaces.executive.TickClient``), which let a node cut off from the sim follow it again.
+
 A refusal is counted by kind (``Admission.refused``) and logged (rate-limited) by the Bus;
 nothing else happens.
 """
@@ -50,6 +54,8 @@ class Admission:
     highest_seq: dict[str, int] = field(default_factory=dict)
     refused: Counter[str] = field(default_factory=Counter)
     """Refusals so far, by kind (counted by ``Bus.refuse``)."""
+    judged_by_subscriber: set[str] = field(default_factory=set)
+    """Keys exempt from the sequence and time rules: their subscriber judges them (the tick)."""
     _owner: dict[str, str | None] = field(default_factory=dict)
 
     def advance(self, t_s: float) -> None:
@@ -73,6 +79,15 @@ class Admission:
         owner = self.owner(key)
         if msg.sender != owner:
             return "sender", f"sender {msg.sender!r} does not own the key (owner {owner!r})"
+        why = None if key in self.judged_by_subscriber else self._out_of_order(key, msg)
+        if why is not None:
+            return why
+        if pending >= MAX_PENDING:
+            return "queue", f"{pending} messages already waiting for delivery"
+        return None
+
+    def _out_of_order(self, key: str, msg: Message) -> Refusal | None:
+        """The sequence and time rules."""
         last = self.highest_seq.get(key)
         if last is None and msg.seq > MAX_FIRST_SEQ:
             return "sequence", f"first sequence number {msg.seq} exceeds {MAX_FIRST_SEQ}"
@@ -81,8 +96,6 @@ class Admission:
         if self.clock_s is not None and msg.t_sim > self.clock_s + MAX_AHEAD_S:
             return "time", (f"dated t={msg.t_sim:.6g} s, more than {MAX_AHEAD_S:g} s after "
                             f"the clock's t={self.clock_s:g} s")
-        if pending >= MAX_PENDING:
-            return "queue", f"{pending} messages already waiting for delivery"
         return None
 
     def forget(self, prefix: str = "") -> None:

@@ -21,6 +21,7 @@ from typing import ClassVar
 
 from interfaces import catalogue as cat
 from interfaces import topics
+from interfaces.admission import MAX_AHEAD_S
 from interfaces.app import RATE_GROUPS, App
 from interfaces.bus import Bus
 from interfaces.catalogue import Topic
@@ -141,7 +142,13 @@ class Executive:
 
 
 MAX_TICK_GAP = 100
-"""Most ticks a node may find skipped between two it receives (none are, on a reliable link)."""
+"""Most ticks a node may find skipped between two it receives (none are, on a reliable link);
+fewer when they span more than ``admission.MAX_AHEAD_S`` of simulated time."""
+REJOIN_RUN = 5
+"""Ticks in a row, each the one after the last, too far ahead of a node's lockstep that make it
+rejoin at the sim's present: evidence that the node was cut off from the sim without seeing the
+sim's liveliness token drop (its session came back before it noticed the loss, or a tick of the
+lost epoch arrived after it rejoined).  A lone tick far ahead is refused."""
 
 
 @dataclass(eq=False)
@@ -153,7 +160,8 @@ class TickClient:
     reports the run finished, or the sim's liveliness token has been gone for
     ``rejoin_grace_s`` (wall).  A node cut off from the sim (its process stalled, its link
     lost) that sees the sim again within that time rejoins: it forgets its tick count, clock
-    and sequence numbers and runs the next tick it receives.  A node whose token comes back
+    and sequence numbers and runs the next tick it receives; so does a node that receives
+    ``REJOIN_RUN`` ticks in a row too far ahead of its own.  A node whose token comes back
     (a restarted process numbers its messages from 1 again) has its sequence numbers
     forgotten."""
 
@@ -166,17 +174,26 @@ class TickClient:
     sim_lost: bool = False
     rejoin_grace_s: float = 60.0
     _last_k: int = -1
+    _ahead: tuple[int, int] = (-1, 0)
+    """The last tick refused as too far ahead, and how many in a row led up to it."""
     _lost_at: float = 0.0
     _rejoin: threading.Event = field(default_factory=threading.Event)
 
     def __post_init__(self) -> None:
         bus = self.executive.bus
+        rates = self.executive.scenario.rates
         self._n_ticks = self.executive.scenario.n_ticks
+        self._max_gap = min(MAX_TICK_GAP, int(MAX_AHEAD_S / rates.dt_s + 1e-9))
+        bus.admission.judged_by_subscriber.add(cat.TICK.key(bus.mission))
         bus.subscribe(cat.TICK.key(bus.mission), Tick, self._on_tick, immediate=True)
         bus.subscribe(cat.SIM_STATUS.key(bus.mission), SimStatus, self._on_status, immediate=True)
 
     def _on_tick(self, tick: Tick) -> None:
         why = self._implausible(tick)
+        if why and self._cut_off(tick):
+            self._lose_epoch(f"{REJOIN_RUN} ticks in a row up to k={tick.k} came from the "
+                             f"sim's present, past this node's tick {self._last_k}")
+            why = self._implausible(tick)
         if why:
             bus = self.executive.bus
             bus.refuse(cat.TICK.key(bus.mission), "tick", f"tick k={tick.k}: {why}")
@@ -190,17 +207,28 @@ class TickClient:
 
     def _implausible(self, tick: Tick) -> str:
         """Why ``tick`` cannot be the sim's next tick ("" if it can): tick numbers only increase,
-        by at most ``MAX_TICK_GAP``, stay within the run, and match the sim's clock t = k·dt."""
+        by at most ``MAX_TICK_GAP`` and ``admission.MAX_AHEAD_S`` of time, stay within the run,
+        and match the sim's clock t = k·dt."""
         rates, n_ticks = self.executive.scenario.rates, self._n_ticks
         if not 0 <= tick.k < n_ticks:
             return f"outside the run's {n_ticks} ticks"
-        if tick.k <= self._last_k:
-            return f"not after tick {self._last_k}"
-        if self._last_k >= 0 and tick.k > self._last_k + MAX_TICK_GAP:
-            return f"{tick.k - self._last_k} ticks after tick {self._last_k}"
         if tick.dt_s != rates.dt_s or abs(tick.t_sim - tick.k * rates.dt_s) > 1e-6:
             return f"time t={tick.t_sim:.6g} s, dt={tick.dt_s:g} s off the clock k·{rates.dt_s:g} s"
+        if tick.k <= self._last_k:
+            return f"not after tick {self._last_k}"
+        if self._last_k >= 0 and tick.k > self._last_k + self._max_gap:
+            return f"{tick.k - self._last_k} ticks after tick {self._last_k}"
         return ""
+
+    def _cut_off(self, tick: Tick) -> bool:
+        """Whether the implausible ``tick`` is the ``REJOIN_RUN``-th in a row too far ahead of
+        this node's lockstep, each the one after the last (only a sim that went on without
+        this node sends that)."""
+        if not 0 <= tick.k < self._n_ticks or tick.k <= self._last_k + self._max_gap:
+            return False
+        last, run = self._ahead
+        self._ahead = (tick.k, run + 1 if tick.k == last + 1 else 1)
+        return self._ahead[1] >= REJOIN_RUN
 
     def _on_status(self, status: SimStatus) -> None:
         if status.state in ("finished", "aborted"):
@@ -215,13 +243,18 @@ class TickClient:
             self.sim_lost, self._lost_at = True, time.monotonic()
             self._ticks.put(None)
         elif node == topics.SIM and self.sim_lost:
-            self.sim_lost, self._last_k = False, -1
-            self._rejoin.set()  # the serving thread forgets the lost epoch (_rejoin_lockstep)
-            self._ticks.put(None)
-            self.executive.log.warning("%s: the sim is back; rejoining the lockstep",
-                                       bus.node)
+            self._lose_epoch("the sim is back")
         elif alive and node != bus.node:
             bus.admission.forget(topics.node_prefix(bus.mission, node) + "/")
+
+    def _lose_epoch(self, why: str) -> None:
+        """Rejoin the lockstep at the next tick: the serving thread forgets the lost epoch
+        (``_rejoin_lockstep``)."""
+        self.sim_lost, self._last_k, self._ahead = False, -1, (-1, 0)
+        self._rejoin.set()
+        self._ticks.put(None)
+        self.executive.log.warning("%s: %s; rejoining the lockstep", self.executive.bus.node,
+                                   why)
 
     def serve(self, stop: threading.Event | None = None) -> None:
         """Run ticks until finished, the sim is lost for good, or ``stop`` is set."""

@@ -14,7 +14,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from interfaces import admission, topics
+from interfaces import admission, executive, topics
 from interfaces import catalogue as cat
 from interfaces.admission import Admission
 from interfaces.bus import Bus
@@ -141,15 +141,17 @@ def test_only_plausible_ticks_run() -> None:
     for seq, tick in enumerate(ticks, start=1):  # numbered as the sim's own ticks would be
         raw.publish(tick_key, "Tick", _bytes(tick.model_copy(update={"seq": seq})))
     assert client.executive.ticks == 4  # k = 0, 1, 3, 23 ran
-    # k = 10^6 and k = 24 (10.5 s ahead of t = 1.5 s) by the bus's time rule, the rest by the
-    # lockstep client's (not increasing, off the clock)
-    assert dict(bus.admission.refused) == {"time": 2, "tick": 4} and bus.stats.refused == 6
+    # all by the lockstep client's rules, not the bus's (the tick is its clock): outside the
+    # run, not increasing, off the clock, and k = 24, 10.5 s ahead of t = 1.5 s
+    assert dict(bus.admission.refused) == {"tick": 6} and bus.stats.refused == 6
     assert bus.admission.clock_s == 23 * 0.5
-    # the tick-gap rule where the time rule does not reach: the first tick sets no clock
-    first = TickClient(Executive(Bus("sc2", M, net.endpoint()), sc, []), synchronous=True)
-    assert first._implausible(_tick(50)) == ""
+    # the first tick sets no clock; after it, at most MAX_TICK_GAP ticks and MAX_AHEAD_S
+    fine = small_scenario("ld", duration_s=100.0, rates={"high_hz": 10.0})
+    first = TickClient(Executive(Bus("sc2", M, net.endpoint()), fine, []), synchronous=True)
+    assert first._implausible(_tick(50, dt=0.1)) == ""
     first._last_k = 50
-    assert "ticks after" in first._implausible(_tick(50 + 101))
+    assert first._implausible(_tick(50 + 100, dt=0.1)) == ""
+    assert "ticks after" in first._implausible(_tick(50 + 101, dt=0.1))
 
 
 def test_a_node_cut_off_from_the_sim_rejoins_at_the_sims_present() -> None:
@@ -187,6 +189,48 @@ def test_a_node_cut_off_from_the_sim_rejoins_at_the_sims_present() -> None:
     assert client.executive.ticks == 2  # the stale ticks 0-3 were not run
     assert bus.admission.clock_s == 301 * 0.5
     assert bus.admission.refused["time"] == 0
+
+
+def test_ticks_from_the_sims_present_bring_back_a_node_that_never_saw_the_sim_lost() -> None:
+    """A node whose session came back before it noticed the sim's token drop (no liveliness
+    event), or that ran a tick of the lost epoch after rejoining, receives the sim's present
+    ticks far ahead of its own: a lone one is refused, ``REJOIN_RUN`` in a row make it rejoin,
+    and it runs the ticks after them with the sim's clock."""
+    sc = small_scenario("ld", duration_s=400.0)  # 2 Hz
+    net = InprocNetwork()
+    bus, raw = Bus("sc1", M, net.endpoint()), net.endpoint()
+    client = TickClient(Executive(bus, sc, []), synchronous=False)
+    tick_key = cat.TICK.key(M)
+    seq = iter(range(1, 1000))
+
+    def send(k: int) -> None:
+        raw.publish(tick_key, "Tick", _bytes(_tick(k).model_copy(update={"seq": next(seq)})))
+
+    stop = threading.Event()
+    serving = threading.Thread(target=client.serve, args=(stop,))
+    serving.start()
+    try:
+        for k in (0, 1, 2, 500, 3):  # a lone tick far ahead is refused; the lockstep goes on
+            send(k)
+        deadline = time.monotonic() + 5.0
+        while client.executive.ticks < 4 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert client.executive.ticks == 4 and bus.admission.refused["tick"] == 1
+        present = range(300, 300 + executive.REJOIN_RUN)  # the sim's present, 150 s on
+        for k in present:
+            send(k)
+        while client._rejoin.is_set() and time.monotonic() < deadline:
+            time.sleep(0.01)  # the serving thread forgets the lost epoch
+        send(present[-1] + 1)
+        send(present[-1] + 2)
+        while client.executive.ticks < 6 and time.monotonic() < deadline:
+            time.sleep(0.01)
+    finally:
+        stop.set()
+        serving.join(timeout=5.0)
+    assert bus.admission.refused["tick"] == executive.REJOIN_RUN  # the lone one, then 4
+    assert client.executive.ticks == 6  # the two ticks after the run were run
+    assert bus.admission.clock_s == (present[-1] + 2) * 0.5
 
 
 def test_tick_done_announces_only_the_senders_own_keys() -> None:
