@@ -10,6 +10,12 @@ significant digits (far below the noise; it halves the images' JSON on the bus a
 archive, where 17-digit floats dominated).  Fault hooks (issue 5): ``beta`` (camera
 degradation, information scaled by β ∈ (0, 1]) and ``misalignment`` (a rotation of the
 boresight in body axes: other POIs, or none, are seen).
+
+The precision of every camera-POI pair is computed by the compiled kernel
+(``fsw.lib.infocost_kernels.precision``, ``compiled=True``, the default) or by the numpy
+reference (``fsw.lib.infocost.precision``).  They agree to rounding; after quantisation the
+images are the same unless a pair lies within rounding of the cone, range or horizon boundary
+or a value within rounding of a quantisation step (``tests/test_truth_camera.py``).
 """
 
 from __future__ import annotations
@@ -20,9 +26,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib import quat
+from fsw.lib import infocost, infocost_kernels, quat
 from fsw.lib.checks import finite_array
-from fsw.lib.infocost import Camera, precision
+from fsw.lib.infocost import Camera
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -66,6 +72,7 @@ class TruthCameras:
         beta: camera health per observer (fault hook), 1 = nominal.
         misalignment: boresight rotation per observer in body axes, quaternions (N, 4) scalar
             last (fault hook), identity = nominal.
+        compiled: the precision by the compiled kernel (True) or the numpy reference.
     """
 
     poi_pos: FloatArray
@@ -74,6 +81,7 @@ class TruthCameras:
     boresight_body: FloatArray
     noise_frac: float
     rngs: Sequence[np.random.Generator]
+    compiled: bool = True
     beta: FloatArray = field(init=False)
     misalignment: FloatArray = field(init=False)
 
@@ -100,6 +108,7 @@ class TruthCameras:
         """One image per observer at true positions (N, 3) m and attitudes (N, 4)."""
         n = len(self.rngs)
         r = finite_array("r_lvlh_m", r_lvlh_m, (n, 3))
+        precision = infocost_kernels.precision if self.compiled else infocost.precision
         prec = precision(r, self.boresights_lvlh(q_lvlh_body), self.poi_pos, self.poi_normal,
                          self.camera)
         out = []

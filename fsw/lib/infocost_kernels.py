@@ -1,4 +1,5 @@
-"""Compiled kernel of the per-observation precision (Eq. 5, 14) for the ground's nominal twin.
+"""Compiled kernel of the per-observation precision (Eq. 5, 14): the sim's cameras and the ground's
+nominal twin.
 
 The same test and formula as :func:`fsw.lib.infocost.precision` -- visible ⇔ inside the cone
 (b·(s − p) > 0 and (b·(s − p))² ≥ cos²α d²), 0 < d² ≤ R², front-facing (n·(p − s) > 0) -- with
@@ -9,7 +10,8 @@ temporaries, not the work, set the cost (≈60 ns per camera-POI pair, a few ns 
 
 The numpy version stays the tested reference (``tests/test_infocost_kernels.py``): values equal
 to rounding, a visibility decided differently only on a pair within rounding of the cone, range
-or horizon boundary.  The sim's cameras keep the numpy version.
+or horizon boundary.  The sim's cameras use it too (``sim.camera.TruthCameras``, whose
+``compiled=False`` runs the numpy version).
 """
 
 from __future__ import annotations
