@@ -89,7 +89,13 @@ def _sizes(p: psutil.Process) -> tuple[int, int]:
     try:
         m = p.memory_full_info()
         return m.rss, m.pss
-    except (psutil.NoSuchProcess, psutil.AccessDenied):
+    except psutil.AccessDenied:  # no access to its page map: count its resident size whole
+        try:
+            rss = p.memory_info().rss
+            return rss, rss
+        except psutil.Error:
+            return 0, 0
+    except psutil.NoSuchProcess:
         return 0, 0
 
 

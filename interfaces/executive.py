@@ -144,11 +144,6 @@ class Executive:
 MAX_TICK_GAP = 100
 """Most ticks a node may find skipped between two it receives (none are, on a reliable link);
 fewer when they span more than ``admission.MAX_AHEAD_S`` of simulated time."""
-REJOIN_RUN = 5
-"""Ticks in a row, each the one after the last, too far ahead of a node's lockstep that make it
-rejoin at the sim's present: evidence that the node was cut off from the sim without seeing the
-sim's liveliness token drop (its session came back before it noticed the loss, or a tick of the
-lost epoch arrived after it rejoined).  A lone tick far ahead is refused."""
 
 
 @dataclass(eq=False)
@@ -160,39 +155,42 @@ class TickClient:
     reports the run finished, or the sim's liveliness token has been gone for
     ``rejoin_grace_s`` (wall).  A node cut off from the sim (its process stalled, its link
     lost) that sees the sim again within that time rejoins: it forgets its tick count, clock
-    and sequence numbers and runs the next tick it receives; so does a node that receives
-    ``REJOIN_RUN`` ticks in a row too far ahead of its own.  A node whose token comes back
-    (a restarted process numbers its messages from 1 again) has its sequence numbers
-    forgotten."""
+    and sequence numbers and runs the next tick it receives.  So does a node that the sim names
+    in a tick's ``rejoin`` while that tick is too far ahead of its own (the sim lost it and
+    sees it again, though the node never saw the sim lost, or it took a tick of the lost epoch
+    after rejoining).  Ticks are queued with their epoch; those of a lost epoch are dropped,
+    not run.  A node whose token comes back (a restarted process numbers its messages from 1
+    again) has its sequence numbers forgotten."""
 
     SUBSCRIBES: ClassVar[tuple[Topic, ...]] = (cat.TICK, cat.SIM_STATUS)
 
     executive: Executive
     synchronous: bool = False
-    _ticks: queue.Queue[Tick | None] = field(default_factory=queue.Queue)
+    _ticks: queue.Queue[tuple[int, Tick] | None] = field(default_factory=queue.Queue)
+    """(epoch, tick) to run; None wakes the serving thread."""
     finished: threading.Event = field(default_factory=threading.Event)
     sim_lost: bool = False
     rejoin_grace_s: float = 60.0
     _last_k: int = -1
-    _ahead: tuple[int, int] = (-1, 0)
-    """The last tick refused as too far ahead, and how many in a row led up to it."""
+    _epoch: int = 0
+    """How many times this node lost the lockstep and rejoined it."""
+    _served_epoch: int = 0
     _lost_at: float = 0.0
-    _rejoin: threading.Event = field(default_factory=threading.Event)
 
     def __post_init__(self) -> None:
         bus = self.executive.bus
         rates = self.executive.scenario.rates
         self._n_ticks = self.executive.scenario.n_ticks
-        self._max_gap = min(MAX_TICK_GAP, int(MAX_AHEAD_S / rates.dt_s + 1e-9))
+        self._max_gap = max(1, min(MAX_TICK_GAP, int(MAX_AHEAD_S / rates.dt_s + 1e-9)))
         bus.admission.judged_by_subscriber.add(cat.TICK.key(bus.mission))
         bus.subscribe(cat.TICK.key(bus.mission), Tick, self._on_tick, immediate=True)
         bus.subscribe(cat.SIM_STATUS.key(bus.mission), SimStatus, self._on_status, immediate=True)
 
     def _on_tick(self, tick: Tick) -> None:
         why = self._implausible(tick)
-        if why and self._cut_off(tick):
-            self._lose_epoch(f"{REJOIN_RUN} ticks in a row up to k={tick.k} came from the "
-                             f"sim's present, past this node's tick {self._last_k}")
+        if why and self.executive.bus.node in tick.rejoin:
+            self._lose_epoch(f"the sim names it rejoining at tick {tick.k}, past its tick "
+                             f"{self._last_k}")
             why = self._implausible(tick)
         if why:
             bus = self.executive.bus
@@ -203,7 +201,7 @@ class TickClient:
         if self.synchronous:
             self.executive.run_tick(tick, barrier=not self.executive.bus.transport.synchronous)
         else:
-            self._ticks.put(tick)
+            self._ticks.put((self._epoch, tick))
 
     def _implausible(self, tick: Tick) -> str:
         """Why ``tick`` cannot be the sim's next tick ("" if it can): tick numbers only increase,
@@ -219,16 +217,6 @@ class TickClient:
         if self._last_k >= 0 and tick.k > self._last_k + self._max_gap:
             return f"{tick.k - self._last_k} ticks after tick {self._last_k}"
         return ""
-
-    def _cut_off(self, tick: Tick) -> bool:
-        """Whether the implausible ``tick`` is the ``REJOIN_RUN``-th in a row too far ahead of
-        this node's lockstep, each the one after the last (only a sim that went on without
-        this node sends that)."""
-        if not 0 <= tick.k < self._n_ticks or tick.k <= self._last_k + self._max_gap:
-            return False
-        last, run = self._ahead
-        self._ahead = (tick.k, run + 1 if tick.k == last + 1 else 1)
-        return self._ahead[1] >= REJOIN_RUN
 
     def _on_status(self, status: SimStatus) -> None:
         if status.state in ("finished", "aborted"):
@@ -248,10 +236,14 @@ class TickClient:
             bus.admission.forget(topics.node_prefix(bus.mission, node) + "/")
 
     def _lose_epoch(self, why: str) -> None:
-        """Rejoin the lockstep at the next tick: the serving thread forgets the lost epoch
-        (``_rejoin_lockstep``)."""
-        self.sim_lost, self._last_k, self._ahead = False, -1, (-1, 0)
-        self._rejoin.set()
+        """Rejoin the lockstep at the next tick: the ticks queued so far belong to a lost epoch
+        (dropped by ``serve``, which forgets the bus's clock and sequence numbers before it
+        runs the first tick of the new one)."""
+        self.sim_lost, self._last_k = False, -1
+        self._epoch += 1
+        if self.synchronous:
+            self.executive.bus.admission.forget()
+            self._served_epoch = self._epoch
         self._ticks.put(None)
         self.executive.log.warning("%s: %s; rejoining the lockstep", self.executive.bus.node,
                                    why)
@@ -259,30 +251,28 @@ class TickClient:
     def serve(self, stop: threading.Event | None = None) -> None:
         """Run ticks until finished, the sim is lost for good, or ``stop`` is set."""
         while not (stop is not None and stop.is_set()):
-            if self._rejoin.is_set():
-                self._rejoin_lockstep()
             try:
-                tick = self._ticks.get(timeout=0.5)
+                item = self._ticks.get(timeout=0.5)
             except queue.Empty:
-                tick = None
-            if tick is not None:  # every tick queued before the end is run
-                self.executive.run_tick(tick)
+                item = None
+            if item is not None:  # every tick queued before the end is run
+                self._run(*item)
             elif self.finished.is_set() or self._gone():
                 return
 
-    def _rejoin_lockstep(self) -> None:
-        """Forget the epoch lost with the sim, on the thread that runs ticks: drop the ticks
-        still queued from it, then the bus's clock and sequence numbers.  (Forgotten on the
-        liveliness thread, a stale tick run afterwards set the clock back to its own time, and
-        every message of the sim's present was then refused as dated too far ahead: the node
-        never rejoined.)"""
-        self._rejoin.clear()
-        while True:
-            try:
-                self._ticks.get_nowait()
-            except queue.Empty:
-                break
-        self.executive.bus.admission.forget()
+    def _run(self, epoch: int, tick: Tick) -> None:
+        """Run a queued tick unless its epoch was lost.  The first tick of a new epoch first
+        forgets the bus's clock and sequence numbers, on this thread: forgotten on the
+        receiving thread, a tick of the lost epoch still running here set the clock back to its
+        own time, and every message of the sim's present was then refused as dated too far
+        ahead (the node never rejoined)."""
+        if epoch < self._epoch:
+            return
+        if epoch > self._served_epoch:
+            self.executive.bus.admission.forget()
+            self.executive.bus.admission.advance(tick.t_sim)
+            self._served_epoch = epoch
+        self.executive.run_tick(tick)
 
     def _gone(self) -> bool:
         """Whether the sim has been lost for longer than ``rejoin_grace_s``."""

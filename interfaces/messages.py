@@ -113,6 +113,10 @@ class Tick(Message):
     dt_s: float = Field(gt=0.0)
     expect: dict[str, int] = Field(default_factory=dict)
     final: bool = Field(default=False, description="last tick of the run")
+    rejoin: list[str] = Field(
+        default_factory=list,
+        description="participants the sim lost and sees again, until each answers a tick: "
+                    "such a node takes this tick as its own next one, however far ahead")
 
 
 class TickDone(Message):

@@ -114,6 +114,8 @@ class SimNode:
         self._answer_k = -1
         self._alive: set[str] = set()
         self._dead: set[str] = set()
+        self._rejoining: set[str] = set()
+        """Participants seen again after they were lost, until they answer a tick."""
         self.events: dict[str, list[tuple[str, float]]] = {}
         """Per participant, ("lost" | "rejoined", sim time s) in order."""
         self.missed_answers = 0
@@ -171,19 +173,23 @@ class SimNode:
                 own = self._prefixes[msg.sender]
                 self._answers[msg.sender] = {k: s for k, s in msg.published.items()
                                              if k.startswith(own)}
+                self._rejoining.discard(msg.sender)
                 self._cond.notify_all()
 
     def on_liveness(self, node: str, alive: bool) -> None:
         """Liveliness handler: a participant that disappears is not waited for any more (its
         last commands are held by the hardware, within their own limits); one that comes back
         (a stalled process resumed, a crashed one restarted) is waited for again from the next
-        tick.  Both are recorded with their sim time for the final status."""
+        tick, and named in the ticks' ``rejoin`` until it answers one (a node that never saw
+        the sim lost takes them as its present, ``TickClient``).  Both are recorded with their
+        sim time for the final status."""
         with self._cond:
             t = self._t_now
             if alive:
                 self._alive.add(node)
                 if node in self._dead:
                     self._dead.discard(node)
+                    self._rejoining.add(node)
                     self.events.setdefault(node, []).append(("rejoined", t))
                     self.log.warning("participant %s rejoined at t=%.1f s", node, t)
             elif node in self.participants and node in self._alive:
@@ -226,9 +232,10 @@ class SimNode:
             expect.update(self.bus.published_since_last())
             with self._cond:
                 self._answers, self._answer_k = {}, k
+                rejoin = sorted(self._rejoining)
             self.bus.publish(self._keys["tick"], Tick(
-                sender=topics.SIM, t_sim=t, k=k, dt_s=dt, expect=expect, final=k == n_ticks - 1),
-                announce=False)
+                sender=topics.SIM, t_sim=t, k=k, dt_s=dt, expect=expect, final=k == n_ticks - 1,
+                rejoin=rejoin), announce=False)
             deadline = (wall0 + (t + dt) / self.realtime_speed if self.realtime_speed
                         else time.monotonic() + sc.sim.lockstep_timeout_s)
             expect = self._collect_answers(k, deadline)
