@@ -23,11 +23,11 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from interfaces import catalogue as cat  # noqa: E402
-from interfaces import topics  # noqa: E402
-from interfaces.bus import Bus  # noqa: E402
-from interfaces.messages import Tick, TickDone  # noqa: E402
-from interfaces.zenoh_transport import ZenohSettings, ZenohTransport  # noqa: E402
+from interfaces.contracts import catalogue as cat  # noqa: E402
+from interfaces.contracts import topics  # noqa: E402
+from interfaces.contracts.messages import Tick, TickDone  # noqa: E402
+from interfaces.runtime.bus import Bus  # noqa: E402
+from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport  # noqa: E402
 
 MISSION = "lockbench"
 

@@ -43,9 +43,11 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from benchmarks.lockstep_limit import free_port, measure as lockstep_rate  # noqa: E402
-from benchmarks.tick_budget import CALLS, TARGETS_MS as TICK_TARGETS_MS  # noqa: E402
-from interfaces.scenario import load_scenario  # noqa: E402
+from benchmarks.lockstep_limit import free_port  # noqa: E402
+from benchmarks.lockstep_limit import measure as lockstep_rate  # noqa: E402
+from benchmarks.tick_budget import CALLS  # noqa: E402
+from benchmarks.tick_budget import TARGETS_MS as TICK_TARGETS_MS  # noqa: E402
+from interfaces.contracts.scenario import load_scenario  # noqa: E402
 
 TWO_ORBITS_S = 11354.0
 TARGETS = {
@@ -176,7 +178,7 @@ from pathlib import Path
 from ground.analysis.digest import digest_run
 from ground.analysis.report import write_report
 from ground.analysis.summary import write_summary
-from interfaces.scenario import load_scenario
+from interfaces.contracts.scenario import load_scenario
 out, scen, dur = Path(sys.argv[1]), load_scenario(sys.argv[2]), float(sys.argv[3])
 scen = scen.with_overrides(None, dur)
 digest = digest_run(out / "run.mcap", scen, scen.name)

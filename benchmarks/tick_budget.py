@@ -4,7 +4,7 @@ with the default mission's work, by rate group.
     python benchmarks/tick_budget.py [--duration S] [--bare-ticks N] [--json FILE]
 
 * **bare lockstep**: a ticker and 6 nodes (5 observers and the ground) on the in-process
-  transport, each a real :class:`~interfaces.executive.Executive` with no apps, answering
+  transport, each a real :class:`~interfaces.runtime.executive.Executive` with no apps, answering
   every tick and publishing its housekeeping at ω_mid: the message pattern of a run with no
   work in it.  Wall time per tick.
 * **the default mission's ticks**: the default scenario in one process with its archive (the
@@ -48,13 +48,13 @@ if str(REPO) not in sys.path:
 from deploy.inproc import run_inproc  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
-from interfaces import catalogue as cat  # noqa: E402
-from interfaces import topics  # noqa: E402
-from interfaces.bus import Bus  # noqa: E402
-from interfaces.executive import Executive, TickClient  # noqa: E402
-from interfaces.messages import Tick, TickDone  # noqa: E402
-from interfaces.scenario import Scenario, load_scenario  # noqa: E402
-from interfaces.transport import InprocNetwork, Sample  # noqa: E402
+from interfaces.contracts import catalogue as cat  # noqa: E402
+from interfaces.contracts import topics  # noqa: E402
+from interfaces.contracts.messages import Tick, TickDone  # noqa: E402
+from interfaces.contracts.scenario import Scenario, load_scenario  # noqa: E402
+from interfaces.runtime.bus import Bus  # noqa: E402
+from interfaces.runtime.executive import Executive, TickClient  # noqa: E402
+from interfaces.runtime.transport import InprocNetwork, Sample  # noqa: E402
 
 DEFAULT = REPO / "deploy" / "scenarios" / "default.toml"
 TARGETS_MS = {"bare": 0.05, "high": 0.5, "mid": 3.0, "low": 10.0}

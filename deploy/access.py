@@ -22,7 +22,8 @@ account       may publish (put, liveliness token, schemas)  may subscribe
 
 A client without an account cannot open a session at all; a put outside the publisher's own key
 space is dropped by the router (silently, for the publisher).  The key space a message came on
-therefore names its sender, which the Bus checks against the body (``interfaces.admission``).
+therefore names its sender, which the Bus checks against the body
+(``interfaces.runtime.admission``).
 
 Each account's client configuration is ``access/<account>.json5`` (endpoint, user, password
 and, with TLS, the certificate authority inline: the one file is all a node on another host
@@ -41,7 +42,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from interfaces import topics
+from interfaces.contracts import topics
 
 TLM_ACCOUNT = "tlm"
 """The read-only telemetry account."""

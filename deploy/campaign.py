@@ -43,7 +43,7 @@ from typing import Annotated, Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from interfaces.scenario import FaultKind, Scenario
+from interfaces.contracts.scenario import FaultKind, Scenario
 
 
 class _Strict(BaseModel):
@@ -327,9 +327,9 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
     import traceback
 
     from deploy.inproc import run_inproc
-    from ground.archive.metadata import run_metadata
     from ground.analysis.digest import LiveDigest, RunDigest
     from ground.analysis.summary import write_summary
+    from ground.archive.metadata import run_metadata
     from ground.archive.recorder import McapRecorder
 
     handler = logging.FileHandler(out / "run.log")

@@ -29,7 +29,7 @@ from ground.analysis.campaign_report import detector_figures, write_campaign_rep
 from ground.archive.metadata import archived_scenario
 from ground.archive.reader import ArchiveError
 from ground.fdir.replay import replay_run, with_settings
-from interfaces.scenario import ScenarioError
+from interfaces.contracts.scenario import ScenarioError
 
 log = logging.getLogger("insp.campaign")
 
@@ -74,7 +74,8 @@ def _local(jobs: list[tuple[str, dict[str, str], str]], workers: int
 
 def _dask(jobs: list[tuple[str, dict[str, str], str]], address: str
           ) -> Iterator[dict[str, Any]]:
-    from distributed import Client, as_completed as dask_completed
+    from distributed import Client
+    from distributed import as_completed as dask_completed
 
     with Client(address, timeout="30s") as client:
         futures = [client.submit(replay_job, *job, pure=False) for job in jobs]

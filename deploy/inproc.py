@@ -13,12 +13,12 @@ from collections.abc import Callable
 
 from fsw.spacecraft import spacecraft_executive
 from ground.station import ground_executive
-from interfaces import topics
-from interfaces.bus import Bus
-from interfaces.channel import ChannelModel, history_for
-from interfaces.executive import Executive, TickClient
-from interfaces.scenario import Scenario
-from interfaces.transport import InprocNetwork, RawHandler, SampleHandler
+from interfaces.contracts import topics
+from interfaces.contracts.scenario import Scenario
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.channel import ChannelModel, history_for
+from interfaces.runtime.executive import Executive, TickClient
+from interfaces.runtime.transport import InprocNetwork, RawHandler, SampleHandler
 from sim.node import SimNode
 
 

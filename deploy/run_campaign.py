@@ -61,7 +61,7 @@ from deploy.campaign import (  # noqa: E402
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
 from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
 from ground.fdir.replay import parse_settings  # noqa: E402
-from interfaces.scenario import ScenarioError  # noqa: E402
+from interfaces.contracts.scenario import ScenarioError  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
 

@@ -50,17 +50,17 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
 from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor  # noqa: E402
 from ground.analysis.digest import LiveDigest, RunDigest, digest_run  # noqa: E402
-from ground.archive.reader import ArchiveError  # noqa: E402
-from ground.archive.metadata import run_metadata  # noqa: E402
-from ground.archive.recorder_process import RecorderProcess  # noqa: E402
 from ground.analysis.report import write_report  # noqa: E402
 from ground.analysis.summary import add_recovery_comparison, write_summary  # noqa: E402
-from interfaces import catalogue as cat  # noqa: E402
-from interfaces import topics  # noqa: E402
-from interfaces.messages import Heartbeat, SimStatus  # noqa: E402
-from interfaces.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
-from interfaces.transport import Sample  # noqa: E402
-from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
+from ground.archive.metadata import run_metadata  # noqa: E402
+from ground.archive.reader import ArchiveError  # noqa: E402
+from ground.archive.recorder_process import RecorderProcess  # noqa: E402
+from interfaces.contracts import catalogue as cat  # noqa: E402
+from interfaces.contracts import topics  # noqa: E402
+from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
+from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
+from interfaces.runtime.transport import Sample  # noqa: E402
+from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
 
 if TYPE_CHECKING:
     from ground.tools.live import LiveView

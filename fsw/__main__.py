@@ -6,11 +6,11 @@ import argparse
 from functools import partial
 
 from fsw.spacecraft import spacecraft_executive
-from interfaces import topics
-from interfaces.bus import Bus
-from interfaces.cli import add_node_args, run_participant
-from interfaces.executive import Executive
-from interfaces.scenario import Scenario
+from interfaces.contracts import topics
+from interfaces.contracts.scenario import Scenario
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.cli import add_node_args, run_participant
+from interfaces.runtime.executive import Executive
 
 
 def _build(spacecraft: int, bus: Bus, scenario: Scenario) -> Executive:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from interfaces.scenario import Scenario
+from interfaces.contracts.scenario import Scenario
 
 
 def reported_h_factor(scenario: Scenario, spacecraft: int) -> Callable[[float], float]:

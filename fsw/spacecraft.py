@@ -10,12 +10,12 @@ from fsw.apps.guidance import GuidanceApp
 from fsw.apps.infocost import InfoCostApp
 from fsw.apps.nav import NavApp
 from fsw.faults import reported_h_factor
-from interfaces import topics
-from interfaces.app import App, AppContext
-from interfaces.bus import Bus
-from interfaces.executive import Executive
-from interfaces.rng import stream
-from interfaces.scenario import Scenario
+from interfaces.contracts import topics
+from interfaces.contracts.rng import stream
+from interfaces.contracts.scenario import Scenario
+from interfaces.runtime.app import App, AppContext
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.executive import Executive
 
 APPS: tuple[type[App], ...] = (AttitudeApp, NavApp, CameraApp, InfoCostApp, GuidanceApp)
 """The onboard apps, in execution order within a rate group."""

@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 
 from ground.station import ground_executive
-from interfaces import topics
-from interfaces.cli import add_node_args, run_participant
+from interfaces.contracts import topics
+from interfaces.runtime.cli import add_node_args, run_participant
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -8,12 +8,12 @@ from ground.apps.baselines import BaselinesApp
 from ground.apps.fdir import FdirApp
 from ground.apps.planner import MissionPlanner
 from ground.apps.telemetry import TelemetryMonitor
-from interfaces import topics
-from interfaces.app import App, AppContext
-from interfaces.bus import Bus
-from interfaces.executive import Executive
-from interfaces.rng import stream
-from interfaces.scenario import Scenario
+from interfaces.contracts import topics
+from interfaces.contracts.rng import stream
+from interfaces.contracts.scenario import Scenario
+from interfaces.runtime.app import App, AppContext
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.executive import Executive
 
 APPS: tuple[type[App], ...] = (MissionPlanner, TelemetryMonitor, FdirApp, BaselinesApp)
 

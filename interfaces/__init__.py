@@ -1,4 +1,6 @@
-"""The contracts every process agrees on: messages, topics, the Bus, the channel, scenarios.
+"""What every process shares, in two rooms: the contracts (``interfaces.contracts``: messages,
+topics, scenario models) and the runtime (``interfaces.runtime``: Bus, transports, executive).
 
-This package imports nothing else of the project (see DESIGN.md, import rules).
+Neither imports flight, sim or ground code; the runtime imports the contracts, never the
+reverse.
 """

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from interfaces import topics
-from interfaces.bus import Bus
-from interfaces.cli import (
+from interfaces.contracts import topics
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.cli import (
     add_node_args,
     load_node_scenario,
     mission_of,

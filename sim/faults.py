@@ -21,11 +21,12 @@ The sim's kinds act on the truth, as a failing unit would:
   models k: no single observer explains it.
 
 The link kinds (``link_loss``, ``packet_loss``) act in every node's channel model
-(``interfaces.channel``) and ``faulty_data`` in the faulty spacecraft's software
+(``interfaces.runtime.channel``) and ``faulty_data`` in the faulty spacecraft's software
 (``fsw.faults``); they are listed here too so that the truth of every fault is archived.
 
 Every switch is returned as a :class:`FaultSwitch` (for the ``FaultEvent`` truth message).
-Random directions come from ``interfaces.rng.stream(seed, "fault", k)`` for the k-th fault.
+Random directions come from ``interfaces.contracts.rng.stream(seed, "fault", k)`` for the k-th
+fault.
 """
 
 from __future__ import annotations
@@ -36,8 +37,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fsw.lib.attitude_control import gains_for
-from interfaces.rng import stream
-from interfaces.scenario import Fault, Scenario
+from interfaces.contracts.rng import stream
+from interfaces.contracts.scenario import Fault, Scenario
 from sim.camera import TruthCameras
 from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor

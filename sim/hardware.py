@@ -18,8 +18,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from fsw.lib import quat
-from interfaces.rng import stream
-from interfaces.scenario import Scenario
+from interfaces.contracts.rng import stream
+from interfaces.contracts.scenario import Scenario
 from sim import kernels
 from sim.actuators import ThrusterBank, WheelArray
 from sim.attitude import AttitudeTruth

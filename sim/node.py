@@ -11,6 +11,7 @@ attitude) to t + dt.
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from dataclasses import dataclass, field
@@ -19,17 +20,14 @@ from typing import ClassVar
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-import math
-
 from fsw.lib import quat
 from fsw.lib.hcw import mean_motion, pro_state
 from fsw.lib.infocost import Camera
 from fsw.lib.poi import sphere_pois
-from interfaces import catalogue as cat
-from interfaces import topics
-from interfaces.bus import Bus
-from interfaces.catalogue import Topic
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.catalogue import Topic
+from interfaces.contracts.messages import (
     AttitudeMeasurement,
     CameraImage,
     FaultEvent,
@@ -41,8 +39,9 @@ from interfaces.messages import (
     TruthState,
     WheelCommand,
 )
-from interfaces.rng import stream
-from interfaces.scenario import Scenario
+from interfaces.contracts.rng import stream
+from interfaces.contracts.scenario import Scenario
+from interfaces.runtime.bus import Bus
 from sim.camera import TruthCameras
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
 from sim.faults import FaultInjector

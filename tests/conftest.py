@@ -14,8 +14,8 @@ from typing import Any
 
 import pytest
 
-from interfaces.messages import Message
-from interfaces.scenario import Scenario, parse_scenario
+from interfaces.contracts.messages import Message
+from interfaces.contracts.scenario import Scenario, parse_scenario
 
 REPO = Path(__file__).resolve().parent.parent
 

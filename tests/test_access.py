@@ -18,9 +18,9 @@ import zenoh
 
 from deploy.access import RunAccess, write_run_access
 from deploy.certificates import write_tls_files
-from interfaces import catalogue as cat
-from interfaces import topics
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.messages import (
     FaultReport,
     InfoCostTelemetry,
     Message,

@@ -22,7 +22,7 @@ from mcap.reader import make_reader
 
 from ground.archive.reader import ArchiveError, Record, load_run
 from ground.archive.recorder import LIBRARY, McapRecorder
-from interfaces.messages import (
+from interfaces.contracts.messages import (
     ExecStats,
     GroupStats,
     Heartbeat,
@@ -399,7 +399,7 @@ _KILLED_WRITER = """
 import sys, time
 sys.path.insert(0, sys.argv[2])
 from ground.archive.recorder import McapRecorder
-from interfaces.messages import RelNavMeasurement
+from interfaces.contracts.messages import RelNavMeasurement
 
 rec = McapRecorder(sys.argv[1], metadata={"run": {"seed": "1"}}, chunk_size=4096)
 i = 0

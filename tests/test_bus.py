@@ -8,11 +8,11 @@ from collections.abc import Iterator
 
 import pytest
 
-from interfaces import topics
-from interfaces.bus import Bus
-from interfaces.messages import Heartbeat, StateEstimate, json_schema
-from interfaces.transport import InprocNetwork
-from interfaces.zenoh_transport import ZenohSettings, ZenohTransport
+from interfaces.contracts import topics
+from interfaces.contracts.messages import Heartbeat, StateEstimate, json_schema
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.transport import InprocNetwork
+from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
 from tests.conftest import settle
 
 M = "bt"

@@ -9,14 +9,14 @@ import pytest
 from deploy.inproc import run_inproc
 from fsw.spacecraft import APPS as FLIGHT_APPS
 from ground.station import APPS as GROUND_APPS
-from interfaces import catalogue as cat
-from interfaces import topics
-from interfaces.app import App
-from interfaces.bus import Bus
-from interfaces.catalogue import Space, Topic
-from interfaces.executive import Executive, TickClient
-from interfaces.messages import Heartbeat, Message, StateEstimate
-from interfaces.transport import InprocNetwork, Sample
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.catalogue import Space, Topic
+from interfaces.contracts.messages import Heartbeat, Message, StateEstimate
+from interfaces.runtime.app import App
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.executive import Executive, TickClient
+from interfaces.runtime.transport import InprocNetwork, Sample
 from sim.node import SimNode
 from tests.conftest import small_scenario
 

@@ -7,14 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from interfaces.channel import (
+from interfaces.contracts.scenario import Burst, Comms, Fault, LinkCut
+from interfaces.runtime.channel import (
     ChannelModel,
     TruthHistory,
     Verdict,
     applies,
     gilbert_elliott_rates,
 )
-from interfaces.scenario import Burst, Comms, Fault, LinkCut
 
 
 def _channel(**comms: object) -> ChannelModel:

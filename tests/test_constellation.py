@@ -16,10 +16,10 @@ import numpy as np
 
 from deploy.inproc import run_inproc
 from ground.archive.reader import load_run
-from interfaces import catalogue as cat
-from interfaces import topics
-from interfaces.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry
-from interfaces.zenoh_transport import ZenohSettings, ZenohTransport
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry
+from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
 from tests.conftest import REPO, small_scenario, write_scenario
 
 LAUNCHER = [sys.executable, str(REPO / "deploy" / "run_constellation.py"), "--no-report"]

@@ -17,14 +17,14 @@ from ground.analysis.digest import (
     digest_run,
     unread_keys,
 )
+from ground.analysis.summary import build_summary
 from ground.archive.live import LiveArchive
 from ground.archive.reader import ArchiveError, Record, load_run
 from ground.archive.recorder import McapRecorder
-from ground.analysis.summary import build_summary
-from interfaces.encoding import encode
-from interfaces.messages import StateEstimate
-from interfaces.scenario import Scenario, load_scenario
-from interfaces.transport import Sample
+from interfaces.contracts.messages import StateEstimate
+from interfaces.contracts.scenario import Scenario, load_scenario
+from interfaces.runtime.encoding import encode
+from interfaces.runtime.transport import Sample
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -1,4 +1,5 @@
-"""Message bytes (interfaces/encoding.py): the JSON pydantic writes, for every message type."""
+"""Message bytes (interfaces/runtime/encoding.py): the JSON pydantic writes, for every message
+type."""
 
 from __future__ import annotations
 
@@ -7,8 +8,7 @@ import pytest
 from pydantic import ValidationError
 
 from deploy.inproc import run_inproc
-from interfaces.encoding import encode
-from interfaces.messages import (
+from interfaces.contracts.messages import (
     AssignmentDecision,
     CameraImage,
     FaultReport,
@@ -17,7 +17,8 @@ from interfaces.messages import (
     SimStatus,
     registry,
 )
-from interfaces.transport import Sample
+from interfaces.runtime.encoding import encode
+from interfaces.runtime.transport import Sample
 from tests.conftest import small_scenario
 
 

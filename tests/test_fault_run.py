@@ -4,7 +4,7 @@ hardware, link and software faults act where they should."""
 from __future__ import annotations
 
 from deploy.inproc import run_inproc
-from interfaces.messages import FaultEvent, InfoCostTelemetry, LinkStats, TruthState
+from interfaces.contracts.messages import FaultEvent, InfoCostTelemetry, LinkStats, TruthState
 from tests.conftest import collector, small_scenario
 
 

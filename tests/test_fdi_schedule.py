@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from interfaces.fdi_schedule import FdiSchedule
+from interfaces.contracts.fdi_schedule import FdiSchedule
 
 
 @pytest.mark.parametrize("period", [100.0, 2.0, 0.3, 7.0 / 3.0])

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from ground.apps.fdir import FdirApp
-from interfaces.app import AppContext
-from interfaces.bus import Bus
-from interfaces.transport import InprocNetwork
-from interfaces.messages import FaultReport, FdirWindow, Message, PoiObservations
+from interfaces.contracts.messages import FaultReport, FdirWindow, Message, PoiObservations
+from interfaces.runtime.app import AppContext
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.transport import InprocNetwork
 from tests.conftest import small_scenario
 
 

@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from interfaces.messages import ConstellationWindow, FaultReport, FdirWindow
+from interfaces.contracts.messages import ConstellationWindow, FaultReport, FdirWindow
 from tests.conftest import recorded_run, small_scenario
 
 ONSET_S = 150.0

@@ -22,7 +22,7 @@ from ground.fdir.hardware_threshold import (
     window_false_alarm,
 )
 from ground.fdir.twin import TwinModel, centre_boresights, delta_h
-from interfaces.rng import stream
+from interfaces.contracts.rng import stream
 from sim.camera import TruthCameras
 
 CAM = Camera(math.radians(12.0), 200.0, 1.0)

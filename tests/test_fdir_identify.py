@@ -22,7 +22,7 @@ from ground.fdir.identify import (
     offset_alignment,
     seen_overlap,
 )
-from interfaces.scenario import FdirSettings
+from interfaces.contracts.scenario import FdirSettings
 
 R = 5.0
 POS, NORMAL = sphere_pois(5000, R)

@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from interfaces.messages import BaselineVerdict, FaultReport
+from interfaces.contracts.messages import BaselineVerdict, FaultReport
 from tests.conftest import recorded_run, small_scenario
 
 

@@ -7,7 +7,7 @@ holds nearly every observation (``fdir.integrity_max_loss``)."""
 from __future__ import annotations
 
 from deploy.inproc import run_inproc
-from interfaces.messages import BaselineVerdict, FaultReport, FdirWindow
+from interfaces.contracts.messages import BaselineVerdict, FaultReport, FdirWindow
 from tests.conftest import collector, small_scenario
 
 

@@ -10,7 +10,7 @@ import pytest
 from fsw.lib import infocost as ic
 from ground.fdir.metric import direction, global_check, metric, ratio
 from ground.fdir.threshold import Persistence, adaptive_threshold, calibrate_floor
-from interfaces.scenario import FdirSettings
+from interfaces.contracts.scenario import FdirSettings
 
 S_1DOF = np.array([[1.0, 1.0, 0.0], [-1.0, -1.0, 0.0]])  # Eq. 13, a = 1
 PHI, W_INV, CAM = 0.5, 0.0, ic.Camera(k=1.0)               # Eq. 22

@@ -10,7 +10,7 @@ import pytest
 
 from deploy.inproc import run_inproc
 from ground.analysis.summary import _series
-from interfaces.messages import FaultReport, FdirWindow
+from interfaces.contracts.messages import FaultReport, FdirWindow
 from tests.conftest import collector, small_scenario
 
 ONSET_S = 50.0

@@ -12,7 +12,7 @@ import pytest
 
 from ground.analysis.calibrate import main as calibrate_main
 from ground.analysis.report import write_report
-from interfaces.messages import FaultReport, FdirWindow
+from interfaces.contracts.messages import FaultReport, FdirWindow
 from tests.conftest import recorded_run, small_scenario
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from ground.analysis.scoring import Alarm, Judged, score
-from interfaces.scenario import Fault
+from interfaces.contracts.scenario import Fault
 
 FAULTS = [Fault(spacecraft=2, kind="camera_degradation", start_s=100.0, magnitude=0.5),
           Fault(spacecraft=4, kind="link_loss", start_s=300.0, end_s=400.0)]

@@ -11,8 +11,8 @@ time)."""
 from __future__ import annotations
 
 import json
-import math
 import logging
+import math
 from collections.abc import Iterator
 from typing import Any
 
@@ -23,12 +23,12 @@ from hypothesis import strategies as st
 
 from fsw.spacecraft import APPS as FSW_APPS
 from ground.station import APPS as GROUND_APPS
-from interfaces import topics
-from interfaces.app import App, AppContext, Input
-from interfaces.bus import Bus
-from interfaces.executive import Executive
-from interfaces.messages import Message, Tick
-from interfaces.transport import InprocNetwork
+from interfaces.contracts import topics
+from interfaces.contracts.messages import Message, Tick
+from interfaces.runtime.app import App, AppContext, Input
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.executive import Executive
+from interfaces.runtime.transport import InprocNetwork
 from tests.conftest import small_scenario
 
 M = "fuzz"

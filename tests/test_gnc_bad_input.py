@@ -15,9 +15,7 @@ from scipy.spatial.transform import Rotation
 
 from fsw.apps.attitude import AttitudeApp
 from fsw.apps.guidance import GuidanceApp
-from interfaces.app import AppContext
-from interfaces.bus import Bus
-from interfaces.messages import (
+from interfaces.contracts.messages import (
     AttitudeEstimate,
     AttitudeMeasurement,
     PointingTarget,
@@ -28,7 +26,9 @@ from interfaces.messages import (
     ThrustCommand,
     WheelCommand,
 )
-from interfaces.transport import InprocNetwork
+from interfaces.runtime.app import AppContext
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.transport import InprocNetwork
 from sim.hardware import WHEEL_COMMAND_TIMEOUT_S
 from sim.node import SimNode
 from tests.conftest import small_scenario

@@ -16,15 +16,15 @@ from fsw.apps.guidance import KEEP_OUT_MARGIN_M
 from fsw.lib.hcw import mean_motion
 from fsw.lib.poi import sphere_pois
 from fsw.lib.pro import Pro
-from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
 from ground.archive.reader import load_run
-from interfaces.messages import (
+from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
     AttitudeEstimate,
     GuidanceStatus,
     TransferPlanMsg,
 )
-from interfaces import catalogue as cat
-from interfaces.scenario import load_scenario
+from interfaces.contracts.scenario import load_scenario
 
 SCENARIO = """
 name = "gnc"

@@ -10,7 +10,12 @@ import numpy as np
 from deploy.inproc import run_inproc
 from fsw.apps.camera import RETARGET_S
 from fsw.lib.poi import sphere_pois
-from interfaces.messages import AttitudeEstimate, InfoCostTelemetry, LinkStats, PointingTarget
+from interfaces.contracts.messages import (
+    AttitudeEstimate,
+    InfoCostTelemetry,
+    LinkStats,
+    PointingTarget,
+)
 from tests.conftest import small_scenario
 
 

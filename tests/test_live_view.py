@@ -12,7 +12,7 @@ import struct
 from tornado.websocket import websocket_connect
 
 from ground.tools.live import POSES_TOPIC, LiveView
-from interfaces.messages import FaultReport, TruthState
+from interfaces.contracts.messages import FaultReport, TruthState
 
 
 def _free_port() -> int:

@@ -14,14 +14,15 @@ from collections.abc import Iterator
 
 import pytest
 
-from interfaces import admission, topics
-from interfaces import catalogue as cat
-from interfaces.admission import Admission
-from interfaces.bus import Bus
-from interfaces.executive import Executive, TickClient
-from interfaces.messages import Heartbeat, Message, Tick, TickDone
-from interfaces.transport import InprocNetwork
-from interfaces.zenoh_transport import ZenohSettings, ZenohTransport
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.messages import Heartbeat, Message, Tick, TickDone
+from interfaces.runtime import admission
+from interfaces.runtime.admission import Admission
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.executive import Executive, TickClient
+from interfaces.runtime.transport import InprocNetwork
+from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
 from sim.node import SimNode
 from tests.conftest import settle, small_scenario
 

@@ -16,7 +16,7 @@ from fsw.lib.poi_map import PoiMap
 from fsw.lib.pro import Pro, min_distance_between, min_distance_to_origin
 from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
 from ground.planning.orbit_assignment import expected_precision, greedy_assignment
-from interfaces.scenario import Scenario
+from interfaces.contracts.scenario import Scenario
 
 POS, NOR = sphere_pois(400, 5.0)
 

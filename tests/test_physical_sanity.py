@@ -13,11 +13,9 @@ from pydantic import ValidationError
 
 from fsw.apps.nav import NavApp
 from ground.apps.telemetry import TelemetryMonitor
-from interfaces import catalogue as cat
-from interfaces import messages as m
-from interfaces.app import AppContext
-from interfaces.bus import Bus
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import messages as m
+from interfaces.contracts.messages import (
     AttitudeEstimate,
     RelNavMeasurement,
     StateEstimate,
@@ -25,7 +23,9 @@ from interfaces.messages import (
     TruthState,
     WheelCommand,
 )
-from interfaces.transport import InprocNetwork
+from interfaces.runtime.app import AppContext
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.transport import InprocNetwork
 from tests.conftest import small_scenario
 
 MISSION = "phys"

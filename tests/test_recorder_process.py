@@ -16,8 +16,8 @@ import pytest
 from ground.archive.reader import load_run
 from ground.archive.recorder import McapRecorder
 from ground.archive.recorder_process import BATCH, RecorderDied, RecorderProcess
-from interfaces.messages import Heartbeat
-from interfaces.transport import Sample
+from interfaces.contracts.messages import Heartbeat
+from interfaces.runtime.transport import Sample
 
 REPO = Path(__file__).resolve().parent.parent
 

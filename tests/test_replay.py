@@ -18,8 +18,8 @@ from ground.archive.reader import ArchiveError, load_run
 from ground.archive.recorder import McapRecorder
 from ground.fdir.replay import UNREAD, GroundOutput, main, replay_run, with_settings
 from ground.station import APPS as GROUND_APPS
-from interfaces import catalogue as cat
-from interfaces.scenario import Scenario, ScenarioError
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.scenario import Scenario, ScenarioError
 from tests.conftest import small_scenario
 
 

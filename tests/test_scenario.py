@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from interfaces.scenario import ScenarioError, load_scenario, parse_scenario
+from interfaces.contracts.scenario import ScenarioError, load_scenario, parse_scenario
 from tests.conftest import REPO
 
 

@@ -15,8 +15,8 @@ from fsw.lib import quat
 from fsw.lib.attitude_control import gains_for, tracking_torque
 from fsw.lib.infocost import Camera
 from fsw.lib.poi import sphere_pois
-from interfaces.rng import stream
-from interfaces.scenario import Scenario
+from interfaces.contracts.rng import stream
+from interfaces.contracts.scenario import Scenario
 from sim.attitude import AttitudeTruth
 from sim.camera import TruthCameras
 from sim.faults import FaultInjector

@@ -2,18 +2,17 @@
 
 from __future__ import annotations
 
-import numpy as np
-import pytest
-
 from pathlib import Path
 
+import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 from fsw.lib import quat
-from interfaces.scenario import load_scenario
+from interfaces.contracts.scenario import load_scenario
+from sim.actuators import WheelArray
 from sim.attitude import AttitudeTruth
 from sim.dynamics import RelativeTruth, circular_chief_eci
-from sim.actuators import WheelArray
 from sim.hardware import ObserverHardware
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "deploy" / "scenarios"

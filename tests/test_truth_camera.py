@@ -8,7 +8,7 @@ from scipy.spatial.transform import Rotation
 
 from fsw.lib.infocost import Camera, visibility
 from fsw.lib.poi import sphere_pois
-from interfaces.rng import stream
+from interfaces.contracts.rng import stream
 from sim.camera import TruthCameras
 
 CAM = Camera(half_angle_rad=np.radians(20.0), max_range_m=200.0, k=1.0)

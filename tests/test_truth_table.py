@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ground.archive.reader import ArchiveError
 from ground.analysis.truth_table import TruthTable
-from interfaces.messages import TruthState
+from ground.archive.reader import ArchiveError
+from interfaces.contracts.messages import TruthState
 
 
 def _truth(t: float, rng: np.random.Generator, ids: list[int], attitude: bool) -> TruthState:

@@ -34,15 +34,15 @@ from fsw.lib import hcw, mekf, quat
 from fsw.lib.attitude import AttitudePlan, repoint, scp_slew, slerp_plan
 from fsw.lib.attitude_control import gains_for
 from fsw.lib.frames import lvlh_to_eci_quat
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
     AttitudeEstimate,
     AttitudeMeasurement,
     PointingTarget,
     StateEstimate,
     WheelCommand,
 )
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 DESIRED_RATE_STEP_S = 1.0
 """Finite-difference step for the desired angular velocity, s."""

@@ -24,15 +24,15 @@ import numpy as np
 
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
     AttitudeEstimate,
     CameraImage,
-    PoiObservations,
     PointingTarget,
+    PoiObservations,
     StateEstimate,
 )
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 RETARGET_S = 10.0
 """Period of the pointing-target choice, s."""

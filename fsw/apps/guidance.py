@@ -31,9 +31,8 @@ from fsw.lib.constants import R_EARTH_M
 from fsw.lib.mpc import MpcConfig, MpcTracker
 from fsw.lib.pro import Pro, energy_matched_state
 from fsw.lib.scp import TransferPlan, plan_transfer
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
     AttitudeEstimate,
     GuidanceStatus,
     ProAssignment,
@@ -42,6 +41,7 @@ from interfaces.messages import (
     ThrustCommand,
     TransferPlanMsg,
 )
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 MIN_TRANSFER_S = 120.0
 """Shortest transfer planned when an assignment arrives late, s."""

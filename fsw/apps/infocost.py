@@ -2,7 +2,7 @@
 
 Rate group mid (ω_mid).  Input: the observations of every observer (its own, and a neighbour's
 only while in communication range: the channel decides).  Output: at every FDI window
-boundary (``interfaces.fdi_schedule``, every ``rates.fdi_period_s``) the information-cost
+boundary (``interfaces.contracts.fdi_schedule``, every ``rates.fdi_period_s``) the information-cost
 telemetry to the ground — its contribution H_i, the cost H and prior term of its fused view,
 every contribution H_j as fused here, and counts.
 """
@@ -12,10 +12,10 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from fsw.lib.poi_map import PoiMap
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.fdi_schedule import FdiSchedule
-from interfaces.messages import InfoCostTelemetry, PoiObservations
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.fdi_schedule import FdiSchedule
+from interfaces.contracts.messages import InfoCostTelemetry, PoiObservations
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 
 class InfoCostApp(App):
@@ -31,7 +31,7 @@ class InfoCostApp(App):
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self.schedule = FdiSchedule(sc.rates.fdi_period_s)
         self.last_boundary = -1
-        """the FDI window boundary last reported (``interfaces.fdi_schedule``)"""
+        """the FDI window boundary last reported (``interfaces.contracts.fdi_schedule``)"""
         self.images = 0
         self.shared = 0
         self.report_factor: Callable[[float], float] = lambda t: 1.0

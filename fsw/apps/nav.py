@@ -10,7 +10,7 @@ direction error) held over the command period T acts like white acceleration noi
 ``(THRUST_ERROR_FRAC·|u|)²·T`` (m²/s³).
 
 A filter that diverges anyway (a state or variance beyond what its message may carry,
-``interfaces.messages``) restarts from its next measurement, counts it in
+``interfaces.contracts.messages``) restarts from its next measurement, counts it in
 ``StateEstimate.resets`` and publishes nothing until then.
 """
 
@@ -19,15 +19,15 @@ from __future__ import annotations
 import numpy as np
 
 from fsw.lib import hcw, kalman
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
     MAX_RANGE_M,
     MAX_SPEED_MPS,
     GuidanceStatus,
     RelNavMeasurement,
     StateEstimate,
 )
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 THRUST_ERROR_FRAC = 0.05
 """1σ execution error of a commanded acceleration, as a fraction of it."""

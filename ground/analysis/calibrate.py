@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ground.fdir.threshold import calibrate_floor
 from ground.archive.reader import ArchiveError, load_run
-from interfaces.messages import FdirWindow
+from ground.fdir.threshold import calibrate_floor
+from interfaces.contracts.messages import FdirWindow
 
 
 def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[FdirWindow]:

@@ -35,8 +35,8 @@ from scipy.stats import beta  # noqa: E402
 
 from ground.analysis.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
 from ground.fdir.threshold import Persistence  # noqa: E402
-from interfaces.messages import WINDOW_TESTS  # noqa: E402
-from interfaces.scenario import Fault  # noqa: E402
+from interfaces.contracts.messages import WINDOW_TESTS  # noqa: E402
+from interfaces.contracts.scenario import Fault  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", "common_mode", None)
 SCALES = np.geomspace(0.1, 10.0, 41)

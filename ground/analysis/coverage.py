@@ -8,9 +8,9 @@ from dataclasses import dataclass, field
 
 from fsw.lib.poi_map import PoiMap
 from ground.archive.reader import Record, RunArchive
-from interfaces import catalogue as cat
-from interfaces.messages import AssignmentDecision, CameraImage
-from interfaces.scenario import Scenario
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import AssignmentDecision, CameraImage
+from interfaces.contracts.scenario import Scenario
 
 
 @dataclass

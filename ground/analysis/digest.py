@@ -22,15 +22,15 @@ from pathlib import Path
 from typing import Protocol
 
 from ground.analysis.coverage import Coverage, CoverageFuser, camera_images, coverage
-from ground.analysis.nav import NavErrors, nav_errors
 from ground.analysis.gnc import GncSeries, gnc_series
+from ground.analysis.nav import NavErrors, nav_errors
+from ground.analysis.truth_table import TruthTable, TruthTableBuilder
 from ground.archive.live import LiveArchive
 from ground.archive.reader import Record, RecordSink, RunArchive, load_run
 from ground.archive.recorder import Pending, prepared
-from interfaces.transport import Sample
-from ground.analysis.truth_table import TruthTable, TruthTableBuilder
-from interfaces import catalogue as cat
-from interfaces.scenario import Scenario
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.scenario import Scenario
+from interfaces.runtime.transport import Sample
 
 
 @dataclass

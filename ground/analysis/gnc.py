@@ -18,11 +18,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from fsw.lib import hcw
-from ground.archive.reader import RunArchive
 from ground.analysis.truth_table import TIME_DECIMALS, TruthTable
-from interfaces import catalogue as cat
-from interfaces.messages import AttitudeEstimate
-from interfaces.scenario import Scenario
+from ground.archive.reader import RunArchive
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import AttitudeEstimate
+from interfaces.contracts.scenario import Scenario
 
 
 @dataclass

@@ -8,10 +8,10 @@ import numpy as np
 from scipy.stats import chi2
 
 from fsw.lib.kalman import nees
-from ground.archive.reader import RunArchive
 from ground.analysis.truth_table import TruthTable
-from interfaces import catalogue as cat
-from interfaces.messages import StateEstimate
+from ground.archive.reader import RunArchive
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import StateEstimate
 
 
 @dataclass(frozen=True)

@@ -13,13 +13,13 @@ import numpy as np  # noqa: E402
 
 from ground.analysis.coverage import Coverage  # noqa: E402
 from ground.analysis.digest import RunDigest, digest_run  # noqa: E402
-from ground.analysis.nav import NavErrors  # noqa: E402
 from ground.analysis.gnc import GncSeries  # noqa: E402
-from ground.archive.reader import ArchiveError, RunArchive  # noqa: E402
+from ground.analysis.nav import NavErrors  # noqa: E402
 from ground.analysis.truth_table import TruthTable  # noqa: E402
-from interfaces import catalogue as cat  # noqa: E402
-from interfaces.messages import FdirWindow  # noqa: E402
-from interfaces.scenario import Scenario  # noqa: E402
+from ground.archive.reader import ArchiveError, RunArchive  # noqa: E402
+from interfaces.contracts import catalogue as cat  # noqa: E402
+from interfaces.contracts.messages import FdirWindow  # noqa: E402
+from interfaces.contracts.scenario import Scenario  # noqa: E402
 
 
 def write_report(out: Path, scenario: Scenario, mission: str | None = None,

@@ -21,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from interfaces.scenario import Fault
+from interfaces.contracts.scenario import Fault
 
 EXPECTED_CLASS = {
     "thruster_bias": "actuator", "pointing_actuator": "actuator",

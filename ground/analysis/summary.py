@@ -9,21 +9,21 @@ from typing import Any, TypeVar
 
 from ground.analysis.coverage import coverage_summary
 from ground.analysis.digest import RunDigest, digest_run
-from ground.analysis.scoring import Alarm, Judged, overlaps_fault, score
 from ground.analysis.gnc import gnc_summary
+from ground.analysis.scoring import Alarm, Judged, overlaps_fault, score
 from ground.archive.reader import ArchiveError, RunArchive
-from interfaces import catalogue as cat
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
+    WINDOW_TESTS,
     BaselineVerdict,
-    Message,
     ExecStats,
     FaultReport,
     FdirWindow,
     LinkStats,
+    Message,
     Tick,
-    WINDOW_TESTS,
 )
-from interfaces.scenario import Scenario
+from interfaces.contracts.scenario import Scenario
 
 M = TypeVar("M", bound=Message)
 

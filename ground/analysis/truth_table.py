@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ground.archive.reader import ArchiveError, Record, RunArchive
-from interfaces import catalogue as cat
-from interfaces.messages import TruthState
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import TruthState
 
 TIME_DECIMALS = 6
 """Times are matched to the truth rounded to this many decimals of a second (1 µs)."""

@@ -15,9 +15,9 @@ from typing import Literal
 
 from ground.fdir.baselines import Cusum, nis_window_test
 from ground.fdir.threshold import Persistence
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import BaselineVerdict, FdirWindow, StateEstimate
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import BaselineVerdict, FdirWindow, StateEstimate
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 Detector = Literal["chi2_nis", "cusum", "fixed_threshold"]
 

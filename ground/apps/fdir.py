@@ -63,8 +63,8 @@ from fsw.lib.infocost import Camera
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
 from ground.fdir.consistency import failed_tests, nis_test
-from ground.fdir.hardware_threshold import position_sigma, ratio_model, window_false_alarm
 from ground.fdir.constellation import ConstellationVerdict, ObserverGain, constellation_check
+from ground.fdir.hardware_threshold import position_sigma, ratio_model, window_false_alarm
 from ground.fdir.identify import Evidence, Tolerances, classify, window_evidence
 from ground.fdir.metric import direction, metric
 from ground.fdir.observer import (
@@ -75,10 +75,9 @@ from ground.fdir.observer import (
 from ground.fdir.threshold import Persistence, WindowThreshold, sampled_threshold
 from ground.fdir.twin import FlightPlan, Transfer, TwinModel, delta_h, planned_boresights
 from ground.planning.mission_plan import pro_of
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.fdi_schedule import FdiSchedule
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.fdi_schedule import FdiSchedule
+from interfaces.contracts.messages import (
     AttitudeEstimate,
     ConstellationWindow,
     FaultReport,
@@ -90,6 +89,7 @@ from interfaces.messages import (
     StateEstimate,
     TransferPlanMsg,
 )
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 
 @dataclass(frozen=True)
@@ -150,7 +150,7 @@ class FdirApp(App):
         """per-window false-alarm probability of the hardware threshold and of the NIS test"""
         self._reported: dict[tuple[int, int], float] = {}  # (observer, boundary) -> H_i
         self.next_window = 0
-        """the next FDI window to judge (``interfaces.fdi_schedule``)"""
+        """the next FDI window to judge (``interfaces.contracts.fdi_schedule``)"""
         self.rejected = 0
         self.shortfall = 0.0
         """Σ over judged windows of (ΔH^pred − ΔH) over the constellation: the running integral

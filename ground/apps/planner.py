@@ -19,15 +19,15 @@ from __future__ import annotations
 from fsw.lib.poi import sphere_pois
 from fsw.lib.poi_map import PoiMap
 from ground.planning.mission_plan import MissionPlan
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
     AssignmentDecision,
     FaultReport,
     PoiObservations,
     ProAssignment,
     ProAssignments,
 )
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 
 class MissionPlanner(App):

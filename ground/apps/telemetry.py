@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from interfaces import topics
-from interfaces import catalogue as cat
-from interfaces.app import App, AppContext, Input, Output
-from interfaces.messages import Message, StateEstimate, TelemetryStatus
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.messages import Message, StateEstimate, TelemetryStatus
+from interfaces.runtime.app import App, AppContext, Input, Output
 
 
 @dataclass

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from mcap.records import Header, Schema
 
-from ground.archive.reader import Record, RecordSink, RunArchive, RecordLoader
+from ground.archive.reader import Record, RecordLoader, RecordSink, RunArchive
 from ground.archive.recorder import (
     LIBRARY,
     PROFILE,
@@ -27,8 +27,8 @@ from ground.archive.recorder import (
     Pending,
     prepared,
 )
-from interfaces.messages import Message, json_schema, registry
-from interfaces.transport import Sample
+from interfaces.contracts.messages import Message, json_schema, registry
+from interfaces.runtime.transport import Sample
 
 
 @dataclass(frozen=True, slots=True)

@@ -13,7 +13,7 @@ from mcap.exceptions import McapError
 from mcap.reader import make_reader
 
 from ground.archive.reader import ArchiveError
-from interfaces.scenario import Scenario
+from interfaces.contracts.scenario import Scenario
 
 
 @functools.cache

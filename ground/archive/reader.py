@@ -21,8 +21,8 @@ The archive is held in memory: :class:`Record` s ordered by log time (mission el
 ties in file order.  Keys given to ``load_run(stream=...)`` are not held: their records go, in
 file order, to a sink as they are read (a two-orbit run's camera images alone are 1.7 GB of
 JSON); they are counted all the same.  Records are filtered by key expression with
-:func:`interfaces.topics.matches` (``*`` one chunk, ``**`` any number) and decoded through the
-message registry on demand.
+:func:`interfaces.contracts.topics.matches` (``*`` one chunk, ``**`` any number) and decoded
+through the message registry on demand.
 """
 
 from __future__ import annotations
@@ -30,15 +30,15 @@ from __future__ import annotations
 import io
 import os
 import struct
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from operator import attrgetter
 from pathlib import Path
-from collections.abc import Callable, Mapping
 from typing import IO, Final, TypeVar, overload
 
 import zstandard
-from mcap.exceptions import EndOfFile, McapError, RecordLengthLimitExceeded
 from mcap.data_stream import ReadDataStream
+from mcap.exceptions import EndOfFile, McapError, RecordLengthLimitExceeded
 from mcap.opcode import Opcode
 from mcap.records import (
     Channel,
@@ -52,9 +52,9 @@ from mcap.records import Message as McapMessage
 from mcap.stream_reader import StreamReader, get_chunk_data_stream
 from pydantic import ValidationError
 
-from interfaces.catalogue import Topic
-from interfaces.messages import Message, registry
-from interfaces.topics import matches
+from interfaces.contracts.catalogue import Topic
+from interfaces.contracts.messages import Message, registry
+from interfaces.contracts.topics import matches
 
 MCAP_MAGIC: Final = b"\x89MCAP0\r\n"
 

@@ -10,8 +10,8 @@ import argparse
 
 from ground.archive.metadata import run_metadata
 from ground.archive.recorder import McapRecorder
-from interfaces import topics
-from interfaces.cli import (
+from interfaces.contracts import topics
+from interfaces.runtime.cli import (
     add_node_args,
     load_node_scenario,
     mission_of,

@@ -10,7 +10,8 @@ File layout (Foxglove opens it as is):
   more than one type name (a confused or hostile sender) gets one channel per (key, type), all
   with the same topic;
 * one **schema per type name**, ``encoding="jsonschema"``, data = the pydantic JSON schema of the
-  model from :func:`interfaces.messages.registry`.  A type name that is *not* in the registry is
+  model from :func:`interfaces.contracts.messages.registry`.  A type name that is *not* in the
+  registry is
   recorded all the same (the archive is evidence) under a schema with that name, encoding
   ``"jsonschema"`` and the permissive schema ``{"type": "object", "title": <name>, ...}``; such
   messages are counted in :attr:`McapRecorder.unknown_type`.  (Encoding ``""`` was rejected:
@@ -47,8 +48,8 @@ from typing import Final
 from mcap.writer import CompressionType, IndexType, Writer
 from pydantic_core import from_json
 
-from interfaces.messages import Message, json_schema, registry
-from interfaces.transport import Sample
+from interfaces.contracts.messages import Message, json_schema, registry
+from interfaces.runtime.transport import Sample
 
 LIBRARY: Final = "insp-recorder"
 """Library name written in the MCAP header."""
@@ -203,7 +204,8 @@ def _unknown_type_schema(name: str) -> bytes:
         {
             "type": "object",
             "title": name,
-            "description": "unknown message type (not in interfaces.messages.registry()); "
+            "description": "unknown message type "
+                           "(not in interfaces.contracts.messages.registry()); "
             "payload stored as received",
         }
     ).encode("utf-8")

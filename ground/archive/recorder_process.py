@@ -21,7 +21,7 @@ from pathlib import Path
 from types import TracebackType
 
 from ground.archive.recorder import McapRecorder, Pending, prepared
-from interfaces.transport import Sample
+from interfaces.runtime.transport import Sample
 
 BATCH = 1024
 """Samples per message on the pipe (about 0.3 MB of JSON at the default scenario's mix)."""

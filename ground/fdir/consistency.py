@@ -17,9 +17,10 @@ from collections.abc import Sequence
 from ground.fdir.baselines import nis_window_test
 from ground.fdir.identify import Evidence, Tolerances
 
+
 def failed_tests(ev: Evidence, tol: Tolerances) -> tuple[str, ...]:
     """Names of the consistency tests the window's evidence fails, by the names a window's
-    verdict gives them (``interfaces.messages.WINDOW_TESTS``)."""
+    verdict gives them (``interfaces.contracts.messages.WINDOW_TESTS``)."""
     failed = []
     if (ev.nav_vs_plan_m or 0.0) > tol.position_m:
         failed.append("plan")

@@ -95,7 +95,7 @@ from fsw.lib.infocost import visibility
 from ground.fdir.boresight import boresight_offset
 from ground.fdir.hardware_threshold import clipped_noise_moments
 from ground.fdir.twin import TwinModel, sample_stride
-from interfaces.scenario import FdirSettings
+from interfaces.contracts.scenario import FdirSettings
 
 FloatArray = npt.NDArray[np.float64]
 

@@ -38,20 +38,20 @@ from ground.analysis.summary import fdir_results
 from ground.archive.metadata import scenario_from_metadata
 from ground.archive.reader import ArchiveError, Record, RunArchive, load_run
 from ground.station import ground_executive
-from interfaces import catalogue as cat
-from interfaces import topics
-from interfaces.bus import Bus
-from interfaces.channel import ChannelModel
-from interfaces.executive import TickClient
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.messages import (
     BaselineVerdict,
     ConstellationWindow,
     FaultReport,
     FdirWindow,
     ProAssignments,
 )
-from interfaces.scenario import Scenario, ScenarioError
-from interfaces.transport import InprocNetwork, Sample
+from interfaces.contracts.scenario import Scenario, ScenarioError
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.channel import ChannelModel
+from interfaces.runtime.executive import TickClient
+from interfaces.runtime.transport import InprocNetwork, Sample
 
 SETTABLE = ("fdir.", "rates.fdi_period_s")
 """Settings a replay may change: the ground's detector only.  Anything else changes what the

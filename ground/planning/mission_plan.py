@@ -49,8 +49,8 @@ from ground.planning.orbit_assignment import (
     pro_library,
     set_gain,
 )
-from interfaces.messages import ProElements
-from interfaces.scenario import Phase, Scenario
+from interfaces.contracts.messages import ProElements
+from interfaces.contracts.scenario import Phase, Scenario
 
 log = logging.getLogger(__name__)
 

@@ -20,7 +20,7 @@ import foxglove
 from foxglove.channels import PosesInFrameChannel
 from foxglove.messages import Pose, PosesInFrame, Quaternion, Timestamp, Vector3
 
-from interfaces.messages import json_schema, registry
+from interfaces.contracts.messages import json_schema, registry
 
 log = logging.getLogger("insp.live")
 

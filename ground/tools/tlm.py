@@ -18,7 +18,7 @@ import threading
 import time
 from dataclasses import dataclass
 
-from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
+from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
 
 SKIP_FIELDS = {"sender", "seq", "t_sim", "t_wall"}
 

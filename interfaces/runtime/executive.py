@@ -19,13 +19,10 @@ import time
 from dataclasses import dataclass, field
 from typing import ClassVar
 
-from interfaces import catalogue as cat
-from interfaces import topics
-from interfaces.admission import MAX_AHEAD_S
-from interfaces.app import RATE_GROUPS, App
-from interfaces.bus import Bus
-from interfaces.catalogue import Topic
-from interfaces.messages import (
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.catalogue import Topic
+from interfaces.contracts.messages import (
     ExecStats,
     GroupStats,
     Heartbeat,
@@ -34,7 +31,10 @@ from interfaces.messages import (
     Tick,
     TickDone,
 )
-from interfaces.scenario import Scenario
+from interfaces.contracts.scenario import Scenario
+from interfaces.runtime.admission import MAX_AHEAD_S
+from interfaces.runtime.app import RATE_GROUPS, App
+from interfaces.runtime.bus import Bus
 
 
 @dataclass

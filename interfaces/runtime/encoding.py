@@ -15,7 +15,7 @@ from __future__ import annotations
 import orjson
 from pydantic import BaseModel
 
-from interfaces.messages import Message
+from interfaces.contracts.messages import Message
 
 
 def encode(msg: Message) -> bytes:

@@ -14,10 +14,10 @@ from typing import ClassVar
 
 import numpy as np
 
-from interfaces.bus import Bus
-from interfaces.catalogue import Topic
-from interfaces.messages import Message, RateGroupName
-from interfaces.scenario import Scenario
+from interfaces.contracts.catalogue import Topic
+from interfaces.contracts.messages import Message, RateGroupName
+from interfaces.contracts.scenario import Scenario
+from interfaces.runtime.bus import Bus
 
 RATE_GROUPS: tuple[RateGroupName, ...] = ("high", "mid", "low")
 

@@ -83,7 +83,7 @@ class CameraSettings(_Section):
 
 class Rates(_Section):
     """Rate groups ω_high / ω_mid / ω_low (Hz) and the FDI period (s), a whole number of ω_mid
-    periods (``interfaces.fdi_schedule``)."""
+    periods (``interfaces.contracts.fdi_schedule``)."""
 
     high_hz: float = Field(default=10.0, gt=0.0)
     mid_hz: float = Field(default=1.0, gt=0.0)

@@ -23,11 +23,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
-from interfaces.encoding import encode
-from interfaces.topics import matches
+from interfaces.contracts.topics import matches
+from interfaces.runtime.encoding import encode
 
 if TYPE_CHECKING:
-    from interfaces.messages import Message
+    from interfaces.contracts.messages import Message
 
 
 class Sample:

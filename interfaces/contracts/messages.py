@@ -612,7 +612,7 @@ class GroupStats(BaseModel):
 
 class ExecStats(Message):
     """Executive statistics: cycle slips per rate group, app errors, invalid messages dropped,
-    messages refused at admission (``interfaces.admission``: a sender not owning its key, an
+    messages refused at admission (``interfaces.runtime.admission``: a sender not owning its key, an
     absurd sequence number or date, a full queue, an implausible tick)."""
 
     node: str

@@ -72,8 +72,8 @@ def all_spacecraft(mission: str, *path: str) -> str:
     return "/".join((ROOT, mission, "sc", "*", *path))
 
 
-# The message topics and their types are in ``interfaces.catalogue``; the keys below carry no
-# message (services and liveliness).
+# The message topics and their types are in ``interfaces.contracts.catalogue``; the keys below
+# carry no message (services and liveliness).
 
 
 def schema_queryable(mission: str, node: str) -> str:

@@ -8,11 +8,11 @@ import signal
 import threading
 from collections.abc import Callable
 
-from interfaces.bus import Bus
-from interfaces.channel import ChannelModel
-from interfaces.executive import Executive, TickClient
-from interfaces.scenario import Scenario, ScenarioError, load_scenario
-from interfaces.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
+from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.channel import ChannelModel
+from interfaces.runtime.executive import Executive, TickClient
+from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
 
 
 def add_node_args(parser: argparse.ArgumentParser) -> None:

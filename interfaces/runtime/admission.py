@@ -16,7 +16,8 @@ A message that passed its schema can still be hostile or broken in ways only the
 
 The lockstep's tick is exempt from the sequence and time rules (``Admission.judged_by_subscriber``):
 it defines the clock the time rule reads, and its subscriber judges it by rules of its own
-(``interfaces.executive.TickClient``), which let a node cut off from the sim follow it again.
+(``interfaces.runtime.executive.TickClient``), which let a node cut off from the sim follow it
+again.
 
 A refusal is counted by kind (``Admission.refused``) and logged (rate-limited) by the Bus;
 nothing else happens.
@@ -27,8 +28,8 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass, field
 
-from interfaces import topics
-from interfaces.messages import Message
+from interfaces.contracts import topics
+from interfaces.contracts.messages import Message
 
 MAX_FIRST_SEQ = 10**9
 """Highest sequence number a key's first message may carry (10 Hz for three years)."""

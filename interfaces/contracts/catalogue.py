@@ -11,8 +11,8 @@ and so who may publish it:
 - ``EVERY_NODE``: ``<node prefix>/<app>/<name>``, published by every lockstep node (the
   executive's lockstep answer and housekeeping).
 
-Apps declare their inputs and outputs from these topics (``interfaces.app``), the sim and the
-executive declare theirs (``PUBLISHES``), the bus refuses to publish a message of the wrong type
+Apps declare their inputs and outputs from these topics (``interfaces.runtime.app``), the sim and
+the executive declare theirs (``PUBLISHES``), the bus refuses to publish a message of the wrong type
 on a catalogued key, and ``tests/test_catalogue.py`` checks that every input has exactly one
 producer of its type.
 """
@@ -23,8 +23,8 @@ import enum
 from dataclasses import dataclass
 from typing import Generic, TypeVar
 
-from interfaces import messages as m
-from interfaces import topics
+from interfaces.contracts import messages as m
+from interfaces.contracts import topics
 
 
 class Space(enum.Enum):

@@ -3,8 +3,8 @@
 What the Bus guarantees, identically on every transport:
 
 * **Own key space.** A node publishes only under its own prefix (``topics.node_prefix``).
-* **Typed topics.** A key of the topic catalogue (``interfaces.catalogue``) is published and
-  subscribed with its catalogue type only; anything else is a programming error (TypeError).
+* **Typed topics.** A key of the topic catalogue (``interfaces.contracts.catalogue``) is published
+  and subscribed with its catalogue type only; anything else is a programming error (TypeError).
 * **Sequence numbers.** Each key has its own sequence count starting at 1, set on publish.
 * **Validation where bytes come in.** A received payload that is not valid JSON of the subscribed
   model (wrong fields, NaN, oversize) is dropped, counted in ``invalid_dropped`` and logged;
@@ -12,8 +12,8 @@ What the Bus guarantees, identically on every transport:
   of the message's own type receives the publisher's validated, immutable object, with no JSON
   in between; JSON is made only for the transports and raw subscribers that need bytes.
 * **Admission.** A valid message is then held to the plausibility rules of
-  ``interfaces.admission`` (its sender owns the key, a sane sequence number and date, a bounded
-  queue); a refused one is counted in ``refused`` and logged, and never reaches the barrier.
+  ``interfaces.runtime.admission`` (its sender owns the key, a sane sequence number and date, a
+  bounded queue); a refused one is counted in ``refused`` and logged, and never reaches the barrier.
 * **Deterministic delivery.** Deferred subscriptions (the default) are delivered by
   ``dispatch(t_now)`` on the caller's thread, sorted by (send time, key, sequence).  Messages of
   other flight/ground nodes become eligible one tick after they were sent (at the earliest) and
@@ -36,11 +36,11 @@ from typing import TypeVar
 
 from pydantic import ValidationError
 
-from interfaces import catalogue, topics
-from interfaces.admission import MAX_SEQ_JUMP, Admission
-from interfaces.channel import ChannelModel, Verdict, applies
-from interfaces.messages import Message, TruthState, json_schema, registry, stamp
-from interfaces.transport import LivenessHandler, RawHandler, Sample, Transport
+from interfaces.contracts import catalogue, topics
+from interfaces.contracts.messages import Message, TruthState, json_schema, registry, stamp
+from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
+from interfaces.runtime.channel import ChannelModel, Verdict, applies
+from interfaces.runtime.transport import LivenessHandler, RawHandler, Sample, Transport
 
 M = TypeVar("M", bound=Message)
 MAX_PAYLOAD_BYTES = 1 << 20
@@ -179,7 +179,7 @@ class Bus:
         return expected  # type: ignore[return-value]
 
     def _check_type(self, key: str, msg_type: type[Message]) -> None:
-        """A catalogued key carries its catalogue type only (``interfaces.catalogue``)."""
+        """A catalogued key carries its catalogue type only (``interfaces.contracts.catalogue``)."""
         expected = self._catalogue_type(key)
         if expected is not None and msg_type is not expected:
             raise TypeError(f"{key} carries {expected.__name__}, not {msg_type.__name__}")

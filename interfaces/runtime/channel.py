@@ -34,10 +34,10 @@ from enum import Enum
 
 import numpy as np
 
-from interfaces.messages import LinkCounter, TruthState
-from interfaces.rng import stream
-from interfaces.scenario import Comms, Fault, LinkCut, Scenario
-from interfaces.topics import GROUND, spacecraft_of
+from interfaces.contracts.messages import LinkCounter, TruthState
+from interfaces.contracts.rng import stream
+from interfaces.contracts.scenario import Comms, Fault, LinkCut, Scenario
+from interfaces.contracts.topics import GROUND, spacecraft_of
 
 
 class Verdict(Enum):

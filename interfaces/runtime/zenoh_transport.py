@@ -23,7 +23,7 @@ from typing import Any, Literal
 
 import zenoh
 
-from interfaces.transport import (
+from interfaces.runtime.transport import (
     LivenessHandler,
     MadeHereHandler,
     RawHandler,
