@@ -1,0 +1,57 @@
+"""The import rules of the house: the contracts import nothing else of the project; the runtime
+imports only the contracts; neither imports flight, sim or ground code (imports inside functions
+included: they are read from the source, not from what a run happens to load)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+from tests.conftest import REPO
+
+PROJECT = ("interfaces", "fsw", "sim", "ground", "deploy", "benchmarks", "tests")
+
+
+def _imports(path: Path) -> set[str]:
+    """The project modules ``path`` imports, dotted (``from a.b import c`` gives ``a.b`` and
+    ``a.b.c``: ``c`` may be a module)."""
+    out: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            out.add(node.module)
+            out.update(f"{node.module}.{a.name}" for a in node.names)
+    return {m for m in out if m.split(".")[0] in PROJECT}
+
+
+def _violations(room: str, allowed: tuple[str, ...], root: Path = REPO) -> list[str]:
+    """Imports from the files of ``room`` (a package path under ``root``) outside the
+    ``allowed`` prefixes."""
+    bad = []
+    for path in sorted((root / room.replace(".", "/")).rglob("*.py")):
+        for module in sorted(_imports(path)):
+            if not any(module == a or module.startswith(a + ".") for a in allowed):
+                bad.append(f"{path.relative_to(root)} imports {module}")
+    return bad
+
+
+RUNTIME_MAY = ("interfaces.contracts", "interfaces.runtime")
+
+
+def test_the_contracts_import_only_the_contracts() -> None:
+    assert _violations("interfaces.contracts", ("interfaces.contracts",)) == []
+
+
+def test_the_runtime_imports_only_the_contracts_and_itself() -> None:
+    assert _violations("interfaces.runtime", RUNTIME_MAY) == []
+
+
+def test_the_rule_reader_sees_a_violation(tmp_path: Path) -> None:
+    """The checker itself: an import of flight code inside a runtime function is reported."""
+    room = tmp_path / "interfaces" / "runtime"
+    room.mkdir(parents=True)
+    (room / "probe.py").write_text("def f() -> None:\n    from fsw.lib import hcw\n")
+    assert _violations("interfaces.runtime", RUNTIME_MAY, root=tmp_path) == [
+        "interfaces/runtime/probe.py imports fsw.lib",
+        "interfaces/runtime/probe.py imports fsw.lib.hcw"]
