@@ -1,4 +1,4 @@
-"""Attitude library speed: the 10 Hz attitude-cycle functions before/after fsw.lib.quat, and
+"""Attitude library speed: the 10 Hz attitude-cycle functions before/after gnc.quat, and
 scp_slew per 90° slew.
 
     python benchmarks/bench_attitude.py [--calls N] [--slews N] [--no-slew]
@@ -6,7 +6,7 @@ scp_slew per 90° slew.
 Cycle table: for mekf_propagate, mekf_update, tracking_torque, SlerpPlan.at, SlewPlan.at,
 repoint and lvlh_to_eci, the median (and p90) wall time of one call ("after"), and of the scipy
 ``Rotation``/``Slerp`` operations the function used to do ("scipy core") against the
-:mod:`fsw.lib.quat` code that replaced them ("quat core").  The former implementation is gone,
+:mod:`gnc.quat` code that replaced them ("quat core").  The former implementation is gone,
 so "before" is estimated as ``after − quat core + scipy core`` (the rest of each function,
 input checks and linear algebra, is unchanged).  For mekf_propagate the cores include
 ``mekf_transition``, whose one-filter path now uses floats: the old path is timed by calling it
@@ -31,11 +31,11 @@ from scipy.spatial.transform import Rotation, Slerp
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from fsw.lib import quat  # noqa: E402
 from fsw.lib.attitude import SlewPlan, repoint, scp_slew, slerp_plan  # noqa: E402
 from fsw.lib.attitude_control import AttitudeGains, tracking_torque  # noqa: E402
-from fsw.lib.frames import lvlh_to_eci, lvlh_to_eci_quat  # noqa: E402
 from fsw.lib.mekf import mekf_propagate, mekf_transition, mekf_update  # noqa: E402
+from gnc import quat  # noqa: E402
+from gnc.frames import lvlh_to_eci, lvlh_to_eci_quat  # noqa: E402
 
 J = np.array([[0.10, 0.006, -0.004], [0.006, 0.12, 0.003], [-0.004, 0.003, 0.08]])
 DT = 0.1  # s, attitude cycle

@@ -1,4 +1,4 @@
-"""Speed of the information-cost kernel (fsw/lib/infocost.py): the per-image work.
+"""Speed of the information-cost kernel (gnc/infocost.py): the per-image work.
 
     python benchmarks/bench_infocost.py [--repeats R] [--seed N]
 
@@ -22,8 +22,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from fsw.lib import infocost as ic  # noqa: E402
-from fsw.lib.poi import sphere_pois  # noqa: E402
+from gnc import infocost as ic  # noqa: E402
+from gnc.poi import sphere_pois  # noqa: E402
 
 
 def kernel(p: np.ndarray, b: np.ndarray, s: np.ndarray, n: np.ndarray, cam: ic.Camera,

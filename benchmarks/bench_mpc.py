@@ -23,8 +23,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from fsw.lib import hcw  # noqa: E402
 from fsw.lib.mpc import MpcConfig, MpcTracker  # noqa: E402
+from gnc import hcw  # noqa: E402
 
 
 def closed_loop(n: float, cfg: MpcConfig, steps: int, rng: np.random.Generator,

@@ -21,8 +21,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from fsw.lib import hcw  # noqa: E402
 from fsw.lib.scp import TransferPlan, plan_transfer  # noqa: E402
+from gnc import hcw  # noqa: E402
 
 U_MAX = 1e-3
 

@@ -2,7 +2,7 @@
 sees and with what precision, from the TRUE pose and the camera's faults.
 
 An image of observer i sees the POIs visible from its true position along its true boresight
-(``fsw.lib.infocost.visibility``: inside the field-of-view cone, within range, front-facing on
+(``gnc.infocost.visibility``: inside the field-of-view cone, within range, front-facing on
 the convex target) and measures each with precision σ⁻¹ = 1/(k d²) (Eq. 5), scaled by the
 camera's health β and perturbed by multiplicative noise: σ⁻¹_meas = β σ⁻¹ max(0, 1 + ν ε),
 ε ~ N(0, 1) from the observer's own generator, and quantised to ``SIGNIFICANT_DIGITS``
@@ -12,8 +12,8 @@ degradation, information scaled by β ∈ (0, 1]) and ``misalignment`` (a rotati
 boresight in body axes: other POIs, or none, are seen).
 
 The precision of every camera-POI pair is computed by the compiled kernel
-(``fsw.lib.infocost_kernels.precision``, ``compiled=True``, the default) or by the numpy
-reference (``fsw.lib.infocost.precision``).  They agree to rounding; after quantisation the
+(``gnc.infocost_kernels.precision``, ``compiled=True``, the default) or by the numpy
+reference (``gnc.infocost.precision``).  They agree to rounding; after quantisation the
 images are the same unless a pair lies within rounding of the cone, range or horizon boundary
 or a value within rounding of a quantisation step (``tests/test_truth_camera.py``).
 """
@@ -26,9 +26,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib import infocost, infocost_kernels, quat
-from fsw.lib.checks import finite_array
-from fsw.lib.infocost import Camera
+from gnc import infocost, infocost_kernels, quat
+from gnc.checks import finite_array
+from gnc.infocost import Camera
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]

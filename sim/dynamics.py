@@ -1,7 +1,7 @@
 """Truth relative translational dynamics of N deputies about a chief in LEO.
 
 This is the simulator's *truth* model, deliberately not the flight model
-(HCW, :mod:`fsw.lib.hcw`): gravity is full nonlinear two-body, optionally
+(HCW, :mod:`gnc.hcw`): gravity is full nonlinear two-body, optionally
 with the J2 zonal harmonic, for the chief and every deputy, so the flight
 software sees real model error (nonlinearity, orbit curvature, J2).
 
@@ -32,7 +32,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib.constants import J2_EARTH, MU_EARTH_M3_S2, R_EARTH_M
+from gnc.constants import J2_EARTH, MU_EARTH_M3_S2, R_EARTH_M
 from sim import kernels
 
 __all__ = [
@@ -372,7 +372,7 @@ class RelativeTruth:
         Args:
             chief_eci: chief ECI state, shape (6,), m and m/s.
             rel_lvlh: deputy relative states in LVLH, shape (N, 6), m and m/s
-                (e.g. from :func:`fsw.lib.hcw.pro_state`).
+                (e.g. from :func:`gnc.hcw.pro_state`).
             j2: include the J2 perturbation on chief and deputies.
             energy_match: apply :func:`energy_matched` to the initial
                 deputies so that their two-body semi-major axes equal the

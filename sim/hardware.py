@@ -17,7 +17,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import quat
+from gnc import quat
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Scenario
 from sim import kernels

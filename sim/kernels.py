@@ -170,7 +170,7 @@ def relative_rk4(y0: np.ndarray, a_lvlh: np.ndarray, has_accel: bool, mu: float,
 @njit(cache=True)
 def lvlh_attitudes(q_lvlh_eci: np.ndarray, q_eci_body: np.ndarray) -> np.ndarray:
     """R_lvlh_body = R_lvlh_eci R_eci_body per spacecraft (N, 4), scalar last: the Hamilton
-    product of :func:`fsw.lib.quat.mul` with the frame quaternion (4,) on every row."""
+    product of :func:`gnc.quat.mul` with the frame quaternion (4,) on every row."""
     n = q_eci_body.shape[0]
     out = np.empty((n, 4))
     px, py, pz, pw = q_lvlh_eci[0], q_lvlh_eci[1], q_lvlh_eci[2], q_lvlh_eci[3]
@@ -188,7 +188,7 @@ def thrust_accel_lvlh(q_lvlh_body: np.ndarray, force_body: np.ndarray, force_unt
                       force_bias_body: np.ndarray, t_s: float, mass_kg: float) -> np.ndarray:
     """Thrust acceleration in LVLH (N, 3), m/s²: the commanded force while its command runs
     (``t_s`` before ``force_until`` less 1 ns) plus the continuous bias, body axes (N), rotated
-    by R(q_lvlh_body) (:func:`fsw.lib.quat.rotate`) and divided by the mass (kg)."""
+    by R(q_lvlh_body) (:func:`gnc.quat.rotate`) and divided by the mass (kg)."""
     n = force_body.shape[0]
     out = np.empty((n, 3))
     for i in range(n):

@@ -20,10 +20,10 @@ from typing import ClassVar
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import quat
-from fsw.lib.hcw import mean_motion, pro_state
-from fsw.lib.infocost import Camera
-from fsw.lib.poi import sphere_pois
+from gnc import quat
+from gnc.hcw import mean_motion, pro_state
+from gnc.infocost import Camera
+from gnc.poi import sphere_pois
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.catalogue import Topic

@@ -8,10 +8,11 @@ import numpy as np
 import pytest
 
 from fsw.lib import attitude_kernels as kern
-from fsw.lib import mekf, quat
+from fsw.lib import mekf
 from fsw.lib.attitude import repoint
 from fsw.lib.attitude_control import AttitudeGains, tracking_torque
-from fsw.lib.frames import lvlh_to_eci_quat
+from gnc import quat
+from gnc.frames import lvlh_to_eci_quat
 
 TOL = 1e-12
 

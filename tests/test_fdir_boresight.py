@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from fsw.lib.infocost import Camera, visibility
-from fsw.lib.poi import sphere_pois
+from gnc.infocost import Camera, visibility
+from gnc.poi import sphere_pois
 from ground.fdir.boresight import STEP_DEG, boresight_offset, candidate_boresights
 
 POS, NORMAL = sphere_pois(2000, 5.0)

@@ -11,8 +11,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 from scipy.stats import norm
 
-from fsw.lib.infocost import Camera
-from fsw.lib.poi import sphere_pois
+from gnc.infocost import Camera
+from gnc.poi import sphere_pois
 from ground.fdir.hardware_threshold import (
     RatioModel,
     clipped_noise_moments,

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from scipy.stats import median_abs_deviation
 
-from fsw.lib.infocost import Camera, precision
-from fsw.lib.poi import sphere_pois
+from gnc.infocost import Camera, precision
+from gnc.poi import sphere_pois
 from ground.fdir.identify import (
     Evidence,
     Tolerances,

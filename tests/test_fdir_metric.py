@@ -1,13 +1,13 @@
 """The FDIR metric (Eq. 9), direction (Table 3), global check (Eq. 6), adaptive threshold
 (Eq. 11-12) with its floor and persistence, on constructed cases and the paper's Sec. III.F
-numbers computed through fsw.lib.infocost."""
+numbers computed through gnc.infocost."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from fsw.lib import infocost as ic
+from gnc import infocost as ic
 from ground.fdir.metric import direction, global_check, metric, ratio
 from ground.fdir.threshold import Persistence, adaptive_threshold, calibrate_floor
 from interfaces.contracts.scenario import FdirSettings

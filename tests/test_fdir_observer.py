@@ -9,9 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from fsw.lib.infocost import Camera, agent_contributions
-from fsw.lib.poi import sphere_pois
-from fsw.lib.poi_map import PoiMap
+from gnc.infocost import Camera, agent_contributions
+from gnc.poi import sphere_pois
+from gnc.poi_map import PoiMap
 from ground.fdir.observer import MAX_JUDGED_LOSS, ObserverState, ground_contributions, loss_limit
 from ground.fdir.threshold import sampled_threshold
 from ground.fdir.twin import TwinModel, centre_boresights, planned_boresights

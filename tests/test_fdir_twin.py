@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from fsw.lib import infocost as ic
-from fsw.lib.hcw import mean_motion
-from fsw.lib.poi import sphere_pois
-from fsw.lib.pro import Pro
 from fsw.lib.scp import plan_transfer
+from gnc import infocost as ic
+from gnc.hcw import mean_motion
+from gnc.poi import sphere_pois
+from gnc.pro import Pro
 from ground.fdir.twin import (
     FlightPlan,
     Transfer,

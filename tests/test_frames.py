@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from fsw.lib.frames import lvlh_rate_lvlh, lvlh_to_eci
-from fsw.lib.hcw import mean_motion
+from gnc.frames import lvlh_rate_lvlh, lvlh_to_eci
+from gnc.hcw import mean_motion
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
 
 

@@ -141,7 +141,7 @@ def test_guidance_refuses_an_assignment_it_cannot_fly_safely_and_keeps_its_orbit
     it has, once, without retrying the refused command the ground keeps repeating."""
     app = GuidanceApp(_ctx())
     sent = _capture(app)
-    from fsw.lib.hcw import mean_motion, pro_state
+    from gnc.hcw import mean_motion, pro_state
     n = mean_motion(500e3)
     app.on_estimate(StateEstimate(sender="sc1", t_sim=0.0, spacecraft=1,
                                   x=pro_state(n, 20.0, 0.0, 0.0, 20.0, 0.0).tolist(),

@@ -13,9 +13,9 @@ import pytest
 
 from deploy.run_constellation import main
 from fsw.apps.guidance import KEEP_OUT_MARGIN_M
-from fsw.lib.hcw import mean_motion
-from fsw.lib.poi import sphere_pois
-from fsw.lib.pro import Pro
+from gnc.hcw import mean_motion
+from gnc.poi import sphere_pois
+from gnc.pro import Pro
 from ground.archive.reader import load_run
 from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
 from interfaces.contracts import catalogue as cat

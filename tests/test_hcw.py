@@ -1,4 +1,4 @@
-"""Tests of the HCW flight model (fsw.lib.hcw) against independent references.
+"""Tests of the HCW flight model (gnc.hcw) against independent references.
 
 References: Vallado, *Fundamentals of Astrodynamics and Applications*,
 Example 6-14 and the ``hillsv`` intercept; matrix exponentials and numerical
@@ -15,8 +15,8 @@ import pytest
 from scipy.integrate import quad_vec, solve_ivp
 from scipy.linalg import expm
 
-from fsw.lib import constants
-from fsw.lib.hcw import (
+from gnc import constants
+from gnc.hcw import (
     discretize,
     drift_per_orbit,
     hcw_matrices,

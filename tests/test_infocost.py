@@ -1,4 +1,4 @@
-"""Information-cost library (fsw/lib/infocost.py, fsw/lib/poi.py) against independent truth:
+"""Information-cost library (gnc/infocost.py, gnc/poi.py) against independent truth:
 the paper's Sec. III.F worked example computed through the library, closed forms (REFERENCE.md
 "Information cost"), finite differences, a per-pair brute-force visibility check, and invariants
 on random poses drawn from seeded generators."""
@@ -10,8 +10,8 @@ import math
 import numpy as np
 import pytest
 
-from fsw.lib import infocost as ic
-from fsw.lib.poi import sphere_pois
+from gnc import infocost as ic
+from gnc.poi import sphere_pois
 
 # ----------------------------------------------------------------------------- POIs
 

@@ -1,5 +1,5 @@
-"""The compiled precision kernel (fsw/lib/infocost_kernels.py) against the numpy reference
-(fsw/lib/infocost.py) on random poses: equal values, visibility decided alike except within
+"""The compiled precision kernel (gnc/infocost_kernels.py) against the numpy reference
+(gnc/infocost.py) on random poses: equal values, visibility decided alike except within
 rounding of a boundary, the same errors on bad input."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ import math
 import numpy as np
 import pytest
 
-from fsw.lib import infocost, infocost_kernels
-from fsw.lib.infocost import Camera
-from fsw.lib.poi import sphere_pois
+from gnc import infocost, infocost_kernels
+from gnc.infocost import Camera
+from gnc.poi import sphere_pois
 
 CAM = Camera(math.radians(15.0), 40.0, 2.0)
 

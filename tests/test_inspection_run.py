@@ -9,7 +9,7 @@ import numpy as np
 
 from deploy.inproc import run_inproc
 from fsw.apps.camera import RETARGET_S
-from fsw.lib.poi import sphere_pois
+from gnc.poi import sphere_pois
 from interfaces.contracts.messages import (
     AttitudeEstimate,
     InfoCostTelemetry,

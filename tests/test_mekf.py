@@ -2,7 +2,7 @@
 
 References: the matrix exponential of the continuous error dynamics (scipy.linalg.expm) for Φ
 and Van Loan's method for Q; the scalar Kalman gain for an isotropic update; the project's
-linear Kalman filter (fsw.lib.kalman) for a general update; and Monte Carlo consistency (NEES,
+linear Kalman filter (gnc.kalman) for a general update; and Monte Carlo consistency (NEES,
 NIS against χ² bounds from scipy.stats) of the filter run on the sim truth (sim.attitude) with the
 sim's Farrenkopf gyro and star tracker (sim.sensors), which are separate code.
 """
@@ -15,8 +15,8 @@ from scipy import stats
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import kalman
 from fsw.lib.mekf import error_state, mekf_init, mekf_propagate, mekf_transition, mekf_update
+from gnc import kalman
 from sim.attitude import AttitudeTruth
 from sim.sensors import GYRO_BIAS0_RAD_S, Gyro, StarTracker
 

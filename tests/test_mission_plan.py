@@ -11,9 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from fsw.lib.poi import sphere_pois
-from fsw.lib.poi_map import PoiMap
-from fsw.lib.pro import Pro, min_distance_between, min_distance_to_origin
+from gnc.poi import sphere_pois
+from gnc.poi_map import PoiMap
+from gnc.pro import Pro, min_distance_between, min_distance_to_origin
 from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
 from ground.planning.orbit_assignment import expected_precision, greedy_assignment
 from interfaces.contracts.scenario import Scenario

@@ -16,8 +16,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import linprog
 
-from fsw.lib import hcw
 from fsw.lib.mpc import MpcConfig, MpcResult, MpcTracker
+from gnc import hcw
 
 FloatArray = npt.NDArray[np.float64]
 

@@ -6,7 +6,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from deploy.inproc import run_inproc
-from fsw.lib import kalman
+from gnc import kalman
 from ground.analysis.nav import nav_errors
 from ground.archive.reader import load_run
 from ground.archive.recorder import McapRecorder

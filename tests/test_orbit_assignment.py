@@ -1,5 +1,5 @@
 """Tests of ground.planning.orbit_assignment against independent truth: exhaustive search with the
-information cost of fsw.lib.infocost, a hand-written visibility model, dense sampling of PRO
+information cost of gnc.infocost, a hand-written visibility model, dense sampling of PRO
 distances, brute-force permutations."""
 
 from __future__ import annotations
@@ -10,10 +10,10 @@ import math
 import numpy as np
 import pytest
 
-from fsw.lib.hcw import mean_motion
-from fsw.lib.infocost import Camera, information_cost
-from fsw.lib.poi import sphere_pois
-from fsw.lib.pro import Pro
+from gnc.hcw import mean_motion
+from gnc.infocost import Camera, information_cost
+from gnc.poi import sphere_pois
+from gnc.pro import Pro
 from ground.planning.orbit_assignment import (
     expected_precision,
     gain_saturated,
@@ -42,7 +42,7 @@ PREC = np.array([expected_precision(p, N_MEAN, 0.0, PERIOD, SAMPLES, POS, NOR, C
 
 
 def _truth_gain(rows: np.ndarray, phi: np.ndarray, w_inv: np.ndarray) -> float:
-    """H(now) - H(after) from fsw.lib.infocost.information_cost (independent of set_gain)."""
+    """H(now) - H(after) from gnc.infocost.information_cost (independent of set_gain)."""
     m = w_inv.size
     before = information_cost(phi, w_inv, np.zeros((1, m)))
     after = information_cost(phi, w_inv, rows if rows.size else np.zeros((1, m)))

@@ -1,6 +1,6 @@
-"""Tests of the passive-relative-orbit library (fsw.lib.pro) against independent references.
+"""Tests of the passive-relative-orbit library (gnc.pro) against independent references.
 
-References: the closed-form HCW STM (fsw.lib.hcw.hcw_stm) for boundedness; a nonlinear two-body
+References: the closed-form HCW STM (gnc.hcw.hcw_stm) for boundedness; a nonlinear two-body
 integration in ECI (scipy solve_ivp, DOP853) for energy matching; an energy evaluated in 40-digit
 decimal arithmetic; brute-force dense sampling for the distance searches; the e/i-vector formula
 of D'Amico & Montenbruck (JGCD 29(3), 2006) for the radial-normal separation.
@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from fsw.lib.constants import MU_EARTH_M3_S2, R_EARTH_M
-from fsw.lib.hcw import drift_per_orbit, hcw_stm, mean_motion
-from fsw.lib.pro import (
+from gnc.constants import MU_EARTH_M3_S2, R_EARTH_M
+from gnc.hcw import drift_per_orbit, hcw_stm, mean_motion
+from gnc.pro import (
     Pro,
     energy_matched_state,
     min_distance_between,

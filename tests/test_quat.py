@@ -1,4 +1,4 @@
-"""fsw.lib.quat against scipy's Rotation (the reference implementation of the same conventions).
+"""gnc.quat against scipy's Rotation (the reference implementation of the same conventions).
 
 Random rotations plus the hard cases: angles near 0 (around the Exp series threshold, down to
 1e-15 rad and exactly 0), near and at π, and both signs of every quaternion.  Each function is
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import quat
+from gnc import quat
 
 TOL = 1e-12
 
@@ -192,7 +192,7 @@ def test_algebra_identities(rng: np.random.Generator) -> None:
 
 
 # ---------------------------------------------------------------------------
-# the hot paths that use fsw.lib.quat, against the scipy computation they replaced
+# the hot paths that use gnc.quat, against the scipy computation they replaced
 
 
 def test_plans_match_scipy_slerp(rng: np.random.Generator) -> None:
@@ -240,7 +240,7 @@ def test_tracking_torque_takes_quaternions(rng: np.random.Generator) -> None:
 
 def test_lvlh_quaternion_is_the_matrix_construction(rng: np.random.Generator) -> None:
     """lvlh_to_eci_quat equals scipy's from_matrix of the LVLH basis (sign included)."""
-    from fsw.lib.frames import lvlh_to_eci, lvlh_to_eci_quat
+    from gnc.frames import lvlh_to_eci, lvlh_to_eci_quat
 
     for _ in range(50):
         t, n = rng.uniform(0.0, 1e5), rng.uniform(0.0, 1.2e-3)

@@ -17,9 +17,6 @@ import pytest
 from scipy.integrate import quad_vec, solve_ivp
 from scipy.optimize import linprog
 
-from fsw.lib.constants import R_EARTH_M
-from fsw.lib.hcw import discretize, hcw_stm, mean_motion
-from fsw.lib.pro import Pro, energy_matched_state
 from fsw.lib.scp import (
     STATUS_INFEASIBLE_ENDPOINT,
     STATUS_INFEASIBLE_THRUST,
@@ -28,6 +25,9 @@ from fsw.lib.scp import (
     plan_transfer,
     zoh_matrices,
 )
+from gnc.constants import R_EARTH_M
+from gnc.hcw import discretize, hcw_stm, mean_motion
+from gnc.pro import Pro, energy_matched_state
 
 N_500 = mean_motion(500e3)
 U_MAX = 1e-3

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import quat
 from fsw.lib.attitude_control import gains_for, tracking_torque
-from fsw.lib.infocost import Camera
-from fsw.lib.poi import sphere_pois
+from gnc import quat
+from gnc.infocost import Camera
+from gnc.poi import sphere_pois
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Scenario
 from sim.attitude import AttitudeTruth

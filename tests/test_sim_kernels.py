@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import quat
+from gnc import quat
 from interfaces.contracts.scenario import load_scenario
 from sim.actuators import WheelArray
 from sim.attitude import AttitudeTruth

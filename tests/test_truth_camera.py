@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from fsw.lib.infocost import Camera, visibility
-from fsw.lib.poi import sphere_pois
+from gnc.infocost import Camera, visibility
+from gnc.poi import sphere_pois
 from interfaces.contracts.rng import stream
 from sim.camera import TruthCameras
 

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad_vec, solve_ivp
 
-from fsw.lib.constants import J2_EARTH, MU_EARTH_M3_S2, R_EARTH_M
-from fsw.lib.hcw import hcw_stm, mean_motion, pro_state
+from gnc.constants import J2_EARTH, MU_EARTH_M3_S2, R_EARTH_M
+from gnc.hcw import hcw_stm, mean_motion, pro_state
 from sim.dynamics import (
     RelativeTruth,
     circular_chief_eci,

@@ -11,7 +11,7 @@ mathematics as ``fsw.lib.mekf``, ``fsw.lib.attitude.repoint`` and
 
 Each cycle: the MEKF (``fsw.lib.mekf``) propagates with the gyro and updates with the star
 tracker; the desired attitude puts the camera boresight on the line of sight to the pointing
-target (LVLH, carried into ECI by the onboard LVLH model ``fsw.lib.frames``) by the shortest
+target (LVLH, carried into ECI by the onboard LVLH model ``gnc.frames``) by the shortest
 rotation from the previous desired attitude (``fsw.lib.attitude.repoint``: roll-free pointing,
 no singular line of sight).  An error larger than ``attitude.slew_threshold_deg`` starts a slew
 planned by SCP with the rate limit (``scp_slew``; slerp if SCP fails); otherwise the nonlinear
@@ -30,10 +30,11 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from fsw.lib import attitude_kernels as kern
-from fsw.lib import hcw, mekf, quat
+from fsw.lib import mekf
 from fsw.lib.attitude import AttitudePlan, repoint, scp_slew, slerp_plan
 from fsw.lib.attitude_control import gains_for
-from fsw.lib.frames import lvlh_to_eci_quat
+from gnc import hcw, quat
+from gnc.frames import lvlh_to_eci_quat
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     AttitudeEstimate,

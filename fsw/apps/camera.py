@@ -22,8 +22,8 @@ import math
 
 import numpy as np
 
-from fsw.lib.poi import sphere_pois
-from fsw.lib.poi_map import PoiMap
+from gnc.poi import sphere_pois
+from gnc.poi_map import PoiMap
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     AttitudeEstimate,

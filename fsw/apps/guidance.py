@@ -7,7 +7,7 @@ thrusters, the transfer plan when one is made, and the guidance status.
 A new assignment is kept pending (the current orbit is still held) until its departure time;
 then the app plans a fuel-optimal transfer to
 the assigned PRO's state at the arrival time — SCP with an L1 fuel cost, per-axis thrust limit and
-a keep-out sphere (``fsw.lib.scp``), the terminal state energy matched (``fsw.lib.pro``) — and
+a keep-out sphere (``fsw.lib.scp``), the terminal state energy matched (``gnc.pro``) — and
 tracks the plan, then the PRO, with the MPC (``fsw.lib.mpc``) every cycle.  The first MPC input is
 held for one cycle (ZOH), converted from LVLH to body axes with the attitude estimate.  With no
 assignment the spacecraft drifts (no thrust); without an attitude estimate, or while the
@@ -26,11 +26,11 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import hcw
-from fsw.lib.constants import R_EARTH_M
 from fsw.lib.mpc import MpcConfig, MpcTracker
-from fsw.lib.pro import Pro, energy_matched_state
 from fsw.lib.scp import TransferPlan, plan_transfer
+from gnc import hcw
+from gnc.constants import R_EARTH_M
+from gnc.pro import Pro, energy_matched_state
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     AttitudeEstimate,

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from fsw.lib.poi_map import PoiMap
+from gnc.poi_map import PoiMap
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import InfoCostTelemetry, PoiObservations

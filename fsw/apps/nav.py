@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from fsw.lib import hcw, kalman
+from gnc import hcw, kalman
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     MAX_RANGE_M,

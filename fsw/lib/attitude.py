@@ -16,7 +16,7 @@ Conventions (project-wide):
 Plans expose ``at(t) -> (Rotation, ω_body (3,), ω̇_body (3,))`` (:class:`AttitudePlan`),
 which is what the tracking controller (:mod:`fsw.lib.attitude_control`) consumes.  The
 per-cycle functions (``at``, :func:`repoint`) do their algebra on quaternion arrays with
-:mod:`fsw.lib.quat` and build one Rotation for the result (scipy's Rotation costs tens of µs
+:mod:`gnc.quat` and build one Rotation for the result (scipy's Rotation costs tens of µs
 per operation).
 
 The paper (Sec. II.B) plans the attitude "using a combination of slerp interpolation
@@ -36,8 +36,8 @@ import osqp
 import scipy.sparse as sp
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import quat
-from fsw.lib.checks import finite_array
+from gnc import quat
+from gnc.checks import finite_array
 
 __all__ = [
     "AttitudePlan",

@@ -8,7 +8,7 @@ with ``J`` the inertia (kg·m²), ``ω`` the body rate w.r.t. inertial (rad/s), 
 the wheel momentum (N·m·s) and ``τ`` the commanded torque on the body (N·m),
 realised by the wheels.  Attitudes are ``R_ref_body`` (body → an inertial reference
 frame), given as scipy Rotations or as scalar-last quaternion arrays (4,); the algebra is
-done on the quaternions with :mod:`fsw.lib.quat` (scipy's Rotation costs tens of µs per
+done on the quaternions with :mod:`gnc.quat` (scipy's Rotation costs tens of µs per
 operation).
 
 Control law (quaternion error feedback with feed-forward and gyroscopic
@@ -51,8 +51,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import quat
-from fsw.lib.checks import finite_array
+from gnc import quat
+from gnc.checks import finite_array
 
 __all__ = ["AttitudeGains", "gains_for", "tracking_torque"]
 

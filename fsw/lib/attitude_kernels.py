@@ -18,7 +18,7 @@ set the cost (≈0.5 ms per spacecraft step with numpy, tens of µs compiled):
 Inputs are float64 arrays already validated (finite, unit quaternions where stated): the
 attitude app feeds them from validated messages and its own state.  The numpy versions stay
 the tested reference; ``tests/test_attitude_kernels.py`` checks these against them on random
-inputs.  Quaternions are scalar last [x, y, z, w], as in :mod:`fsw.lib.quat`.
+inputs.  Quaternions are scalar last [x, y, z, w], as in :mod:`gnc.quat`.
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ def _qconj(q: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def _qrot(q: np.ndarray, v: np.ndarray, sign: float) -> np.ndarray:
-    """R(q) v (sign 1) or R(q)ᵀ v (sign -1), as fsw.lib.quat._rotated."""
+    """R(q) v (sign 1) or R(q)ᵀ v (sign -1), as gnc.quat._rotated."""
     qx, qy, qz, qw = sign * q[0], sign * q[1], sign * q[2], q[3]
     vx, vy, vz = v[0], v[1], v[2]
     tx = 2.0 * (qy * vz - qz * vy)
@@ -234,7 +234,7 @@ def angle_between(q_a: np.ndarray, q_b: np.ndarray) -> float:
 
 @njit(cache=True)
 def lvlh_to_eci_quat(t_s: float, n: float, inclination_rad: float) -> np.ndarray:
-    """:func:`fsw.lib.frames.lvlh_to_eci_quat` with Ω = u0 = 0."""
+    """:func:`gnc.frames.lvlh_to_eci_quat` with Ω = u0 = 0."""
     u = n * t_s
     half_i = 0.5 * inclination_rad
     diff, total = -0.5 * u, 0.5 * u

@@ -36,7 +36,7 @@ Every function accepts either one filter (q (4,), b (3,), P (6, 6), ...) or a ba
 leading axis (q (N, 4), b (N, 3), P (N, 6, 6), ...); noise parameters and ``R`` may be shared
 ((3, 3)) or per filter ((N, 3, 3)).  Bad input raises ``ValueError``.
 
-Quaternion algebra is done by :mod:`fsw.lib.quat` on plain arrays (same conventions and results
+Quaternion algebra is done by :mod:`gnc.quat` on plain arrays (same conventions and results
 as scipy's ``Rotation`` to rounding, at a fraction of its per-call cost); input quaternions are
 normalised, as ``Rotation.from_quat`` did.
 """
@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib import quat
+from gnc import quat
 
 __all__ = ["error_state", "mekf_init", "mekf_propagate", "mekf_transition", "mekf_update"]
 

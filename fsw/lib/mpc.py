@@ -54,8 +54,8 @@ import numpy.typing as npt
 import osqp
 import scipy.sparse as sp
 
-from fsw.lib.checks import finite_array
-from fsw.lib.hcw import discretize
+from gnc.checks import finite_array
+from gnc.hcw import discretize
 
 __all__ = ["MpcConfig", "MpcResult", "MpcTracker"]
 

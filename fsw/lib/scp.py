@@ -11,7 +11,7 @@ discretised exactly (``hcw.discretize``)::
                 |r(t)| >= d_min  for all t in [0, T]      (keep-out sphere about the target)
 
 The terminal state ``xf`` is supplied by the caller (the assigned PRO's state at arrival, energy
-matched with ``fsw.lib.pro.energy_matched_state`` for the nonlinear world).  The L1 cost is
+matched with ``gnc.pro.energy_matched_state`` for the nonlinear world).  The L1 cost is
 written with slacks ``s >= u``, ``s >= -u``.  The keep-out constraint is non-convex; about the
 previous iterate ``r_bar`` it is replaced by the half-space ``r_hat^T r >= d_min`` with
 ``r_hat = r_bar / |r_bar|``, which lies outside the sphere (``|r| >= r_hat^T r``), so every
@@ -61,7 +61,8 @@ import osqp
 import scipy.sparse as sp
 from scipy.optimize import minimize_scalar
 
-from fsw.lib import hcw
+from gnc import hcw
+from gnc.hcw import zoh_matrices
 
 __all__ = [
     "STATUS_INFEASIBLE_ENDPOINT",
@@ -211,49 +212,6 @@ class TransferPlan:
     def state_at(self, t: float) -> FloatArray:
         """Exact ZOH-propagated state at time ``t`` in ``[0, T]`` (s); shape (6,)."""
         return self.states_at(np.array([t]))[0]
-
-
-def zoh_matrices(n: float, tau: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
-    """Closed-form ZOH transition ``x(tau) = Phi(tau) x(0) + Gamma(tau) u`` (vectorised).
-
-    ``Phi`` is ``hcw.hcw_stm``; ``Gamma(tau) = int_0^tau Phi(s) B ds`` integrates the velocity
-    columns of the classical HCW STM (Vallado Sec. 6.8) term by term.  With ``th = n tau``,
-    ``C1 = 1 - cos th = 2 sin^2(th/2)`` (cancellation-free) and ``S = sin th``::
-
-        Gamma = [[ C1/n^2,        2(th - S)/n^2,            0     ],
-                 [ 2(S - th)/n^2, (4 C1 - 1.5 th^2)/n^2,    0     ],
-                 [ 0,             0,                        C1/n^2],
-                 [ S/n,           2 C1/n,                   0     ],
-                 [ -2 C1/n,       (4 S - 3 th)/n,           0     ],
-                 [ 0,             0,                        S/n   ]]
-
-    Equal to ``hcw.discretize(n, tau)`` to round-off (tested); used for the many intermediate
-    times, where a matrix exponential per time would be slow.
-
-    Args:
-        n: mean motion, rad/s.
-        tau: times since the start of the interval, s, any shape ``S``.
-
-    Returns:
-        ``(Phi, Gamma)`` of shapes ``S + (6, 6)`` and ``S + (6, 3)``.
-    """
-    tt = np.asarray(tau, dtype=float)
-    phi = hcw.hcw_stm(n, tt)
-    th = n * tt
-    s = np.sin(th)
-    c1 = 2.0 * np.sin(0.5 * th) ** 2
-    zero = np.zeros_like(th)
-    n2 = n * n
-    rows = (
-        (c1 / n2, 2.0 * (th - s) / n2, zero),
-        (2.0 * (s - th) / n2, (4.0 * c1 - 1.5 * th * th) / n2, zero),
-        (zero, zero, c1 / n2),
-        (s / n, 2.0 * c1 / n, zero),
-        (-2.0 * c1 / n, (4.0 * s - 3.0 * th) / n, zero),
-        (zero, zero, s / n),
-    )
-    gam = np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
-    return phi, gam
 
 
 # --------------------------------------------------------------------------------------------

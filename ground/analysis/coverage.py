@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from fsw.lib.poi_map import PoiMap
+from gnc.poi_map import PoiMap
 from ground.archive.reader import Record, RunArchive
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import AssignmentDecision, CameraImage

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from fsw.lib import hcw
+from gnc import hcw
 from ground.analysis.truth_table import TIME_DECIMALS, TruthTable
 from ground.archive.reader import RunArchive
 from interfaces.contracts import catalogue as cat

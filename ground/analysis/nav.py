@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
-from fsw.lib.kalman import nees
+from gnc.kalman import nees
 from ground.analysis.truth_table import TruthTable
 from ground.archive.reader import RunArchive
 from interfaces.contracts import catalogue as cat

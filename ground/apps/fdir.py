@@ -57,11 +57,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fsw.lib import quat
-from fsw.lib.hcw import mean_motion
-from fsw.lib.infocost import Camera
-from fsw.lib.poi import sphere_pois
-from fsw.lib.poi_map import PoiMap
+from gnc import quat
+from gnc.hcw import mean_motion
+from gnc.infocost import Camera
+from gnc.poi import sphere_pois
+from gnc.poi_map import PoiMap
 from ground.fdir.consistency import failed_tests, nis_test
 from ground.fdir.constellation import ConstellationVerdict, ObserverGain, constellation_check
 from ground.fdir.hardware_threshold import position_sigma, ratio_model, window_false_alarm

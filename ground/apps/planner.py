@@ -16,8 +16,8 @@ received later (a spacecraft acts on a new ``assignment_id`` once).
 
 from __future__ import annotations
 
-from fsw.lib.poi import sphere_pois
-from fsw.lib.poi_map import PoiMap
+from gnc.poi import sphere_pois
+from gnc.poi_map import PoiMap
 from ground.planning.mission_plan import MissionPlan
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (

@@ -25,7 +25,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib.infocost import Camera
+from gnc.infocost import Camera
 
 FloatArray = npt.NDArray[np.float64]
 

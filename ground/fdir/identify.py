@@ -91,7 +91,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib.infocost import visibility
+from gnc.infocost import visibility
 from ground.fdir.boresight import boresight_offset
 from ground.fdir.hardware_threshold import clipped_noise_moments
 from ground.fdir.twin import TwinModel, sample_stride

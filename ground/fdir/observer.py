@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fsw.lib.infocost import agent_contributions
-from fsw.lib.poi_map import PoiMap
+from gnc.infocost import agent_contributions
+from gnc.poi_map import PoiMap
 from ground.fdir.twin import FlightPlan
 
 

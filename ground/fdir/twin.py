@@ -24,10 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib.infocost import Camera
-from fsw.lib.infocost_kernels import precision
-from fsw.lib.pro import Pro
-from fsw.lib.scp import zoh_matrices
+from gnc.hcw import zoh_matrices
+from gnc.infocost import Camera
+from gnc.infocost_kernels import precision
+from gnc.pro import Pro
 
 FloatArray = npt.NDArray[np.float64]
 

@@ -37,10 +37,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib.hcw import mean_motion
-from fsw.lib.infocost import Camera
-from fsw.lib.poi_map import PoiMap
-from fsw.lib.pro import Pro, min_distance_between, min_distance_to_origin
+from gnc.hcw import mean_motion
+from gnc.infocost import Camera
+from gnc.poi_map import PoiMap
+from gnc.pro import Pro, min_distance_between, min_distance_to_origin
 from ground.planning.orbit_assignment import (
     expected_precision,
     gain_saturated,

@@ -5,7 +5,7 @@ reassign.
 Source: the hierarchical planner of the paper (/work/shared/paper.md, Sec. II.C: "the
 hierarchical algorithm uses the information cost and the sensor model to select the informative
 PROs"), with the information cost of Sec. II.D, Eq. 4-5 (Schwager, Julian & Rus, "information
-per pixel"), evaluated by :mod:`fsw.lib.infocost`.
+per pixel"), evaluated by :mod:`gnc.infocost`.
 
 Objective.  With ``w⁻¹_now(s)`` the current fused precision of POI ``s`` (prior ``w⁻¹`` plus every
 observation fused so far) and ``P_c(s)`` the precision candidate PRO ``c`` is expected to add
@@ -29,7 +29,7 @@ for any set G and any |S*| ≤ N, submodularity and monotonicity give::
 evaluated after every greedy step (every prefix G_i gives a valid bound; the smallest is kept).
 
 Everything here is a pure function or a frozen dataclass; nothing touches a bus or a file.
-Units: m, s, rad; precision in inverse variance units of :class:`fsw.lib.infocost.Camera`.
+Units: m, s, rad; precision in inverse variance units of :class:`gnc.infocost.Camera`.
 """
 
 from __future__ import annotations
@@ -43,9 +43,9 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linear_sum_assignment
 
-from fsw.lib.checks import finite_array
-from fsw.lib.infocost import Camera, precision
-from fsw.lib.pro import Pro, min_distance_between, min_distance_to_origin
+from gnc.checks import finite_array
+from gnc.infocost import Camera, precision
+from gnc.pro import Pro, min_distance_between, min_distance_to_origin
 
 __all__ = [
     "Assignment",
@@ -90,7 +90,7 @@ def pro_library(
 ) -> list[Pro]:
     """The candidate PRO set: the Cartesian product of amplitudes, phases and phase offsets.
 
-    Parameterisation (PRO form of REFERENCE.md / :mod:`fsw.lib.pro`)::
+    Parameterisation (PRO form of REFERENCE.md / :mod:`gnc.pro`)::
 
         x = ρx sin(n t + αx),  y = ρy + 2 ρx cos(n t + αx),  z = ρz sin(n t + αz),
         αz = αx + offset   (wrapped to [-π, π)).
@@ -142,7 +142,7 @@ def expected_precision(
     ``t_j = t0 + (j + ½)·window/samples`` (midpoint rule: a whole-orbit window has no duplicated
     phase), with the camera boresight pointed at the target centre (the LVLH origin),
     ``b = −p/|p|``.  σ⁻¹ = 1/(k d²) for visible POIs (cone, range, front-facing), else 0
-    (Eq. 5, :func:`fsw.lib.infocost.precision`).  In flight the camera app points at the
+    (Eq. 5, :func:`gnc.infocost.precision`).  In flight the camera app points at the
     maximum-variance visible POIs; centre pointing is the conservative nominal used to rank
     orbits, not a prediction of the exact images.  The samples are evaluated together as
     ``samples`` "observers" in one vectorised call.
@@ -338,12 +338,12 @@ def greedy_assignment(
     """Choose N PROs from ``library`` greedily by marginal expected information gain.
 
     1. Candidates whose minimum distance to the target centre over an orbit
-       (:func:`fsw.lib.pro.min_distance_to_origin`) is below ``keep_out_m`` are excluded.
+       (:func:`gnc.pro.min_distance_to_origin`) is below ``keep_out_m`` are excluded.
     2. Each admissible candidate's expected precision over [t0, t0 + window] is computed once
        (:func:`expected_precision`).
     3. N times: pick the candidate with the largest marginal gain Δ(c | G) (ties: lowest index)
        among those whose minimum distance to every PRO already chosen
-       (:func:`fsw.lib.pro.min_distance_between`, over one period) is at least
+       (:func:`gnc.pro.min_distance_between`, over one period) is at least
        ``min_separation_m``; candidates too close are skipped (collision safety).
 
     Guarantees.  Without the separation rule (or when it never changes a pick,

@@ -1,6 +1,6 @@
 """An observer's knowledge of the target's POIs: the accumulated precision of every observer
 whose observations it has received (its own and its neighbours'), and the information cost of
-that fused view (Eq. 4, 7, 8 through ``fsw.lib.infocost``).  No bus, no I/O."""
+that fused view (Eq. 4, 7, 8 through ``gnc.infocost``).  No bus, no I/O."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib import infocost
-from fsw.lib.checks import finite_array
+from gnc import infocost
+from gnc.checks import finite_array
 
 FloatArray = npt.NDArray[np.float64]
 

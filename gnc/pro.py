@@ -1,7 +1,7 @@
 """Passive relative orbits (PROs): parametrisation, conversion, energy matching, distances.
 
 A PRO is the bounded solution of the Hill-Clohessy-Wiltshire (HCW) equations (frame and state as
-in :mod:`fsw.lib.hcw`: x radial, y along-track, z cross-track; state ``[x, y, z, vx, vy, vz]`` in
+in :mod:`gnc.hcw`: x radial, y along-track, z cross-track; state ``[x, y, z, vx, vy, vz]`` in
 m and m/s).  With ``t`` the absolute mission time in s (t = 0 at mission start) and ``n`` the
 chief mean motion in rad/s, the PRO form used throughout the project (REFERENCE.md) is::
 
@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib import hcw
-from fsw.lib.checks import finite_array
-from fsw.lib.constants import MU_EARTH_M3_S2
+from gnc import hcw
+from gnc.checks import finite_array
+from gnc.constants import MU_EARTH_M3_S2
 
 __all__ = [
     "Pro",

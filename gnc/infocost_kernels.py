@@ -1,7 +1,7 @@
 """Compiled kernel of the per-observation precision (Eq. 5, 14): the sim's cameras and the ground's
 nominal twin.
 
-The same test and formula as :func:`fsw.lib.infocost.precision` -- visible ⇔ inside the cone
+The same test and formula as :func:`gnc.infocost.precision` -- visible ⇔ inside the cone
 (b·(s − p) > 0 and (b·(s − p))² ≥ cos²α d²), 0 < d² ≤ R², front-facing (n·(p − s) > 0) -- with
 d² = |p|² + |s|² − 2 p·s as there, in one compiled pass over cameras × POIs (numba, cached on
 disk) instead of numpy's blocked temporaries: the FDIR's twin, hardware threshold and Eq.
@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from fsw.lib.infocost import _TINY, Camera, _inputs
+from gnc.infocost import _TINY, Camera, _inputs
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -51,7 +51,7 @@ def _fill(p: FloatArray, b: FloatArray, s: FloatArray, n: FloatArray, facing: bo
 
 def precision(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.ArrayLike,
               poi_normal: npt.ArrayLike | None, camera: Camera) -> FloatArray:
-    """σ⁻¹ (N, M) = 1/(k d²) where visible, else 0: :func:`fsw.lib.infocost.precision`
+    """σ⁻¹ (N, M) = 1/(k d²) where visible, else 0: :func:`gnc.infocost.precision`
     compiled (same arguments, same validation and errors)."""
     p, b, s, n = _inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
     out = np.empty((p.shape[0], s.shape[0]))

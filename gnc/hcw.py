@@ -30,7 +30,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.linalg import expm
 
-from fsw.lib.constants import MU_EARTH_M3_S2, R_EARTH_M
+from gnc.constants import MU_EARTH_M3_S2, R_EARTH_M
 
 __all__ = [
     "discretize",
@@ -247,3 +247,46 @@ def drift_per_orbit(n: float, state: npt.ArrayLike) -> float:
     if s.shape != (6,):
         raise ValueError(f"state must have shape (6,), got {s.shape}")
     return float(-6.0 * math.pi * (2.0 * s[0] + s[4] / n))
+
+
+def zoh_matrices(n: float, tau: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Closed-form ZOH transition ``x(tau) = Phi(tau) x(0) + Gamma(tau) u`` (vectorised).
+
+    ``Phi`` is ``hcw_stm``; ``Gamma(tau) = int_0^tau Phi(s) B ds`` integrates the velocity
+    columns of the classical HCW STM (Vallado Sec. 6.8) term by term.  With ``th = n tau``,
+    ``C1 = 1 - cos th = 2 sin^2(th/2)`` (cancellation-free) and ``S = sin th``::
+
+        Gamma = [[ C1/n^2,        2(th - S)/n^2,            0     ],
+                 [ 2(S - th)/n^2, (4 C1 - 1.5 th^2)/n^2,    0     ],
+                 [ 0,             0,                        C1/n^2],
+                 [ S/n,           2 C1/n,                   0     ],
+                 [ -2 C1/n,       (4 S - 3 th)/n,           0     ],
+                 [ 0,             0,                        S/n   ]]
+
+    Equal to ``discretize(n, tau)`` to round-off (tested); used for the many intermediate
+    times, where a matrix exponential per time would be slow.
+
+    Args:
+        n: mean motion, rad/s.
+        tau: times since the start of the interval, s, any shape ``S``.
+
+    Returns:
+        ``(Phi, Gamma)`` of shapes ``S + (6, 6)`` and ``S + (6, 3)``.
+    """
+    tt = np.asarray(tau, dtype=float)
+    phi = hcw_stm(n, tt)
+    th = n * tt
+    s = np.sin(th)
+    c1 = 2.0 * np.sin(0.5 * th) ** 2
+    zero = np.zeros_like(th)
+    n2 = n * n
+    rows = (
+        (c1 / n2, 2.0 * (th - s) / n2, zero),
+        (2.0 * (s - th) / n2, (4.0 * c1 - 1.5 * th * th) / n2, zero),
+        (zero, zero, c1 / n2),
+        (s / n, 2.0 * c1 / n, zero),
+        (-2.0 * c1 / n, (4.0 * s - 3.0 * th) / n, zero),
+        (zero, zero, s / n),
+    )
+    gam = np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+    return phi, gam

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from fsw.lib.checks import finite_array
+from gnc.checks import finite_array
 
 __all__ = [
     "Camera",
