@@ -1,6 +1,7 @@
 """The import rules of the house: the contracts import nothing else of the project; the runtime
-imports only the contracts; neither imports flight, sim or ground code (imports inside functions
-included: they are read from the source, not from what a run happens to load)."""
+imports only the contracts; the shared GNC library (``gnc``) only the contracts; none of them
+imports flight, sim or ground code (imports inside functions included: they are read from the
+source, not from what a run happens to load)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from pathlib import Path
 
 from tests.conftest import REPO
 
-PROJECT = ("interfaces", "fsw", "sim", "ground", "deploy", "benchmarks", "tests")
+PROJECT = ("interfaces", "gnc", "fsw", "sim", "ground", "deploy", "benchmarks", "tests")
 
 
 def _imports(path: Path) -> set[str]:
@@ -47,6 +48,10 @@ def test_the_runtime_imports_only_the_contracts_and_itself() -> None:
     assert _violations("interfaces.runtime", RUNTIME_MAY) == []
 
 
+def test_the_gnc_library_imports_only_the_contracts_and_itself() -> None:
+    assert _violations("gnc", ("interfaces.contracts", "gnc")) == []
+
+
 def test_the_rule_reader_sees_a_violation(tmp_path: Path) -> None:
     """The checker itself: an import of flight code inside a runtime function is reported."""
     room = tmp_path / "interfaces" / "runtime"
@@ -54,4 +59,4 @@ def test_the_rule_reader_sees_a_violation(tmp_path: Path) -> None:
     (room / "probe.py").write_text("def f() -> None:\n    from fsw.lib import hcw\n")
     assert _violations("interfaces.runtime", RUNTIME_MAY, root=tmp_path) == [
         "interfaces/runtime/probe.py imports fsw.lib",
-        "interfaces/runtime/probe.py imports fsw.lib.hcw"]
+        "interfaces/runtime/probe.py imports gnc.hcw"]
