@@ -56,7 +56,7 @@ def test_the_rule_reader_sees_a_violation(tmp_path: Path) -> None:
     """The checker itself: an import of flight code inside a runtime function is reported."""
     room = tmp_path / "interfaces" / "runtime"
     room.mkdir(parents=True)
-    (room / "probe.py").write_text("def f() -> None:\n    from fsw.lib import hcw\n")
+    (room / "probe.py").write_text("def f() -> None:\n    from fsw.lib import mpc\n")
     assert _violations("interfaces.runtime", RUNTIME_MAY, root=tmp_path) == [
         "interfaces/runtime/probe.py imports fsw.lib",
-        "interfaces/runtime/probe.py imports gnc.hcw"]
+        "interfaces/runtime/probe.py imports fsw.lib.mpc"]
