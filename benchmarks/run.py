@@ -1,4 +1,4 @@
-"""The project's speed figures in one run, each beside its target (issue 13, DESIGN.md "Targets").
+"""The project's speed figures in one run, each beside its target (issue 13, docs/targets.md).
 
     python benchmarks/run.py [--quick] [--only NAME ...] [--json FILE]
 

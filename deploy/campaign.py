@@ -1,5 +1,5 @@
 """Campaign files: a base scenario plus dispersions, expanded into a deterministic list of runs
-(DESIGN.md "Campaigns"; issue 6).
+(docs/contracts.md "Campaigns"; issue 6).
 
 A campaign TOML names a base scenario and groups of runs::
 

@@ -1,7 +1,7 @@
 """Software fault injection (test harness): the faults of a scenario that live in a
 spacecraft's own software rather than in its hardware.
 
-``faulty_data`` (DESIGN.md): the spacecraft reports a corrupted information cost — its H_i
+``faulty_data`` (docs/contracts.md): the spacecraft reports a corrupted information cost — its H_i
 multiplied by ``magnitude`` while the fault is active — whereas the observations it shares stay
 as measured.  The executive wires the factor into the infocost app's output; the app's logic
 does not know about faults.

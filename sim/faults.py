@@ -1,5 +1,5 @@
 """Fault injection into the hardware stand-in: the scenario's ``[[faults]]`` switched on at
-``start_s`` and off at ``end_s`` (DESIGN.md, "Scenario TOML": kinds and magnitudes).
+``start_s`` and off at ``end_s`` (docs/contracts.md, "Scenario TOML": kinds and magnitudes).
 
 The sim's kinds act on the truth, as a failing unit would:
 

@@ -1,8 +1,8 @@
-"""DESIGN.md's reliability target in a real (in-process) run: 30% packet loss on every link in
-long bursts (mean 50 packets, issue 16), no fault injected, and the FDIR raises no alarm of any
-class -- lost observations drop out of both sides of the comparison, the link limit accounts for
-the nominal loss and its burstiness, and the data-integrity check judges only while the ground
-holds nearly every observation (``fdir.integrity_max_loss``)."""
+"""The reliability target (docs/targets.md) in a real (in-process) run: 30% packet loss on every
+link in long bursts (mean 50 packets, issue 16), no fault injected, and the FDIR raises no alarm
+of any class -- lost observations drop out of both sides of the comparison, the link limit
+accounts for the nominal loss and its burstiness, and the data-integrity check judges only while
+the ground holds nearly every observation (``fdir.integrity_max_loss``)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Calibrate the FDIR threshold floor from nominal runs (DESIGN.md: "a floor calibrated from
+"""Calibrate the FDIR threshold floor from nominal runs (docs/fdir.md: "a floor calibrated from
 nominal runs for a chosen false-alarm rate").
 
     python -m ground.analysis.calibrate runs/nominal [runs/nominal-seed2 ...] [--rate 1e-3]

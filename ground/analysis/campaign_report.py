@@ -1,5 +1,5 @@
 """Campaign report: detection, latency, false-alarm, isolation and identification figures over
-many runs, for the main detector and each baseline side by side (issue 6; DESIGN.md
+many runs, for the main detector and each baseline side by side (issue 6; docs/contracts.md
 "Campaigns").
 
 Reads ``<out>/runs/<id>/summary.json`` of every run and writes ``<out>/results.csv`` (one row

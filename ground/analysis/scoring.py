@@ -1,5 +1,5 @@
-"""Scoring a detector against the injected faults (DESIGN.md, summary.json ``detections`` and
-``scores``).
+"""Scoring a detector against the injected faults (docs/contracts.md, summary.json
+``detections`` and ``scores``).
 
 Definitions (one run):
 
@@ -29,7 +29,7 @@ EXPECTED_CLASS = {
     "nav_sensor_bias": "state_sensor", "link_loss": "link", "packet_loss": "link",
     "faulty_data": "data_integrity", "camera_calibration": "common_mode",
 }
-"""The class each fault kind should be identified as (DESIGN.md)."""
+"""The class each fault kind should be identified as (docs/contracts.md)."""
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""summary.json of a run (DESIGN.md contract), computed from the archive read back."""
+"""summary.json of a run (docs/contracts.md), computed from the archive read back."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Ground FDIR: detect and isolate faulty observers from their information gain (paper
-Sec. III.B-E; DESIGN.md "Information cost and FDIR").
+Sec. III.B-E; docs/fdir.md).
 
 Rate group mid.  Inputs: every observer's POI observations (the images that reached the
 ground), its transfer plans, its nav, attitude, guidance and H_i telemetry, and the ground's

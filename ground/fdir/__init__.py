@@ -1,3 +1,3 @@
 """Ground FDIR: detection, isolation and identification of faults from the information cost
-(paper Sec. III-IV; DESIGN.md "Information cost and FDIR").  Pure functions here; the ground
+(paper Sec. III-IV; docs/fdir.md).  Pure functions here; the ground
 app that runs them is ``ground.apps.fdir``."""

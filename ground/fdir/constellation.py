@@ -1,4 +1,4 @@
-"""The global check at runtime (paper Eq. 6; DESIGN.md "Information cost and FDIR"): the
+"""The global check at runtime (paper Eq. 6; docs/fdir.md): the
 constellation's information gain against its prediction, for faults no single observer
 explains.
 

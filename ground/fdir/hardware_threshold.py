@@ -1,5 +1,5 @@
-"""The threshold that comes from the hardware (the chapter's future work, Sec. III.E; DESIGN.md
-"Information cost and FDIR"): the distribution of the ratio x = ΔH_i / ΔH_i^pred of one
+"""The threshold that comes from the hardware (the chapter's future work, Sec. III.E; docs/fdir.md
+"Detection and isolation"): the distribution of the ratio x = ΔH_i / ΔH_i^pred of one
 observer over one FDI window when nothing is faulty, from what the ground knows of the
 observer's hardware, and τ_i as its quantile for a stated false-alarm probability.
 

@@ -1,4 +1,4 @@
-"""Fault identification: which part of a faulty observer failed (DESIGN.md, "Information cost
+"""Fault identification: which part of a faulty observer failed (docs/fdir.md, "Information cost
 and FDIR": identification beyond the paper's 1-DOF example, Eq. 17-21).
 
 Once H_m,i has isolated observer i, the ground weighs four pieces of evidence from one FDI

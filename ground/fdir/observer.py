@@ -1,4 +1,4 @@
-"""The FDIR's knowledge of one observer between windows (DESIGN.md "Information cost and
+"""The FDIR's knowledge of one observer between windows (docs/fdir.md "Information cost and
 FDIR"): its plans, reported attitude modes, nav and attitude series, guidance reports, silence
 and observation-loss counts -- the state the FDIR app keeps per observer, as plain code that
 tests call directly.

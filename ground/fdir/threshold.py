@@ -1,5 +1,5 @@
 """The adaptive fault threshold (paper Eq. 11-12), its calibrated floor, and the persistence
-rule (DESIGN.md: a fault is declared when H_m,i > τ_i for a configurable number of windows, as
+rule (docs/fdir.md: a fault is declared when H_m,i > τ_i for a configurable number of windows, as
 cFS Limit Checker's fails-before-action).
 """
 

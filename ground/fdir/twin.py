@@ -1,5 +1,5 @@
 """The ground's nominal twin of one observer: where the plan puts it, where its camera points,
-and the information its images should bring (DESIGN.md: H_i^pred over [t − Δt, t] from the
+and the information its images should bring (docs/fdir.md: H_i^pred over [t − Δt, t] from the
 plan and the fused state at t − Δt).
 
 Information change with ψ held at the window start.  With F the fused precision and

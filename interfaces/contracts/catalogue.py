@@ -1,5 +1,5 @@
 """The topic catalogue: every kind of message on the bus, its key and its type, named once
-(DESIGN.md, "Key expressions").
+(docs/architecture.md, "Key expressions").
 
 A ``Topic`` is one ``(space, app, name, type)``.  Its *space* says whose key space it lives in
 and so who may publish it:

@@ -1,4 +1,4 @@
-"""Scenario files (TOML) as pydantic models: the contract of DESIGN.md ("Scenario TOML").
+"""Scenario files (TOML) as pydantic models: the contract of docs/contracts.md ("Scenario TOML").
 
 Every section has defaults, so a scenario states only what differs.  Unknown keys are errors
 (a typo must not silently fall back to a default); values are checked for range and
@@ -172,7 +172,7 @@ class ObserverOverride(_Section):
 
 
 class _ProFormation(_Section):
-    """A set of passive relative orbits, one per observer (HCW form, DESIGN/REFERENCE):
+    """A set of passive relative orbits, one per observer (HCW form):
     x = ρx sin(nt+αx), y = ρy + 2ρx cos(nt+αx), z = ρz sin(nt+αz), t from the mission start.
     By default spacecraft i of N has αx = αz = phase0_deg + 360°·(i-1)/N; ``overrides`` set any
     parameter of one spacecraft."""
@@ -342,7 +342,7 @@ class Nav(_Section):
 
 
 class FdirSettings(_Section):
-    """The ground FDIR (ground/apps/fdir.py, DESIGN.md "Information cost and FDIR"): every
+    """The ground FDIR (ground/apps/fdir.py, docs/fdir.md): every
     FDI window (``rates.fdi_period_s``) each observer's information gain is compared with the
     nominal twin's prediction (Eq. 9).  The threshold in force (``threshold``) is by default
     the hardware model's (ground/fdir/hardware_threshold.py): the quantile, for

@@ -1,4 +1,4 @@
-"""Key expressions of the mission (DESIGN.md): ``insp/<mission>/sc/<id>/<app>/<name>``,
+"""Key expressions of the mission (docs/architecture.md): ``insp/<mission>/sc/<id>/<app>/<name>``,
 ``insp/<mission>/sim/...``, ``insp/<mission>/ground/...``.
 
 A *node* is a process-level participant: ``"sim"``, ``"ground"`` or ``"sc<id>"``.  The node that

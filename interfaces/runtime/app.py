@@ -1,4 +1,5 @@
-"""The application model shared by flight and ground software (DESIGN.md, "Runtime model").
+"""The application model shared by flight and ground software (docs/architecture.md,
+"Runtime model").
 
 An app declares at class level its rate group, what it subscribes to and what it publishes; the
 executive wires the declarations to the bus and runs ``step(t)`` when the group is due.  Apps talk
