@@ -8,7 +8,7 @@ The sim's kinds act on the truth, as a failing unit would:
   thrusters fire, and it is counted in the Δv spent).
 * ``pointing_actuator``: a wheel torque bias perpendicular to the boresight, sized so that the
   nominal attitude loop settles ``magnitude`` degrees off its target: with the small-error
-  closed loop ``J δθ̈ + J kd δθ̇ + J (kp/2) δθ = τ_bias`` (``fsw.lib.attitude_control``),
+  closed loop ``J δθ̈ + J kd δθ̇ + J (kp/2) δθ = τ_bias`` (``gnc.attitude_gains``),
   ``τ_bias = J kp θ / 2`` per axis.  The attitude estimate sees the error; the loop cannot
   remove it.
 * ``camera_degradation``: every precision scaled by β = ``magnitude`` (Eq. 21).
@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fsw.lib.attitude_control import gains_for
+from gnc.attitude_gains import gains_for
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Fault, Scenario
 from sim.camera import TruthCameras
