@@ -1,12 +1,15 @@
 """The import rules of the house: the contracts import nothing else of the project; the runtime
 imports only the contracts; the shared GNC library (``gnc``) only the contracts; none of them
-imports flight, sim or ground code (imports inside functions included: they are read from the
-source, not from what a run happens to load)."""
+imports flight, sim or ground code, and flight, sim and ground never import each other (imports
+inside functions included: they are read from the source, not from what a run happens to
+load)."""
 
 from __future__ import annotations
 
 import ast
 from pathlib import Path
+
+import pytest
 
 from tests.conftest import REPO
 
@@ -50,6 +53,11 @@ def test_the_runtime_imports_only_the_contracts_and_itself() -> None:
 
 def test_the_gnc_library_imports_only_the_contracts_and_itself() -> None:
     assert _violations("gnc", ("interfaces.contracts", "gnc")) == []
+
+
+@pytest.mark.parametrize("room", ["fsw", "sim", "ground"])
+def test_flight_sim_and_ground_import_none_of_each_other(room: str) -> None:
+    assert _violations(room, ("interfaces", "gnc", room)) == []
 
 
 def test_the_rule_reader_sees_a_violation(tmp_path: Path) -> None:
