@@ -51,9 +51,12 @@ from interfaces.contracts.scenario import load_scenario  # noqa: E402
 
 TWO_ORBITS_S = 11354.0
 TARGETS = {
-    "rtf_inproc": 365.0, "rtf_zenoh": 100.0, "report_s": 30.0, "archive_mb_per_h": 100.0,
-    "peak_memory_gb": 1.5, "campaign_s_per_run": 4.5, "rtf_scaling": 30.0,
+    "rtf_inproc": 100.0, "rtf_inproc_stretch": 365.0, "zenoh_of_lockstep": 0.5,
+    "report_s": 30.0, "archive_mb_per_h": 100.0, "peak_memory_gb": 1.5,
+    "campaign_s_per_run": 4.5, "rtf_scaling": 30.0,
 }
+"""Issue 25's targets (docs/targets.md): in one process ≥ 100× real time (Basilisk's 365× the
+stretch); over Zenoh ≥ 50% of the bare lockstep limit measured in the same run."""
 
 
 @dataclass
@@ -134,8 +137,21 @@ def bench_lockstep(quick: bool, rows: list[tuple[str, str, str]], res: dict) -> 
     res["lockstep_ticks_per_s"] = rate
     rtf = rate * 0.1
     rows.append(("lockstep limit over Zenoh, 6 idle nodes",
-                 f"{rate:.0f} ticks/s ({rtf:.0f}x real time at 10 Hz)",
-                 ratio(rtf, TARGETS["rtf_zenoh"])))
+                 f"{rate:.0f} ticks/s ({rtf:.0f}x real time at 10 Hz)", ""))
+
+
+def _rtf_ratio(transport: str, rtf: float, res: dict) -> str:
+    """The reference mission's real-time factor against its target: ≥ 100× in one process
+    (365× the stretch); over Zenoh, ≥ 50% of the lockstep limit measured in this run (only
+    when the ``lockstep`` benchmark ran first)."""
+    if transport == "inproc":
+        stretch = rtf / TARGETS["rtf_inproc_stretch"]
+        return f"{ratio(rtf, TARGETS['rtf_inproc'])} (stretch {stretch:.2f})"
+    limit = res.get("lockstep_ticks_per_s")
+    if limit is None:
+        return "(run with the lockstep benchmark for its ratio)"
+    share = rtf / (0.1 * limit)  # the mission ticks at 10 Hz
+    return f"{share:.1%} of the lockstep limit: {ratio(share, TARGETS['zenoh_of_lockstep'])}"
 
 
 def bench_reference(quick: bool, tmp: Path, rows: list, res: dict) -> None:
@@ -145,13 +161,13 @@ def bench_reference(quick: bool, tmp: Path, rows: list, res: dict) -> None:
         out = tmp / f"ref-{transport}"
         m = constellation(scenario, out, transport, duration)
         rtf = duration / m.wall_s
-        key = "rtf_inproc" if transport == "inproc" else "rtf_zenoh"
         res[f"reference_{transport}"] = {"wall_s": m.wall_s, "rtf": rtf,
                                          "peak_rss_mb": m.peak_rss_mb,
                                          "peak_pss_mb": m.peak_pss_mb,
                                          "run_wall_s": m.summary.get("wall_s")}
         rows.append((f"reference mission {duration:.0f} s, {transport}",
-                     f"{rtf:.0f}x real time ({m.wall_s:.1f} s wall)", ratio(rtf, TARGETS[key])))
+                     f"{rtf:.0f}x real time ({m.wall_s:.1f} s wall)", _rtf_ratio(transport, rtf,
+                                                                         res)))
         rows.append((f"  peak memory, whole tree ({transport}), PSS", f"{m.peak_pss_mb:.0f} MB",
                      ratio(m.peak_pss_mb / 1e3, TARGETS["peak_memory_gb"], False)))
         rows.append(("  (summed RSS: shared pages once per process)", f"{m.peak_rss_mb:.0f} MB",
