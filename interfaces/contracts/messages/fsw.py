@@ -1,0 +1,167 @@
+"""Messages the flight software publishes: actuator commands, nav and attitude estimates,
+guidance status and transfer plans, observations and the information cost it reports."""
+
+from __future__ import annotations
+
+from typing import ClassVar, Literal
+
+from pydantic import Field, model_validator
+
+from interfaces.contracts.messages.base import (
+    MAX_SPEED_MPS,
+    Accel,
+    Angle,
+    Force,
+    Mat6,
+    Message,
+    PoiPrecisions,
+    Position,
+    Quat,
+    Rate,
+    State6,
+    Time,
+    Torque,
+    Velocity,
+    header_ok,
+)
+from interfaces.contracts.messages.sim import CameraImage
+
+
+class ThrustCommand(Message):
+    """Thruster command of one observer: force in body axes (N) to hold for ``duration_s`` from
+    ``t_sim`` (then zero).  The hardware clips each axis to its limit and drops impulses below the
+    minimum impulse bit."""
+
+    spacecraft: int = Field(ge=1)
+    force_body_n: Force
+    duration_s: float = Field(gt=0.0, le=3600.0)
+
+
+class WheelCommand(Message):
+    """Reaction-wheel command of one observer: torque on the body (body axes, N·m), held until the
+    next command (the wheels realise it as dh/dt = -torque, within their torque and momentum
+    limits)."""
+
+    spacecraft: int = Field(ge=1)
+    torque_body_nm: Torque
+
+
+class StateEstimate(Message):
+    """Navigation filter output: relative state [x, y, z, vx, vy, vz] (m, m/s, LVLH) and its 6x6
+    covariance; ``nis`` is the normalized innovation squared of this step's measurement update
+    (chi-square, 6 dof), None when the step had none."""
+
+    spacecraft: int = Field(ge=1)
+    x: State6
+    P: Mat6
+    nis: float | None = Field(default=None, ge=0.0)
+    resets: int = Field(default=0, ge=0, description="times the filter has diverged and "
+                        "restarted from a measurement")
+
+    @model_validator(mode="after")
+    def _velocity_in_range(self) -> StateEstimate:
+        if max(abs(v) for v in self.x[3:]) > MAX_SPEED_MPS:
+            raise ValueError(f"velocity beyond {MAX_SPEED_MPS} m/s")
+        return self
+
+
+class TransferPlanMsg(Message):
+    """A planned transfer (SCP, L1 fuel): node times (s, mission time), LVLH states (m, m/s) and
+    ZOH accelerations (m/s², one per interval) — the nominal plan the ground's twin replays."""
+
+    WALL_CLOCK_FIELDS: ClassVar[frozenset[str]] = frozenset({"t_wall", "solve_ms"})
+
+    spacecraft: int = Field(ge=1)
+    assignment_id: int = Field(ge=1)
+    t_s: list[Time]
+    x: list[State6]
+    u_mps2: list[Accel]
+    dv_mps: float = Field(ge=0.0, description="planned L1 fuel, Σ|u|·h, m/s")
+    status: str
+    iterations: int = Field(ge=0)
+    min_range_m: float = Field(ge=0.0)
+    solve_ms: float = Field(ge=0.0)
+
+
+class GuidanceStatus(Message):
+    """Guidance state of one observer at ω_low: mode, current assignment, tracking error of the
+    estimate against the reference (m, m/s), the acceleration commanded (LVLH, m/s²), Δv
+    commanded so far (m/s, Σ|u|₁·dt) and the MPC solver status and time."""
+
+    WALL_CLOCK_FIELDS: ClassVar[frozenset[str]] = frozenset({"t_wall", "mpc_ms"})
+
+    spacecraft: int = Field(ge=1)
+    mode: Literal["idle", "transfer", "hold"]
+    assignment_id: int = Field(default=0, ge=0)
+    phase: str = ""
+    pos_error_m: float = Field(default=0.0, ge=0.0)
+    vel_error_mps: float = Field(default=0.0, ge=0.0)
+    accel_lvlh_mps2: Accel = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    dv_commanded_mps: float = Field(default=0.0, ge=0.0)
+    mpc_status: str = ""
+    mpc_ms: float = Field(default=0.0, ge=0.0)
+
+
+class PoiObservations(PoiPrecisions):
+    """The observations of one image of ``spacecraft`` (taken at ``image_t_s``) as shared with
+    the other observers and the ground.  Received only within range."""
+
+    image_t_s: Time
+
+    @classmethod
+    def of_image(cls, image: CameraImage, sender: str, t_sim: float) -> PoiObservations:
+        """The observations of ``image``, sent by ``sender`` at ``t_sim`` (s): the image's own
+        validated, immutable lists, not validated again (``model_construct`` of valid parts;
+        a 2,500-POI image's lists cost ~0.1 ms to validate).  A header outside the rules goes
+        to pydantic, which raises."""
+        fields = {"sender": sender, "t_sim": t_sim, "spacecraft": image.spacecraft,
+                  "image_t_s": image.t_sim, "poi": image.poi, "precision": image.precision}
+        msg = cls.model_construct(**fields) if header_ok(sender, t_sim) else cls(**fields)
+        msg.__pydantic_private__["_arrays"] = image._arrays  # type: ignore[index]
+        return msg
+
+
+class InfoCostTelemetry(Message):
+    """Information-cost telemetry of one observer at the FDI period (Eq. 8): its contribution
+    H_i, the information cost H and the prior term of its fused view (H = prior + Σ_j H_j),
+    the POIs it has seen, and the observers whose observations it has fused."""
+
+    spacecraft: int = Field(ge=1)
+    h_i: float = Field(ge=0.0)
+    h_local: float = Field(ge=0.0)
+    prior_term: float = Field(ge=0.0)
+    contributions: dict[str, float] = Field(default_factory=dict,
+                                            description="H_j by spacecraft id, as fused here")
+    pois_seen_own: int = Field(ge=0)
+    pois_seen_fused: int = Field(ge=0)
+    images: int = Field(ge=0)
+    shared_received: int = Field(ge=0)
+
+
+class PointingTarget(Message):
+    """Where the camera wants the boresight: a point in LVLH (m) at ``t_sim``, moving at
+    ``target_rate_lvlh_mps`` (m/s) with ``target_accel_lvlh_mps2`` (m/s²) — from the camera app;
+    the attitude app extrapolates it and uses its motion as feed-forward."""
+
+    spacecraft: int = Field(ge=1)
+    target_lvlh_m: Position
+    target_rate_lvlh_mps: Velocity = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    target_accel_lvlh_mps2: Accel = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
+class AttitudeEstimate(Message):
+    """Attitude determination and control state of one observer: estimated attitude (body ->
+    ECI and body -> LVLH, scalar last), gyro bias (rad/s) and 1σ attitude uncertainty (rad);
+    the pointing target (LVLH, m), the estimated pointing error (rad), the controller mode and
+    the commanded torque (N·m)."""
+
+    spacecraft: int = Field(ge=1)
+    q_eci_body: Quat
+    q_lvlh_body: Quat
+    gyro_bias_radps: Rate
+    sigma_att_rad: Angle
+    target_lvlh_m: Position
+    pointing_error_rad: Angle
+    mode: Literal["init", "slew", "track"]
+    torque_body_nm: Torque
+    nis: float | None = None

@@ -1,0 +1,105 @@
+"""Messages of the lockstep and of every node's housekeeping: the sim's ticks and status, the
+nodes' answers, heartbeats, executive statistics and link counters."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from interfaces.contracts.messages.base import MAX_TIME_S, Message
+
+
+class Tick(Message):
+    """Tick k from the sim (the time master): nodes run their rate groups for t_sim = k*dt.
+
+    ``expect`` maps each key published since the previous tick to its last sequence number; a
+    receiver waits until it holds those of its subscriptions before it runs the tick, so message
+    arrival order never changes the result (determinism across transports).
+    """
+
+    k: int = Field(ge=0)
+    dt_s: float = Field(gt=0.0)
+    expect: dict[str, int] = Field(default_factory=dict)
+    final: bool = Field(default=False, description="last tick of the run")
+    rejoin: list[str] = Field(
+        default_factory=list,
+        description="participants the sim lost and sees again, until each answers a tick: "
+                    "such a node takes this tick as its own next one, however far ahead")
+
+
+class TickDone(Message):
+    """A node's answer to tick k: it has run its groups; ``published`` as in Tick.expect."""
+
+    k: int = Field(ge=0)
+    published: dict[str, int] = Field(default_factory=dict)
+
+
+class SimStatus(Message):
+    """Lifecycle of the run, from the sim: ``running`` then ``finished`` (nodes then exit);
+    ``participants``: the nodes lost from the lockstep (process died, stalled, disconnected) and
+    rejoined, with their sim times."""
+
+    class Event(BaseModel):
+        model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+        what: Literal["lost", "rejoined"]
+        t_sim: float = Field(ge=0.0, le=MAX_TIME_S)
+
+    state: Literal["waiting", "running", "finished", "aborted"]
+    k: int = Field(default=0, ge=0)
+    reason: str = ""
+    rejected_commands: int = Field(
+        default=0, ge=0, description="actuator commands refused (stale, future or wrong sender)")
+    participants: dict[str, list[Event]] = Field(default_factory=dict, max_length=64)
+
+
+class Heartbeat(Message):
+    """Node liveness and identity, at ω_mid."""
+
+    node: str
+    apps: list[str]
+    k: int = Field(ge=0)
+
+
+class GroupStats(BaseModel):
+    """Execution statistics of one rate group."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    runs: int = 0
+    cycle_slips: int = Field(default=0, description="runs longer than the group's budget")
+    max_exec_ms: float = 0.0
+    budget_ms: float = 0.0
+
+
+class ExecStats(Message):
+    """Executive statistics: cycle slips per rate group, app errors, invalid messages dropped,
+    messages refused at admission (``interfaces.runtime.admission``: a sender not owning its key, an
+    absurd sequence number or date, a full queue, an implausible tick)."""
+
+    node: str
+    groups: dict[str, GroupStats]
+    app_errors: int = 0
+    invalid_dropped: int = 0
+    refused: int = 0
+    barrier_timeouts: int = 0
+    ticks: int = 0
+
+
+class LinkCounter(BaseModel):
+    """Counters of one directed link src -> dst (messages offered to the channel)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    src: str
+    dst: str
+    sent: int = 0
+    delivered: int = 0
+    dropped_range: int = 0
+    dropped_loss: int = 0
+    dropped_cut: int = 0
+
+
+class LinkStats(Message):
+    """Per-link counters of the receiving node's channel model."""
+
+    node: str
+    links: list[LinkCounter]
