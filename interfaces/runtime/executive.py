@@ -241,10 +241,11 @@ class TickClient:
         runs the first tick of the new one)."""
         self.sim_lost, self._last_k = False, -1
         self._epoch += 1
-        if self.synchronous:
+        if self.synchronous:  # the next tick runs on this thread: forget here
             self.executive.bus.admission.forget()
             self._served_epoch = self._epoch
-        self._ticks.put(None)
+        else:
+            self._ticks.put(None)  # wakes the serving thread
         self.executive.log.warning("%s: %s; rejoining the lockstep", self.executive.bus.node,
                                    why)
 
