@@ -111,7 +111,6 @@ class Bus:
     _published_since: dict[str, int] = field(default_factory=dict)
     _groups: dict[str, list[_Sub]] = field(default_factory=dict)
     _raw: dict[str, list[RawHandler]] = field(default_factory=dict)
-    _local_cache: dict[str, list[_Sub]] = field(default_factory=dict)
     _split: dict[str, _Group] = field(default_factory=dict)
     _routes: dict[str, tuple[type[Message] | None, list[_Sub]]] = field(default_factory=dict)
     """Per key published: its catalogue type (None: not catalogued) and this node's own
@@ -210,7 +209,6 @@ class Bus:
                 made_here=lambda key, msg, e=key_expr: self._on_made_here(e, key, msg))
         group.append(sub)
         self._split[key_expr] = _Group.of(group)
-        self._local_cache.clear()
         self._routes.clear()
         self._await_cache.clear()
 
@@ -224,11 +222,8 @@ class Bus:
         self.transport.subscribe(key_expr, handler)
 
     def _local_subs(self, key: str) -> list[_Sub]:
-        subs = self._local_cache.get(key)
-        if subs is None:
-            subs = [s for e, g in self._groups.items() if topics.matches(e, key) for s in g]
-            self._local_cache[key] = subs
-        return subs
+        """This node's own subscribers of ``key`` (read once per key, by ``_route``)."""
+        return [s for e, g in self._groups.items() if topics.matches(e, key) for s in g]
 
     def _on_sample(self, key_expr: str, sample: Sample) -> None:
         """Transport callback (any thread): validate bytes (an object of the subscribed type is
