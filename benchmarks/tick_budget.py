@@ -63,7 +63,8 @@ CALLS: tuple[tuple[str, str, str, float], ...] = (
     ("sim.camera", "TruthCameras.images", "sim camera, one image", 0.3),
     ("fsw.apps.nav", "NavApp.step", "nav step", 0.1),
     ("fsw.apps.infocost", "InfoCostApp.on_observations", "infocost fusion, one image", 0.3),
-    ("ground.apps.fdir", "FdirApp._judge", "ground FDIR, one observer-window", 5.0),
+    ("ground.fdir.information", "InformationTest.judge", "ground FDIR, one observer-window",
+     5.0),
     ("fsw.lib.mpc", "MpcTracker.solve", "MPC solve", 1.0),
 )
 """The slower work timed per call, with its target per call (ms)."""

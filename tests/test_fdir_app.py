@@ -37,12 +37,12 @@ def _obs(sc: int, t: float, seq: int, poi: list[int]) -> PoiObservations:
 def test_late_observation_is_fused_not_judged() -> None:
     app, sent = _app()
     app.step(10.0)  # window [0, 10) judged: nothing received
-    assert app.window_start == 10.0
-    before = app.settled.F.copy()
+    assert app.pipeline.window_start == 10.0
+    before = app.pipeline.settled.F.copy()
     app.on_observations(_obs(1, 5.0, 1, [3, 4]))  # image of the judged window, arriving late
-    assert not app.pending
-    assert app.settled.F[0, 3] == pytest.approx(before[0, 3] + 0.01)
-    assert app.settled.F[1, 3] == before[1, 3]
+    assert not app.pipeline.pending
+    assert app.pipeline.settled.F[0, 3] == pytest.approx(before[0, 3] + 0.01)
+    assert app.pipeline.settled.F[1, 3] == before[1, 3]
     windows = [m for m in sent if isinstance(m, FdirWindow)]
     assert len(windows) == 2 and all(w.metric is None and w.exceeded is None for w in windows)
 
@@ -63,4 +63,4 @@ def test_observations_missing_by_sequence_make_a_link_fault() -> None:
     reports = [m for m in sent if isinstance(m, FaultReport)]
     assert [(r.spacecraft, r.fault_class, r.t_sim) for r in reports] == [(2, "link", 30.0)]
     assert reports[0].metric == pytest.approx(0.6)
-    assert app.observers[2].lost_fraction() == pytest.approx(18 / 40)
+    assert app.pipeline.observers[2].lost_fraction() == pytest.approx(18 / 40)

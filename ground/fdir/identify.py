@@ -86,7 +86,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -310,30 +310,32 @@ Observation = tuple[np.ndarray, np.ndarray]
 """One image's observations: POI indices and their precisions σ⁻¹."""
 
 
-def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndarray | None,
-                    attitude: np.ndarray | None, planned: np.ndarray, psi: np.ndarray,
-                    phi: np.ndarray, gap: tuple[float, float] | None,
-                    dv_rate: float | None, fit_boresight: bool = True) -> Evidence:
-    """Identification evidence of one window.  ``nav``: reported positions at the image times
-    (LVLH, m); ``attitude``: reported boresight, pointing error and aim point rows; ``planned``:
-    the plan's positions.  The cheap parts (camera fixes, nav and attitude against the plan)
-    every window, so their nominal spread is in the archive; the twin at the reported pose and
-    the seen-set overlap only when the window exceeded its threshold (``gap`` = (ΔH_i,
-    ΔH_i^pred)), and of those the boresight fit only with ``fit_boresight`` (a window that
-    must name a class)."""
+def located_cameras(twin: TwinModel, images: Sequence[Observation]
+                    ) -> list[tuple[int, CameraFix]]:
+    """The camera located from each image that allows it (:func:`locate_camera`), by image
+    index; none when fewer than ``MIN_FIXES`` images do."""
     fixes = [locate_camera(twin.poi_pos[poi], prec, twin.camera.k, twin.radius_m,
                            twin.noise_frac) for poi, prec in images]
     located = [(i, f) for i, f in enumerate(fixes) if f is not None]
-    if len(located) < MIN_FIXES:
-        located = []
+    return located if len(located) >= MIN_FIXES else []
+
+
+def pose_evidence(located: list[tuple[int, CameraFix]], nav: np.ndarray | None,
+                  attitude: np.ndarray | None, planned: np.ndarray, radius_m: float,
+                  dv_rate: float | None) -> Evidence:
+    """The cheap part of a window's identification evidence, judged every window so that its
+    nominal spread is in the archive: the located cameras (``located``), the nav and the
+    attitude against the plan.  ``nav``: reported positions at the image times (LVLH, m);
+    ``attitude``: reported boresight, pointing error and aim point rows; ``planned``: the
+    plan's positions; ``radius_m``: the target's."""
     betas = np.array([f.beta for _, f in located])
     beta, beta_se = (float(np.median(betas)), median_se(betas)) if located else (None, None)
-    cam_nav = nav_plan = point = align = offset = cam_plan = None
+    cam_nav = nav_plan = point = align = cam_plan = None
     camera_se: tuple[float | None, float | None] = (None, None)
     if located:
         off_plan = np.array([f.position_m - planned[i] for i, f in located])
         cam_plan = float(np.linalg.norm(np.median(off_plan, axis=0)))
-        camera_se = _camera_se(off_plan, planned, twin.radius_m)
+        camera_se = _camera_se(off_plan, planned, radius_m)
     if nav is not None:
         nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
         if located:
@@ -343,14 +345,27 @@ def window_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndar
                                      nav[[i for i, _ in located]], planned[[i for i, _ in located]])
     if attitude is not None:
         point = math.degrees(float(np.median(attitude[:, 3])))
-    explained = explained_loc = overlap = None
-    if gap is not None and nav is not None and attitude is not None:
+    return Evidence(beta_hat=beta, camera_vs_nav_m=cam_nav, nav_vs_plan_m=nav_plan,
+                    pointing_error_deg=point, dv_rate_mps2=dv_rate, offset_alignment=align,
+                    camera_vs_plan_m=cam_plan, beta_se=beta_se, camera_se_m=camera_se[0],
+                    camera_se_deg=camera_se[1])
+
+
+def gap_evidence(ev: Evidence, twin: TwinModel, images: Sequence[Observation],
+                 located: list[tuple[int, CameraFix]], nav: np.ndarray | None,
+                 attitude: np.ndarray | None, psi: np.ndarray, phi: np.ndarray,
+                 gap: tuple[float, float], fit_boresight: bool) -> Evidence:
+    """``ev`` completed for a window that exceeded its threshold (``gap`` = (ΔH_i,
+    ΔH_i^pred)): the twin at the reported pose and the seen-set overlap, and with
+    ``fit_boresight`` (a window that must name a class) the boresight the seen POIs show."""
+    explained = explained_loc = overlap = offset = None
+    if nav is not None and attitude is not None:
         explained, explained_loc, overlap = _gap_evidence(twin, images, nav, attitude, located,
                                                           psi, phi, gap)
-    if gap is not None and fit_boresight and attitude is not None and located:
+    if fit_boresight and attitude is not None and located:
         offset = camera_offset_deg(twin, images, attitude, located)
-    return Evidence(beta, cam_nav, nav_plan, point, overlap, explained, explained_loc, dv_rate,
-                    align, cam_plan, offset, beta_se, *camera_se)
+    return replace(ev, seen_overlap=overlap, explained_reported=explained,
+                   explained_located=explained_loc, camera_offset_deg=offset)
 
 
 def _camera_se(off_plan: np.ndarray, planned: np.ndarray, radius_m: float

@@ -1,0 +1,74 @@
+"""The FDIR pipeline's declaration and identification (docs/fdir.md): a fault is declared on
+an observer after ``fdir.persistence`` failed windows (``Persistence``), and identified
+(``ground/fdir/identify.py``) on the declaring window or, when that shows no class, a later
+one of the episode: while its windows fail, and on the first that passes.
+
+An information test failed by every observer together is the constellation's (common mode,
+the global check's verdict), not held against any observer.
+"""
+
+from __future__ import annotations
+
+import logging
+
+from ground.fdir.constellation import ConstellationVerdict
+from ground.fdir.identify import Evidence, Tolerances, classify
+from ground.fdir.information import Judgement
+from ground.fdir.threshold import Persistence
+from interfaces.contracts.messages import FaultReport, FdirWindow, Message
+from interfaces.contracts.scenario import FdirSettings
+
+
+class Declarer:
+    """The declaration state of every observer: its persistence counter and whether its
+    declared fault still awaits a class."""
+
+    def __init__(self, cfg: FdirSettings, node: str, log: logging.Logger) -> None:
+        self.tol = Tolerances.of(cfg)
+        self.persistence = Persistence(cfg.persistence, cfg.persistence_window)
+        self.node = node
+        self.log = log
+        self._unidentified: set[int] = set()
+
+    def identifying(self, sc: int) -> bool:
+        """Whether observer ``sc``'s declared fault still has no class."""
+        return sc in self._unidentified
+
+    def naming(self, sc: int) -> bool:
+        """Whether a failed window of ``sc`` would have to name a class (no fault declared, or
+        one still without a class)."""
+        return sc in self._unidentified or not self.persistence.declared(sc)
+
+    def declare(self, sc: int, j: Judgement, common: ConstellationVerdict | None
+                ) -> list[Message]:
+        """The window's verdict (``exceeded`` set) and the fault reports it brings."""
+        failed = [f for f in j.window.failed
+                  if not (f == "information" and common is not None and common.common_mode)]
+        exceeded = bool(failed) if failed or j.decided else None
+        w = j.window.model_copy(update={"exceeded": exceeded})
+        out: list[Message] = [w]
+        if self.persistence.update(sc, exceeded):
+            cls = classify(j.evidence, self.tol, failed)
+            self.log.warning("FDIR: fault declared on sc%d at %.0f s (failed %s; H_m %s, τ %s, "
+                             "%s): %s", sc, w.t_end_s, "+".join(failed), _g(w.metric),
+                             _g(w.threshold), w.direction, cls or "unidentified")
+            out.append(self._report(sc, cls, w, j.evidence))
+            if cls is None:
+                self._unidentified.add(sc)
+        elif sc in self._unidentified:
+            cls = classify(j.evidence, self.tol, failed)
+            if cls is not None or not exceeded:
+                self._unidentified.discard(sc)
+            if cls is not None:
+                self.log.warning("FDIR: sc%d identified at %.0f s: %s", sc, w.t_end_s, cls)
+                out.append(self._report(sc, cls, w, j.evidence))
+        return out
+
+    def _report(self, sc: int, cls: str | None, w: FdirWindow, ev: Evidence) -> FaultReport:
+        return FaultReport(sender=self.node, t_sim=w.t_end_s, spacecraft=sc, fault_class=cls,
+                           direction=w.direction, metric=w.metric, threshold=w.threshold,
+                           window_end_s=w.t_end_s, evidence=ev.as_dict())
+
+
+def _g(value: float | None) -> str:
+    return "-" if value is None else f"{value:.3g}"

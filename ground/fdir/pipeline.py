@@ -1,0 +1,210 @@
+"""The ground FDIR as a pipeline (paper Sec. III.B-E; docs/fdir.md, "The pipeline"): what the
+FDIR knows of each observer, fed message by message, and every FDI window judged through its
+stages, in this order:
+
+1. **link checks** (``link_checks.py``): observations missing by sequence number, silence;
+2. **information test** (``information.py``) on the window's context (``window.py``: a, b,
+   ψ, φ, h_prev, the judged images and their poses), with the identification evidence;
+3. **global check** (``global_check.py``, Eq. 6) over the observers the test judged;
+4. **declaration and identification** (``declaration.py``);
+5. **data integrity** (``integrity.py``) of the H_i reported at the window's end, once the
+   window's images are in the ground's map.
+
+Each window [a, b) (length ``rates.fdi_period_s``) is judged ``fdir.latency_s`` after it
+closes, with ψ the squared fused variance of the ground's map settled at a (every observation
+with image time < a).  Only lost images are missing from both sides of the comparison; a window
+without any image or any plan gives no decision.  The stages return the messages to publish,
+in order; the app (``ground/apps/fdir.py``) publishes them.
+"""
+
+from __future__ import annotations
+
+import bisect
+import logging
+import math
+
+import numpy as np
+
+from gnc import quat
+from gnc.hcw import mean_motion
+from gnc.infocost import Camera
+from gnc.poi import sphere_pois
+from gnc.poi_map import PoiMap
+from ground.fdir.declaration import Declarer
+from ground.fdir.global_check import GlobalCheck
+from ground.fdir.hardware_threshold import window_false_alarm
+from ground.fdir.information import InformationTest, Judgement
+from ground.fdir.integrity import IntegrityCheck
+from ground.fdir.link_checks import LinkChecks
+from ground.fdir.observer import ObserverState
+from ground.fdir.twin import FlightPlan, Transfer, TwinModel
+from ground.fdir.window import SettledMap, window_context
+from ground.planning.mission_plan import pro_of
+from interfaces.contracts.fdi_schedule import FdiSchedule
+from interfaces.contracts.messages import (
+    AttitudeEstimate,
+    FdirWindow,
+    GuidanceStatus,
+    InfoCostTelemetry,
+    Message,
+    PoiObservations,
+    ProAssignments,
+    StateEstimate,
+    TransferPlanMsg,
+)
+from interfaces.contracts.scenario import Scenario
+
+class FdirPipeline:
+    """The FDIR's state and its window-by-window judgement, for ``scenario`` on node
+    ``node``."""
+
+    def __init__(self, scenario: Scenario, node: str, log: logging.Logger) -> None:
+        sc, cfg = scenario, scenario.fdir
+        self.node, self.log, self.settle_s, self.latency_s = node, log, cfg.settle_s, cfg.latency_s
+        self.schedule = FdiSchedule(sc.rates.fdi_period_s)
+        self.n = mean_motion(sc.orbit.altitude_km * 1e3)
+        camera = Camera(math.radians(sc.camera.half_angle_deg), sc.camera.max_range_m,
+                        sc.camera.k)
+        self.twin = TwinModel(*sphere_pois(sc.target.pois, sc.target.radius_m), camera,
+                              sc.target.radius_m, sc.camera.noise_frac)
+        self.settled = PoiMap.uniform(sc.target.pois, sc.target.prior_variance,
+                                      sc.observers.count)
+        self.pending: list[PoiObservations] = []
+        self.observers = {i: ObserverState() for i in range(1, sc.observers.count + 1)}
+        self.boresight_body = np.array(sc.attitude.boresight_body, dtype=float)
+        self.boresight_body /= np.linalg.norm(self.boresight_body)
+        q_window = window_false_alarm(cfg.false_alarms_per_observer_hour, sc.rates.fdi_period_s,
+                                      cfg.persistence, 2 if cfg.fuse_nis else 1)
+        self.links = LinkChecks(sc, node, log)
+        self.information = InformationTest(sc, self.twin, q_window)
+        self.global_check = GlobalCheck(cfg, q_window, node, log)
+        self.declarer = Declarer(cfg, node, log)
+        self.integrity = IntegrityCheck(cfg, node, log)
+        self.next_window = 0
+        """the next FDI window to judge (``interfaces.contracts.fdi_schedule``)"""
+        self.rejected = 0
+        self._transfers: dict[tuple[int, int], Transfer] = {}
+
+    # --- what the observers report ---------------------------------------------------------
+
+    def observations(self, msg: PoiObservations) -> None:
+        if msg.spacecraft not in self.observers:
+            return
+        if msg.poi and (min(msg.poi) < 0 or max(msg.poi) >= len(self.twin.poi_pos)):
+            self.rejected += 1
+            self.log.error("FDIR: dropped observations of sc%d with POI indices outside the "
+                           "%d of the target (%d dropped)", msg.spacecraft, len(self.twin.poi_pos),
+                           self.rejected)
+            return
+        if msg.image_t_s >= self.window_start:
+            self.pending.append(msg)
+        else:  # too late for its window's verdict, not for the ground's map
+            self.settled.add(msg.spacecraft, *msg.arrays())
+
+    def transfer(self, msg: TransferPlanMsg) -> None:
+        if msg.spacecraft not in self.observers or len(msg.t_s) < 2:
+            return
+        tr = Transfer(np.array(msg.t_s), np.array(msg.x), np.array(msg.u_mps2))
+        self._transfers[(msg.spacecraft, msg.assignment_id)] = tr
+        obs = self.observers[msg.spacecraft]
+        plan = obs.plans.get(msg.assignment_id)
+        if plan is not None:
+            obs.plans[msg.assignment_id] = FlightPlan(plan.t_from_s, plan.pro, tr,
+                                                      plan.t_arrive_s)
+
+    def assignments(self, msg: ProAssignments) -> None:
+        for a in msg.assignments:
+            obs = self.observers.get(a.spacecraft)
+            if obs is None or a.assignment_id in obs.plans:
+                continue
+            obs.plans[a.assignment_id] = FlightPlan(
+                a.t_depart_s, pro_of(a.pro), self._transfers.get((a.spacecraft, a.assignment_id)),
+                a.t_arrive_s if a.t_arrive_s > a.t_depart_s else None)
+
+    def telemetry(self, msg: InfoCostTelemetry) -> None:
+        j = self.schedule.boundary_at(msg.t_sim)
+        if msg.spacecraft in self.observers and j is not None and j > self.next_window:
+            self.integrity.reported(msg, j)
+
+    def attitude(self, msg: AttitudeEstimate) -> None:
+        obs = self.observers.get(msg.spacecraft)
+        if obs is None:
+            return
+        if not obs.modes or obs.modes[-1][1] != msg.mode:
+            bisect.insort(obs.modes, (msg.t_sim, msg.mode))
+        if msg.t_sim >= self.window_start:
+            bore = quat.rotate(np.array(msg.q_lvlh_body), self.boresight_body)
+            obs.attitude.add(msg.t_sim, np.concatenate(
+                (bore, [msg.pointing_error_rad], msg.target_lvlh_m, [msg.sigma_att_rad])))
+
+    def nav(self, msg: StateEstimate) -> None:
+        obs = self.observers.get(msg.spacecraft)
+        if obs is not None and msg.t_sim >= self.window_start:
+            obs.nav.add(msg.t_sim, np.array(msg.x[:3]))
+            obs.nav_sigma.add(msg.t_sim, np.array([math.sqrt(max(
+                (msg.P[0][0] + msg.P[1][1] + msg.P[2][2]) / 3.0, 0.0))]))
+            if msg.nis is not None:
+                obs.nis.append((msg.t_sim, msg.nis))
+
+    def guidance(self, msg: GuidanceStatus) -> None:
+        obs = self.observers.get(msg.spacecraft)
+        if obs is not None and msg.t_sim >= self.window_start - self.schedule.period_s:
+            bisect.insort(obs.guidance, (msg.t_sim, msg.dv_commanded_mps, msg.mode == "hold"))
+
+    # --- the windows ------------------------------------------------------------------------
+
+    @property
+    def window_start(self) -> float:
+        """Start of the next window to judge (s): later data is still to come."""
+        return self.schedule.start(self.next_window)
+
+    def due(self, t: float) -> list[Message]:
+        """Judge every window due by time t (s): ``fdir.latency_s`` after it closed."""
+        out: list[Message] = []
+        while t >= self.schedule.end(self.next_window) + self.latency_s - 1e-9:
+            k = self.next_window
+            self.next_window += 1  # first: a failing window is not retried forever
+            out += self.evaluate(k)
+        return out
+
+    def evaluate(self, k: int) -> list[Message]:
+        """Window k through every stage; the window's images then join the ground's map."""
+        a, b = self.schedule.start(k), self.schedule.end(k)
+        inside = [m for m in self.pending if a <= m.image_t_s < b]
+        settled = SettledMap.of(self.settled)
+        out: list[Message] = []
+        judged: dict[int, Judgement] = {}
+        for sc, obs in self.observers.items():
+            mine = sorted((m for m in inside if m.spacecraft == sc), key=lambda m: m.image_t_s)
+            planned = obs.plan_at(a) is not None
+            lost, reports = self.links.judge(sc, obs, mine, planned, b)
+            out += reports
+            window = FdirWindow(sender=self.node, t_sim=b, spacecraft=sc, t_start_s=a,
+                                t_end_s=b, images=len(mine), lost=lost)
+            ctx, images = (window_context(sc, obs, mine, a, b, settled, self.n, self.settle_s)
+                           if planned and mine else (None, len(mine)))
+            if ctx is None:
+                out.append(window.model_copy(update={"images": images}))
+                continue
+            judged[sc] = self.information.judge(
+                ctx, obs, window.model_copy(update={"images": images}),
+                self.declarer.identifying(sc), self.declarer.naming(sc))
+        common, messages = self.global_check.check(a, b, judged, self._cost())
+        out += messages
+        for sc, j in judged.items():
+            out += self.declarer.declare(sc, j, common)
+        self._settle(inside, b)
+        out += self.integrity.check(k + 1, b, self.settled, self.observers)
+        return out
+
+    def _settle(self, inside: list[PoiObservations], b: float) -> None:
+        """The judged window's images join the ground's map; what no later window needs goes."""
+        for obs in self.observers.values():
+            obs.forget_before(b)
+        for m in inside:
+            self.settled.add(m.spacecraft, *m.arrays())
+        self.pending = [m for m in self.pending if m.image_t_s >= b]
+
+    def _cost(self) -> float:
+        """H of the ground's fused map (Eq. 4, 7)."""
+        return float(np.sum(self.settled.phi * self.settled.variance()))

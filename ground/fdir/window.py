@@ -1,0 +1,95 @@
+"""The window context: one observer's FDI window [a, b) as the FDIR pipeline's stages see it
+(docs/fdir.md, "The pipeline") -- the ground's map settled at a (ψ, φ, the observer's H_i),
+and the images the information test judges with the poses at their times (the plan's
+position, the reported attitude and nav).
+
+Which images are judged: those whose observations reached the ground, taken while the
+observer reports it tracks (not a slew, nor within ``fdir.settle_s`` of its end), at times a
+known plan covers (a transfer whose plan was lost is not).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gnc.poi_map import PoiMap
+from ground.fdir.identify import Observation
+from ground.fdir.observer import ObserverState
+from interfaces.contracts.messages import PoiObservations
+
+
+@dataclass(frozen=True)
+class SettledMap:
+    """The ground's fused map at a window's start a (every image taken before a): ψ, the
+    squared fused variance per POI (Eq. 8), the weights φ, and each observer's precision F."""
+
+    psi: np.ndarray
+    phi: np.ndarray
+    precision: np.ndarray
+    """(observers, POIs) fused precision F_i"""
+
+    @classmethod
+    def of(cls, poi_map: PoiMap) -> SettledMap:
+        return cls(poi_map.variance() ** 2, poi_map.phi, poi_map.F)
+
+    def h_prev(self, spacecraft: int) -> float:
+        """Observer ``spacecraft``'s contribution H_i at the window's start (Eq. 8)."""
+        return float(np.sum(self.phi * self.psi * self.precision[spacecraft - 1]))
+
+
+@dataclass(frozen=True)
+class WindowContext:
+    """One observer's window: its bounds (s), the map settled at ``a``, the judged images in
+    time order and, at their times (K rows), the plan's positions (LVLH, m), whether any falls
+    on a transfer, the reported attitude rows (``ObserverState.attitude``; None when stale)
+    and nav positions (LVLH, m; None when stale), and what each image saw."""
+
+    spacecraft: int
+    a: float
+    b: float
+    settled: SettledMap
+    images: list[PoiObservations]
+    times: np.ndarray
+    planned: np.ndarray
+    moving: bool
+    attitude: np.ndarray | None
+    nav: np.ndarray | None
+    seen: list[Observation]
+    """each image's observed POIs and their precisions σ⁻¹"""
+
+    @property
+    def psi(self) -> np.ndarray:
+        return self.settled.psi
+
+    @property
+    def phi(self) -> np.ndarray:
+        return self.settled.phi
+
+    @property
+    def h_prev(self) -> float:
+        return self.settled.h_prev(self.spacecraft)
+
+
+def window_context(spacecraft: int, obs: ObserverState, images: list[PoiObservations],
+                   a: float, b: float, settled: SettledMap, n: float, settle_s: float
+                   ) -> tuple[WindowContext | None, int]:
+    """The context of a window with a plan and images (``images``: those received, in time
+    order), and the count of images the window message reports; no context when none can be
+    judged.  ``n``: the mean motion (rad/s) the plans' PROs fly."""
+    received = len(images)
+    images = [m for m in images if obs.tracking_at(m.image_t_s, settle_s)]
+    if not images:
+        return None, 0
+    planned = obs.planned(n, np.array([m.image_t_s for m in images]))
+    if planned is None:  # no plan in force at an image time: nothing to compare with
+        return None, received
+    pos, moving, known = planned  # unknown: on a transfer whose plan was lost
+    images = [m for m, k in zip(images, known) if k]
+    if not images:
+        return None, 0
+    times = np.array([m.image_t_s for m in images])
+    return WindowContext(spacecraft, a, b, settled, images, times, pos[known],
+                         bool(moving[known].any()), obs.attitude.at(times),
+                         obs.nav.at(times), [m.arrays() for m in images]), len(images)

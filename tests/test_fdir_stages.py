@@ -1,0 +1,160 @@
+"""The FDIR pipeline's stages on constructed windows, without a bus: the link checks (loss by
+sequence number against the link's limit, silence once per episode), the window context
+(tracking and plan coverage decide which images are judged), the global check (a ratio every
+observer shares is common mode, declared once), the declaration (persistence, a common mode is
+not the observer's, a class found on a later window) and the data-integrity check (a report
+off the ground's recomputation)."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+
+from gnc.poi_map import PoiMap
+from gnc.pro import Pro
+from ground.fdir.constellation import ConstellationVerdict
+from ground.fdir.declaration import Declarer
+from ground.fdir.global_check import GlobalCheck
+from ground.fdir.hardware_threshold import RatioModel
+from ground.fdir.identify import Evidence
+from ground.fdir.information import Judgement
+from ground.fdir.integrity import IntegrityCheck
+from ground.fdir.link_checks import LinkChecks
+from ground.fdir.observer import ObserverState
+from ground.fdir.threshold import WindowThreshold
+from ground.fdir.twin import FlightPlan
+from ground.fdir.window import SettledMap, window_context
+from interfaces.contracts.messages import (
+    ConstellationWindow,
+    FaultReport,
+    FdirWindow,
+    InfoCostTelemetry,
+    PoiObservations,
+)
+from tests.conftest import small_scenario
+
+LOG = logging.getLogger("test")
+
+
+def _obs(sc: int, t: float, seq: int) -> PoiObservations:
+    return PoiObservations(sender=f"sc{sc}", t_sim=t, seq=seq, spacecraft=sc, image_t_s=t,
+                           poi=[1, 2], precision=[0.01, 0.02])
+
+
+def test_silence_is_a_link_fault_once_per_episode() -> None:
+    links = LinkChecks(small_scenario(fdir={"silent_windows": 2}), "ground", LOG)
+    obs = ObserverState()
+    reports = [links.judge(1, obs, [], True, b)[1] for b in (10.0, 20.0, 30.0)]
+    assert [len(r) for r in reports] == [0, 1, 0]
+    assert reports[1][0].fault_class == "link" and reports[1][0].t_sim == 20.0
+    assert links.judge(1, obs, [_obs(1, 31.0, 1)], True, 40.0) == (0, [])  # speaks again
+    assert obs.silent == 0 and not obs.link_declared
+    assert [len(links.judge(1, obs, [], True, b)[1]) for b in (50.0, 60.0)] == [0, 1]
+    assert links.judge(2, ObserverState(), [], False, 10.0) == (0, [])  # no plan: no silence
+
+
+def test_loss_beyond_the_links_limit_for_two_windows_is_a_link_fault() -> None:
+    scenario = small_scenario(comms={"packet_loss": 0.0}, fdir={"loss_tol": 0.1,
+                                                                "checks_persistence": 2})
+    links = LinkChecks(scenario, "ground", LOG)
+    assert links.limit(15) == pytest.approx(0.1)  # no nominal loss: no spread either
+    obs, seq, out = ObserverState(), 0, []
+    for k in range(3):  # 10 received, 5 missing before them, each window
+        seq += 5
+        images = [_obs(1, 10.0 * k + i, seq + i + 1) for i in range(10)]
+        seq += 10
+        out.append(links.judge(1, obs, images, True, 10.0 * (k + 1)))
+    assert [lost for lost, _ in out] == [5, 5, 5]
+    assert [len(r) for _, r in out] == [0, 1, 0]
+    assert out[1][1][0].metric == pytest.approx(5 / 15)
+    assert out[1][1][0].threshold == pytest.approx(0.1)
+
+
+def test_window_context_judges_tracked_images_under_a_plan() -> None:
+    obs = ObserverState()
+    obs.modes = [(0.0, "slew"), (40.0, "track")]
+    obs.plans[1] = FlightPlan(0.0, Pro(20.0, 0.0, 0.0, 25.0, 0.0), None, None)
+    settled = SettledMap.of(PoiMap.uniform(10, 1.0, 1))
+    images = [_obs(1, t, i) for i, t in enumerate((50.0, 69.0, 71.0, 75.0), 1)]
+    n = 1.1e-3
+    ctx, count = window_context(1, obs, images, 60.0, 80.0, settled, n, settle_s=30.0)
+    assert count == 2 and ctx is not None  # tracking since 40 s: judged from 70 s on
+    assert list(ctx.times) == [71.0, 75.0]
+    assert np.allclose(ctx.planned, obs.plans[1].positions(n, ctx.times))
+    assert ctx.attitude is None and ctx.nav is None  # nothing reported: no pose
+    assert ctx.h_prev == 0.0  # nothing fused yet
+    assert window_context(1, obs, images[:2], 60.0, 80.0, settled, n, 30.0) == (None, 0)
+    obs.plans.clear()
+    assert window_context(1, obs, images, 60.0, 80.0, settled, n, 30.0) == (None, 4)
+
+
+def _judgement(sc: int, metric: float, evidence: Evidence, model: RatioModel | None = None,
+               dh: float = 0.5, dh_pred: float = 1.0) -> Judgement:
+    failed = ["information"] if metric > 0.1 else []
+    window = FdirWindow(sender="ground", t_sim=10.0, spacecraft=sc, t_start_s=0.0, t_end_s=10.0,
+                        images=5, lost=0, dh=dh, dh_pred=dh_pred, metric=metric, threshold=0.1,
+                        failed=failed, direction="degraded")
+    return Judgement(window, evidence, WindowThreshold(model, None, None, 0.1, "model"))
+
+
+def test_a_ratio_every_observer_shares_is_common_mode_declared_once() -> None:
+    check = GlobalCheck(small_scenario().fdir, 1e-3, "ground", LOG)
+    model = RatioModel(1.0, 0.01, 0.01, 0.0)
+    judged = {sc: _judgement(sc, 0.5, Evidence(), model) for sc in (1, 2, 3)}
+    verdict, out = check.check(0.0, 10.0, judged, cost=7.0)
+    assert verdict is not None and verdict.common_mode and verdict.ratio == pytest.approx(0.5)
+    window, report = out
+    assert isinstance(window, ConstellationWindow) and window.observers == 3
+    assert window.cost == 7.0 and window.shortfall == pytest.approx(1.5)  # Σ (ΔH_pred − ΔH)
+    assert isinstance(report, FaultReport) and report.spacecraft == 0
+    assert report.fault_class == "common_mode" and report.direction == "degraded"
+    _, again = check.check(10.0, 20.0, judged, cost=6.0)
+    assert len(again) == 1 and check.shortfall == pytest.approx(3.0)
+    verdict, out = check.check(20.0, 30.0, {1: judged[1]}, cost=6.0)
+    assert verdict is None and out[0].observers == 1  # too few observers to judge
+
+
+def test_declaration_after_persistence_with_the_class_the_evidence_shows() -> None:
+    declarer = Declarer(small_scenario(fdir={"persistence": 2}).fdir, "ground", LOG)
+    camera = Evidence(beta_hat=0.5)  # half the nominal health: a camera fault
+    first = declarer.declare(1, _judgement(1, 0.5, camera), None)
+    assert len(first) == 1 and first[0].exceeded is True
+    second = declarer.declare(1, _judgement(1, 0.5, camera), None)
+    assert [type(m) for m in second] == [FdirWindow, FaultReport]
+    assert second[1].fault_class == "camera" and second[1].evidence == {"beta_hat": 0.5}
+    assert not declarer.naming(1)  # declared and named: the episode goes on
+    assert len(declarer.declare(1, _judgement(1, 0.5, camera), None)) == 1  # once per episode
+
+
+def test_a_class_found_on_a_later_window_and_common_mode_not_held_against_one() -> None:
+    declarer = Declarer(small_scenario().fdir, "ground", LOG)
+    out = declarer.declare(2, _judgement(2, 0.5, Evidence()), None)
+    assert out[1].fault_class is None and declarer.identifying(2)
+    out = declarer.declare(2, _judgement(2, 0.5, Evidence(pointing_error_deg=5.0)), None)
+    assert out[1].fault_class == "actuator" and not declarer.identifying(2)
+    common = ConstellationVerdict(0.5, RatioModel(1.0, 0.01, 0.01, 0.0), 0.05, True, None)
+    out = declarer.declare(3, _judgement(3, 0.5, Evidence(beta_hat=0.5)), common)
+    assert out[0].exceeded is False and len(out) == 1
+
+
+def test_a_reported_h_i_off_the_grounds_recomputation_is_a_data_integrity_fault() -> None:
+    cfg = small_scenario(fdir={"checks_persistence": 2, "integrity_tol": 0.2}).fdir
+    check = IntegrityCheck(cfg, "ground", LOG)
+    settled = PoiMap.uniform(10, 1.0, 2)
+    settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
+    settled.add(2, np.array([2, 3]), np.array([0.5, 0.5]))
+    truth = settled.contributions()
+    observers = {1: ObserverState(), 2: ObserverState()}
+    out = []
+    for j in (1, 2):
+        for sc, factor in ((1, 1.5), (2, 1.0)):  # sc1 inflates its H_i by half
+            check.reported(InfoCostTelemetry(
+                sender=f"sc{sc}", t_sim=10.0 * j, spacecraft=sc,
+                h_i=factor * float(truth[sc - 1]), h_local=1.0, prior_term=0.5,
+                pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=0), j)
+        out.append(check.check(j, 10.0 * j, settled, observers))
+    assert [len(r) for r in out] == [0, 1]
+    assert out[1][0].spacecraft == 1 and out[1][0].fault_class == "data_integrity"
+    assert out[1][0].metric == pytest.approx(0.5)
