@@ -2,14 +2,17 @@
 
     python -m ground.archive list RUN.mcap [RUN2.mcap ...]
     python -m ground.archive summary RUN.mcap
-    python -m ground.archive export RUN.mcap --topic KEY_EXPR [--out FILE.csv]
+    python -m ground.archive export RUN.mcap --topic KEY_EXPR [--out FILE.csv|FILE.parquet]
 
 ``list`` prints each key with its message type, count and sim-time span; ``summary`` the
 metadata the recorder wrote (scenario, seed, transport, software version), the message counts
 per type, the injected faults and the FDIR's declarations; ``export`` writes the messages of
 a key expression (``*`` one chunk, ``**`` any number) as CSV, one row per message, nested
-fields flattened (``r_m.0``, ``P.2.3``), to ``--out`` or stdout.  A damaged archive is read up
-to its last complete chunk (ground/archive/reader.py) and said so.
+fields flattened (``r_m.0``, ``P.2.3``), to ``--out`` or stdout; an ``--out`` ending in
+``.parquet`` (or ``.pq``) gets instead the topic's DataFrame (ground/archive/frame.py: indexed
+by sim time ``t_sim_s``, lists of varying length kept whole) as Parquet, which
+``pandas.read_parquet`` reads back as it was.  A damaged archive is read up to its last
+complete chunk (ground/archive/reader.py) and said so.
 """
 
 from __future__ import annotations
@@ -22,7 +25,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, TextIO
 
+from ground.archive.frame import topic_frame
 from ground.archive.reader import ArchiveError, RunArchive, load_run
+
+PARQUET_SUFFIXES = (".parquet", ".pq")
+"""``export --out`` file suffixes that choose Parquet over CSV."""
 
 
 def flatten(value: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
@@ -89,16 +96,31 @@ def export_csv(archive: RunArchive, key_expr: str, out: TextIO) -> int:
     return len(rows)
 
 
+def export(run: Path, key_expr: str, out: Path | None) -> int:
+    """Export the messages of ``key_expr``: Parquet if ``out`` has a Parquet suffix, else CSV
+    to ``out`` or stdout; returns the number of rows (a Parquet export of nothing raises)."""
+    if out is not None and out.suffix.lower() in PARQUET_SUFFIXES:
+        frame = topic_frame(run, key_expr)
+        frame.to_parquet(out)
+        return len(frame)
+    archive = load_run(run)
+    if out is None:
+        return export_csv(archive, key_expr, sys.stdout)
+    with open(out, "w", newline="") as f:
+        return export_csv(archive, key_expr, f)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m ground.archive", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("list", help="keys, types, counts").add_argument("runs", nargs="+", type=Path)
     sub.add_parser("summary", help="metadata, counts, faults").add_argument("run", type=Path)
-    e = sub.add_parser("export", help="CSV of a key expression")
+    e = sub.add_parser("export", help="CSV or Parquet of a key expression")
     e.add_argument("run", type=Path)
     e.add_argument("--topic", required=True, help="key expression, e.g. 'insp/*/sc/1/nav/**'")
-    e.add_argument("--out", type=Path, help="CSV file (default: stdout)")
+    e.add_argument("--out", type=Path,
+                   help="CSV file (default: stdout), or Parquet if it ends in .parquet or .pq")
     args = p.parse_args(argv)
     try:
         if args.command == "list":
@@ -107,19 +129,14 @@ def main(argv: list[str] | None = None) -> int:
         elif args.command == "summary":
             summarize(load_run(args.run), sys.stdout)
         else:
-            archive = load_run(args.run)
-            if args.out is None:
-                n = export_csv(archive, args.topic, sys.stdout)
-            else:
-                with open(args.out, "w", newline="") as f:
-                    n = export_csv(archive, args.topic, f)
+            n = export(args.run, args.topic, args.out)
             print(f"{n} messages exported", file=sys.stderr)
             if n == 0:
                 print(f"warning: no message matches {args.topic!r}; `list` shows the keys",
                       file=sys.stderr)
     except BrokenPipeError:  # e.g. piped into `head`
         return 0
-    except (ArchiveError, OSError) as err:
+    except (ArchiveError, OSError, ValueError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     return 0
