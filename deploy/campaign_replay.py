@@ -1,6 +1,6 @@
 """A finished campaign re-judged under other detector settings, without re-simulating.
 
-Every run of ``<out>/runs/`` is replayed (``ground.fdir.replay``: the ground station itself
+Every run of ``<out>/runs/`` is replayed (``ground.tools.replay``: the ground station itself
 on the run's archive) with the settings given; its ``summary.json`` is rewritten with the
 replay's FDIR fields (detections, scores, baselines, series, settings) and a ``replay`` section
 (settings, ``faithful_until_s``, ``matches_live``, replay wall time) into
@@ -28,7 +28,7 @@ from typing import Any
 from ground.analysis.campaign_report import detector_figures, write_campaign_report
 from ground.archive.metadata import archived_scenario
 from ground.archive.reader import ArchiveError
-from ground.fdir.replay import replay_run, with_settings
+from ground.tools.replay import replay_run, with_settings
 from interfaces.contracts.scenario import ScenarioError
 
 log = logging.getLogger("insp.campaign")

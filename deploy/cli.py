@@ -28,7 +28,7 @@ class Command(NamedTuple):
 COMMANDS: Final = {
     "run": Command("deploy.run_constellation", "run one scenario (sim, flight software, ground)"),
     "campaign": Command("deploy.run_campaign", "run, replay or sweep a fault campaign"),
-    "replay": Command("ground.fdir.replay", "re-run the ground FDIR on a run's archive"),
+    "replay": Command("ground.tools.replay", "re-run the ground FDIR on a run's archive"),
     "tlm": Command("ground.tools.tlm", "watch a running constellation's telemetry live"),
     "archive": Command("ground.archive.cli", "list, summarize or export a run archive"),
 }

@@ -60,7 +60,7 @@ from deploy.campaign import (  # noqa: E402
 )
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
 from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
-from ground.fdir.replay import parse_settings  # noqa: E402
+from ground.tools.replay import parse_settings  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
@@ -83,7 +83,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help="rewrite the report from the run directories, run nothing")
     p.add_argument("--replay", action="store_true",
                    help="re-judge the finished runs of --out under --set detector settings "
-                        "(ground.fdir.replay), simulating nothing")
+                        "(ground.tools.replay), simulating nothing")
     p.add_argument("--set", dest="settings", action="append", default=[],
                    metavar="fdir.KEY=VALUE", help="with --replay/--sweep: a detector setting")
     p.add_argument("--sweep", metavar="fdir.KEY=V1,V2,...",

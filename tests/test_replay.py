@@ -1,4 +1,4 @@
-"""Replay (ground/fdir/replay.py): the live ground re-run on a recorded run reproduces the live
+"""Replay (ground/tools/replay.py): the live ground re-run on a recorded run reproduces the live
 detections, windows and verdicts exactly -- with lossy, range-limited and cut links and three
 faults -- and, under another setting, what the live run with that setting declared, up to the
 first uplink the two runs differ in."""
@@ -16,7 +16,7 @@ from ground.analysis.summary import write_summary
 from ground.archive.metadata import archived_scenario, run_metadata
 from ground.archive.reader import ArchiveError, load_run
 from ground.archive.recorder import McapRecorder
-from ground.fdir.replay import UNREAD, GroundOutput, main, replay_run, with_settings
+from ground.tools.replay import UNREAD, GroundOutput, main, replay_run, with_settings
 from ground.station import APPS as GROUND_APPS
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.scenario import Scenario, ScenarioError

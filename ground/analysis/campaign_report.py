@@ -178,7 +178,7 @@ def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> d
     """One detector's figures over the finished runs ``ids`` of ``out`` (a campaign or its
     replay): faults, detected, isolated, identified (counts), latency median and p90 of the
     isolated faults (s), false alarms and nominal cycles (over whole runs, and over each
-    replay's faithful span: ``ground.fdir.replay``), runs, and runs whose replay (if any)
+    replay's faithful span: ``ground.tools.replay``), runs, and runs whose replay (if any)
     stayed faithful to the end."""
     runs = _load(out, ids)
     rows = [r for r in _rows(runs) if r["detector"] == detector]
@@ -203,7 +203,7 @@ def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> d
 def _main_scores(summary: dict[str, Any]) -> dict[str, Any]:
     """The main detector's scores of a run: over the faithful span for a replay (what the
     replay declared after its uplinks diverged from the flown run judges a trajectory nobody
-    commanded; ``ground.fdir.replay``), else the run's own."""
+    commanded; ``ground.tools.replay``), else the run's own."""
     return summary.get("replay", {}).get("scores_faithful") or summary.get("scores", {})
 
 

@@ -1,7 +1,7 @@
 """Replay: the live ground re-run on the telemetry in a run's archive, under the run's own or
 other detector settings.
 
-    python -m ground.fdir.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR]
+    python -m ground.tools.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR]
 
 RUN is a run directory (holding ``run.mcap``) or an archive.  The ground station itself
 (``ground.station``: planner, telemetry monitor, FDIR, baselines -- the code the live ground
@@ -258,7 +258,7 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m ground.fdir.replay", description=__doc__,
+    p = argparse.ArgumentParser(prog="python -m ground.tools.replay", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("runs", nargs="+", type=Path, help="run directories or run.mcap files")
     p.add_argument("--set", dest="settings", action="append", default=[],
