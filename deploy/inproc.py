@@ -1,4 +1,5 @@
-"""The whole constellation in one process on the in-process transport (tests, campaigns).
+"""The whole constellation in one process on the in-process transport (tests, campaigns): every
+node of the declared topology (``interfaces/contracts/topology.py``) and the sim.
 
 Same apps, messages, channel model and lockstep as the multi-process run; ticks run
 synchronously inside the sim's publish, so no threads are involved.  The lean runtime: routes
@@ -9,12 +10,11 @@ node's channel stage, no barrier wait (every announced message was delivered bef
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
 
-from fsw.spacecraft import spacecraft_executive
-from ground.station import ground_executive
 from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.topology import topology
+from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.channel import ChannelModel, history_for
 from interfaces.runtime.executive import Executive, TickClient
@@ -39,20 +39,15 @@ def run_inproc(
         Bus("ground", mission, net.endpoint()).subscribe_raw(topics.mission_wildcard(mission), tap)
     if sample_tap is not None:
         net.endpoint().subscribe_samples(topics.mission_wildcard(mission), sample_tap)
-    builders: dict[str, Callable[[Bus, Scenario], Executive]] = {
-        topics.sc_node(i): (lambda b, s, i=i: spacecraft_executive(b, s, i))
-        for i in range(1, scenario.observers.count + 1)
-    }
-    if ground:
-        builders[topics.GROUND] = ground_executive
+    topo = topology(scenario, ground=ground)
     executives: dict[str, Executive] = {}
     truth = history_for(scenario)  # one truth feed for every node's channel
-    for node, build in builders.items():
-        bus = Bus(node, mission, net.endpoint(),
-                  channel=ChannelModel.of(node, scenario, truth))
-        executives[node] = build(bus, scenario)
-        TickClient(executives[node], synchronous=True)
-    sim = SimNode(Bus(topics.SIM, mission, net.endpoint()), scenario, list(builders),
+    for node in topo.nodes:
+        bus = Bus(node.name, mission, net.endpoint(),
+                  channel=ChannelModel.of(node.name, scenario, truth))
+        executives[node.name] = executive_of(node, bus, scenario)
+        TickClient(executives[node.name], synchronous=True)
+    sim = SimNode(Bus(topics.SIM, mission, net.endpoint()), scenario, topo.participants,
                   log=logging.getLogger("insp.sim"))
     sim.run()
     return sim, executives

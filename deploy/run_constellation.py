@@ -59,6 +59,7 @@ from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
+from interfaces.contracts.topology import RECORDER, ROUTER, SIM, topology  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
 
@@ -122,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     except ScenarioError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    known = {*(f"sc{i}" for i in range(1, scenario.observers.count + 1)), topics.GROUND}
+    known = set(topology(scenario).participants)
     if set(args.external) - known or (args.external and args.transport == "inproc"):
         print(f"error: --external takes nodes of a Zenoh run ({', '.join(sorted(known))}), not "
               f"{', '.join(args.external)}", file=sys.stderr)
@@ -237,8 +238,8 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
         return "failed", str(e)
     sup = Supervisor(REPO)
     audit = ["--audit", str(out / "logs" / "access.json")] if args.audit_access else []
-    router = sup.start(Child("router", ["-m", "deploy.router", "--config",
-                                        str(access.router_config), *audit],
+    router = sup.start(Child(ROUTER.name, [*ROUTER.command, "--config",
+                                           str(access.router_config), *audit],
                              out / "logs" / "router.log"))
     hub = _join(access, router, timeout_s=30.0)
     if hub is None:
@@ -320,21 +321,19 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         return [*common, "--zenoh-config", str(access.client_config(name))]
 
     logs = out / "logs"
-    recorder = sup.start(Child("recorder", ["-m", "ground.archive.record", *account("recorder"),
-                                            "--out", str(out / "run.mcap"),
-                                            "--transport-name", "zenoh"],
+    recorder = sup.start(Child(RECORDER.name, [*RECORDER.command, *account(RECORDER.name),
+                                               "--out", str(out / "run.mcap"),
+                                               "--transport-name", "zenoh"],
                                logs / "recorder.log"))
     if not _wait_token(hub, topics.recorder_token(mission), recorder, timeout_s=30.0):
-        sup.stop_all(exclude={"router"})
+        sup.stop_all(exclude={ROUTER.name})
         return "failed", (f"recorder did not start ({recorder.describe_exit()}):\n"
                           f"{recorder.log_tail()}")
-    sim_argv = ["-m", "sim", *account(topics.SIM)] + (["--realtime", str(args.realtime)]
-                                                      if args.realtime else [])
-    sup.start(Child("sim", sim_argv, logs / "sim.log"))
-    nodes = [f"sc{i}" for i in range(1, scenario.observers.count + 1)]
-    commands = {node: ["-m", "fsw", "--spacecraft", str(i), *account(node)]
-                for i, node in enumerate(nodes, start=1)}
-    commands[topics.GROUND] = ["-m", "ground", *account(topics.GROUND)]
+    sim_argv = [*SIM.command, *account(SIM.name)] + (["--realtime", str(args.realtime)]
+                                                    if args.realtime else [])
+    sup.start(Child(SIM.name, sim_argv, logs / "sim.log"))
+    topo = topology(scenario)
+    commands = {n.name: [*n.command, *account(n.name)] for n in topo.nodes}
     for node, argv in commands.items():
         if node in args.external:
             log.info("%s runs elsewhere: on its host, with this run's scenario and %s there, "
@@ -342,16 +341,14 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
                          "--zenoh-config", access.client_config(node).name]))
         else:
             sup.start(Child(node, argv, logs / f"{node}.log"))
-    watch = _Watch(sup, progress, flight=[*(n for n in nodes if n not in args.external),
-                                          *([topics.GROUND] if topics.GROUND not in args.external
-                                            else [])],
+    watch = _Watch(sup, progress, flight=[n for n in topo.participants if n not in args.external],
                    restart=args.restart_on_crash)
     error = watch.run()
     progress.report(final=True)
     # Stop the flight side first, then the recorder, so the archive holds everything sent.
-    sup.stop_all(order=["sim", *nodes, "ground"], exclude={"recorder", "router"})
+    sup.stop_all(order=[SIM.name, *topo.participants], exclude={RECORDER.name, ROUTER.name})
     time.sleep(0.2)
-    recorder = sup.named("recorder")
+    recorder = sup.named(RECORDER.name)
     if recorder.returncode is None:
         recorder.stop(timeout_s=10.0)
         if recorder.returncode != 0 and error is None:
@@ -390,7 +387,8 @@ class _Watch:
                 error = self._essential_stopped()
                 if error is not None:
                     return error
-                sim_done = self.progress.finished.is_set() or self.sup.named("sim").returncode == 0
+                sim_done = (self.progress.finished.is_set()
+                            or self.sup.named(SIM.name).returncode == 0)
                 self._flight_stopped(sim_done)
                 running = [n for n in self.flight
                            if n not in self.down and self.sup.named(n).returncode is None]
@@ -407,7 +405,7 @@ class _Watch:
             return "interrupted by the user"
 
     def _essential_stopped(self) -> str | None:
-        sim, recorder = self.sup.named("sim"), self.sup.named("recorder")
+        sim, recorder = self.sup.named(SIM.name), self.sup.named(RECORDER.name)
         for child, consequence in ((recorder, "nothing after it is recorded; stopping the run"),
                                    (sim, "no time without it; stopping the constellation")):
             if child.returncode is not None and (child is recorder or child.returncode != 0):

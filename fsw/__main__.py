@@ -3,21 +3,14 @@
 from __future__ import annotations
 
 import argparse
-from functools import partial
 
-from fsw.spacecraft import spacecraft_executive
 from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.topology import topology
+from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import add_node_args, run_participant
 from interfaces.runtime.executive import Executive
-
-
-def _build(spacecraft: int, bus: Bus, scenario: Scenario) -> Executive:
-    if spacecraft > scenario.observers.count:
-        raise SystemExit(f"spacecraft {spacecraft} not in scenario "
-                         f"({scenario.observers.count} observers)")
-    return spacecraft_executive(bus, scenario, spacecraft)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -25,7 +18,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--spacecraft", type=int, required=True, help="spacecraft id (1-based)")
     add_node_args(parser)
     args = parser.parse_args(argv)
-    return run_participant(args, topics.sc_node(args.spacecraft), partial(_build, args.spacecraft))
+    node = topics.sc_node(args.spacecraft)
+
+    def build(bus: Bus, scenario: Scenario) -> Executive:
+        try:
+            return executive_of(topology(scenario).node(node), bus, scenario)
+        except ValueError as e:
+            raise SystemExit(f"spacecraft {args.spacecraft} is not in this scenario: {e}") from e
+
+    return run_participant(args, node, build)
 
 
 if __name__ == "__main__":

@@ -4,15 +4,23 @@ from __future__ import annotations
 
 import argparse
 
-from ground.station import ground_executive
 from interfaces.contracts import topics
+from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.topology import topology
+from interfaces.runtime.assembly import executive_of
+from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import add_node_args, run_participant
+from interfaces.runtime.executive import Executive
+
+
+def _build(bus: Bus, scenario: Scenario) -> Executive:
+    return executive_of(topology(scenario).node(topics.GROUND), bus, scenario)
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m ground", description=__doc__)
     add_node_args(parser)
-    return run_participant(parser.parse_args(argv), topics.GROUND, ground_executive)
+    return run_participant(parser.parse_args(argv), topics.GROUND, _build)
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from interfaces.contracts import topics
+from interfaces.contracts.topology import topology
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import (
     add_node_args,
@@ -28,9 +29,7 @@ def main(argv: list[str] | None = None) -> int:
     log = setup_logging(args.log_level, "sim")
     scenario = load_node_scenario(args)
     stop = stop_on_signals()
-    participants = [topics.sc_node(i) for i in range(1, scenario.observers.count + 1)]
-    if not args.no_ground:
-        participants.append(topics.GROUND)
+    participants = topology(scenario, ground=not args.no_ground).participants
     bus = Bus(topics.SIM, mission_of(args, scenario), open_zenoh(args))
     try:
         sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime, log=log, stop=stop)

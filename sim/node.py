@@ -15,7 +15,8 @@ import math
 import threading
 import time
 from dataclasses import dataclass, field
-from typing import ClassVar
+from functools import partial
+from typing import ClassVar, Literal
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -63,14 +64,33 @@ def initial_states(scenario: Scenario) -> np.ndarray:
     return np.array([pro_state(n, *obs.pro(i)) for i in range(1, obs.count + 1)])
 
 
+@dataclass(frozen=True)
+class NodeInput:
+    """A sim subscription: ``topic`` on the key of each node ``of`` names (every lockstep
+    participant, or every observer's flight software), to method ``handler``, called with the
+    node's index in that list and the message; ``immediate``: handled on arrival (the lockstep's
+    answers), not queued to the tick."""
+
+    topic: Topic
+    handler: str
+    of: Literal["participants", "spacecraft"]
+    immediate: bool = False
+
+
 @dataclass(eq=False)
 class SimNode:
-    """The sim's side of the bus (its topics are declared below for the wiring check)."""
+    """The sim's side of the bus: what it publishes, and its inputs, wired from these
+    declarations (``INPUTS``) as an app's are."""
 
     PUBLISHES: ClassVar[tuple[Topic, ...]] = (
         cat.TICK, cat.SIM_STATUS, cat.TRUTH, cat.FAULT_EVENTS,
         cat.RELNAV, cat.ATTITUDE_SENSORS, cat.CAMERA_IMAGE)
-    SUBSCRIBES: ClassVar[tuple[Topic, ...]] = (cat.TICK_DONE, cat.THRUST, cat.WHEELS)
+    INPUTS: ClassVar[tuple[NodeInput, ...]] = (
+        NodeInput(cat.TICK_DONE, "_on_done", "participants", immediate=True),
+        NodeInput(cat.THRUST, "_on_thrust", "spacecraft"),
+        NodeInput(cat.WHEELS, "_on_wheels", "spacecraft"),
+    )
+    SUBSCRIBES: ClassVar[tuple[Topic, ...]] = tuple(i.topic for i in INPUTS)
 
     bus: Bus
     scenario: Scenario
@@ -122,13 +142,16 @@ class SimNode:
         self._t_now = 0.0
         self._q_now = np.array([0.0, 0.0, 0.0, 1.0])  # ECI -> LVLH now (set each tick)
         self._dt = sc.rates.dt_s
-        for node in self.participants:
-            self.bus.subscribe(cat.TICK_DONE.key(m, node), TickDone, self._on_done, immediate=True)
-        for index, node in enumerate(nodes):
-            self.bus.subscribe(cat.THRUST.key(m, node), ThrustCommand,
-                               lambda msg, index=index: self._on_thrust(index, msg))
-            self.bus.subscribe(cat.WHEELS.key(m, node), WheelCommand,
-                               lambda msg, index=index: self._on_wheels(index, msg))
+        self._wire(nodes)
+
+    def _wire(self, spacecraft_nodes: list[str]) -> None:
+        """Subscribe the declared inputs (``INPUTS``) on each of their nodes' keys."""
+        of = {"participants": self.participants, "spacecraft": spacecraft_nodes}
+        for i in self.INPUTS:
+            handler = getattr(self, i.handler)
+            for index, node in enumerate(of[i.of]):
+                self.bus.subscribe(i.topic.key(self.bus.mission, node), i.topic.type,
+                                   partial(handler, index), immediate=i.immediate)
 
     # --- commands to the hardware ---------------------------------------------------------
 
@@ -164,7 +187,7 @@ class SimNode:
 
     # --- lockstep bookkeeping -------------------------------------------------------------
 
-    def _on_done(self, msg: TickDone) -> None:
+    def _on_done(self, _index: int, msg: TickDone) -> None:
         """A participant's answer to the current tick (its sender is the owner of the key it
         came on: the Bus's admission).  Only keys of its own space count as announced."""
         with self._cond:

@@ -21,11 +21,11 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-from fsw.spacecraft import APPS as FSW_APPS
-from ground.station import APPS as GROUND_APPS
 from interfaces.contracts import topics
 from interfaces.contracts.messages import Message, Tick
+from interfaces.contracts.topology import GROUND_APPS, SPACECRAFT_APPS
 from interfaces.runtime.app import App, AppContext, Input
+from interfaces.runtime.assembly import app_class
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import Executive
 from interfaces.runtime.transport import InprocNetwork
@@ -105,8 +105,8 @@ def message_payloads(msg_type: type[Message], owner: str) -> st.SearchStrategy[b
 
 
 def _apps() -> Iterator[tuple[type[App], str]]:
-    yield from ((a, "sc1") for a in FSW_APPS)
-    yield from ((a, topics.GROUND) for a in GROUND_APPS)
+    yield from ((app_class(a), "sc1") for a in SPACECRAFT_APPS)
+    yield from ((app_class(a), topics.GROUND) for a in GROUND_APPS)
 
 
 def _node(app_cls: type[App], node: str) -> tuple[Executive, App, Bus, object]:

@@ -17,9 +17,10 @@ from ground.archive.metadata import archived_scenario, run_metadata
 from ground.archive.reader import ArchiveError, load_run
 from ground.archive.recorder import McapRecorder
 from ground.tools.replay import UNREAD, GroundOutput, main, replay_run, with_settings
-from ground.station import APPS as GROUND_APPS
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.scenario import Scenario, ScenarioError
+from interfaces.contracts.topology import GROUND_APPS
+from interfaces.runtime.assembly import app_class
 from tests.conftest import small_scenario
 
 
@@ -101,7 +102,7 @@ def test_another_setting_replays_as_the_live_run_with_it(
 
 
 def test_what_a_replay_drops_unread_no_ground_app_reads() -> None:
-    ground_inputs = {i.topic for app in GROUND_APPS for i in app.INPUTS}
+    ground_inputs = {i.topic for app in map(app_class, GROUND_APPS) for i in app.INPUTS}
     assert ground_inputs and not ground_inputs & set(UNREAD)
     assert cat.TRUTH not in UNREAD and cat.TICK not in UNREAD
 

@@ -37,9 +37,9 @@ from typing import Any
 from ground.analysis.summary import fdir_results
 from ground.archive.metadata import scenario_from_metadata
 from ground.archive.reader import ArchiveError, Record, RunArchive, load_run
-from ground.station import ground_executive
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
+from interfaces.contracts.topology import topology
 from interfaces.contracts.messages import (
     BaselineVerdict,
     ConstellationWindow,
@@ -48,6 +48,7 @@ from interfaces.contracts.messages import (
     ProAssignments,
 )
 from interfaces.contracts.scenario import Scenario, ScenarioError
+from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.channel import ChannelModel
 from interfaces.runtime.executive import TickClient
@@ -197,7 +198,7 @@ def _run_ground(archive: RunArchive, mission: str, scenario: Scenario) -> Ground
     net = InprocNetwork()
     bus = Bus(topics.GROUND, mission, net.endpoint(),
               channel=ChannelModel.of(topics.GROUND, scenario))
-    executive = ground_executive(bus, scenario)
+    executive = executive_of(topology(scenario).node(topics.GROUND), bus, scenario)
     executive.barrier_timeout_s = 0.0  # everything the archive holds is delivered before a tick
     TickClient(executive, synchronous=True)
     own = topics.node_prefix(mission, topics.GROUND)

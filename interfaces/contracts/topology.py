@@ -1,0 +1,138 @@
+"""The constellation's topology, declared once (docs/architecture.md, "Processes"): which
+nodes take part in a run, which apps each runs, how each node's executive is assembled, and
+which process holds what.
+
+Read by the in-process runner (``deploy/inproc.py``: every node in one process), the
+multi-process launcher (``deploy/run_constellation.py``: one process per node, plus the
+router, the recorder and the sim), replay (``ground/tools/replay.py``: the ground node alone),
+the spacecraft and station processes (``python -m fsw``, ``python -m ground``) and the sim
+(the participants it waits for).
+
+Apps and builders are named ``"module:attribute"`` so that this contract imports no flight,
+sim or ground code; ``interfaces/runtime/assembly.py`` resolves them.  Each app declares its
+own rate group, inputs and outputs (``interfaces/runtime/app.py``); the order here is the
+execution order within a rate group.  ``python -m interfaces.contracts.topology`` prints the
+default scenario's topology.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from interfaces.contracts import topics
+from interfaces.contracts.scenario import Scenario
+
+SPACECRAFT_APPS: tuple[str, ...] = (
+    "fsw.apps.attitude:AttitudeApp",
+    "fsw.apps.nav:NavApp",
+    "fsw.apps.camera:CameraApp",
+    "fsw.apps.infocost:InfoCostApp",
+    "fsw.apps.guidance:GuidanceApp",
+)
+"""A spacecraft's onboard apps, in execution order within a rate group."""
+
+GROUND_APPS: tuple[str, ...] = (
+    "ground.apps.planner:MissionPlanner",
+    "ground.apps.telemetry:TelemetryMonitor",
+    "ground.apps.fdir:FdirApp",
+    "ground.apps.baselines:BaselinesApp",
+)
+"""The ground station's apps, in execution order within a rate group."""
+
+
+@dataclass(frozen=True)
+class Node:
+    """A lockstep participant: one executive running ``apps``, built by ``executive``
+    (``"module:function"`` taking the node, its bus and the scenario), its random stream
+    named ``rng`` (``interfaces/contracts/rng.py``), and its process started by
+    ``python -m module *args`` when it runs in a process of its own."""
+
+    name: str
+    apps: tuple[str, ...]
+    executive: str
+    rng: tuple[str, int]
+    module: str
+    args: tuple[str, ...] = ()
+    spacecraft: int | None = None
+
+    @property
+    def command(self) -> list[str]:
+        """The Python arguments starting its own process (the run's common ones aside)."""
+        return ["-m", self.module, *self.args]
+
+
+@dataclass(frozen=True)
+class Service:
+    """A process that is not a lockstep participant: ``python -m module``."""
+
+    name: str
+    module: str
+
+    @property
+    def command(self) -> list[str]:
+        return ["-m", self.module]
+
+
+ROUTER = Service("router", "deploy.router")
+"""The run's Zenoh router (multi-process runs only)."""
+RECORDER = Service("recorder", "ground.archive.record")
+"""The archive's recorder (in one process: a tap on the in-process network)."""
+SIM = Service(topics.SIM, "sim")
+"""The time master and hardware stand-in."""
+
+
+def spacecraft_node(spacecraft: int) -> Node:
+    """Spacecraft ``spacecraft``'s flight software (1-based)."""
+    return Node(topics.sc_node(spacecraft), SPACECRAFT_APPS, "fsw.spacecraft:executive",
+                ("fsw", spacecraft), "fsw", ("--spacecraft", str(spacecraft)), spacecraft)
+
+
+GROUND = Node(topics.GROUND, GROUND_APPS, "interfaces.runtime.assembly:build_executive",
+              ("ground", 0), "ground")
+"""The ground station (central agent)."""
+
+
+@dataclass(frozen=True)
+class Topology:
+    """A run's lockstep participants (the spacecraft in order, then the ground if any), and
+    the services beside them."""
+
+    nodes: tuple[Node, ...]
+    services: tuple[Service, ...] = (ROUTER, RECORDER, SIM)
+
+    @property
+    def participants(self) -> list[str]:
+        """The node names the sim waits for each tick."""
+        return [n.name for n in self.nodes]
+
+    def node(self, name: str) -> Node:
+        """The node called ``name``; a clear error when the run has none."""
+        for n in self.nodes:
+            if n.name == name:
+                return n
+        raise ValueError(f"no node {name!r} in this run (nodes: {', '.join(self.participants)})")
+
+
+def topology(scenario: Scenario, ground: bool = True) -> Topology:
+    """The topology of a run of ``scenario``: one node per observer, and the ground unless
+    ``ground`` is False (spacecraft only)."""
+    nodes = [spacecraft_node(i) for i in range(1, scenario.observers.count + 1)]
+    return Topology(tuple(nodes + ([GROUND] if ground else [])))
+
+
+def describe(topo: Topology) -> str:
+    """The topology as a table: each process, what it runs and how it starts."""
+    rows = [(s.name, "-", "python " + " ".join(s.command)) for s in topo.services]
+    rows += [(n.name, ", ".join(a.split(":")[1] for a in n.apps), "python " + " ".join(n.command))
+             for n in topo.nodes]
+    width = [max(len(r[i]) for r in rows) for i in range(2)]
+    return "\n".join(f"{r[0]:<{width[0]}}  {r[1]:<{width[1]}}  {r[2]}" for r in rows)
+
+
+if __name__ == "__main__":
+    from pathlib import Path
+
+    from interfaces.contracts.scenario import load_scenario
+
+    default = Path(__file__).resolve().parents[2] / "deploy" / "scenarios" / "default.toml"
+    print(describe(topology(load_scenario(default))))
