@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from fsw.apps.infocost import InfoCostApp
-from fsw.faults import reported_h_factor
+from faults.software import reported_h_factor
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import Node
 from interfaces.runtime.assembly import build_executive
@@ -14,7 +14,7 @@ from interfaces.runtime.executive import Executive
 
 def executive(node: Node, bus: Bus, scenario: Scenario) -> Executive:
     """The executive of spacecraft node ``node`` with every onboard app wired, and the
-    software fault injection (``faulty_data``, ``fsw/faults.py``) hooked into its infocost
+    software fault injection (``faulty_data``, ``faults/software.py``) hooked into its infocost
     app's output."""
     built = build_executive(node, bus, scenario)
     for app in built.apps:

@@ -2,7 +2,7 @@
 closed-loop settling time and damping, for the flight tracking law
 (``fsw.lib.attitude_control.tracking_torque``, whose module docstring gives the closed loop).
 
-Shared: the sim sizes a pointing-actuator fault with the same design (``sim/faults.py``: the
+Shared: the sim sizes a pointing-actuator fault with the same design (``faults/hardware.py``: the
 torque bias at which the nominal loop settles a stated angle off its target).
 """
 

@@ -45,7 +45,7 @@ from interfaces.contracts.scenario import Scenario
 from interfaces.runtime.bus import Bus
 from sim.camera import TruthCameras
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
-from sim.faults import FaultInjector
+from faults.hardware import FaultInjector
 from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
 

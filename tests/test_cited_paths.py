@@ -9,9 +9,10 @@ from pathlib import Path
 from tests.conftest import REPO
 
 CITED = re.compile(
-    r"(?<![\w./-])((?:interfaces|gnc|fsw|sim|ground|deploy|docs|benchmarks|tests)"
+    r"(?<![\w./-])((?:interfaces|gnc|faults|fsw|sim|ground|deploy|docs|benchmarks|tests)"
     r"/[\w./-]*\w\.(?:py|md|toml))")
-SOURCES = ("interfaces", "gnc", "fsw", "sim", "ground", "deploy", "benchmarks", "tests", "docs")
+SOURCES = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "deploy", "benchmarks", "tests",
+           "docs")
 
 
 def _citing_files() -> list[Path]:

@@ -13,7 +13,7 @@ import pytest
 
 from tests.conftest import REPO
 
-PROJECT = ("interfaces", "gnc", "fsw", "sim", "ground", "deploy", "benchmarks", "tests")
+PROJECT = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "deploy", "benchmarks", "tests")
 
 
 def _imports(path: Path) -> set[str]:
@@ -57,7 +57,7 @@ def test_the_gnc_library_imports_only_the_contracts_and_itself() -> None:
 
 @pytest.mark.parametrize("room", ["fsw", "sim", "ground"])
 def test_flight_sim_and_ground_import_none_of_each_other(room: str) -> None:
-    assert _violations(room, ("interfaces", "gnc", room)) == []
+    assert _violations(room, ("interfaces", "gnc", "faults", room)) == []
 
 
 def test_the_rule_reader_sees_a_violation(tmp_path: Path) -> None:

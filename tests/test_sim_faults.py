@@ -1,4 +1,4 @@
-"""Fault injection in the sim (sim/faults.py): each kind acts on the truth as specified, is
+"""Fault injection in the sim (faults/hardware.py): each kind acts on the truth as specified, is
 switched on and off at its times, and its realised parameters are reproducible from the seed.
 The pointing-actuator sizing is checked by closing the real attitude loop (fsw tracking law on
 the sim's rigid-body truth and wheels) and measuring the steady error."""
@@ -19,7 +19,7 @@ from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Scenario
 from sim.attitude import AttitudeTruth
 from sim.camera import TruthCameras
-from sim.faults import FaultInjector
+from faults.hardware import FaultInjector
 from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
 

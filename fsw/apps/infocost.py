@@ -36,7 +36,7 @@ class InfoCostApp(App):
         self.shared = 0
         self.report_factor: Callable[[float], float] = lambda t: 1.0
         """Factor on the reported H_i at time t: 1 unless the harness injects ``faulty_data``
-        (fsw/faults.py)."""
+        (faults/software.py)."""
 
     def on_observations(self, msg: PoiObservations) -> None:
         self.map.add(msg.spacecraft, *msg.arrays())

@@ -103,7 +103,7 @@ class CameraImage(PoiPrecisions):
 class FaultEvent(Message):
     """Truth of an injected fault (sim): ``kind`` on ``spacecraft`` switched on or off at
     ``t_sim``, with the scenario's ``magnitude`` and the realised parameters (``detail``:
-    directions, torques, rotations; see sim/faults.py); spacecraft 0: every observer."""
+    directions, torques, rotations; see faults/hardware.py); spacecraft 0: every observer."""
 
     spacecraft: int = Field(ge=0)
     kind: str = Field(max_length=64)

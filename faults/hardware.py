@@ -22,7 +22,7 @@ The sim's kinds act on the truth, as a failing unit would:
 
 The link kinds (``link_loss``, ``packet_loss``) act in every node's channel model
 (``interfaces.runtime.channel``) and ``faulty_data`` in the faulty spacecraft's software
-(``fsw.faults``); they are listed here too so that the truth of every fault is archived.
+(``faults.software``); they are listed here too so that the truth of every fault is archived.
 
 Every switch is returned as a :class:`FaultSwitch` (for the ``FaultEvent`` truth message).
 Random directions come from ``interfaces.contracts.rng.stream(seed, "fault", k)`` for the k-th
