@@ -1,5 +1,6 @@
 """Fault injection into the hardware stand-in: the scenario's ``[[faults]]`` switched on at
-``start_s`` and off at ``end_s`` (docs/contracts.md, "Scenario TOML": kinds and magnitudes).
+``start_s`` and off at ``end_s`` (``faults/schedule.py``; docs/contracts.md, "Scenario TOML":
+kinds and magnitudes).  The sim hands its units to the injector.
 
 The sim's kinds act on the truth, as a failing unit would:
 
@@ -20,9 +21,10 @@ The sim's kinds act on the truth, as a failing unit would:
   by ``magnitude``, as if the true variance coefficient were k / ``magnitude`` while the ground
   models k: no single observer explains it.
 
-The link kinds (``link_loss``, ``packet_loss``) act in every node's channel model
-(``interfaces.runtime.channel``) and ``faulty_data`` in the faulty spacecraft's software
-(``faults.software``); they are listed here too so that the truth of every fault is archived.
+The link kinds (``link_loss``, ``packet_loss``) act in every node's channel stage
+(``faults/link.py``) and ``faulty_data`` in the faulty spacecraft's software
+(``faults/software.py``); the injector switches them too, so that the truth of every fault is
+archived.
 
 Every switch is returned as a :class:`FaultSwitch` (for the ``FaultEvent`` truth message).
 Random directions come from ``interfaces.contracts.rng.stream(seed, "fault", k)`` for the k-th
@@ -33,18 +35,42 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
+from faults.schedule import HARDWARE_KINDS, switched_on
 from gnc.attitude_gains import gains_for
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Fault, Scenario
-from sim.camera import TruthCameras
-from sim.hardware import ObserverHardware
-from sim.sensors import RelNavSensor
 
-SIM_KINDS = frozenset({"thruster_bias", "pointing_actuator", "camera_degradation",
-                       "camera_misalignment", "nav_sensor_bias", "camera_calibration"})
+
+class Wheels(Protocol):
+    torque_bias_nm: np.ndarray
+    """per observer, body axes, N·m"""
+
+
+class Hardware(Protocol):
+    """The sim's actuators as the faults reach them (``sim/hardware.py``)."""
+
+    force_bias_body: np.ndarray
+    """per observer, body axes, N"""
+
+    @property
+    def wheels(self) -> Wheels: ...
+
+
+class Cameras(Protocol):
+    """The sim's cameras as the faults reach them (``sim/camera.py``)."""
+
+    beta: np.ndarray
+    misalignment: np.ndarray
+
+
+class RelNav(Protocol):
+    """One relative-navigation sensor (``sim/sensors.py``)."""
+
+    bias_m: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -88,9 +114,9 @@ class FaultInjector:
     """
 
     scenario: Scenario
-    hardware: ObserverHardware
-    cameras: TruthCameras
-    relnav: list[RelNavSensor]
+    hardware: Hardware
+    cameras: Cameras
+    relnav: list[RelNav]
     detail: list[dict[str, list[float] | float]] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -127,10 +153,10 @@ class FaultInjector:
         returns the switches."""
         out = []
         for k, f in enumerate(self.scenario.faults):
-            on = f.start_s <= t_s + 1e-9 and (f.end_s is None or t_s < f.end_s - 1e-9)
+            on = switched_on(f, t_s)
             if on != self._active[k]:
                 self._active[k] = on
-                if f.kind in SIM_KINDS:
+                if f.kind in HARDWARE_KINDS:
                     self._apply(k, f, on)
                 out.append(FaultSwitch(k, f, on, t_s, self.detail[k]))
         return out

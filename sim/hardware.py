@@ -20,6 +20,7 @@ from scipy.spatial.transform import Rotation
 from gnc import quat
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.timing import TIME_TOL_S
 from sim import kernels
 from sim.actuators import ThrusterBank, WheelArray
 from sim.attitude import AttitudeTruth
@@ -106,7 +107,7 @@ class ObserverHardware:
         if self.compiled:
             return kernels.thrust_accel_lvlh(q_lvlh_body, self.force_body, self.force_until,
                                              self.force_bias_body, float(t_s), self.mass_kg)
-        active = (t_s < self.force_until - 1e-9)[:, None]
+        active = (t_s < self.force_until - TIME_TOL_S)[:, None]
         f = np.where(active, self.force_body, 0.0) + self.force_bias_body
         out: np.ndarray = quat.rotate(q_lvlh_body, f) / self.mass_kg
         return out
@@ -120,10 +121,10 @@ class ObserverHardware:
                                           self.force_bias_body, self.tau_cmd, self.tau_until,
                                           float(t_s), float(dt_s), self.mass_kg)
         else:
-            active = (t_s < self.force_until - 1e-9)[:, None]
+            active = (t_s < self.force_until - TIME_TOL_S)[:, None]
             spent = np.abs(np.where(active, self.force_body, 0.0)) + np.abs(self.force_bias_body)
             self.dv_mps += spent.sum(axis=1) * dt_s / self.mass_kg
-            held = np.where((t_s < self.tau_until - 1e-9)[:, None], self.tau_cmd, 0.0)
+            held = np.where((t_s < self.tau_until - TIME_TOL_S)[:, None], self.tau_cmd, 0.0)
         tau = self.wheels.realise(held, self.attitude.h, dt_s)
         self.attitude.step(dt_s, tau)
 

@@ -24,6 +24,8 @@ import math
 import numpy as np
 from numba import njit
 
+from interfaces.contracts.timing import TIME_TOL_S
+
 
 @njit(cache=True)
 def _attitude_deriv(y: np.ndarray, J: np.ndarray, Jinv: np.ndarray, tau_total: np.ndarray,
@@ -192,7 +194,7 @@ def thrust_accel_lvlh(q_lvlh_body: np.ndarray, force_body: np.ndarray, force_unt
     n = force_body.shape[0]
     out = np.empty((n, 3))
     for i in range(n):
-        active = t_s < force_until[i] - 1e-9
+        active = t_s < force_until[i] - TIME_TOL_S
         vx = (force_body[i, 0] if active else 0.0) + force_bias_body[i, 0]
         vy = (force_body[i, 1] if active else 0.0) + force_bias_body[i, 1]
         vz = (force_body[i, 2] if active else 0.0) + force_bias_body[i, 2]
@@ -216,13 +218,13 @@ def spend_and_hold(dv_mps: np.ndarray, force_body: np.ndarray, force_until: np.n
     n = force_body.shape[0]
     held = np.empty((n, 3))
     for i in range(n):
-        active = t_s < force_until[i] - 1e-9
+        active = t_s < force_until[i] - TIME_TOL_S
         spent = 0.0
         for k in range(3):
             f = abs(force_body[i, k] if active else 0.0) + abs(force_bias_body[i, k])
             spent = f if k == 0 else spent + f
         dv_mps[i] += spent * dt_s / mass_kg
-        holding = t_s < tau_until[i] - 1e-9
+        holding = t_s < tau_until[i] - TIME_TOL_S
         for k in range(3):
             held[i, k] = tau_cmd[i, k] if holding else 0.0
     return held

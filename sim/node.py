@@ -11,7 +11,6 @@ attitude) to t + dt.
 from __future__ import annotations
 
 import logging
-import math
 import threading
 import time
 from dataclasses import dataclass, field
@@ -22,9 +21,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from gnc import quat
-from gnc.hcw import mean_motion, pro_state
-from gnc.infocost import Camera
-from gnc.poi import sphere_pois
+from gnc.hcw import pro_state
+from gnc.mission import MissionConstants
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.catalogue import Topic
@@ -50,17 +48,16 @@ from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
 
 
-def initial_states(scenario: Scenario) -> np.ndarray:
+def initial_states(scenario: Scenario, n: float) -> np.ndarray:
     """Initial LVLH relative states (N, 6) of the observers: on their scenario PROs, or just
     released from the target (``observers.start = "deploy"``: at ``deploy_radius_m`` moving
     outward at ``deploy_speed_mps``, directions fanned evenly in the along-track/cross-track
-    plane)."""
+    plane); ``n``: the target's mean motion, rad/s."""
     obs = scenario.observers
     if obs.start == "deploy":
         theta = 2.0 * np.pi * np.arange(obs.count) / obs.count
         d = np.stack([np.zeros(obs.count), np.cos(theta), np.sin(theta)], axis=1)
         return np.hstack([obs.deploy_radius_m * d, obs.deploy_speed_mps * d])
-    n = mean_motion(scenario.orbit.altitude_km * 1e3)
     return np.array([pro_state(n, *obs.pro(i)) for i in range(1, obs.count + 1)])
 
 
@@ -101,16 +98,16 @@ class SimNode:
 
     def __post_init__(self) -> None:
         sc = self.scenario
+        self.constants = MissionConstants.of(sc)
         chief = circular_chief_eci(sc.orbit.altitude_km * 1e3, np.radians(sc.orbit.inclination_deg))
         self.truth = RelativeTruth(
-            chief, initial_states(sc), j2=sc.orbit.j2,
+            chief, initial_states(sc, self.constants.n_rad_s), j2=sc.orbit.j2,
             energy_match=sc.observers.energy_match and sc.observers.start == "pro")
         self.ids = list(range(1, sc.observers.count + 1))
         self.hw = ObserverHardware(sc, Rotation.from_quat(quat.conj(self._q_lvlh_eci())))
         cam = sc.camera
         self.cameras = TruthCameras(
-            *sphere_pois(sc.target.pois, sc.target.radius_m),
-            Camera(math.radians(cam.half_angle_deg), cam.max_range_m, cam.k),
+            self.constants.poi_pos, self.constants.poi_normal, self.constants.camera,
             np.array(sc.attitude.boresight_body), cam.noise_frac,
             [stream(sc.seed, "camera", i) for i in self.ids])
         self.sensors = [

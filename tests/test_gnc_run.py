@@ -14,7 +14,7 @@ import pytest
 from deploy.run_constellation import main
 from fsw.apps.guidance import KEEP_OUT_MARGIN_M
 from gnc.hcw import mean_motion
-from gnc.poi import sphere_pois
+from gnc.mission import MissionConstants
 from gnc.pro import Pro
 from ground.archive.reader import load_run
 from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
@@ -72,7 +72,7 @@ def test_reconfiguration_arrives_on_the_new_pro_and_holds_it(run: tuple[Path, di
     assert decision.reason == "phase" and decision.switched
     assert decision.t_sim == phase.start_s - UPLINK_LEAD_S
     assert 0.0 < decision.expected_gain <= decision.upper_bound
-    library = MissionPlan(sc, *sphere_pois(sc.target.pois, sc.target.radius_m)).library
+    library = MissionPlan(sc, MissionConstants.of(sc)).library
     for i in (1, 2):
         pro = library[decision.library_indices[i - 1]]
         # Truth against the assigned PRO from arrival to the end: within 0.5 m (nav noise ~3 cm,

@@ -1,8 +1,9 @@
 """The import rules of the house: the contracts import nothing else of the project; the runtime
-imports only the contracts; the shared GNC library (``gnc``) only the contracts; none of them
-imports flight, sim or ground code, and flight, sim and ground never import each other (imports
-inside functions included: they are read from the source, not from what a run happens to
-load)."""
+imports only the contracts (and the link faults its channel stage applies, and the mission's
+constants it hands the apps); the shared GNC library (``gnc``) only the contracts; fault
+injection (``faults``) the contracts and the library; none of them imports flight, sim or
+ground code, and flight, sim and ground never import each other (imports inside functions
+included: they are read from the source, not from what a run happens to load)."""
 
 from __future__ import annotations
 
@@ -30,29 +31,46 @@ def _imports(path: Path) -> set[str]:
 
 
 def _violations(room: str, allowed: tuple[str, ...], root: Path = REPO) -> list[str]:
-    """Imports from the files of ``room`` (a package path under ``root``) outside the
-    ``allowed`` prefixes."""
+    """Imports from the files of ``room`` (a package or module, dotted, under ``root``) outside
+    the ``allowed`` prefixes."""
     bad = []
-    for path in sorted((root / room.replace(".", "/")).rglob("*.py")):
+    base = root / room.replace(".", "/")
+    module = base.with_suffix(".py")
+    paths = [module] if module.is_file() else sorted(base.rglob("*.py"))
+    assert paths, f"no source in {room}"
+    for path in paths:
         for module in sorted(_imports(path)):
             if not any(module == a or module.startswith(a + ".") for a in allowed):
                 bad.append(f"{path.relative_to(root)} imports {module}")
     return bad
 
 
-RUNTIME_MAY = ("interfaces.contracts", "interfaces.runtime")
+RUNTIME_MAY = ("interfaces.contracts", "interfaces.runtime", "faults.link", "faults.schedule",
+               "gnc.mission")
+"""The runtime's channel stage applies the link faults (``faults/link.py``), and an app's
+context carries the mission's constants (``gnc/mission.py``)."""
 
 
 def test_the_contracts_import_only_the_contracts() -> None:
     assert _violations("interfaces.contracts", ("interfaces.contracts",)) == []
 
 
-def test_the_runtime_imports_only_the_contracts_and_itself() -> None:
+def test_the_runtime_imports_only_the_contracts_itself_and_what_it_hands_on() -> None:
     assert _violations("interfaces.runtime", RUNTIME_MAY) == []
 
 
 def test_the_gnc_library_imports_only_the_contracts_and_itself() -> None:
     assert _violations("gnc", ("interfaces.contracts", "gnc")) == []
+
+
+def test_fault_injection_imports_only_the_contracts_the_library_and_itself() -> None:
+    assert _violations("faults", ("interfaces.contracts", "gnc", "faults")) == []
+
+
+def test_the_link_faults_import_no_library() -> None:
+    """The channel stage of every process loads them: the contracts are all they need."""
+    for room in ("faults.link", "faults.schedule"):
+        assert _violations(room, ("interfaces.contracts", "faults")) == []
 
 
 @pytest.mark.parametrize("room", ["fsw", "sim", "ground"])

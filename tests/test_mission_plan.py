@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from gnc.poi import sphere_pois
+from gnc.mission import MissionConstants
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro, min_distance_between, min_distance_to_origin
 from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
@@ -52,7 +53,7 @@ def _fly(plan: MissionPlan, fused: PoiMap, t0: float, t1: float, dt: float = 20.
 def test_scenario_phases_are_issued_at_their_uplink_time() -> None:
     sc = _scenario([{"name": "a", "start_s": 500.0, "transfer_s": 300.0, "rho_x_m": 12.0},
                     {"name": "b", "start_s": 1500.0, "transfer_s": 400.0, "phase0_deg": 40.0}])
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     assert plan.current is not None and plan.current.phase == "initial"
     plan.update(500.0 - UPLINK_LEAD_S - 10.0, fused)
@@ -73,7 +74,7 @@ def test_scenario_phases_are_issued_at_their_uplink_time() -> None:
 def test_information_phase_takes_the_greedy_set_matched_to_the_observers() -> None:
     sc = _scenario([{"name": "insp", "start_s": 600.0, "transfer_s": 500.0,
                      "assign": "information"}])
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     rng = np.random.default_rng(3)
     fused.add(1, np.arange(400), rng.uniform(0.0, 2.0, 400))  # an uneven fused view
@@ -104,7 +105,7 @@ def test_information_phase_takes_the_greedy_set_matched_to_the_observers() -> No
 def test_reassigns_when_the_measured_gain_saturates() -> None:
     sc = _scenario([{"name": "insp", "start_s": 300.0, "transfer_s": 300.0,
                      "assign": "information"}], check_period_s=300.0, saturation_fraction=0.5)
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     _fly(plan, fused, 0.0, 6000.0)
     saturated = [d for d in plan.decisions if d.reason == "saturated"]
@@ -136,7 +137,7 @@ def test_reassigns_when_the_measured_gain_saturates() -> None:
 def test_keeps_the_current_set_unless_the_new_one_is_better_by_the_margin() -> None:
     sc = _scenario([{"name": "insp", "start_s": 300.0, "transfer_s": 300.0,
                      "assign": "information"}], min_improvement=1e6)
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     _fly(plan, fused, 0.0, 4000.0)
     saturated = [d for d in plan.decisions if d.reason == "saturated"]
@@ -154,7 +155,7 @@ def test_a_coming_phase_preempts_reassignment() -> None:
                      "assign": "information"},
                     {"name": "end", "start_s": 2400.0, "transfer_s": 300.0}],
                    check_period_s=200.0, saturation_fraction=0.9, transfer_s=2000.0)
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     _fly(plan, fused, 0.0, 2300.0)
     # any reassignment would arrive after "end" starts, so none is decided
@@ -165,7 +166,7 @@ def test_a_coming_phase_preempts_reassignment() -> None:
 def test_poi_subsample_evaluates_every_kth_poi_with_scaled_importance() -> None:
     sc = _scenario([{"name": "insp", "start_s": 600.0, "transfer_s": 500.0,
                      "assign": "information"}], poi_stride=4)
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     fused.add(2, np.arange(400), np.random.default_rng(4).uniform(0.0, 1.0, 400))
     plan.update(600.0 - UPLINK_LEAD_S, fused)
@@ -178,7 +179,8 @@ def test_poi_subsample_evaluates_every_kth_poi_with_scaled_importance() -> None:
                             sc.guidance.keep_out_m + a.keep_out_margin_m)
     assert sorted(d.library_indices) == sorted(ref.indices)
     assert math.isclose(d.expected_gain, ref.gain, rel_tol=1e-12)
-    full = MissionPlan(_scenario(sc.model_dump()["phases"], poi_stride=1), POS, NOR)
+    whole = _scenario(sc.model_dump()["phases"], poi_stride=1)
+    full = MissionPlan(whole, MissionConstants.of(whole))
     full.update(600.0 - UPLINK_LEAD_S, fused)
     # the subsample estimates the full expected gain (uniform Fibonacci subsample)
     assert math.isclose(d.expected_gain, full.decisions[0].expected_gain, rel_tol=0.1)
@@ -186,7 +188,7 @@ def test_poi_subsample_evaluates_every_kth_poi_with_scaled_importance() -> None:
 
 def test_recovery_drops_a_failed_camera_and_reassigns_around_it() -> None:
     sc = _scenario([])
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     _fly(plan, fused, 0.0, 400.0)
     before = plan.current
@@ -215,7 +217,7 @@ def test_recovery_gives_an_actuator_fault_a_pro_it_can_hold() -> None:
     plus twice that.  Faults of one FDIR cycle make one assignment; the others keep the
     nominal keep-out."""
     sc = _scenario([])
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     issued = len(plan.issued)
     assert plan.recover(100.0, [(1, "actuator", {"pointing_error_deg": 5.0}),
@@ -236,7 +238,7 @@ def test_later_information_phases_keep_the_recovery() -> None:
     the failed camera's observer untasked and give the impaired one a PRO it can hold."""
     sc = _scenario([{"name": "insp", "start_s": 1000.0, "transfer_s": 300.0,
                      "assign": "information"}], check_period_s=200.0)
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     _fly(plan, fused, 0.0, 300.0)
     assert plan.recover(300.0, [(2, "camera", {}), (3, "actuator", {"nav_vs_plan_m": 3.0})],
@@ -254,7 +256,7 @@ def test_later_information_phases_keep_the_recovery() -> None:
 
 def test_an_impossible_keep_out_falls_back_and_an_impossible_set_changes_nothing() -> None:
     sc = _scenario([])
-    plan = MissionPlan(sc, POS, NOR)
+    plan = MissionPlan(sc, MissionConstants.of(sc))
     fused = PoiMap.uniform(400, 1.0, 3)
     # no library PRO keeps 1 km: the impaired one falls back to the nominal keep-out
     plan._holdable_keep_out = lambda ev: 1000.0  # type: ignore[method-assign]

@@ -33,7 +33,7 @@ from fsw.lib import attitude_kernels as kern
 from fsw.lib import mekf
 from fsw.lib.attitude import AttitudePlan, repoint, scp_slew, slerp_plan
 from fsw.lib.attitude_control import gains_for
-from gnc import hcw, quat
+from gnc import quat
 from gnc.frames import lvlh_to_eci_quat
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
@@ -43,6 +43,7 @@ from interfaces.contracts.messages import (
     StateEstimate,
     WheelCommand,
 )
+from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.runtime.app import App, AppContext, Input, Output
 
 DESIRED_RATE_STEP_S = 1.0
@@ -63,7 +64,7 @@ class AttitudeApp(App):
         super().__init__(ctx)
         sc = ctx.scenario
         self.sc_id = ctx.spacecraft or 0
-        self.n = hcw.mean_motion(sc.orbit.altitude_km * 1e3)
+        self.n = ctx.constants.n_rad_s
         self.incl = math.radians(sc.orbit.inclination_deg)
         self.dt = sc.rates.dt_s
         self.mid_every = sc.rates.ticks_per("mid")
@@ -146,7 +147,7 @@ class AttitudeApp(App):
         it; after a lost sample that rate is used over the whole gap (no rotation is lost)."""
         w_meas = np.array(meas.gyro_radps)
         dt = meas.t_sim - self.t_att if self.t_att is not None else 0.0
-        if self.q is not None and dt > 1e-9:
+        if self.q is not None and dt > TIME_TOL_S:
             self.q, self.b, self.P = kern.mekf_propagate(self.q, self.b, self.P, w_meas, dt,
                                                          self.sigma_v, self.sigma_u)
         if meas.star_tracker is not None:

@@ -22,7 +22,6 @@ import math
 
 import numpy as np
 
-from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
@@ -32,6 +31,7 @@ from interfaces.contracts.messages import (
     PoiObservations,
     StateEstimate,
 )
+from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.runtime.app import App, AppContext, Input, Output
 
 RETARGET_S = 10.0
@@ -55,7 +55,7 @@ class CameraApp(App):
         super().__init__(ctx)
         sc = ctx.scenario
         self.sc_id = ctx.spacecraft or 0
-        self.poi_pos, self.poi_normal = sphere_pois(sc.target.pois, sc.target.radius_m)
+        self.poi_pos, self.poi_normal = ctx.constants.poi_pos, ctx.constants.poi_normal
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self.max_range = sc.camera.max_range_m
         self.max_variance = sc.camera.pointing == "max_variance"
@@ -84,7 +84,7 @@ class CameraApp(App):
         images, self._images = self._images, []
         for img in images:
             self.publish("observations", PoiObservations.of_image(img, self.ctx.node, t))
-        if self.max_variance and t >= self.next_retarget - 1e-9 and self._est is not None \
+        if self.max_variance and t >= self.next_retarget - TIME_TOL_S and self._est is not None \
                 and self._tracking:
             self.next_retarget = t + RETARGET_S
             self.aim_start, self.aim_t = self._aim_at(t)[0], t

@@ -29,7 +29,6 @@ from scipy.spatial.transform import Rotation
 from fsw.lib.mpc import MpcConfig, MpcTracker
 from fsw.lib.scp import TransferPlan, plan_transfer
 from gnc import hcw
-from gnc.constants import R_EARTH_M
 from gnc.pro import Pro, energy_matched_state
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
@@ -41,6 +40,7 @@ from interfaces.contracts.messages import (
     ThrustCommand,
     TransferPlanMsg,
 )
+from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.runtime.app import App, AppContext, Input, Output
 
 MIN_TRANSFER_S = 120.0
@@ -71,8 +71,8 @@ class GuidanceApp(App):
         super().__init__(ctx)
         sc = ctx.scenario
         self.sc_id = ctx.spacecraft or 0
-        self.n = hcw.mean_motion(sc.orbit.altitude_km * 1e3)
-        self.chief_radius_m = R_EARTH_M + sc.orbit.altitude_km * 1e3
+        self.n = ctx.constants.n_rad_s
+        self.chief_radius_m = ctx.constants.chief_radius_m
         self.dt = 1.0 / sc.rates.low_hz
         self.mass = sc.observers.mass_kg
         self.u_max = sc.actuators.thruster_max_force_n / (self.mass * math.sqrt(3.0))
@@ -114,7 +114,7 @@ class GuidanceApp(App):
     # --- cycle ---------------------------------------------------------------------------------
 
     def step(self, t: float) -> None:
-        if self.pending is not None and t >= self.pending.t_depart_s - 1e-9:
+        if self.pending is not None and t >= self.pending.t_depart_s - TIME_TOL_S:
             self._activate(self.pending)
             self.pending = None
         a = self.assignment
@@ -256,4 +256,4 @@ class GuidanceApp(App):
 
 def _propagate(n: float, x: np.ndarray, dt: float) -> np.ndarray:
     """HCW propagation of an estimate to the cycle time (dt ≥ 0, usually 0)."""
-    return x if abs(dt) < 1e-9 else hcw.hcw_stm(n, dt) @ x
+    return x if abs(dt) < TIME_TOL_S else hcw.hcw_stm(n, dt) @ x

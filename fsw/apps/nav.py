@@ -27,6 +27,7 @@ from interfaces.contracts.messages import (
     RelNavMeasurement,
     StateEstimate,
 )
+from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.runtime.app import App, AppContext, Input, Output
 
 THRUST_ERROR_FRAC = 0.05
@@ -44,7 +45,7 @@ class NavApp(App):
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
         sc = ctx.scenario
-        self.n = hcw.mean_motion(sc.orbit.altitude_km * 1e3)
+        self.n = ctx.constants.n_rad_s
         self.q = sc.nav.q_accel_m2_s3
         self.x: np.ndarray | None = None
         self.P = np.eye(6)
@@ -65,7 +66,7 @@ class NavApp(App):
     def _accel(self, t: float) -> np.ndarray:
         """The commanded acceleration acting from time t (zero outside its hold period)."""
         t0, u = self._cmd
-        return u if t0 - 1e-9 <= t < t0 + self.cmd_period - 1e-9 else np.zeros(3)
+        return u if t0 - TIME_TOL_S <= t < t0 + self.cmd_period - TIME_TOL_S else np.zeros(3)
 
     def step(self, t: float) -> None:
         meas, self._meas = self._meas, None

@@ -11,6 +11,7 @@ from ground.archive.reader import Record, RunArchive
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import AssignmentDecision, CameraImage
 from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.timing import TIME_TOL_S
 
 
 @dataclass
@@ -50,7 +51,7 @@ class CoverageFuser:
 
     def add(self, img: CameraImage) -> None:
         """Fuse one image (H is sampled before the first image at or after each sample time)."""
-        if img.t_sim >= self._next_sample - 1e-9:
+        if img.t_sim >= self._next_sample - TIME_TOL_S:
             self.out.t_s.append(img.t_sim)
             self.out.h.append(self.fused.cost())
             self._next_sample = img.t_sim + self.sample_every_s

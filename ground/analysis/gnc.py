@@ -18,6 +18,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from gnc import hcw
+from gnc.mission import MissionConstants
 from ground.analysis.truth_table import TIME_DECIMALS, TruthTable
 from ground.archive.reader import RunArchive
 from interfaces.contracts import catalogue as cat
@@ -84,7 +85,7 @@ def _hold_errors(archive: RunArchive, scenario: Scenario, mission: str, truth: T
                  out: dict[int, GncSeries]) -> None:
     """Commanded Δv, and the distance of the true position from the assigned PRO while
     guidance holds it (from the assignment's arrival time on)."""
-    n = hcw.mean_motion(scenario.orbit.altitude_km * 1e3)
+    n = MissionConstants.of(scenario).n_rad_s
     assignments = {(a.spacecraft, a.assignment_id): a
                    for m in archive.of(cat.ASSIGNMENTS, mission) for a in m.assignments}
     for st in archive.of(cat.GUIDANCE_STATUS, mission):

@@ -50,7 +50,7 @@ class FdirApp(App):
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
-        self.pipeline = FdirPipeline(ctx.scenario, ctx.node, self.log)
+        self.pipeline = FdirPipeline(ctx.scenario, ctx.constants, ctx.node, self.log)
 
     def on_observations(self, msg: PoiObservations) -> None:
         self.pipeline.observations(msg)

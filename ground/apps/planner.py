@@ -16,7 +16,6 @@ received later (a spacecraft acts on a new ``assignment_id`` once).
 
 from __future__ import annotations
 
-from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
 from ground.planning.mission_plan import MissionPlan
 from interfaces.contracts import catalogue as cat
@@ -42,8 +41,7 @@ class MissionPlanner(App):
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
         sc = ctx.scenario
-        pos, normal = sphere_pois(sc.target.pois, sc.target.radius_m)
-        self.plan = MissionPlan(sc, pos, normal)
+        self.plan = MissionPlan(sc, ctx.constants)
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self._decisions_sent = 0
         self._faults: list[FaultReport] = []

@@ -1,5 +1,5 @@
-"""The FDIR pipeline's link checks (docs/fdir.md, "Link faults"): an observer's data that
-does not reach the ground is a link fault, never zero information gain.
+"""The FDIR pipeline's link checks (docs/fdir.md, "Link and data faults"): an observer's data
+that does not reach the ground is a link fault, never zero information gain.
 
 * **Loss**: more of a window's observations missing by sequence number (the observer numbers
   every message it publishes on its key) than the link's nominal loss allows

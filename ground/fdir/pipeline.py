@@ -26,9 +26,7 @@ import math
 import numpy as np
 
 from gnc import quat
-from gnc.hcw import mean_motion
-from gnc.infocost import Camera
-from gnc.poi import sphere_pois
+from gnc.mission import MissionConstants
 from gnc.poi_map import PoiMap
 from ground.fdir.declaration import Declarer
 from ground.fdir.global_check import GlobalCheck
@@ -53,26 +51,26 @@ from interfaces.contracts.messages import (
     TransferPlanMsg,
 )
 from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.timing import TIME_TOL_S
+
 
 class FdirPipeline:
-    """The FDIR's state and its window-by-window judgement, for ``scenario`` on node
-    ``node``."""
+    """The FDIR's state and its window-by-window judgement, for ``scenario`` (whose constants
+    are ``constants``) on node ``node``."""
 
-    def __init__(self, scenario: Scenario, node: str, log: logging.Logger) -> None:
+    def __init__(self, scenario: Scenario, constants: MissionConstants, node: str,
+                 log: logging.Logger) -> None:
         sc, cfg = scenario, scenario.fdir
         self.node, self.log, self.settle_s, self.latency_s = node, log, cfg.settle_s, cfg.latency_s
         self.schedule = FdiSchedule(sc.rates.fdi_period_s)
-        self.n = mean_motion(sc.orbit.altitude_km * 1e3)
-        camera = Camera(math.radians(sc.camera.half_angle_deg), sc.camera.max_range_m,
-                        sc.camera.k)
-        self.twin = TwinModel(*sphere_pois(sc.target.pois, sc.target.radius_m), camera,
+        self.n = constants.n_rad_s
+        self.twin = TwinModel(constants.poi_pos, constants.poi_normal, constants.camera,
                               sc.target.radius_m, sc.camera.noise_frac)
         self.settled = PoiMap.uniform(sc.target.pois, sc.target.prior_variance,
                                       sc.observers.count)
         self.pending: list[PoiObservations] = []
         self.observers = {i: ObserverState() for i in range(1, sc.observers.count + 1)}
-        self.boresight_body = np.array(sc.attitude.boresight_body, dtype=float)
-        self.boresight_body /= np.linalg.norm(self.boresight_body)
+        self.boresight_body = constants.boresight_body
         q_window = window_false_alarm(cfg.false_alarms_per_observer_hour, sc.rates.fdi_period_s,
                                       cfg.persistence, 2 if cfg.fuse_nis else 1)
         self.links = LinkChecks(sc, node, log)
@@ -161,7 +159,7 @@ class FdirPipeline:
     def due(self, t: float) -> list[Message]:
         """Judge every window due by time t (s): ``fdir.latency_s`` after it closed."""
         out: list[Message] = []
-        while t >= self.schedule.end(self.next_window) + self.latency_s - 1e-9:
+        while t >= self.schedule.end(self.next_window) + self.latency_s - TIME_TOL_S:
             k = self.next_window
             self.next_window += 1  # first: a failing window is not retried forever
             out += self.evaluate(k)

@@ -37,8 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from gnc.hcw import mean_motion
-from gnc.infocost import Camera
+from gnc.mission import MissionConstants
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro, min_distance_between, min_distance_to_origin
 from ground.planning.orbit_assignment import (
@@ -51,6 +50,7 @@ from ground.planning.orbit_assignment import (
 )
 from interfaces.contracts.messages import ProElements
 from interfaces.contracts.scenario import Phase, Scenario
+from interfaces.contracts.timing import TIME_TOL_S
 
 log = logging.getLogger(__name__)
 
@@ -114,28 +114,27 @@ class MissionPlan:
 
     Attributes:
         scenario: the mission.
-        poi_pos, poi_normal: the target model (M, 3), m; the planner's camera model sees every
-            ``assignment.poi_stride``-th of them (expected gains are scaled accordingly).
+        constants: the mission's constants (``gnc/mission.py``): mean motion, the camera
+            model, the target's POIs, of which the planner sees every
+            ``assignment.poi_stride``-th (expected gains are scaled accordingly).
         issued: every assignment issued so far, in order (the last one is current).
         decisions: every information-driven decision, in order.
     """
 
     scenario: Scenario
-    poi_pos: npt.NDArray[np.float64]
-    poi_normal: npt.NDArray[np.float64]
+    constants: MissionConstants
     issued: list[PlannedAssignment] = field(default_factory=list)
     decisions: list[Decision] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         sc = self.scenario
         a = sc.assignment
-        self.n = mean_motion(sc.orbit.altitude_km * 1e3)
+        self.n = self.constants.n_rad_s
         self.count = sc.observers.count
-        self.camera = Camera(math.radians(sc.camera.half_angle_deg), sc.camera.max_range_m,
-                             sc.camera.k)
+        self.camera = self.constants.camera
         self._stride = a.poi_stride
-        self._plan_pos = self.poi_pos[::a.poi_stride]
-        self._plan_normal = self.poi_normal[::a.poi_stride]
+        self._plan_pos = self.constants.poi_pos[::a.poi_stride]
+        self._plan_normal = self.constants.poi_normal[::a.poi_stride]
         self.library = pro_library(
             a.rho_x_m, a.rho_z_m, np.linspace(0.0, 2.0 * math.pi, a.phases, endpoint=False),
             cross_phase_offsets_rad=[math.radians(d) for d in a.cross_phase_offsets_deg])
@@ -162,7 +161,7 @@ class MissionPlan:
         set for saturation.  ``fused``: the ground's fused POI map at ``t``."""
         phases = self.scenario.phases
         while (self._next_phase < len(phases)
-               and phases[self._next_phase].start_s - UPLINK_LEAD_S <= t + 1e-9):
+               and phases[self._next_phase].start_s - UPLINK_LEAD_S <= t + TIME_TOL_S):
             self._start_phase(phases[self._next_phase], t, fused)
             self._next_phase += 1
         self._check_saturation(t, fused)
@@ -187,14 +186,14 @@ class MissionPlan:
 
     def _check_saturation(self, t: float, fused: PoiMap) -> None:
         cur = self.current
-        if cur is None or self._current_indices is None or t < cur.t_arrive_s - 1e-9:
+        if cur is None or self._current_indices is None or t < cur.t_arrive_s - TIME_TOL_S:
             return
         a = self.scenario.assignment
         if self._last_check is None:
             self._last_check = (t, fused.cost())
             return
         t_last, h_last = self._last_check
-        if t - t_last < a.check_period_s - 1e-9:
+        if t - t_last < a.check_period_s - TIME_TOL_S:
             return
         h = fused.cost()
         self._gains.append(h_last - h)

@@ -10,11 +10,12 @@ an app's step stays short.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
 
+from gnc.mission import MissionConstants
 from interfaces.contracts.catalogue import Topic
 from interfaces.contracts.messages import Message, RateGroupName
 from interfaces.contracts.scenario import Scenario
@@ -25,7 +26,9 @@ RATE_GROUPS: tuple[RateGroupName, ...] = ("high", "mid", "low")
 
 @dataclass(frozen=True)
 class AppContext:
-    """What an app gets from its executive."""
+    """What an app gets from its executive: its bus, the scenario and the constants it implies
+    (computed once per node; from the scenario when not given), its node and spacecraft, its
+    random stream and its logger."""
 
     bus: Bus
     scenario: Scenario
@@ -33,6 +36,11 @@ class AppContext:
     spacecraft: int | None
     rng: np.random.Generator
     log: logging.Logger
+    constants: MissionConstants = field(default=None)  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.constants is None:
+            object.__setattr__(self, "constants", MissionConstants.of(self.scenario))
 
     @property
     def mission(self) -> str:

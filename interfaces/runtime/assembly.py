@@ -14,6 +14,7 @@ import logging
 from collections.abc import Callable
 from typing import Any
 
+from gnc.mission import MissionConstants
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import Node
@@ -44,10 +45,12 @@ def app_class(name: str) -> type[App]:
 
 def build_executive(node: Node, bus: Bus, scenario: Scenario) -> Executive:
     """``node``'s executive on ``bus``: every declared app with the node's context (its
-    spacecraft, its random stream, its logger ``insp.<node>``)."""
+    spacecraft, its random stream, its logger ``insp.<node>``, the mission's constants
+    computed once for all its apps)."""
     log = logging.getLogger(f"insp.{node.name}")
     ctx = AppContext(bus=bus, scenario=scenario, node=node.name, spacecraft=node.spacecraft,
-                     rng=stream(scenario.seed, *node.rng), log=log)
+                     rng=stream(scenario.seed, *node.rng), log=log,
+                     constants=MissionConstants.of(scenario))
     return Executive(bus, scenario, [app_class(a)(ctx) for a in node.apps], log=log)
 
 

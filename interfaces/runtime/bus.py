@@ -38,13 +38,13 @@ from pydantic import ValidationError
 
 from interfaces.contracts import catalogue, topics
 from interfaces.contracts.messages import Message, TruthState, json_schema, registry, stamp
+from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
 from interfaces.runtime.channel import ChannelModel, Verdict, applies
 from interfaces.runtime.transport import LivenessHandler, RawHandler, Sample, Transport
 
 M = TypeVar("M", bound=Message)
 MAX_PAYLOAD_BYTES = 1 << 20
-_EPS_S = 1e-6
 _UNKNOWN = object()
 """Marks a key not yet looked up in the catalogue."""
 
@@ -350,10 +350,10 @@ class Bus:
     def _is_due(self, env: _Envelope, t_now: float, include_now: bool, delay: float) -> bool:
         t = env.msg.t_sim
         if env.local or env.src == topics.SIM:
-            return t <= t_now + _EPS_S
+            return t <= t_now + TIME_TOL_S
         link_delay = delay if self._crosses_link(env.src) else 0.0
-        sent_before = t <= t_now + _EPS_S if include_now else t < t_now - _EPS_S
-        return sent_before and t + link_delay <= t_now + _EPS_S
+        sent_before = t <= t_now + TIME_TOL_S if include_now else t < t_now - TIME_TOL_S
+        return sent_before and t + link_delay <= t_now + TIME_TOL_S
 
     def _crosses_link(self, src: str | None) -> bool:
         """Whether messages from node ``src`` cross a modelled link to this node (cached)."""

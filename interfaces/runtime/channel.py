@@ -7,12 +7,13 @@ transport or on arrival order:
 * range: delivered only when the two ends are within ``comms.range_m`` at the *send* time, using
   the sim's truth positions (LVLH, m).  The ground is reached through the target, at the origin.
 * cuts: scheduled link cuts (``comms.cuts``), ``link_loss`` faults (every link of the faulty
-  spacecraft) and injected ones (``cut``) drop everything.
+  spacecraft: ``faults/link.py``) and injected ones (``cut``) drop everything.
 * loss: Bernoulli with ``comms.packet_loss``, or Gilbert-Elliott bursts with the same mean loss
   rate and a mean burst length ``comms.burst.mean_length_packets`` (Gilbert 1960, Elliott 1963:
   two-state Markov chain, loss in the bad state).  Every directed link has its own generator
   seeded from the scenario seed and the link name.  A ``packet_loss`` fault adds an independent
-  Bernoulli loss (its ``magnitude``) on every link of its spacecraft, from a separate stream.
+  Bernoulli loss (its ``magnitude``) on every link of its spacecraft, from a separate stream
+  (``faults/link.py``).
 * delay: a fixed ``comms.delay_s``; the Bus holds a message until the receiver's time reaches
   send time + delay (and at least one tick).
 
@@ -34,6 +35,7 @@ from enum import Enum
 
 import numpy as np
 
+from faults.link import LinkFaults
 from interfaces.contracts.messages import LinkCounter, TruthState
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Comms, Fault, LinkCut, Scenario
@@ -172,14 +174,8 @@ class ChannelModel:
 
     def __post_init__(self) -> None:
         self._cuts = [_Cut(c.a, c.b, c.start_s, c.end_s) for c in self.comms.cuts]
-        for f in self.faults:
-            if f.kind == "link_loss":
-                self._cuts.append(_Cut(f"sc{f.spacecraft}", "*", f.start_s,
-                                       math.inf if f.end_s is None else f.end_s))
-        self._fault_loss = [(f"sc{f.spacecraft}", f.start_s,
-                             math.inf if f.end_s is None else f.end_s, float(f.magnitude or 0.0))
-                            for f in self.faults if f.kind == "packet_loss"]
-        self._fault_rngs: dict[str, np.random.Generator] = {}
+        self._faults = LinkFaults(self.receiver, self.seed, self.faults)
+        self._cuts += [_Cut(c.node, "*", c.start_s, c.end_s) for c in self._faults.cuts()]
         self._ge = (
             gilbert_elliott_rates(self.comms.packet_loss, self.comms.burst.mean_length_packets)
             if self.comms.burst is not None and self.comms.packet_loss > 0.0
@@ -236,20 +232,7 @@ class ChannelModel:
             lost = link.bad
         elif self.comms.packet_loss > 0.0:
             lost = link.rng.random() < self.comms.packet_loss
-        return Verdict.LOSS if lost or self._fault_lost(src, t_send) else Verdict.DELIVER
-
-    def _fault_lost(self, src: str, t_send: float) -> bool:
-        """Loss from active ``packet_loss`` faults on this link (each an independent Bernoulli
-        draw from the link's own fault stream, so the nominal loss draws are unchanged)."""
-        lost = False
-        for node, start, end, p in self._fault_loss:
-            if start <= t_send < end and node in (src, self.receiver):
-                rng = self._fault_rngs.get(src)
-                if rng is None:
-                    rng = self._fault_rngs[src] = stream(self.seed,
-                                                         f"link-fault:{src}->{self.receiver}")
-                lost = (rng.random() < p) or lost
-        return lost
+        return Verdict.LOSS if lost or self._faults.lost(src, t_send) else Verdict.DELIVER
 
     def _in_range(self, src: str, t_send: float) -> bool:
         pos = self.truth.positions_at(t_send)
