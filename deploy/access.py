@@ -16,7 +16,7 @@ account       may publish (put, liveliness token, schemas)  may subscribe
               reports, FDIR series)
 ``recorder``  its liveliness token only                    the mission
 ``tlm``       nothing (read-only telemetry account for     the mission
-              outside viewers: ``python -m ground.tlm``,
+              outside viewers: ``python -m ground.tools.tlm``,
               any Zenoh client)
 ============  ===========================================  ======================================
 
@@ -27,7 +27,7 @@ therefore names its sender, which the Bus checks against the body
 
 Each account's client configuration is ``access/<account>.json5`` (endpoint, user, password
 and, with TLS, the certificate authority inline: the one file is all a node on another host
-needs): the ``--zenoh-config`` of every node process and of ``ground.tlm``.  With a ``tls/``
+needs): the ``--zenoh-config`` of every node process and of ``ground.tools.tlm``.  With a ``tls/``
 endpoint the router serves the certificate of ``access/tls/`` (``deploy.certificates``) and
 clients verify it against the run's own authority.
 """
@@ -94,7 +94,7 @@ def access_control(mission: str, n_observers: int) -> dict[str, Any]:
     rules: list[dict[str, Any]] = [
         _rule("receive", ["put", "delete", "reply", "liveliness_token"], "egress", mission_keys),
         # a publisher must learn of subscribers, or it drops its data; a subscriber's key
-        # expression may be wider than the mission (ground.tlm's default insp/**)
+        # expression may be wider than the mission (ground.tools.tlm's default insp/**)
         _rule("see-subscribers", ["declare_subscriber"], "egress", [f"{topics.ROOT}/**"]),
         _rule("subscribe", ["declare_subscriber", "declare_liveliness_subscriber", "query",
                             "liveliness_query"], "ingress", [f"{topics.ROOT}/**"]),

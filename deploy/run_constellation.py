@@ -14,7 +14,7 @@ Over Zenoh the network is closed (deploy/access.py): the launcher starts the run
 client with an account of its own, and access-control rules let each publish only in its own key
 space.  The accounts are made for the run in <out>/access/ (owner-only files); the read-only
 telemetry account <out>/access/tlm.json5 lets any Zenoh client watch the run
-(``python -m ground.tlm --zenoh-config <out>/access/tlm.json5``).  A ``tls/`` endpoint serves
+(``python -m ground.tools.tlm --zenoh-config <out>/access/tlm.json5``).  A ``tls/`` endpoint serves
 TLS with a certificate made for the run (its authority is <out>/access/tls/authority.pem).
 --audit-access counts the router's refusals (failed logins, denied messages) into
 <out>/logs/access.json and summary.json's ``access``.  Across hosts: listen on all interfaces

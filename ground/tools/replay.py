@@ -3,13 +3,14 @@ other detector settings.
 
     python -m ground.tools.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR]
 
-RUN is a run directory (holding ``run.mcap``) or an archive.  The ground station itself
-(``ground.station``: planner, telemetry monitor, FDIR, baselines -- the code the live ground
-runs, not a copy) is fed, on the in-process bus, every archived message of the other nodes that
-the ground subscribes to, in the lockstep's order: all messages of sim time t, then the sim's
-Tick at t.  Its own channel model (the scenario's comms, seed, cuts and link faults) decides
-again, in the same deterministic order, which of them reached it, so losses and range cuts
-replay as they happened.  What it publishes -- FDI windows, fault reports, baseline verdicts --
+RUN is a run directory (holding ``run.mcap``) or an archive.  The ground node itself, built
+from the declared topology as a run builds it (``interfaces.contracts.topology``: planner,
+telemetry monitor, FDIR, baselines -- the code the live ground runs, not a copy) is fed, on
+the in-process bus, every archived message of the other nodes that the ground subscribes to,
+in the lockstep's order: all messages of sim time t, then the sim's Tick at t.  Its own
+channel model (the scenario's comms, seed, cuts and link faults) decides again, in the same
+deterministic order, which of them reached it, so losses and range cuts replay as they
+happened.  What it publishes -- FDI windows, fault reports, baseline verdicts --
 is scored as ``summary.json`` scores the live run (``ground.analysis.summary.fdir_results``);
 ``scores_faithful`` scores only what it declared and judged up to ``faithful_until_s``.
 
