@@ -39,7 +39,7 @@ def test_late_observation_is_fused_not_judged() -> None:
     app.step(10.0)  # window [0, 10) judged: nothing received
     assert app.pipeline.window_start == 10.0
     before = app.pipeline.settled.F.copy()
-    app.on_observations(_obs(1, 5.0, 1, [3, 4]))  # image of the judged window, arriving late
+    app.pipeline.observations(_obs(1, 5.0, 1, [3, 4]))  # image of the judged window, arriving late
     assert not app.pipeline.pending
     assert app.pipeline.settled.F[0, 3] == pytest.approx(before[0, 3] + 0.01)
     assert app.pipeline.settled.F[1, 3] == before[1, 3]
@@ -55,7 +55,7 @@ def test_observations_missing_by_sequence_make_a_link_fault() -> None:
             if k >= 1 and i < 6:
                 seq += 1
                 continue
-            app.on_observations(_obs(2, 10.0 * k + i, seq + 1, [1]))
+            app.pipeline.observations(_obs(2, 10.0 * k + i, seq + 1, [1]))
             seq += 1
         app.step(10.0 * (k + 1))
     windows = [m for m in sent if isinstance(m, FdirWindow) and m.spacecraft == 2]

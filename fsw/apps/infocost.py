@@ -34,11 +34,18 @@ class InfoCostApp(App):
         """the FDI window boundary last reported (``interfaces.contracts.fdi_schedule``)"""
         self.images = 0
         self.shared = 0
+        self.rejected = 0
+        """observations dropped for naming a spacecraft outside the constellation"""
         self.report_factor: Callable[[float], float] = lambda t: 1.0
         """Factor on the reported H_i at time t: 1 unless the harness injects ``faulty_data``
         (faults/software.py)."""
 
     def on_observations(self, msg: PoiObservations) -> None:
+        if msg.spacecraft > self.map.n_agents:  # a hostile or corrupted id: dropped, counted
+            self.rejected += 1
+            self.log.warning("dropped observations of spacecraft %d: the constellation has %d "
+                             "(%d dropped)", msg.spacecraft, self.map.n_agents, self.rejected)
+            return
         self.map.add(msg.spacecraft, *msg.arrays())
         if msg.spacecraft == self.sc_id:
             self.images += 1

@@ -2,10 +2,10 @@
 (paper Sec. III.B-E; docs/fdir.md).  The app is the bus adapter of the FDIR pipeline
 (``ground/fdir/pipeline.py``, which holds the stages and says what each judges).
 
-Rate group mid.  Inputs: every observer's POI observations (the images that reached the
-ground), its transfer plans, its nav, attitude, guidance and H_i telemetry, and the ground's
-own PRO assignments.  Outputs: one ``FdirWindow`` per observer and FDI window on
-``ground/fdir/window``, one ``ConstellationWindow`` per FDI window on
+Rate group mid.  Inputs, each handed to the pipeline: every observer's POI observations (the
+images that reached the ground), its transfer plans, its nav, attitude, guidance and H_i
+telemetry, and the ground's own PRO assignments.  Outputs: one ``FdirWindow`` per observer and
+FDI window on ``ground/fdir/window``, one ``ConstellationWindow`` per FDI window on
 ``ground/fdir/constellation``, and a ``FaultReport`` on ``ground/fdir/report`` for each fault
 declared or identified.  Each window is judged ``fdir.latency_s`` after it closes.
 """
@@ -14,19 +14,7 @@ from __future__ import annotations
 
 from ground.fdir.pipeline import FdirPipeline
 from interfaces.contracts import catalogue as cat
-from interfaces.contracts.messages import (
-    AttitudeEstimate,
-    ConstellationWindow,
-    FaultReport,
-    FdirWindow,
-    GuidanceStatus,
-    InfoCostTelemetry,
-    Message,
-    PoiObservations,
-    ProAssignments,
-    StateEstimate,
-    TransferPlanMsg,
-)
+from interfaces.contracts.messages import ConstellationWindow, FaultReport, FdirWindow, Message
 from interfaces.runtime.app import App, AppContext, Input, Output
 
 
@@ -34,13 +22,13 @@ class FdirApp(App):
     NAME = "fdir"
     RATE = "mid"
     INPUTS = (
-        Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
-        Input(cat.TRANSFER_PLAN, "on_transfer", every_spacecraft=True),
-        Input(cat.ASSIGNMENTS, "on_assignments"),
-        Input(cat.ATTITUDE_ESTIMATE, "on_attitude", every_spacecraft=True),
-        Input(cat.INFO_COST, "on_telemetry", every_spacecraft=True),
-        Input(cat.NAV_ESTIMATE, "on_nav", every_spacecraft=True),
-        Input(cat.GUIDANCE_STATUS, "on_guidance", every_spacecraft=True),
+        Input(cat.OBSERVATIONS, "pipeline.observations", every_spacecraft=True),
+        Input(cat.TRANSFER_PLAN, "pipeline.transfer", every_spacecraft=True),
+        Input(cat.ASSIGNMENTS, "pipeline.assignments"),
+        Input(cat.ATTITUDE_ESTIMATE, "pipeline.attitude", every_spacecraft=True),
+        Input(cat.INFO_COST, "pipeline.telemetry", every_spacecraft=True),
+        Input(cat.NAV_ESTIMATE, "pipeline.nav", every_spacecraft=True),
+        Input(cat.GUIDANCE_STATUS, "pipeline.guidance", every_spacecraft=True),
     )
     OUTPUTS = (Output("window", cat.FDIR_WINDOW), Output("report", cat.FAULT_REPORT),
                Output("constellation", cat.CONSTELLATION_WINDOW))
@@ -51,27 +39,6 @@ class FdirApp(App):
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
         self.pipeline = FdirPipeline(ctx.scenario, ctx.constants, ctx.node, self.log)
-
-    def on_observations(self, msg: PoiObservations) -> None:
-        self.pipeline.observations(msg)
-
-    def on_transfer(self, msg: TransferPlanMsg) -> None:
-        self.pipeline.transfer(msg)
-
-    def on_assignments(self, msg: ProAssignments) -> None:
-        self.pipeline.assignments(msg)
-
-    def on_attitude(self, msg: AttitudeEstimate) -> None:
-        self.pipeline.attitude(msg)
-
-    def on_telemetry(self, msg: InfoCostTelemetry) -> None:
-        self.pipeline.telemetry(msg)
-
-    def on_nav(self, msg: StateEstimate) -> None:
-        self.pipeline.nav(msg)
-
-    def on_guidance(self, msg: GuidanceStatus) -> None:
-        self.pipeline.guidance(msg)
 
     def step(self, t: float) -> None:
         for msg in self.pipeline.due(t):

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
+from operator import attrgetter
 from typing import ClassVar
 
 import numpy as np
@@ -49,9 +50,10 @@ class AppContext:
 
 @dataclass(frozen=True)
 class Input:
-    """A subscription: messages of ``topic`` go to method ``handler``.  ``every_spacecraft``:
-    from every spacecraft; otherwise the key that concerns this node (its own spacecraft's,
-    its hardware's sensors, or the sim's/ground's single key)."""
+    """A subscription: messages of ``topic`` go to method ``handler`` (of the app, or dotted, of
+    a part of it: ``"pipeline.observations"``).  ``every_spacecraft``: from every spacecraft;
+    otherwise the key that concerns this node (its own spacecraft's, its hardware's sensors, or
+    the sim's/ground's single key)."""
 
     topic: Topic
     handler: str
@@ -92,7 +94,7 @@ class App:
     def wire(self) -> None:
         """Subscribe the declared inputs (called once by the executive)."""
         for i in self.INPUTS:
-            self.ctx.bus.subscribe(i.key_expr(self.ctx), i.msg_type, getattr(self, i.handler))
+            self.ctx.bus.subscribe(i.key_expr(self.ctx), i.msg_type, attrgetter(i.handler)(self))
 
     def publish(self, name: str, msg: Message) -> None:
         """Publish on a declared output; anything else is a programming error."""
