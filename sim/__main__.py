@@ -7,14 +7,7 @@ import argparse
 from interfaces.contracts import topics
 from interfaces.contracts.topology import topology
 from interfaces.runtime.bus import Bus
-from interfaces.runtime.cli import (
-    add_node_args,
-    load_node_scenario,
-    mission_of,
-    open_zenoh,
-    setup_logging,
-    stop_on_signals,
-)
+from interfaces.runtime.cli import add_node_args, open_zenoh, start_node
 from sim.node import SimNode
 
 
@@ -26,13 +19,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--realtime", type=float, metavar="SPEED",
                         help="pace ticks to the wall clock times SPEED instead of lockstep")
     args = parser.parse_args(argv)
-    log = setup_logging(args.log_level, "sim")
-    scenario = load_node_scenario(args)
-    stop = stop_on_signals()
+    start = start_node(args, topics.SIM)
+    log, scenario = start.log, start.scenario
     participants = topology(scenario, ground=not args.no_ground).participants
-    bus = Bus(topics.SIM, mission_of(args, scenario), open_zenoh(args))
+    bus = Bus(topics.SIM, start.mission, open_zenoh(args))
     try:
-        sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime, log=log, stop=stop)
+        sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime, log=log,
+                      stop=start.stop)
         bus.watch_alive(sim.on_liveness)
         bus.serve_schemas()
         bus.declare_alive()
@@ -41,7 +34,7 @@ def main(argv: list[str] | None = None) -> int:
         except TimeoutError as e:
             log.error("%s", e)
             return 2
-        stop.wait(0.5)  # let the last subscriptions propagate through the mesh
+        start.stop.wait(0.5)  # let the last subscriptions propagate through the mesh
         return 0 if sim.run() else 1
     finally:
         bus.close()

@@ -11,14 +11,7 @@ import argparse
 from ground.archive.metadata import run_metadata
 from ground.archive.recorder import McapRecorder
 from interfaces.contracts import topics
-from interfaces.runtime.cli import (
-    add_node_args,
-    load_node_scenario,
-    mission_of,
-    open_zenoh,
-    setup_logging,
-    stop_on_signals,
-)
+from interfaces.runtime.cli import add_node_args, open_zenoh, start_node
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -27,19 +20,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", required=True, help="MCAP file to write")
     parser.add_argument("--transport-name", default="zenoh", help="recorded in the metadata")
     args = parser.parse_args(argv)
-    log = setup_logging(args.log_level, "recorder")
-    scenario = load_node_scenario(args)
-    mission = mission_of(args, scenario)
-    stop = stop_on_signals()
+    start = start_node(args, "recorder")
+    log, mission = start.log, start.mission
     with open(args.scenario, encoding="utf-8") as f:
-        meta = run_metadata(scenario, args.transport_name, f.read())
+        meta = run_metadata(start.scenario, args.transport_name, f.read())
     rec = McapRecorder(args.out, meta)
     transport = open_zenoh(args)
     try:
         transport.subscribe(topics.mission_wildcard(mission), rec.record)
         transport.declare_alive("recorder", topics.recorder_token(mission))
         log.info("recording %s to %s", topics.mission_wildcard(mission), args.out)
-        while not stop.wait(2.0):
+        while not start.stop.wait(2.0):
             rec.flush()  # a killed recorder loses at most the last 2 s
     finally:
         transport.close()  # no callback can write after this

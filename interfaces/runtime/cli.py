@@ -7,6 +7,7 @@ import logging
 import signal
 import threading
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.runtime.bus import Bus
@@ -49,6 +50,25 @@ def setup_logging(level: str, name: str) -> logging.Logger:
     return logging.getLogger(f"insp.{name}")
 
 
+@dataclass(frozen=True)
+class NodeStart:
+    """What every node process starts with: its logger, the scenario with the command line's
+    overrides, the mission (key-space) name, and the event its signals set."""
+
+    log: logging.Logger
+    scenario: Scenario
+    mission: str
+    stop: threading.Event
+
+
+def start_node(args: argparse.Namespace, name: str) -> NodeStart:
+    """Logging as ``name``, the scenario (exits with a readable message if invalid), the mission
+    name and the stop event of a node process started with :func:`add_node_args`'s options."""
+    log = setup_logging(args.log_level, name)
+    scenario = load_node_scenario(args)
+    return NodeStart(log, scenario, mission_of(args, scenario), stop_on_signals())
+
+
 def stop_on_signals() -> threading.Event:
     """An event set by SIGINT/SIGTERM, so a node finishes its loop and closes cleanly."""
     stop = threading.Event()
@@ -71,20 +91,18 @@ def run_participant(
     Joins the network, wires the executive (with the channel model of ``node``), serves the
     message schemas, announces itself, and runs ticks until the sim finishes (exit 0), the sim
     disappears (exit 3) or a signal stops it (exit 0).  The Zenoh session is always closed."""
-    log = setup_logging(args.log_level, node)
-    scenario = load_node_scenario(args)
-    stop = stop_on_signals()
-    bus = Bus(node, mission_of(args, scenario), open_zenoh(args),
-              channel=ChannelModel.of(node, scenario))
+    start = start_node(args, node)
+    bus = Bus(node, start.mission, open_zenoh(args),
+              channel=ChannelModel.of(node, start.scenario))
     try:
-        client = TickClient(build(bus, scenario))
+        client = TickClient(build(bus, start.scenario))
         bus.watch_alive(client.on_liveness)
         bus.serve_schemas()
         bus.declare_alive()
-        log.info("ready")
-        client.serve(stop)
+        start.log.info("ready")
+        client.serve(start.stop)
         if client.sim_lost and not client.finished.is_set():
-            log.error("sim lost before the end of the run")
+            start.log.error("sim lost before the end of the run")
             return 3
         return 0
     finally:
