@@ -56,7 +56,7 @@ _Part = Any
 
 # Below this rotation angle (rad) Exp uses the Taylor series of sin(θ/2)/θ (as scipy does); the
 # first neglected term, θ⁶/645120, is below 2e-24 there.
-_EXP_SERIES_RAD = 1e-3
+EXP_SERIES_RAD = 1e-3
 
 
 def _parts(a: FloatArray) -> list[_Part]:
@@ -189,6 +189,19 @@ def canonical(q: npt.ArrayLike) -> FloatArray:
     return out
 
 
+def exp_xyz(x: float, y: float, z: float) -> tuple[float, float, float, float]:
+    """:func:`exp` of one rotation vector (x, y, z), rad, as a tuple: plain arithmetic that
+    the compiled attitude kernels compile as it is (``fsw/lib/attitude_kernels.py``), so the
+    two share one text."""
+    theta = math.sqrt(x * x + y * y + z * z)
+    if theta < EXP_SERIES_RAD:
+        t2 = theta * theta
+        s = 0.5 - t2 / 48.0 + t2 * t2 / 3840.0
+    else:
+        s = math.sin(0.5 * theta) / theta
+    return s * x, s * y, s * z, math.cos(0.5 * theta)
+
+
 def exp(rotvec: npt.ArrayLike) -> FloatArray:
     """Unit quaternion of a rotation vector, ``Exp(φ) = [sin(θ/2) φ/θ, cos(θ/2)]``, θ = |φ|.
 
@@ -204,16 +217,9 @@ def exp(rotvec: npt.ArrayLike) -> FloatArray:
     """
     va = np.asarray(rotvec, dtype=float)
     if va.ndim == 1:
-        x, y, z = va.tolist()
-        theta = math.sqrt(x * x + y * y + z * z)
-        if theta < _EXP_SERIES_RAD:
-            t2 = theta * theta
-            s = 0.5 - t2 / 48.0 + t2 * t2 / 3840.0
-        else:
-            s = math.sin(0.5 * theta) / theta
-        return np.array([s * x, s * y, s * z, math.cos(0.5 * theta)])
+        return np.array(exp_xyz(*va.tolist()))
     theta = np.sqrt(np.sum(va * va, axis=-1, keepdims=True))
-    small = theta < _EXP_SERIES_RAD
+    small = theta < EXP_SERIES_RAD
     t2 = theta * theta
     s = np.where(small, 0.5 - t2 / 48.0 + t2 * t2 / 3840.0,
                  np.sin(0.5 * theta) / np.where(small, 1.0, theta))

@@ -28,7 +28,8 @@ import math
 import numpy as np
 from numba import njit
 
-_EXP_SERIES_RAD = 1e-3
+from gnc import quat
+
 _PHI_SERIES_RAD = 1e-2
 
 
@@ -78,16 +79,13 @@ def _norm3(v: np.ndarray) -> float:
     return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
 
 
+_exp_xyz = njit(cache=True)(quat.exp_xyz)
+
+
 @njit(cache=True)
 def _qexp(v: np.ndarray) -> np.ndarray:
-    x, y, z = v[0], v[1], v[2]
-    theta = math.sqrt(x * x + y * y + z * z)
-    if theta < _EXP_SERIES_RAD:
-        t2 = theta * theta
-        s = 0.5 - t2 / 48.0 + t2 * t2 / 3840.0
-    else:
-        s = math.sin(0.5 * theta) / theta
-    return np.array([s * x, s * y, s * z, math.cos(0.5 * theta)])
+    qx, qy, qz, qw = _exp_xyz(v[0], v[1], v[2])
+    return np.array([qx, qy, qz, qw])
 
 
 @njit(cache=True)
