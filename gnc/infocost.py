@@ -140,12 +140,13 @@ def _fused_variance(w_inv: FloatArray, f: FloatArray) -> FloatArray:
 #: below glibc's mmap threshold, such temporaries are recycled from the heap instead of being
 #: mapped afresh (page faults cost ~2 µs each here, REFERENCE.md), and they stay in cache.
 _BLOCK_ELEMS = 8192
-_TINY = float(np.finfo(np.float64).tiny)
+TINY = float(np.finfo(np.float64).tiny)
+"""The smallest squared distance a precision divides by (m²): a camera on a POI stays finite."""
 
 
-def _inputs(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.ArrayLike,
-            poi_normal: npt.ArrayLike | None, camera: Camera,
-            ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray | None]:
+def checked_inputs(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.ArrayLike,
+                   poi_normal: npt.ArrayLike | None, camera: Camera,
+                   ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray | None]:
     """Validated camera positions p (N, 3), unit boresights b (N, 3), POIs s (M, 3), normals.
 
     Normals are only used through the sign of n·(p − s), so they are not normalised; zero rows
@@ -231,7 +232,7 @@ def visibility(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.Ar
     Raises:
         ValueError: on wrong shapes, NaN/inf, zero-length directions.
     """
-    p, b, s, n = _inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
+    p, b, s, n = checked_inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
     out = np.empty((p.shape[0], s.shape[0]), dtype=bool)
     for sl, _, vis in _blocks(p, b, s, n, camera):
         out[:, sl] = vis
@@ -260,7 +261,7 @@ def _fill_precision(p: FloatArray, b: FloatArray, s: FloatArray, n: FloatArray |
         # 1/(k d²) everywhere, then zero where not visible: a masked divide (where=) costs
         # ~5× more.  d² is clamped to the smallest normal so a camera on a hidden POI gives
         # 4e307·0 = 0, never inf·0.
-        np.maximum(d2, _TINY, out=d2)
+        np.maximum(d2, TINY, out=d2)
         block = out[:, sl]
         np.divide(inv_k, d2, out=block)
         block *= vis
@@ -285,7 +286,7 @@ def precision(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.Arr
     Raises:
         ValueError: bad shapes/values, or a POI marked visible at distance 0.
     """
-    p, b, s, n = _inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
+    p, b, s, n = checked_inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
     shape = (p.shape[0], s.shape[0])
     if out is None:
         out = np.empty(shape)
@@ -389,7 +390,7 @@ def cost_gradient(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt
             observation).
         visible: optional bool (N, M) mask used instead of :func:`visibility`.
     """
-    p, b, s, n = _inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
+    p, b, s, n = checked_inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
     shape = (p.shape[0], s.shape[0])
     mask = _user_mask(visible, shape)
     w, f = _state(w_inv, F)

@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from gnc.infocost import _TINY, Camera, _inputs
+from gnc.infocost import TINY, Camera, checked_inputs
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -46,14 +46,14 @@ def _fill(p: FloatArray, b: FloatArray, s: FloatArray, n: FloatArray, facing: bo
             d2 = max(pp + (sx * sx + sy * sy + sz * sz) - 2.0 * (px * sx + py * sy + pz * sz),
                      0.0)
             if proj * proj >= cos2 * d2 and 0.0 < d2 <= r2:
-                out[i, j] = inv_k / max(d2, _TINY)
+                out[i, j] = inv_k / max(d2, TINY)
 
 
 def precision(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.ArrayLike,
               poi_normal: npt.ArrayLike | None, camera: Camera) -> FloatArray:
     """σ⁻¹ (N, M) = 1/(k d²) where visible, else 0: :func:`gnc.infocost.precision`
     compiled (same arguments, same validation and errors)."""
-    p, b, s, n = _inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
+    p, b, s, n = checked_inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
     out = np.empty((p.shape[0], s.shape[0]))
     _fill(p, b, s, s if n is None else n, n is not None, float(np.cos(camera.half_angle_rad)) ** 2,
           camera.max_range_m ** 2, 1.0 / camera.k, out)
