@@ -1,0 +1,123 @@
+"""Scenario files (TOML) as pydantic models: the contract of docs/contracts.md ("Scenario TOML").
+
+Every section has defaults, so a scenario states only what differs.  Unknown keys are errors
+(a typo must not silently fall back to a default); values are checked for range and
+consistency, and errors name the file and the offending field.
+"""
+
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+from pydantic import Field, ValidationError, model_validator
+
+from interfaces.contracts.scenario.base import Section
+from interfaces.contracts.scenario.comms import Comms
+from interfaces.contracts.scenario.faults import Fault
+from interfaces.contracts.scenario.fdir import FdirSettings
+from interfaces.contracts.scenario.flight import Actuators, Attitude, Guidance, Nav, Sensors
+from interfaces.contracts.scenario.mission import CameraSettings, Orbit, Target
+from interfaces.contracts.scenario.observers import Observers, Phase
+from interfaces.contracts.scenario.planning import AssignmentSettings
+from interfaces.contracts.scenario.rates import Rates
+from interfaces.contracts.scenario.sim import SimSettings
+
+
+class Scenario(Section):
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$")
+    seed: int = Field(default=0, ge=0)
+    duration_s: float = Field(gt=0.0)
+    orbit: Orbit = Orbit()
+    target: Target = Target()
+    camera: CameraSettings = CameraSettings()
+    rates: Rates = Rates()
+    comms: Comms = Comms()
+    observers: Observers = Observers()
+    sensors: Sensors = Sensors()
+    nav: Nav = Nav()
+    actuators: Actuators = Actuators()
+    guidance: Guidance = Guidance()
+    attitude: Attitude = Attitude()
+    phases: list[Phase] = Field(default_factory=list)
+    assignment: AssignmentSettings = AssignmentSettings()
+    fdir: FdirSettings = FdirSettings()
+    sim: SimSettings = SimSettings()
+    faults: list[Fault] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _consistency(self) -> Scenario:
+        n = self.observers.count
+        for f in self.faults:
+            if f.spacecraft > n:
+                raise ValueError(f"fault on spacecraft {f.spacecraft} but observers.count = {n}")
+        for where, formation in [("observers", self.observers)] + [
+                (f"phase {p.name!r}", p) for p in self.phases]:
+            for o in formation.overrides:
+                if o.spacecraft > n:
+                    raise ValueError(f"{where}: override of spacecraft {o.spacecraft} but "
+                                     f"observers.count = {n}")
+        starts = [p.start_s for p in self.phases]
+        if starts != sorted(starts) or len(set(starts)) != len(starts):
+            raise ValueError("phases must have strictly increasing start_s")
+        ratio = self.rates.high_hz / self.sensors.star_tracker_hz
+        if abs(ratio - round(ratio)) > 1e-9 or ratio < 1.0 - 1e-9:
+            raise ValueError(f"sensors.star_tracker_hz = {self.sensors.star_tracker_hz} must "
+                             f"divide rates.high_hz = {self.rates.high_hz}")
+        for c in self.comms.cuts:
+            for end in (c.a, c.b):
+                if end.startswith("sc") and int(end[2:]) > n:
+                    raise ValueError(f"link cut names {end} but observers.count = {n}")
+        return self
+
+    @property
+    def n_ticks(self) -> int:
+        """Number of high-rate ticks in the run (t = 0 .. duration_s)."""
+        return int(math.floor(self.duration_s * self.rates.high_hz + 1e-9)) + 1
+
+    def with_overrides(self, seed: int | None = None, duration_s: float | None = None) -> Scenario:
+        """A copy with the command-line overrides applied (and validated)."""
+        data = self.model_dump()
+        if seed is not None:
+            data["seed"] = seed
+        if duration_s is not None:
+            data["duration_s"] = duration_s
+        return Scenario.model_validate(data)
+
+
+class ScenarioError(ValueError):
+    """A scenario file that cannot be read or does not validate; the message names the field."""
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario TOML file (or, with a ``.json`` suffix, a resolved scenario
+    as written by campaigns); raise ScenarioError with a readable message."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as e:
+        raise ScenarioError(f"cannot read scenario {p}: {e.strerror}") from e
+    if p.suffix == ".json":
+        try:
+            return Scenario.model_validate_json(text)
+        except ValidationError as e:
+            raise ScenarioError(f"{p}: invalid scenario: {e}") from None
+    return parse_scenario(text, source=str(p))
+
+
+def parse_scenario(text: str, source: str = "<string>") -> Scenario:
+    """Validate scenario TOML text (see load_scenario)."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ScenarioError(f"{source}: not valid TOML: {e}") from e
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as e:
+        lines = [f"{source}: invalid scenario:"]
+        for err in e.errors():
+            where = ".".join(str(x) for x in err["loc"]) or "(top level)"
+            lines.append(f"  {where}: {err['msg']}")
+        raise ScenarioError("\n".join(lines)) from None
