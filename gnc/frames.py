@@ -14,15 +14,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-__all__ = ["lvlh_rate_lvlh", "lvlh_to_eci", "lvlh_to_eci_quat"]
+__all__ = ["lvlh_rate_lvlh", "lvlh_to_eci_quat"]
 
 
 def lvlh_to_eci_quat(
     t_s: float, n: float, inclination_rad: float, raan_rad: float = 0.0, arg_lat0_rad: float = 0.0
 ) -> np.ndarray:
-    """Quaternion of R_eci_lvlh (see :func:`lvlh_to_eci`), scalar-last [x, y, z, w], shape (4,).
+    """Quaternion of R_eci_lvlh (the rotation taking LVLH vectors into ECI at mission time
+    ``t_s``), scalar-last [x, y, z, w], shape (4,).
 
     R_eci_lvlh = R3(Ω) R1(i) R3(u) (3-1-3 Euler sequence: the columns of R3(Ω) R1(i) are the node
     line p, its in-plane normal q and the orbit normal; R3(u) turns p, q into the radial and
@@ -58,24 +58,6 @@ def lvlh_to_eci_quat(
     return np.array(q) if largest >= 0.0 else -np.array(q)
 
 
-def lvlh_to_eci(
-    t_s: float, n: float, inclination_rad: float, raan_rad: float = 0.0, arg_lat0_rad: float = 0.0
-) -> Rotation:
-    """Rotation taking LVLH vectors into ECI at mission time ``t_s``.
-
-    With the node line p = (cos Ω, sin Ω, 0) and its in-plane normal
-    q = (−sin Ω cos i, cos Ω cos i, sin i), the argument of latitude u = u0 + n t gives
-    x̂ = cos u p + sin u q, ŷ = −sin u p + cos u q, ẑ = p × q (Vallado, Sec. 3.3 perifocal to
-    ECI, with the perifocal axes replaced by the rotating radial/along-track pair).  Built from
-    the closed-form quaternion of :func:`lvlh_to_eci_quat` (one Rotation construction; use that
-    function directly when an array is enough).
-
-    Args: as :func:`lvlh_to_eci_quat`.
-
-    Returns:
-        R_eci_lvlh (columns: the LVLH unit vectors in ECI).
-    """
-    return Rotation.from_quat(lvlh_to_eci_quat(t_s, n, inclination_rad, raan_rad, arg_lat0_rad))
 
 
 def lvlh_rate_lvlh(n: float) -> np.ndarray:
