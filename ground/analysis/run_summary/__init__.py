@@ -1,0 +1,54 @@
+"""The type of a run's summary.json (docs/contracts.md): :class:`RunSummary` and the records
+of its sections, read from and written to the file through pydantic.
+
+``ground.analysis.summary`` builds and writes it; the run report, scoring, the campaign
+report and the campaign replay read it through these records.  On disk it stays the JSON it
+always was (``fdir_series`` rows as positional arrays), and summaries written before a field
+existed still load: the field is filled in with its default and named in
+:attr:`RunSummary.filled`.
+"""
+
+from ground.analysis.run_summary.document import (
+    OTHER_TESTS_FLAG,
+    RunSummary,
+    SummaryError,
+)
+from ground.analysis.run_summary.fdir import (
+    Detection,
+    FailedTests,
+    FaultClass,
+    FaultScore,
+    FdirResults,
+    ModelZ,
+    ReplayResults,
+    ReplaySection,
+    RunFdirSettings,
+    Scores,
+    ThresholdCensus,
+    ThresholdSources,
+)
+from ground.analysis.run_summary.figures import (
+    BUS_HEADER,
+    AccessAudit,
+    ArchiveInfo,
+    AssignmentRecord,
+    CoverageSummary,
+    ExecRecord,
+    FaultEventRecord,
+    GncStats,
+    MessageCounts,
+    NavStats,
+    RecoveryComparison,
+    SimRecord,
+)
+from ground.analysis.run_summary.records import Figure, SummaryRecord
+from ground.analysis.run_summary.series import FdirSeries, MainWindow, SeriesWindow
+
+__all__ = [
+    "BUS_HEADER", "OTHER_TESTS_FLAG", "AccessAudit", "ArchiveInfo", "AssignmentRecord",
+    "CoverageSummary", "Detection", "ExecRecord", "FailedTests", "FaultClass", "FaultEventRecord",
+    "FaultScore", "FdirResults", "FdirSeries", "Figure", "GncStats", "MainWindow", "MessageCounts",
+    "ModelZ", "NavStats", "RecoveryComparison", "ReplayResults", "ReplaySection",
+    "RunFdirSettings", "RunSummary", "Scores", "SeriesWindow", "SimRecord", "SummaryError",
+    "SummaryRecord", "ThresholdCensus", "ThresholdSources",
+]
