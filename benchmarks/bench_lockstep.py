@@ -10,7 +10,6 @@ back from summary.json and the sim's log.  Prints a table and the Zenoh/inproc r
 from __future__ import annotations
 
 import argparse
-import json
 import re
 import socket
 import subprocess
@@ -19,6 +18,10 @@ import tempfile
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+from ground.analysis.run_summary import RunSummary  # noqa: E402
 
 
 def _free_port() -> int:
@@ -32,14 +35,14 @@ def run(transport: str, duration: float, out: Path) -> dict[str, float]:
            "--duration", str(duration), "--out", str(out), "--no-report",
            "--endpoint", f"tcp/127.0.0.1:{_free_port()}"]
     subprocess.run(cmd, cwd=REPO, check=True, capture_output=True)
-    s = json.loads((out / "summary.json").read_text())
+    s = RunSummary.read(out / "summary.json")
     # the sim logs its own tick rate (excludes process start-up and shutdown)
     log = (out / "logs" / "sim.log").read_text() if (out / "logs" / "sim.log").exists() else ""
     rates = [float(x) for x in re.findall(r"([0-9.]+) ticks/s", log)]
-    ticks = s["ticks"]
-    return {"ticks": ticks, "wall_s": s["wall_s"], "ticks_per_s_wall": ticks / s["wall_s"],
-            "ticks_per_s_sim_loop": rates[-1] if rates else ticks / s["wall_s"],
-            "real_time_factor": s["real_time_factor"]}
+    ticks, wall_s = s.ticks or 0, s.wall_s or 0.0
+    return {"ticks": ticks, "wall_s": wall_s, "ticks_per_s_wall": ticks / wall_s,
+            "ticks_per_s_sim_loop": rates[-1] if rates else ticks / wall_s,
+            "real_time_factor": s.real_time_factor}
 
 
 def main() -> None:

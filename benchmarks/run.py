@@ -47,6 +47,7 @@ from benchmarks.lockstep_limit import free_port  # noqa: E402
 from benchmarks.lockstep_limit import measure as lockstep_rate  # noqa: E402
 from benchmarks.tick_budget import CALLS  # noqa: E402
 from benchmarks.tick_budget import TARGETS_MS as TICK_TARGETS_MS  # noqa: E402
+from ground.analysis.run_summary import RunSummary  # noqa: E402
 from interfaces.contracts.scenario import load_scenario  # noqa: E402
 
 TWO_ORBITS_S = 11354.0
@@ -64,7 +65,7 @@ class Measured:
     wall_s: float
     peak_rss_mb: float
     peak_pss_mb: float
-    summary: dict
+    summary: RunSummary
 
 
 def run_tree(cmd: list[str], poll_s: float = 0.25) -> tuple[float, float, float]:
@@ -112,7 +113,7 @@ def constellation(scenario: Path, out: Path, transport: str, duration: float,
     if not report:
         cmd.append("--no-report")
     wall, rss, pss = run_tree(cmd)
-    return Measured(wall, rss, pss, json.loads((out / "summary.json").read_text()))
+    return Measured(wall, rss, pss, RunSummary.read(out / "summary.json"))
 
 
 def scaled_scenario(tmp: Path, observers: int, pois: int) -> Path:
@@ -164,7 +165,7 @@ def bench_reference(quick: bool, tmp: Path, rows: list, res: dict) -> None:
         res[f"reference_{transport}"] = {"wall_s": m.wall_s, "rtf": rtf,
                                          "peak_rss_mb": m.peak_rss_mb,
                                          "peak_pss_mb": m.peak_pss_mb,
-                                         "run_wall_s": m.summary.get("wall_s")}
+                                         "run_wall_s": m.summary.wall_s}
         rows.append((f"reference mission {duration:.0f} s, {transport}",
                      f"{rtf:.0f}x real time ({m.wall_s:.1f} s wall)", _rtf_ratio(transport, rtf,
                                                                          res)))

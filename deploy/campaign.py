@@ -43,6 +43,7 @@ from typing import Annotated, Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
+from ground.analysis.run_summary import RunSummary
 from interfaces.contracts.scenario import FaultKind, Scenario
 
 
@@ -260,8 +261,8 @@ def execute_run(spec: RunSpec, out_root: str, transport: str = "inproc") -> dict
     else:
         raise ValueError(f"unknown transport {transport!r}")
     _finish(spec, partial, final, transport)
-    return {"id": spec.id, "status": summary.get("status"), "error": summary.get("error"),
-            "wall_s": summary.get("wall_s")}
+    return {"id": spec.id, "status": summary.status, "error": summary.error,
+            "wall_s": summary.wall_s}
 
 
 def _attempt_dir(runs: Path, run_id: str, kind: str) -> Path:
@@ -315,14 +316,14 @@ def record_failure(spec: RunSpec, out_root: str, error: str) -> dict[str, Any]:
 
     runs = Path(out_root) / "runs"
     partial = _attempt_dir(runs, spec.id, "failed")
-    (partial / "summary.json").write_text(json.dumps(
-        {"scenario": spec.scenario.name, "seed": spec.seed, "status": "failed", "error": error,
-         "injected_faults": [f.model_dump() for f in spec.scenario.faults]}, indent=2) + "\n")
+    RunSummary(scenario=spec.scenario.name, seed=spec.seed, status="failed", error=error,
+               injected_faults=[f.model_dump() for f in spec.scenario.faults]
+               ).write(partial / "summary.json")
     _finish(spec, partial, runs / spec.id, "-")
     return {"id": spec.id, "status": "failed", "error": error, "wall_s": None}
 
 
-def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
+def _inproc_run(spec: RunSpec, out: Path) -> RunSummary:
     import time
     import traceback
 
@@ -359,7 +360,7 @@ def _inproc_run(spec: RunSpec, out: Path) -> dict[str, Any]:
                          digest=digest)
 
 
-def _zenoh_run(spec: RunSpec, out: Path) -> dict[str, Any]:
+def _zenoh_run(spec: RunSpec, out: Path) -> RunSummary:
     import socket
     import subprocess
     import sys
@@ -388,7 +389,6 @@ def _zenoh_run(spec: RunSpec, out: Path) -> dict[str, Any]:
             break
     summary_path = out / "summary.json"
     if summary_path.exists():
-        summary: dict[str, Any] = json.loads(summary_path.read_text())
-        return summary
+        return RunSummary.read(summary_path)
     return write_summary(out, spec.scenario, "zenoh", 0.0, "failed",
                          "the launcher left no summary (see launcher.log)")

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from ground.analysis.campaign_report import detector_figures, write_campaign_report
+from ground.analysis.run_summary import ReplaySection, RunSummary
 from ground.archive.metadata import archived_scenario
 from ground.archive.reader import ArchiveError
 from ground.tools.replay import replay_run, with_settings
@@ -33,36 +34,33 @@ from interfaces.contracts.scenario import ScenarioError
 
 log = logging.getLogger("insp.campaign")
 
-FDIR_FIELDS = ("detections", "scores", "baselines", "fdir_series", "fdir_thresholds",
-               "fdir_settings")
-"""The fields of a run's summary.json that a replay rewrites."""
-
 
 def replay_job(run_dir: str, settings: dict[str, str], dest_root: str) -> dict[str, Any]:
     """Replay one run directory into ``<dest_root>/runs/<id>/`` (runs on a worker, whose
-    log keeps the ground's errors only: its declarations are in the summaries)."""
+    log keeps the ground's errors only: its declarations are in the summaries).  The run's
+    summary is rewritten with the replay's FDIR sections (``FdirResults``) and ``replay``."""
     logging.getLogger("insp").setLevel(logging.ERROR)
     src = Path(run_dir)
     dest = Path(dest_root) / "runs" / src.name
     dest.mkdir(parents=True, exist_ok=True)
-    summary = json.loads((src / "summary.json").read_text())
+    summary = RunSummary.read(src / "summary.json")
     if (src / "campaign.json").exists():  # the run's group and software version
         shutil.copyfile(src / "campaign.json", dest / "campaign.json")
-    if summary.get("status") == "completed":
+    if summary.status == "completed":
         try:
             replay = replay_run(src / "run.mcap", settings)
         except (ArchiveError, OSError) as e:
-            summary.update(status="failed", error=f"replay: {e}")
+            summary.status, summary.error = "failed", f"replay: {e}"
         else:
             res = replay.results()
-            summary.update({k: res[k] for k in FDIR_FIELDS})
-            summary["replay"] = {"settings": settings, "wall_s": res["replay_wall_s"],
-                                 "faithful_until_s": res["faithful_until_s"],
-                                 "matches_live": res["matches_live"],
-                                 "scores_faithful": res["scores_faithful"]}
-    (dest / "summary.json").write_text(json.dumps(summary, indent=1))
-    return {"id": src.name, "status": summary.get("status"),
-            "matches_live": summary.get("replay", {}).get("matches_live")}
+            summary.set_fdir(res)
+            summary.replay = ReplaySection(settings=settings, wall_s=res.replay_wall_s,
+                                           faithful_until_s=res.faithful_until_s,
+                                           matches_live=res.matches_live,
+                                           scores_faithful=res.scores_faithful)
+    (dest / "summary.json").write_text(summary.to_json(indent=1))
+    return {"id": src.name, "status": summary.status,
+            "matches_live": summary.replay.matches_live if summary.replay else None}
 
 
 def _local(jobs: list[tuple[str, dict[str, str], str]], workers: int
@@ -110,7 +108,7 @@ def rejudge(out: Path, settings: dict[str, str], dest: Path, workers: int = 1,
 def _check_settings(run_dir: Path, settings: dict[str, str]) -> None:
     """Refuse bad settings before any work, against the run's own scenario (read from its
     archive's metadata alone)."""
-    if json.loads((run_dir / "summary.json").read_text()).get("status") == "completed":
+    if RunSummary.read(run_dir / "summary.json").status == "completed":
         with_settings(archived_scenario(run_dir / "run.mcap"), settings)
 
 

@@ -60,6 +60,7 @@ from deploy.campaign import (  # noqa: E402
 )
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
 from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
+from ground.analysis.run_summary import RunSummary  # noqa: E402
 from ground.tools.replay import parse_settings  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
 
@@ -259,7 +260,7 @@ def _sweep_values(text: str) -> tuple[str, list[str]]:
 
 def _failed(out: Path, run_id: str) -> bool:
     p = out / "runs" / run_id / "summary.json"
-    return p.exists() and json.loads(p.read_text()).get("status") != "completed"
+    return p.exists() and RunSummary.read(p).status != "completed"
 
 
 def _run(runs: list[RunSpec], args: argparse.Namespace) -> int:

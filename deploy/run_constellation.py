@@ -34,14 +34,13 @@ process lost, see _Watch) or failed (the sim or recorder died, the run could not
 from __future__ import annotations
 
 import argparse
-import json
 import logging
 import signal
 import sys
 import threading
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # run as a script from a checkout
@@ -51,6 +50,7 @@ from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor  # noqa: E402
 from ground.analysis.digest import LiveDigest, RunDigest, digest_run  # noqa: E402
 from ground.analysis.report import write_report  # noqa: E402
+from ground.analysis.run_summary import AccessAudit, RunSummary  # noqa: E402
 from ground.analysis.summary import add_recovery_comparison, write_summary  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.reader import ArchiveError  # noqa: E402
@@ -148,12 +148,12 @@ def main(argv: list[str] | None = None) -> int:
     digest = digest or _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
                             status=status, error=error, mission=mission, digest=digest,
-                            extra=_access_audit(out))
+                            access=_access_audit(out))
     if args.compare_recovery and status == "completed":
         summary = _compare_recovery(scenario, mission, out, scenario_text, args, summary)
     if not args.no_report:
         write_report(out, scenario, mission, digest=digest)
-    rtf = summary.get("real_time_factor")
+    rtf = summary.real_time_factor
     print(f"{status}: {scenario.name} seed {scenario.seed}, "
           f"{scenario.duration_s:.0f} s simulated in "
           f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time)" if rtf else "")
@@ -210,7 +210,7 @@ def _live_view(args: argparse.Namespace) -> LiveView | None:
 
 
 def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text: str,
-                      args: argparse.Namespace, summary: dict[str, Any]) -> dict[str, Any]:
+                      args: argparse.Namespace, summary: RunSummary) -> RunSummary:
     """Run the counterfactual (recovery flipped) in-process and add the comparison."""
     flipped = scenario.model_copy(update={"fdir": scenario.fdir.model_copy(
         update={"recovery": not scenario.fdir.recovery})})
@@ -296,13 +296,13 @@ def _join(access: RunAccess, router: Child, timeout_s: float) -> ZenohTransport 
     return None
 
 
-def _access_audit(out: Path) -> dict[str, Any] | None:
-    """``{"access": ...}`` from the router's refusal counts, if the run was audited."""
+def _access_audit(out: Path) -> AccessAudit | None:
+    """The router's refusal counts, if the run was audited (and they can be read)."""
     path = out / "logs" / "access.json"
     if not path.is_file():
         return None
     try:
-        return {"access": json.loads(path.read_text(encoding="utf-8"))}
+        return AccessAudit.model_validate_json(path.read_bytes())
     except (OSError, ValueError):
         return None
 

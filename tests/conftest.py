@@ -14,6 +14,7 @@ from typing import Any
 
 import pytest
 
+from ground.analysis.run_summary import RunSummary
 from interfaces.contracts.messages import Message
 from interfaces.contracts.scenario import Scenario, parse_scenario
 
@@ -97,10 +98,10 @@ def collector(*types: type[Message], key_prefix: dict[str, str] | None = None,
 
 
 def recorded_run(scenario: Scenario, out: Path, *types: type[Message]
-                 ) -> tuple[dict[str, list[Any]], dict[str, Any]]:
+                 ) -> tuple[dict[str, list[Any]], RunSummary]:
     """Run ``scenario`` in-process, archiving every message to ``out/run.mcap`` and collecting
     those of ``types`` (as :func:`collector`); returns (collected by type name, the run's
-    summary.json as written)."""
+    summary as written to summary.json)."""
     from deploy.inproc import run_inproc
     from ground.analysis.summary import write_summary
     from ground.archive.recorder import McapRecorder

@@ -11,11 +11,15 @@ from pathlib import Path
 
 import pytest
 
-from deploy.campaign_replay import FDIR_FIELDS
 from deploy.run_campaign import main as run_campaign
 from ground.analysis.campaign_report import detector_figures
+from ground.analysis.run_summary import FdirResults
 from tests.conftest import dask_cluster
 from tests.test_campaign import BASE, CAMPAIGN
+
+
+FDIR_FIELDS = tuple(FdirResults.model_fields)
+"""The fields of a run's summary.json that a replay rewrites."""
 
 
 def _campaign(tmp: Path) -> Path:

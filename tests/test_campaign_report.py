@@ -6,19 +6,23 @@ from __future__ import annotations
 import csv
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
 from ground.analysis.campaign_report import (
     SCALES,
+    CampaignRun,
     _alarms_at,
+    _load,
     _magnitude_bins,
     _rescore,
     _roc,
     detector_figures,
     write_campaign_report,
 )
+from ground.analysis.run_summary import MainWindow, RunSummary, SummaryError
 
 
 def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | None,
@@ -28,14 +32,38 @@ def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | No
             "expected_class": expected, "identified_correctly": cls == expected}
 
 
-def _write(out: Path, rid: str, summary: dict[str, object], group: str | None = None) -> None:
+def _scores(per_fault: list[dict[str, object]], false_alarms: int, nominal_cycles: int
+            ) -> dict[str, object]:
+    return {"per_fault": per_fault, "false_alarms": false_alarms,
+            "nominal_cycles": nominal_cycles,
+            "false_alarm_rate": false_alarms / nominal_cycles if nominal_cycles else None,
+            "false_alarms_per_hour": None}
+
+
+def _detection(sc: int, t: float, cls: str | None, metric: float | None = None,
+               threshold: float | None = None) -> dict[str, object]:
+    return {"spacecraft": sc, "time_s": t, "class": cls, "direction": None, "metric": metric,
+            "threshold": threshold}
+
+
+def _summary(rid: str, sections: dict[str, Any]) -> RunSummary:
+    """A completed run's summary with ``sections`` (the rest as a run would have them)."""
+    return RunSummary.model_validate({
+        "scenario": rid, "seed": 1, "wall_s": 60.0, "status": "completed", "error": None,
+        "detections": [], "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2},
+        **sections})
+
+
+def _run(sections: dict[str, Any]) -> CampaignRun:
+    return CampaignRun("r", "r", "unknown", _summary("r", sections))
+
+
+def _write(out: Path, rid: str, summary: dict[str, Any], group: str | None = None) -> None:
     d = out / "runs" / rid
     d.mkdir(parents=True)
     if group is not None:  # as the campaign runner writes it beside the run
         (d / "campaign.json").write_text(json.dumps({"run": rid, "group": group}))
-    (d / "summary.json").write_text(json.dumps({
-        "status": "completed", "seed": 1, "detections": [],
-        "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2}, "wall_s": 60.0, **summary}))
+    _summary(rid, summary).write(d / "summary.json")
 
 
 @pytest.fixture()
@@ -44,11 +72,10 @@ def campaign(tmp_path: Path) -> Path:
     _write(tmp_path, "a", {
         "injected_faults": [{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0,
                              "end_s": None, "magnitude": 0.5}],
-        "scores": {"per_fault": [_fault(2, "camera_degradation", 0.0, True, 200.0, "camera",
-                                        "camera")], "false_alarms": 0, "nominal_cycles": 2},
-        "baselines": {"cusum": {"per_fault": [_fault(2, "camera_degradation", 0.0, True, 100.0,
-                                                     None, "camera")],
-                                "false_alarms": 0, "nominal_cycles": 2}},
+        "scores": _scores([_fault(2, "camera_degradation", 0.0, True, 200.0, "camera",
+                                  "camera")], 0, 2),
+        "baselines": {"cusum": _scores([_fault(2, "camera_degradation", 0.0, True, 100.0,
+                                               None, "camera")], 0, 2)},
         "fdir_series": {"main": [[2, 0, 100, 0.5, 0.05], [2, 100, 200, 0.5, 0.05],
                                  [1, 0, 100, 0.01, 0.05], [1, 100, 200, 0.01, 0.05]]}},
            group="faulty")
@@ -56,14 +83,14 @@ def campaign(tmp_path: Path) -> Path:
     _write(tmp_path, "b", {
         "injected_faults": [{"spacecraft": 1, "kind": "thruster_bias", "start_s": 100.0,
                              "end_s": None, "magnitude": 0.3}],
-        "scores": {"per_fault": [_fault(1, "thruster_bias", 100.0, False, None, None,
-                                        "actuator")], "false_alarms": 0, "nominal_cycles": 0},
+        "scores": _scores([_fault(1, "thruster_bias", 100.0, False, None, None,
+                                  "actuator")], 0, 0),
         "fdir_series": {"main": [[1, 100, 200, 0.03, 0.05], [1, 200, 300, 0.03, 0.05]]}},
            group="faulty")
     # run c: nominal, one false alarm (two windows just over the threshold)
     _write(tmp_path, "c", {
         "injected_faults": [],
-        "scores": {"per_fault": [], "false_alarms": 1, "nominal_cycles": 2},
+        "scores": _scores([], 1, 2),
         "fdir_series": {"main": [[1, 0, 100, 0.06, 0.05], [1, 100, 200, 0.07, 0.05]]}})
     write_campaign_report(tmp_path, "t", ["a", "b", "c", "missing"])
     return tmp_path
@@ -104,8 +131,7 @@ def test_report_figures(campaign: Path) -> None:
 
 
 def test_roc_rescoring(campaign: Path) -> None:
-    runs = [json.loads((campaign / "runs" / r / "summary.json").read_text()) for r in "abc"]
-    fa, det = _roc(runs, "main")
+    fa, det = _roc(_load(campaign, ["a", "b", "c"]), "main")
     one = int(np.argmin(np.abs(SCALES - 1.0)))
     # at the configured threshold: the camera fault detected, the thruster fault missed; one
     # false alarm (run c) in 4 nominal windows (run a sc1, run c sc1)
@@ -125,11 +151,9 @@ def test_roc_scores_like_the_run(tmp_path: Path) -> None:
                "magnitude": 0.5},
               {"spacecraft": 3, "kind": "link_loss", "start_s": 0.0, "end_s": 150.0,
                "magnitude": None}]
-    run = {"status": "completed", "injected_faults": faults,
-           "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2},
-           "detections": [{"spacecraft": 3, "time_s": 200.0, "class": "link"}],
-           "fdir_series": {"main": [[1, 0, 100, 0.2, 0.05], [1, 100, 200, 0.2, 0.05],
-                                    [2, 0, 100, 0.01, 0.05], [2, 100, 200, 0.01, 0.05]]}}
+    run = _run({"injected_faults": faults, "detections": [_detection(3, 200.0, "link")],
+                "fdir_series": {"main": [[1, 0, 100, 0.2, 0.05], [1, 100, 200, 0.2, 0.05],
+                                         [2, 0, 100, 0.01, 0.05], [2, 100, 200, 0.01, 0.05]]}})
     fa, det = _roc([run], "main")
     one = int(np.argmin(np.abs(SCALES - 1.0)))
     assert det[one] == 1.0  # sc1's alarm at 200 s falls in sc2's fault: detected
@@ -153,8 +177,9 @@ def test_magnitude_bins() -> None:
 def test_m_of_n_persistence() -> None:
     """m exceedances among the last n windows declare once per episode; m == n is n in a row
     (threshold.Persistence)."""
-    def series(levels: list[float]) -> list[list[float]]:
-        return [[1, 100.0 * i, 100.0 * (i + 1), h, 0.05] for i, h in enumerate(levels)]
+    def series(levels: list[float]) -> list[MainWindow]:
+        return [MainWindow(spacecraft=1, t_start_s=100.0 * i, t_end_s=100.0 * (i + 1),
+                           statistic=h, threshold=0.05) for i, h in enumerate(levels)]
 
     gappy = series([0.1, 0.0, 0.1, 0.1, 0.1, 0.0, 0.0, 0.0, 0.1, 0.0, 0.1])
     assert [a.t_s for a in _alarms_at(gappy, 1.0, 2, 2)] == [400.0]
@@ -167,16 +192,16 @@ def test_windows_failed_on_other_tests_count_at_every_threshold_scale() -> None:
     """A main-detector window failed by the plan, pointing, Δv or NIS test (sixth value 1) is
     exceeded whatever the information threshold's scale; a five-value row (a summary written
     before the flag) is judged on H_m alone."""
-    nis_only = [[1, 0.0, 30.0, 0.001, 0.05, 1.0], [1, 30.0, 60.0, 0.001, 0.05, 0.0]]
+    rows = [[1, 0.0, 30.0, 0.001, 0.05, 1.0], [1, 30.0, 60.0, 0.001, 0.05, 0.0]]
+    nis_only = [MainWindow.model_validate(r) for r in rows]
     assert [a.t_s for a in _alarms_at(nis_only, 1.0, 1, 1)] == [30.0]
     assert [a.t_s for a in _alarms_at(nis_only, 100.0, 1, 1)] == [30.0]
-    assert _alarms_at([w[:5] for w in nis_only], 1.0, 1, 1) == []
+    assert _alarms_at([MainWindow.model_validate(r[:5]) for r in rows], 1.0, 1, 1) == []
 
 
 def test_the_report_says_when_summaries_lack_the_other_tests(tmp_path: Path) -> None:
     """Re-scoring from five-value rows undercounts the main detector: the report says so."""
-    base = {"injected_faults": [], "duration_s": 60.0,
-            "scores": {"per_fault": [], "false_alarms": 0, "nominal_cycles": 2}}
+    base = {"injected_faults": [], "duration_s": 60.0, "scores": _scores([], 0, 2)}
     _write(tmp_path, "old", base | {"fdir_series": {"main": [[1, 0, 30, 0.01, 0.05]]}})
     _write(tmp_path, "new", base | {"fdir_series": {"main": [[1, 0, 30, 0.01, 0.05, 0.0]]}})
     write_campaign_report(tmp_path, "x", ["old", "new"])
@@ -189,25 +214,25 @@ def test_the_global_checks_declaration_counts_in_the_rescoring() -> None:
     """A common-mode fault (spacecraft 0) is isolated by the global check, which has no rows in
     ``fdir_series`` (hard campaign, late-common-mode-0000: H 0.33 against 0.031 at 3,300 s):
     the re-scoring keeps it while its statistic passes the scaled threshold."""
-    run = {"injected_faults": [{"spacecraft": 0, "kind": "camera_calibration",
-                                "start_s": 3274.1, "magnitude": 0.6}],
-           "fdir_settings": {"fdi_period_s": 30.0, "persistence": 1},
-           "detections": [{"spacecraft": 0, "time_s": 3300.0, "class": "common_mode",
-                           "metric": 0.33, "threshold": 0.031}],
-           "fdir_series": {"main": [[1, 3270.0, 3300.0, 0.01, 0.05, 0.0]]}}
+    run = _run({"injected_faults": [{"spacecraft": 0, "kind": "camera_calibration",
+                                     "start_s": 3274.1, "magnitude": 0.6}],
+                "fdir_settings": {"fdi_period_s": 30.0, "persistence": 1},
+                "detections": [_detection(0, 3300.0, "common_mode", 0.33, 0.031)],
+                "fdir_series": {"main": [[1, 3270.0, 3300.0, 0.01, 0.05, 0.0]]}})
     for scale, isolated in ((1.0, True), (10.0, True), (11.0, False)):
         (fault,) = _rescore([run], "main", scale).per_fault
-        assert fault["isolated"] is isolated, scale
+        assert fault.isolated is isolated, scale
 
 
 def test_a_replays_main_detector_is_scored_over_its_faithful_span(tmp_path: Path) -> None:
     """A replay's declarations after its uplinks left the flown run's judge a trajectory nobody
     commanded: the report's main detector counts the faithful span's false alarms (0 here), the
     replay table's whole-run column the whole run's (2)."""
-    whole = {"per_fault": [], "false_alarms": 2, "nominal_cycles": 10}
-    faithful = {"per_fault": [], "false_alarms": 0, "nominal_cycles": 8}
+    whole, faithful = _scores([], 2, 10), _scores([], 0, 8)
     _write(tmp_path, "r", {"injected_faults": [], "duration_s": 100.0, "scores": whole,
-                           "replay": {"faithful_until_s": 80.0, "scores_faithful": faithful},
+                           "replay": {"settings": {"fdir.persistence": "1"}, "wall_s": 1.0,
+                                      "faithful_until_s": 80.0, "matches_live": False,
+                                      "scores_faithful": faithful},
                            "fdir_series": {"main": []}})
     write_campaign_report(tmp_path, "x", ["r"])
     main = [r for r in csv.DictReader(open(tmp_path / "results.csv"))
@@ -226,11 +251,10 @@ def test_faults_before_the_first_judged_window_are_reported_apart(tmp_path: Path
                              "end_s": None, "magnitude": 4.0},
                             {"spacecraft": 1, "kind": "thruster_bias", "start_s": 400.0,
                              "end_s": None, "magnitude": 0.3}],
-        "scores": {"per_fault": [_fault(2, "pointing_actuator", 10.0, True, 170.0, "actuator",
-                                        "actuator"),
-                                 _fault(1, "thruster_bias", 400.0, True, 40.0, "actuator",
-                                        "actuator")],
-                   "false_alarms": 0, "nominal_cycles": 4},
+        "scores": _scores([_fault(2, "pointing_actuator", 10.0, True, 170.0, "actuator",
+                                  "actuator"),
+                           _fault(1, "thruster_bias", 400.0, True, 40.0, "actuator",
+                                  "actuator")], 0, 4),
         "fdir_series": {"main": [[1, 60, 90, 0.01, 0.05], [2, 150, 180, 0.5, 0.05],
                                  [2, 180, 210, 0.5, 0.05]]}})
     report = write_campaign_report(tmp_path, "x", ["e"]).read_text()
@@ -240,3 +264,16 @@ def test_faults_before_the_first_judged_window_are_reported_apart(tmp_path: Path
     main = [r for r in csv.DictReader(open(tmp_path / "results.csv"))
             if r["detector"] == "main"]
     assert [float(r["judgeable_s"]) for r in main] == [150.0, 400.0]
+
+
+def test_a_malformed_summary_is_refused_naming_its_file_and_field(tmp_path: Path) -> None:
+    """A summary that is not one stops the report with pydantic's account of the field at
+    fault, and the file it is in, rather than a KeyError deep in a figure."""
+    _write(tmp_path, "ok", {"injected_faults": [], "scores": _scores([], 0, 1)})
+    bad = tmp_path / "runs" / "bad"
+    bad.mkdir()
+    text = (tmp_path / "runs" / "ok" / "summary.json").read_text()
+    (bad / "summary.json").write_text(text.replace('"nominal_cycles": 1', '"nominal_cycles": -1'))
+    with pytest.raises(SummaryError, match=r"runs/bad/summary\.json: .*\nscores\.nominal_cycles\n"
+                                           r".*greater than or equal to 0"):
+        write_campaign_report(tmp_path, "x", ["ok", "bad"])

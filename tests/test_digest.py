@@ -17,7 +17,7 @@ from ground.analysis.digest import (
     digest_run,
     unread_keys,
 )
-from ground.analysis.summary import build_summary
+from ground.analysis.summary import RunOutcome, build_summary
 from ground.archive.live import LiveArchive
 from ground.archive.reader import ArchiveError, Record, load_run
 from ground.archive.recorder import McapRecorder
@@ -27,6 +27,7 @@ from interfaces.runtime.encoding import encode
 from interfaces.runtime.transport import Sample
 
 REPO = Path(__file__).resolve().parent.parent
+OUTCOME = RunOutcome("inproc", 1.0, "completed")
 
 
 @pytest.fixture(scope="module")
@@ -83,7 +84,8 @@ def test_digest_gives_the_summary_of_the_whole_archive(run: tuple[Path, Scenario
     assert streamed.coverage.h == whole.coverage.h
     assert streamed.coverage.h[-1] < streamed.coverage.h_initial  # the cameras saw something
     assert streamed.counters.counts == whole.counters.counts
-    assert build_summary(streamed, sc, sc.name) == build_summary(whole, sc, sc.name)
+    assert build_summary(streamed, sc, sc.name, OUTCOME) \
+        == build_summary(whole, sc, sc.name, OUTCOME)
 
 
 def test_the_digest_built_as_the_run_went_is_the_files(
@@ -102,7 +104,7 @@ def test_the_digest_built_as_the_run_went_is_the_files(
     for field in ("t_s", "r_m", "v_mps", "q_lvlh_body", "dv_mps"):
         assert np.array_equal(getattr(live.truth, field), getattr(read.truth, field))
     assert live.counters.counts == read.counters.counts
-    assert build_summary(live, sc, sc.name) == build_summary(read, sc, sc.name)
+    assert build_summary(live, sc, sc.name, OUTCOME) == build_summary(read, sc, sc.name, OUTCOME)
 
 
 def test_kept_records_hold_no_more_memory_than_their_bytes(tmp_path: Path) -> None:

@@ -9,6 +9,7 @@ from typing import Any
 
 import pytest
 
+from ground.analysis.run_summary import RunSummary
 from interfaces.contracts.messages import ConstellationWindow, FaultReport, FdirWindow
 from tests.conftest import recorded_run, small_scenario
 
@@ -17,7 +18,7 @@ ONSET_S = 150.0
 
 @pytest.fixture(scope="module")
 def common_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, list[Any]],
-                                                                   dict[str, Any]]:
+                                                                   RunSummary]:
     sc = small_scenario(
         "cm", duration_s=350.0, target={"pois": 1000},
         rates={"fdi_period_s": 50.0}, observers={"count": 4, "initial_attitude": "lvlh"},
@@ -52,7 +53,8 @@ def test_constellation_windows_before_and_after_onset(common_run: Any) -> None:
 
 def test_summary_scores_the_common_mode_fault(common_run: Any) -> None:
     _, summary = common_run
-    (f,) = summary["scores"]["per_fault"]
-    assert f["detected"] and f["isolated"] and f["identified_correctly"]
-    assert f["identified_class"] == "common_mode" and f["spacecraft"] == 0
-    assert summary["scores"]["false_alarms"] == 0
+    assert summary.scores is not None
+    (f,) = summary.scores.per_fault
+    assert f.detected and f.isolated and f.identified_correctly
+    assert f.identified_class == "common_mode" and f.spacecraft == 0
+    assert summary.scores.false_alarms == 0

@@ -5,17 +5,17 @@ the baselines are scored beside the main detector in summary.json."""
 
 from __future__ import annotations
 
-from typing import Any
 
 import pytest
 
+from ground.analysis.run_summary import RunSummary
 from interfaces.contracts.messages import BaselineVerdict, FaultReport
 from tests.conftest import recorded_run, small_scenario
 
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory: pytest.TempPathFactory
-        ) -> tuple[list[FaultReport], list[BaselineVerdict], dict[str, Any]]:
+        ) -> tuple[list[FaultReport], list[BaselineVerdict], RunSummary]:
     sc = small_scenario(
         "fi", duration_s=550.0, target={"pois": 2000}, camera={"half_angle_deg": 12.0},
         rates={"high_hz": 5.0, "fdi_period_s": 50.0},
@@ -28,7 +28,7 @@ def run(tmp_path_factory: pytest.TempPathFactory
     return got["FaultReport"], got["BaselineVerdict"], summary
 
 
-Run = tuple[list[FaultReport], list[BaselineVerdict], dict[str, Any]]
+Run = tuple[list[FaultReport], list[BaselineVerdict], RunSummary]
 
 
 def test_each_fault_identified_on_its_spacecraft(run: Run) -> None:
@@ -45,21 +45,21 @@ def test_each_fault_identified_on_its_spacecraft(run: Run) -> None:
     assert first[3].fault_class == "link"
     assert first[3].metric == pytest.approx(0.5, abs=0.15)  # the lost share of observations
     assert all(r.fault_class == "link" for r in reports if r.spacecraft == 3)
-    per_fault = summary["scores"]["per_fault"]
-    assert [f["identified_correctly"] for f in per_fault] == [True, True, True]
-    assert summary["scores"]["false_alarms"] == 0
+    assert summary.scores is not None
+    assert [f.identified_correctly for f in summary.scores.per_fault] == [True, True, True]
+    assert summary.scores.false_alarms == 0
 
 
 def test_baselines_scored_beside(run: Run) -> None:
     _, verdicts, summary = run
     assert {v.detector for v in verdicts} == {"chi2_nis", "cusum", "fixed_threshold"}
-    base = summary["baselines"]
+    base = summary.baselines or {}
     assert set(base) == {"chi2_nis", "cusum", "fixed_threshold"}
     for scores in base.values():
-        assert len(scores["per_fault"]) == 3
+        assert len(scores.per_fault) == 3
     # The nav filter's consistency test sees the sensor bias step (two windows: persistence),
     # not the wheel fault.
-    chi2 = base["chi2_nis"]["per_fault"]
-    assert chi2[1]["isolated"] and chi2[1]["latency_s"] <= 100.0
-    assert not chi2[0]["isolated"]
+    chi2 = base["chi2_nis"].per_fault
+    assert chi2[1].isolated and chi2[1].latency_s is not None and chi2[1].latency_s <= 100.0
+    assert not chi2[0].isolated
 

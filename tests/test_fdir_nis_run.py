@@ -52,7 +52,9 @@ def test_the_campaign_series_records_a_window_failed_on_its_nis(
     """summary.json's ``fdir_series`` marks the leak's first window as failed on another test:
     its H_m is under τ, so a re-scoring from H_m alone would miss it."""
     first = next(w for w in run[0] if w.spacecraft == 1 and w.exceeded is not None)
-    row = next(r for r in _series(run[0], [])["main"] if r[0] == 1 and r[1] == first.t_start_s)
-    assert row[3] < row[4] and row[5] == 1.0
-    healthy = [r for r in _series(run[0], [])["main"] if r[0] != 1]
-    assert healthy and all(r[5] == 0.0 for r in healthy)
+    main = _series(run[0], []).main
+    row = next(r for r in main if r.spacecraft == 1 and r.t_start_s == first.t_start_s)
+    assert row.statistic < row.threshold and row.other_tests_failed
+    assert row.exceeded(scale=10.0) and row.model_dump()[5] == 1.0  # on disk: the sixth value
+    healthy = [r for r in main if r.spacecraft != 1]
+    assert healthy and not any(r.other_tests_failed for r in healthy)

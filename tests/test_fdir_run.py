@@ -6,19 +6,19 @@ that reports a corrupted H_i as a data-integrity fault."""
 from __future__ import annotations
 
 import re
-from typing import Any
 
 import pytest
 
 from ground.analysis.calibrate import main as calibrate_main
 from ground.analysis.report import write_report
+from ground.analysis.run_summary import RunSummary
 from interfaces.contracts.messages import FaultReport, FdirWindow
 from tests.conftest import recorded_run, small_scenario
 
 
 @pytest.fixture(scope="module")
 def fdir_run(tmp_path_factory: pytest.TempPathFactory
-             ) -> tuple[list[FdirWindow], list[FaultReport], dict[str, Any]]:
+             ) -> tuple[list[FdirWindow], list[FaultReport], RunSummary]:
     sc = small_scenario(
         "fd", duration_s=400.0, target={"pois": 1000},
         rates={"high_hz": 5.0, "fdi_period_s": 50.0},
@@ -33,7 +33,7 @@ def fdir_run(tmp_path_factory: pytest.TempPathFactory
     return got["FdirWindow"], got["FaultReport"], summary
 
 
-Run = tuple[list[FdirWindow], list[FaultReport], dict[str, Any]]
+Run = tuple[list[FdirWindow], list[FaultReport], RunSummary]
 
 
 def test_camera_fault_detected_and_isolated(fdir_run: Run) -> None:
@@ -62,15 +62,16 @@ def test_silent_spacecraft_is_a_link_fault(fdir_run: Run) -> None:
 
 def test_summary_scores_the_run(fdir_run: Run) -> None:
     _, reports, summary = fdir_run
-    assert len(summary["detections"]) == len(reports)
-    cam, link, data = summary["scores"]["per_fault"]
-    assert cam["detected"] and cam["isolated"] and cam["spacecraft"] == 2
-    assert cam["latency_s"] == min(r.t_sim for r in reports if r.spacecraft == 2)
-    assert link["isolated"] and link["identified_class"] == "link" and link["identified_correctly"]
-    assert link["latency_s"] == 100.0  # two silent 50 s windows
-    assert data["isolated"] and data["identified_class"] == "data_integrity"
-    assert data["latency_s"] == 50.0  # reports at 150 and 200 s inconsistent: persistence 2
-    assert summary["scores"]["false_alarms"] == 0 and summary["scores"]["nominal_cycles"] >= 4
+    assert summary.detections is not None and summary.scores is not None
+    assert len(summary.detections) == len(reports)
+    cam, link, data = summary.scores.per_fault
+    assert cam.detected and cam.isolated and cam.spacecraft == 2
+    assert cam.latency_s == min(r.t_sim for r in reports if r.spacecraft == 2)
+    assert link.isolated and link.identified_class == "link" and link.identified_correctly
+    assert link.latency_s == 100.0  # two silent 50 s windows
+    assert data.isolated and data.identified_class == "data_integrity"
+    assert data.latency_s == 50.0  # reports at 150 and 200 s inconsistent: persistence 2
+    assert summary.scores.false_alarms == 0 and summary.scores.nominal_cycles >= 4
 
 
 def test_report_plots_metric_against_threshold(fdir_run: Run,
@@ -81,7 +82,8 @@ def test_report_plots_metric_against_threshold(fdir_run: Run,
     assert "## FDIR" in report and (out / "fdir.png").stat().st_size > 10_000
     assert "fdir_gain.png" in report and (out / "fdir_gain.png").stat().st_size > 10_000
     assert "| camera_degradation | 2 | 0 | yes | yes |" in report
-    assert f"False alarms: 0 in {summary['scores']['nominal_cycles']} nominal" in report
+    assert summary.scores is not None
+    assert f"False alarms: 0 in {summary.scores.nominal_cycles} nominal" in report
     assert "| camera_degradation, faulty_data, link_loss | H_m,i > 0, i = 1, 2, 3 |" in report
     assert "| chi2_nis |" in report and "| cusum |" in report and "| fixed_threshold |" in report
     assert "| camera |" in report  # the class and its evidence, β located at 0.5 ± 0.04

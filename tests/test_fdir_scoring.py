@@ -22,24 +22,24 @@ def test_detection_isolation_latency_and_class() -> None:
               Alarm(4, 500.0, "link"),       # after fault 2 ended + grace: a false alarm
               Alarm(1, 50.0, None)]          # before any fault: a false alarm
     s = score(FAULTS, alarms, _windows(4, 600.0, 50.0), grace_s=50.0)
-    f1, f2 = s["per_fault"]
-    assert (f1["detected"], f1["isolated"], f1["latency_s"], f1["identified_class"],
-            f1["identified_correctly"]) == (True, True, 150.0, "camera", True)
-    assert (f2["detected"], f2["isolated"], f2["latency_s"]) == (False, False, None)
-    assert f2["expected_class"] == "link"
+    f1, f2 = s.per_fault
+    assert (f1.detected, f1.isolated, f1.latency_s, f1.identified_class,
+            f1.identified_correctly) == (True, True, 150.0, "camera", True)
+    assert (f2.detected, f2.isolated, f2.latency_s) == (False, False, None)
+    assert f2.expected_class == "link"
     # false alarms: sc3 at 150 (sc3 healthy), sc4 at 500, sc1 at 50
-    assert s["false_alarms"] == 3
+    assert s.false_alarms == 3
     # nominal windows: all but those overlapping a fault: sc2's from [100, 150) on (10) and
     # sc4's [300, 350) and [350, 400)
     faulty_windows = 10 + 2
-    assert s["nominal_cycles"] == 4 * 12 - faulty_windows
-    assert s["false_alarm_rate"] == pytest.approx(3 / (48 - faulty_windows))
-    assert s["false_alarms_per_hour"] == pytest.approx(3 / ((48 - faulty_windows) * 50 / 3600))
+    assert s.nominal_cycles == 4 * 12 - faulty_windows
+    assert s.false_alarm_rate == pytest.approx(3 / (48 - faulty_windows))
+    assert s.false_alarms_per_hour == pytest.approx(3 / ((48 - faulty_windows) * 50 / 3600))
 
 
 def test_detected_but_not_isolated_uses_the_first_alarm() -> None:
     s = score(FAULTS[:1], [Alarm(1, 180.0, "camera")], [], grace_s=50.0)
-    (f,) = s["per_fault"]
-    assert f["detected"] and not f["isolated"] and f["latency_s"] == 80.0
-    assert f["identified_class"] is None and not f["identified_correctly"]
-    assert s["nominal_cycles"] == 0 and s["false_alarm_rate"] is None
+    (f,) = s.per_fault
+    assert f.detected and not f.isolated and f.latency_s == 80.0
+    assert f.identified_class is None and not f.identified_correctly
+    assert s.nominal_cycles == 0 and s.false_alarm_rate is None

@@ -7,11 +7,10 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
-
 import pytest
 
 from deploy.inproc import run_inproc
+from ground.analysis.run_summary import Detection, RunSummary
 from ground.analysis.summary import write_summary
 from ground.archive.metadata import archived_scenario, run_metadata
 from ground.archive.reader import ArchiveError, load_run
@@ -37,7 +36,7 @@ def _scenario(**fdir: object) -> Scenario:
         fdir=fdir)
 
 
-def _record(scenario: Scenario, out: Path) -> dict[str, Any]:
+def _record(scenario: Scenario, out: Path) -> RunSummary:
     out.mkdir(parents=True, exist_ok=True)
     with McapRecorder(out / "run.mcap", run_metadata(scenario, "inproc", "# test\n")) as rec:
         run_inproc(scenario, sample_tap=rec.record_sample)
@@ -45,15 +44,17 @@ def _record(scenario: Scenario, out: Path) -> dict[str, Any]:
 
 
 @pytest.fixture(scope="module")
-def live(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+def live(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, RunSummary]:
     out = tmp_path_factory.mktemp("replay") / "live"
     return out, _record(_scenario(), out)
 
 
-FDIR_FIELDS = ("scores", "baselines", "fdir_series", "fdir_settings")
+def _unmarked(detections: list[Detection] | None) -> list[dict[str, object]]:
+    """Detections as summary.json holds them, less the replay's ``faithful`` mark."""
+    return [d.model_dump(exclude={"faithful"}) for d in detections or []]
 
 
-def test_replay_reproduces_the_live_ground_exactly(live: tuple[Path, dict[str, Any]]) -> None:
+def test_replay_reproduces_the_live_ground_exactly(live: tuple[Path, RunSummary]) -> None:
     out, summary = live
     archive = load_run(out / "run.mcap")
     links = [c for c in json.loads((out / "summary.json").read_text())["links"]
@@ -61,38 +62,38 @@ def test_replay_reproduces_the_live_ground_exactly(live: tuple[Path, dict[str, A
     assert sum(c["dropped_loss"] for c in links) > 0, "the links lost messages"
     assert sum(c["dropped_range"] for c in links) > 0, "range cut some"
     assert sum(c["dropped_cut"] for c in links) > 0, "and scheduled cuts others"
-    assert len({d["spacecraft"] for d in summary["detections"]}) >= 2
+    assert len({d.spacecraft for d in summary.detections or []}) >= 2
     replay = replay_run(out / "run.mcap")
     assert replay.matches_live()
     res = replay.results()
-    assert res["faithful_until_s"] == 400.0
-    assert [{k: v for k, v in d.items() if k != "faithful"} for d in res["detections"]] \
-        == summary["detections"]
-    for k in FDIR_FIELDS:
-        assert res[k] == summary[k], k
+    assert res.faithful_until_s == 400.0
+    assert _unmarked(res.detections) == _unmarked(summary.detections)
+    assert all(d.faithful for d in res.detections)
+    assert (res.scores, res.baselines, res.fdir_series, res.fdir_settings) \
+        == (summary.scores, summary.baselines, summary.fdir_series, summary.fdir_settings)
     live_out = GroundOutput.of_archive(archive, "replay")
     assert len(live_out.windows) == len(replay.replayed.windows) > 20
 
 
 def test_another_setting_replays_as_the_live_run_with_it(
-        live: tuple[Path, dict[str, Any]], tmp_path: Path) -> None:
+        live: tuple[Path, RunSummary], tmp_path: Path) -> None:
     out, summary = live
     replay = replay_run(out / "run.mcap", {"fdir.persistence": "2"})
     other = _record(_scenario(persistence=2), tmp_path / "other")
     horizon = replay.faithful_until_s()
-    def first_camera(dets: list[dict[str, Any]]) -> float:
-        return min(d["time_s"] for d in dets if d["class"] == "camera")
+    def first_camera(dets: list[Detection] | None) -> float:
+        return min(d.time_s for d in dets or [] if d.fault_class == "camera")
 
-    assert first_camera(other["detections"]) > first_camera(summary["detections"]), \
+    assert first_camera(other.detections) > first_camera(summary.detections), \
         "the setting declares the camera fault later"
     assert horizon < 400.0, "and its recovery uplink differs from the live run's"
     res = replay.results()
-    assert res["scores_faithful"]["false_alarms"] <= res["scores"]["false_alarms"]
-    assert res["scores_faithful"]["nominal_cycles"] < res["scores"]["nominal_cycles"]
-    before = [d for d in res["detections"] if d["time_s"] <= horizon]
-    assert before and all(d["faithful"] for d in before)
-    assert [{k: v for k, v in d.items() if k != "faithful"} for d in before] \
-        == [d for d in other["detections"] if d["time_s"] <= horizon]
+    assert res.scores_faithful.false_alarms <= res.scores.false_alarms
+    assert res.scores_faithful.nominal_cycles < res.scores.nominal_cycles
+    before = [d for d in res.detections if d.time_s <= horizon]
+    assert before and all(d.faithful for d in before)
+    assert _unmarked(before) == _unmarked([d for d in other.detections or []
+                                           if d.time_s <= horizon])
     other_windows = GroundOutput.of_archive(load_run(tmp_path / "other" / "run.mcap"),
                                             "replay").windows
     mine = [w.model_dump(exclude={"t_wall"}) for w in replay.replayed.windows
@@ -120,12 +121,14 @@ def test_settings_that_change_the_flight_are_refused() -> None:
 
 
 def test_command_line_writes_the_replay_and_refuses_an_archive_without_scenario(
-        live: tuple[Path, dict[str, Any]], tmp_path: Path,
+        live: tuple[Path, RunSummary], tmp_path: Path,
         capsys: pytest.CaptureFixture[str]) -> None:
     out, _ = live
     assert main([str(out), "--out", str(tmp_path)]) == 0
     res = json.loads((tmp_path / "live.replay.json").read_text())
     assert res["matches_live"] is True and "matches the live run" in capsys.readouterr().out
+    assert list(res)[:6] == ["scenario", "seed", "replay_wall_s", "faithful_until_s",
+                             "matches_live", "detections"] and list(res)[-1] == "scores_faithful"
     bare = tmp_path / "bare.mcap"
     with McapRecorder(bare, {}):
         pass

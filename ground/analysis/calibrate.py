@@ -15,28 +15,29 @@ run's configured floor.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
+from ground.analysis.run_summary import RunSummary
 from ground.archive.reader import ArchiveError, load_run
 from ground.fdir.threshold import calibrate_floor
 from interfaces.contracts.messages import FdirWindow
+from interfaces.contracts.scenario import Fault
 
 
 def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[FdirWindow]:
     """The judged FDIR windows of a run that end after ``skip_s`` and overlap no fault of
     their spacecraft (``summary.json`` ``injected_faults``, when the run has one)."""
     archive = load_run(run_dir / "run.mcap")
-    faults = []
+    faults: list[Fault] = []
     if (run_dir / "summary.json").exists():
-        faults = json.loads((run_dir / "summary.json").read_text()).get("injected_faults", [])
+        faults = RunSummary.read(run_dir / "summary.json").injected_faults
 
     def faulty(w: FdirWindow) -> bool:
-        return any(f["spacecraft"] == w.spacecraft and f["start_s"] < w.t_end_s
-                   and (f.get("end_s") is None or w.t_start_s < f["end_s"]) for f in faults)
+        return any(f.spacecraft == w.spacecraft and f.start_s < w.t_end_s
+                   and (f.end_s is None or w.t_start_s < f.end_s) for f in faults)
 
     keys = [k for k, (t, _) in archive.topics().items()
             if k.endswith("/ground/fdir/window") and t == "FdirWindow"]

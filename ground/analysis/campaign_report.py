@@ -19,8 +19,10 @@ an alarm on a spacecraft with no active fault; rates are per nominal FDI cycle a
 from __future__ import annotations
 
 import csv
+import functools
 import json
 import math
+import operator
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,9 +35,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.stats import beta  # noqa: E402
 
+from ground.analysis.run_summary import (  # noqa: E402
+    OTHER_TESTS_FLAG,
+    Detection,
+    FaultScore,
+    RunSummary,
+    Scores,
+    SeriesWindow,
+)
 from ground.analysis.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
 from ground.fdir.threshold import Persistence  # noqa: E402
-from interfaces.contracts.messages import WINDOW_TESTS  # noqa: E402
 from interfaces.contracts.scenario import Fault  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", "common_mode", None)
@@ -43,88 +52,96 @@ SCALES = np.geomspace(0.1, 10.0, 41)
 """Threshold scales of the ROC sweep."""
 
 
-def _load(out: Path, ids: Sequence[str]) -> list[dict[str, Any]]:
-    """The finished runs' summaries, each with its id, its campaign group and the software
-    version that ran it (``_id``, ``_group``, ``_version``).  The group is the run's campaign
-    group (one per paper figure in paper.toml); without a campaign.json, the id less its
-    ``-<index>``."""
+@dataclass(frozen=True)
+class CampaignRun:
+    """A finished run of the campaign: its id, campaign group, the software version that ran
+    it, and its summary."""
+
+    id: str
+    group: str
+    version: str
+    summary: RunSummary
+
+
+def _load(out: Path, ids: Sequence[str]) -> list[CampaignRun]:
+    """The finished runs.  The group is the run's campaign group (one per paper figure in
+    paper.toml); without a campaign.json, the id less its ``-<index>``.  Raises SummaryError
+    for a summary that is not one."""
     runs = []
     for rid in ids:
         p = out / "runs" / rid / "summary.json"
         if p.exists():
-            s = json.loads(p.read_text())
             meta_path = p.parent / "campaign.json"
             meta = json.loads(meta_path.read_text()) if meta_path.exists() else {}
-            s["_id"] = rid
-            s["_group"] = meta.get("group") or rid.rsplit("-", 1)[0]
-            s["_version"] = meta.get("software_version", "unknown")
-            runs.append(s)
+            runs.append(CampaignRun(rid, meta.get("group") or rid.rsplit("-", 1)[0],
+                                    meta.get("software_version", "unknown"),
+                                    RunSummary.read(p)))
     return runs
 
 
-def _versions(runs: list[dict[str, Any]]) -> str:
+def _versions(runs: list[CampaignRun]) -> str:
     counts: dict[str, int] = {}
-    for s in runs:
-        counts[s["_version"]] = counts.get(s["_version"], 0) + 1
+    for r in runs:
+        counts[r.version] = counts.get(r.version, 0) + 1
     text = ", ".join(f"{v} ({n} runs)" for v, n in sorted(counts.items()))
     return f"Software: {text}" + (" -- MIXED: results may not be comparable." if len(counts) > 1
                                   else ".")
 
 
-def _wall_time(runs: list[dict[str, Any]]) -> str:
+def _wall_time(runs: list[CampaignRun]) -> str:
     """The runs' own wall time (one worker each, from summary.json ``wall_s``)."""
-    wall = [float(s["wall_s"]) for s in runs if s.get("wall_s") is not None]
+    wall = [r.summary.wall_s for r in runs if r.summary.wall_s is not None]
     if not wall:
         return "Run wall time: not recorded."
     return (f"Run wall time (each on one worker): median {np.median(wall):.0f} s, max "
             f"{max(wall):.0f} s, {sum(wall) / 3600.0:.2f} worker-hours in all.")
 
 
-def _rows(runs: list[dict[str, Any]]) -> list[dict[str, Any]]:
+def _rows(runs: list[CampaignRun]) -> list[dict[str, Any]]:
     """results.csv rows: per run, detector and fault (or one nominal row per detector)."""
     rows = []
-    for s in runs:
+    for run in runs:
+        s = run.summary
         first = _first_judged(s)
-        detectors = {"main": _main_scores(s), **s.get("baselines", {})}
+        detectors = {"main": _main_scores(s), **(s.baselines or {})}
         for name, sc in detectors.items():
-            common = {"run": s["_id"], "group": s["_group"], "seed": s.get("seed"),
-                      "status": s.get("status"),
-                      "detector": name, "false_alarms": sc.get("false_alarms", 0),
-                      "nominal_cycles": sc.get("nominal_cycles", 0)}
-            faults = sc.get("per_fault", [])
+            common = {"run": run.id, "group": run.group, "seed": s.seed, "status": s.status,
+                      "detector": name, "false_alarms": sc.false_alarms if sc else 0,
+                      "nominal_cycles": sc.nominal_cycles if sc else 0}
+            faults = sc.per_fault if sc else []
             if not faults:
                 rows.append({**common, "kind": "none"})
+            main = name == "main"
             for i, f in enumerate(faults):
-                inj = s.get("injected_faults", [{}] * len(faults))[i]
-                rows.append({**common, "fault_index": i, "kind": f["kind"],
-                             "spacecraft": f["spacecraft"],
-                             "start_s": f["start_s"], "magnitude": inj.get("magnitude"),
-                             "detected": f["detected"], "isolated": f["isolated"],
-                             "latency_s": f["latency_s"],
-                             "identified_class": f["identified_class"] if name == "main" else None,
-                             "identification_latency_s": f.get("identification_latency_s")
-                             if name == "main" else None,
-                             "expected_class": f["expected_class"],
+                rows.append({**common, "fault_index": i, "kind": f.kind,
+                             "spacecraft": f.spacecraft, "start_s": f.start_s,
+                             "magnitude": s.injected_faults[i].magnitude,
+                             "detected": f.detected, "isolated": f.isolated,
+                             "latency_s": f.latency_s,
+                             "identified_class": f.identified_class if main else None,
+                             "identification_latency_s": f.identification_latency_s
+                             if main else None,
+                             "expected_class": f.expected_class,
                              "judgeable_s": _judgeable_s(f, first)})
     return rows
 
 
-def _first_judged(summary: dict[str, Any]) -> dict[int, float]:
+def _first_judged(summary: RunSummary) -> dict[int, float]:
     """The start of each observer's first window the main detector judged, s (its
     ``fdir_series``: the observer's initial slew and ``settle_s`` come before it)."""
     first: dict[int, float] = {}
-    for w in summary.get("fdir_series", {}).get("main", []):
-        first[int(w[0])] = min(first.get(int(w[0]), math.inf), float(w[1]))
+    for w in summary.fdir_series.main if summary.fdir_series else []:
+        first[w.spacecraft] = min(first.get(w.spacecraft, math.inf), w.t_start_s)
     return first
 
 
-def _judgeable_s(fault: dict[str, Any], first: dict[int, float]) -> float | None:
+def _judgeable_s(fault: FaultScore, first: dict[int, float]) -> float | None:
     """When a fault could first be judged, s: its onset, or its observer's first judged
     window's start when that is later (a common-mode fault, spacecraft 0: the first
     observer's); None when its observer has no judged window."""
-    sc = fault["spacecraft"]
+    sc = fault.spacecraft
     t0 = min(first.values(), default=None) if sc == 0 else first.get(sc)
-    return None if t0 is None else max(float(fault["start_s"]), t0)
+    return None if t0 is None else max(fault.start_s, t0)
 
 
 def _onset_lines(faults: list[dict[str, Any]]) -> list[str]:
@@ -149,8 +166,13 @@ def _onset_lines(faults: list[dict[str, Any]]) -> list[str]:
 
 
 def _latency(faults: Sequence[dict[str, Any]], key: str = "latency_s") -> str:
-    """"median / p90 / max" of the latency of the isolated faults (or ``key``), s."""
-    lat = [f[key] for f in faults if f["isolated"] and f.get(key) is not None]
+    """"median / p90 / max" of the latency of the isolated faults (or ``key``), s, of
+    results.csv rows."""
+    return _spread([f[key] for f in faults if f["isolated"] and f.get(key) is not None])
+
+
+def _spread(lat: Sequence[float]) -> str:
+    """"median / p90 / max" of latencies, s."""
     if not lat:
         return "- / - / -"
     return f"{np.median(lat):.0f} / {np.quantile(lat, 0.9):.0f} / {max(lat):.0f}"
@@ -185,33 +207,40 @@ def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> d
     st = _stats(rows, 0.0)
     lat = [r["latency_s"] for r in rows if r["kind"] != "none" and r["isolated"]
            and r["latency_s"] is not None]
-    faithful = sum(s.get("replay", {}).get("faithful_until_s", math.inf) >= s["duration_s"]
-                   for s in runs)
-    spans = [_detector_scores(_main_scores(s), s, detector) for s in runs]
-    whole = [_detector_scores(s.get("scores", {}), s, detector) for s in runs]
+    faithful = sum(_faithful_to_the_end(r.summary) for r in runs)
+    spans = [_detector_scores(_main_scores(r.summary), r.summary, detector) for r in runs]
+    whole = [_detector_scores(r.summary.scores, r.summary, detector) for r in runs]
     return {"faults": st["faults"], "detected": st["detected"], "isolated": st["isolated"],
             "identified": st["identified"],
             "latency_median_s": float(np.median(lat)) if lat else None,
             "latency_p90_s": float(np.quantile(lat, 0.9)) if lat else None,
-            "false_alarms": sum(sc.get("false_alarms", 0) for sc in whole),
-            "nominal_cycles": sum(sc.get("nominal_cycles", 0) for sc in whole),
-            "false_alarms_faithful": sum(sc.get("false_alarms", 0) for sc in spans),
-            "nominal_cycles_faithful": sum(sc.get("nominal_cycles", 0) for sc in spans),
+            "false_alarms": sum(sc.false_alarms for sc in whole if sc),
+            "nominal_cycles": sum(sc.nominal_cycles for sc in whole if sc),
+            "false_alarms_faithful": sum(sc.false_alarms for sc in spans if sc),
+            "nominal_cycles_faithful": sum(sc.nominal_cycles for sc in spans if sc),
             "runs": len(runs), "faithful_runs": int(faithful)}
 
 
-def _main_scores(summary: dict[str, Any]) -> dict[str, Any]:
+def _faithful_to_the_end(summary: RunSummary) -> bool:
+    """Whether the run is no replay, or a replay faithful to the run's end."""
+    if summary.replay is None:
+        return True
+    return summary.duration_s is not None and \
+        summary.replay.faithful_until_s >= summary.duration_s
+
+
+def _main_scores(summary: RunSummary) -> Scores | None:
     """The main detector's scores of a run: over the faithful span for a replay (what the
     replay declared after its uplinks diverged from the flown run judges a trajectory nobody
     commanded; ``ground.tools.replay``), else the run's own."""
-    return summary.get("replay", {}).get("scores_faithful") or summary.get("scores", {})
+    return summary.replay.scores_faithful if summary.replay else summary.scores
 
 
-def _detector_scores(main: dict[str, Any], summary: dict[str, Any], detector: str
-                     ) -> dict[str, Any]:
+def _detector_scores(main: Scores | None, summary: RunSummary, detector: str
+                     ) -> Scores | None:
     """The scores of ``detector`` in a summary: ``main`` for the main detector (the faithful
     span's, for a replay), else the baseline's."""
-    return main if detector == "main" else summary.get("baselines", {}).get(detector, {})
+    return main if detector == "main" else (summary.baselines or {}).get(detector)
 
 
 def _cells(detector: str, st: dict[str, Any]) -> str:
@@ -248,68 +277,70 @@ def _pct(n: int, d: int) -> str:
     return "-" if d == 0 else f"{100.0 * n / d:.0f}% ({n}/{d})"
 
 
-def _fault_in(window: list[float], faults: list[dict[str, Any]]) -> str | None:
-    """The kind of an injected fault active on the window's spacecraft during the window
-    [sc, t0, t1, ...], or None (a nominal window)."""
-    sc, t0, t1 = window[0], window[1], window[2]
+def _fault_in(window: SeriesWindow, faults: list[Fault]) -> str | None:
+    """The kind of an injected fault active on the window's spacecraft during the window, or
+    None (a nominal window)."""
     for f in faults:  # spacecraft 0: a common-mode fault, on every observer
-        if f["spacecraft"] in (0, sc) and f["start_s"] < t1 and (f.get("end_s") is None
-                                                                 or t0 < f["end_s"]):
-            return str(f["kind"])
+        if f.spacecraft in (0, window.spacecraft) and f.start_s < window.t_end_s \
+                and (f.end_s is None or window.t_start_s < f.end_s):
+            return str(f.kind)
     return None
 
 
-def _nominal_hours(runs: list[dict[str, Any]], detector: str) -> float:
+def _series(summary: RunSummary, detector: str) -> Sequence[SeriesWindow]:
+    """The windows ``detector`` decided in a run (none if unrecorded)."""
+    return summary.fdir_series.of(detector) if summary.fdir_series else []
+
+
+def _nominal_hours(runs: list[CampaignRun], detector: str) -> float:
     """Spacecraft-hours a detector judged without a fault, from its windows."""
     total = 0.0
-    for s in runs:
-        faults = s.get("injected_faults", [])
-        for w in s.get("fdir_series", {}).get(detector, []):
-            if _fault_in(w, faults) is None:
-                total += w[2] - w[1]
+    for r in runs:
+        for w in _series(r.summary, detector):
+            if _fault_in(w, r.summary.injected_faults) is None:
+                total += w.t_end_s - w.t_start_s
     return total / 3600.0
 
 
-def _margins(runs: list[dict[str, Any]]) -> dict[str, np.ndarray]:
+def _margins(runs: list[CampaignRun]) -> dict[str, np.ndarray]:
     """The main detector's H_m,i / τ_i of every window, by the kind of the fault active in it
     (``"nominal"`` for none): the margin the threshold leaves on each side."""
     out: dict[str, list[float]] = {}
-    for s in runs:
-        faults = s.get("injected_faults", [])
-        for w in s.get("fdir_series", {}).get("main", []):
-            if w[4] > 0.0:
-                out.setdefault(_fault_in(w, faults) or "nominal", []).append(w[3] / w[4])
+    for r in runs:
+        for w in _series(r.summary, "main"):
+            if w.threshold > 0.0:
+                kind = _fault_in(w, r.summary.injected_faults) or "nominal"
+                out.setdefault(kind, []).append(w.statistic / w.threshold)
     return {k: np.array(out[k]) for k in sorted(out, key=lambda k: (k != "nominal", k))}
 
 
-def _persistence(run: dict[str, Any], detector: str) -> tuple[int, int]:
+def _persistence(summary: RunSummary, detector: str) -> tuple[int, int]:
     """The persistence rule (m exceedances among the last n windows) the detector used in
     that run, from its settings as summary.json records them: the main detector m of
     ``persistence_window`` (or in a row), chi2_nis ``persistence`` in a row, the plain limit
-    checks one."""
-    cfg = run.get("fdir_settings", {})
-    m = int(cfg.get("persistence", 2))
+    checks one.  A summary without settings: 2 in a row."""
+    cfg = summary.fdir_settings
+    m = cfg.persistence if cfg else 2
     if detector == "main":
-        return m, int(cfg.get("persistence_window") or m)
+        return m, (cfg.persistence_window if cfg else None) or m
     return (m, m) if detector == "chi2_nis" else (1, 1)
 
 
-def _alarms_at(series: list[list[float]], scale: float, m: int, n: int) -> list[Alarm]:
+def _alarms_at(series: Sequence[SeriesWindow], scale: float, m: int, n: int) -> list[Alarm]:
     """The alarms a detector raises on its windows with its threshold scaled, under the
     detector's own rule (``threshold.Persistence``: ``m`` exceedances among the last ``n``
     windows, once per episode).  A main-detector window that failed one of its other tests
-    (the row's sixth value) counts as exceeded at every scale."""
+    counts as exceeded at every scale (``MainWindow.exceeded``)."""
     rule = Persistence(m, n)
-    return [Alarm(int(w[0]), w[2], None)
-            for w in sorted(series, key=lambda w: (w[0], w[2]))
-            if rule.update(int(w[0]), w[3] > scale * w[4] or (len(w) > 5 and w[5] > 0.0))]
+    return [Alarm(w.spacecraft, w.t_end_s, None)
+            for w in sorted(series, key=lambda w: (w.spacecraft, w.t_end_s))
+            if rule.update(w.spacecraft, w.exceeded(scale))]
 
 
-def _information_only(runs: list[dict[str, Any]]) -> int:
-    """How many runs' main-detector series predate the other-tests flag (five values a row):
-    their re-scoring sees the information test alone."""
-    return sum(1 for s in runs
-               if any(len(w) < 6 for w in s.get("fdir_series", {}).get("main", [])))
+def _information_only(runs: list[CampaignRun]) -> int:
+    """How many runs' main-detector series predate the other-tests flag (filled in on load:
+    ``OTHER_TESTS_FLAG``): their re-scoring sees the information test alone."""
+    return sum(1 for r in runs if OTHER_TESTS_FLAG in r.summary.filled)
 
 
 @dataclass
@@ -318,10 +349,10 @@ class Rescored:
 
     false_alarms: int = 0
     nominal_cycles: int = 0
-    per_fault: list[dict[str, Any]] = field(default_factory=list)
+    per_fault: list[FaultScore] = field(default_factory=list)
 
 
-def _rescore(runs: list[dict[str, Any]], detector: str, scale: float,
+def _rescore(runs: list[CampaignRun], detector: str, scale: float,
              rule: tuple[int, int] | None = None) -> Rescored:
     """Re-score each run's windows of ``detector`` with its threshold times ``scale`` and the
     persistence ``rule`` (m of the last n windows; None: the run's own, n in a row) exactly as
@@ -330,41 +361,41 @@ def _rescore(runs: list[dict[str, Any]], detector: str, scale: float,
     (``common_mode``, Eq. 6) where its statistic passes its threshold times ``scale`` (its
     windows are not in ``fdir_series``: one it did not declare cannot be added)."""
     total = Rescored()
-    for s in runs:
-        if detector not in s.get("fdir_series", {}):
+    for run in runs:
+        s = run.summary
+        if s.fdir_series is None or detector not in s.fdir_series.detectors():
             continue
-        series = s["fdir_series"][detector]
-        injected = [Fault.model_validate(f) for f in s.get("injected_faults", [])]
-        grace = float(s.get("fdir_settings", {}).get("fdi_period_s", 0.0))
-        fixed = [Alarm(d["spacecraft"], d["time_s"], d["class"]) for d in s.get("detections", [])
+        series = s.fdir_series.of(detector)
+        grace = s.fdir_settings.fdi_period_s if s.fdir_settings else 0.0
+        fixed = [Alarm(d.spacecraft, d.time_s, d.fault_class) for d in s.detections or []
                  if detector == "main" and _kept(d, scale)]
-        judged = [Judged(int(w[0]), w[1], w[2]) for w in series]
+        judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in series]
         m, n = rule or _persistence(s, detector)
-        sc = score(injected, fixed + _alarms_at(series, scale, m, n), judged, grace)
-        total.false_alarms += int(sc["false_alarms"])  # type: ignore[call-overload]
-        total.nominal_cycles += int(sc["nominal_cycles"])  # type: ignore[call-overload]
-        total.per_fault += sc["per_fault"]  # type: ignore[arg-type]
+        sc = score(s.injected_faults, fixed + _alarms_at(series, scale, m, n), judged, grace)
+        total.false_alarms += sc.false_alarms
+        total.nominal_cycles += sc.nominal_cycles
+        total.per_fault += sc.per_fault
     return total
 
 
-def _kept(declared: dict[str, Any], scale: float) -> bool:
+def _kept(declared: Detection, scale: float) -> bool:
     """Whether a main-detector declaration that is not an observer window's stands in a
     re-scoring at ``scale`` (``_rescore``)."""
-    if declared["class"] in ("link", "data_integrity"):
+    if declared.fault_class in ("link", "data_integrity"):
         return True
-    return (declared["class"] == "common_mode" and declared.get("metric") is not None
-            and declared.get("threshold") is not None
-            and declared["metric"] > scale * declared["threshold"])
+    return (declared.fault_class == "common_mode" and declared.metric is not None
+            and declared.threshold is not None
+            and declared.metric > scale * declared.threshold)
 
 
-def _roc(runs: list[dict[str, Any]], detector: str) -> tuple[np.ndarray, np.ndarray]:
+def _roc(runs: list[CampaignRun], detector: str) -> tuple[np.ndarray, np.ndarray]:
     """(false alarms per nominal cycle, detection rate) at each threshold scale in SCALES,
     each run re-scored with its own persistence (``_rescore``)."""
     fa, det = np.zeros(len(SCALES)), np.zeros(len(SCALES))
     for k, scale in enumerate(SCALES):
         r = _rescore(runs, detector, scale)
         fa[k] = r.false_alarms / max(r.nominal_cycles, 1)
-        det[k] = sum(f["detected"] for f in r.per_fault) / max(len(r.per_fault), 1)
+        det[k] = sum(f.detected for f in r.per_fault) / max(len(r.per_fault), 1)
     return fa, det
 
 
@@ -373,100 +404,49 @@ PERSISTENCE_RULES = ((1, 1), (2, 2), (2, 3), (3, 3))
 detector with."""
 
 
-def _persistence_table(runs: list[dict[str, Any]]) -> list[str]:
+def _persistence_table(runs: list[CampaignRun]) -> list[str]:
     """The main detector re-scored from its windows under each of ``PERSISTENCE_RULES``, at
     its threshold as configured: what persistence buys in false alarms and costs in latency."""
-    own = sorted({_persistence(s, "main") for s in runs})
+    own = sorted({_persistence(r.summary, "main") for r in runs})
     lines = ["| rule | detected | isolated | latency median / p90 / max (s) | "
              "false alarms per nominal cycle |", "|---|---|---|---|---|"]
     for m, n in PERSISTENCE_RULES:
         r = _rescore(runs, "main", 1.0, (m, n))
         f = r.per_fault
         label = f"{m} of {n}" + (" (as run)" if own == [(m, n)] else "")
+        lat = [x.latency_s for x in f if x.isolated and x.latency_s is not None]
         lines.append(
-            f"| {label} | {_pct(sum(x['detected'] for x in f), len(f))} | "
-            f"{_pct(sum(x['isolated'] for x in f), len(f))} | {_latency(f)} | "
+            f"| {label} | {_pct(sum(x.detected for x in f), len(f))} | "
+            f"{_pct(sum(x.isolated for x in f), len(f))} | {_spread(lat)} | "
             f"{_rate(r.false_alarms, r.nominal_cycles)} |")
     return lines
+
+
+RESULT_FIELDS = ["run", "group", "seed", "status", "detector", "kind", "spacecraft", "start_s",
+                 "magnitude", "detected", "isolated", "latency_s", "identified_class",
+                 "identification_latency_s", "expected_class", "judgeable_s", "false_alarms",
+                 "nominal_cycles"]
+"""The columns of results.csv."""
 
 
 def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     """Write results.csv, report.md and plots for the runs ``ids`` of campaign ``name``."""
     loaded = _load(out, ids)
-    failed = [s["_id"] for s in loaded if s.get("status") != "completed"]
-    runs = [s for s in loaded if s.get("status") == "completed"]  # failed runs: listed only
+    runs = [r for r in loaded if r.summary.status == "completed"]  # failed runs: listed only
     rows = _rows(runs)
-    fields = ["run", "group", "seed", "status", "detector", "kind", "spacecraft", "start_s",
-              "magnitude", "detected", "isolated", "latency_s", "identified_class",
-              "identification_latency_s", "expected_class", "judgeable_s", "false_alarms",
-              "nominal_cycles"]
     with open(out / "results.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w = csv.DictWriter(f, fieldnames=RESULT_FIELDS, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
     detectors = ["main"] + sorted({r["detector"] for r in rows} - {"main"})
     hours = {d: _nominal_hours(runs, d) for d in detectors}
-    lines = [f"# Campaign report: {name}", "",
-             f"{len(loaded)} of {len(ids)} runs finished ({len(failed)} failed"
-             + (f": {', '.join(failed[:10])}{' ...' if len(failed) > 10 else ''}" if failed
-                else "") + "; failed runs are left out of every figure below); "
-             f"{hours['main']:.1f} nominal spacecraft-hours judged by the main detector.", "",
-             _versions(loaded), "", _wall_time(loaded), "",
-             "## Detectors side by side", "",
-             "| detector | detected | isolated | identified | latency median / p90 / max (s) | "
-             "false alarms per nominal cycle | per hour |", "|---|---|---|---|---|---|---|"]
-    for d in detectors:
-        lines.append(f"| {d} | " + _cells(d, _stats([r for r in rows if r["detector"] == d],
-                                                      hours[d])))
-    groups = list(dict.fromkeys(s["_group"] for s in runs))
-    lines += ["", "## Per campaign group", "",
-              "Each group of the campaign file (in paper.toml, one per paper figure); false "
-              "alarms are those on the group's unfaulted spacecraft.", "",
-              "| group | detector | detected | isolated | identified | latency median / p90 / "
-              "max (s) | false alarms per nominal cycle | per hour |",
-              "|---|---|---|---|---|---|---|---|"]
-    for g in groups:
-        mine = [s for s in runs if s["_group"] == g]
-        for d in detectors:
-            st = _stats([r for r in rows if r["detector"] == d and r["group"] == g],
-                        _nominal_hours(mine, d))
-            lines.append(f"| {g} | {d} | " + _cells(d, st))
-    lines += ["", "## Per fault kind and magnitude", "",
-              "| kind | magnitude | detector | faults | detected | missed | isolated | "
-              "latency median / p90 / max (s) |", "|---|---|---|---|---|---|---|---|"]
-    bins = _magnitude_bins([r for r in rows if r["kind"] != "none" and r["detector"] == "main"])
-    for (kind, label), members in bins.items():
-        for d in detectors:
-            sel = [r for r in rows if r["detector"] == d and r["kind"] == kind
-                   and (r["run"], r["fault_index"]) in members]
-            st = _stats(sel, hours[d])
-            lines.append(f"| {kind} | {label} | {d} | {st['faults']} | "
-                         f"{_pct(st['detected'], st['faults'])} | "
-                         f"{st['faults'] - st['detected']} | "
-                         f"{_pct(st['isolated'], st['faults'])} | {st['latency']} |")
-    main_stats = _stats([r for r in rows if r["detector"] == "main"], hours["main"])
-    lines += ["", "## Identification (main detector)", "",
-              "Identification may come a window after detection: latency from onset to the "
-              f"first report naming the right class, median / p90 / max: "
-              f"{main_stats['identification_latency']} s.", "",
-              "![confusion](confusion.png)", ""]
-    main_faults = [r for r in rows if r["detector"] == "main" and r["kind"] != "none"]
-    lines += _confusion(out, main_faults)
-    lines += _onset_lines(main_faults)
-    lines += ["", "![latency](latency.png)", "",
-              "## ROC (threshold scale swept, each detector with its persistence)", "",
-              "![roc](roc.png)", "",
-              "## Persistence (main detector re-scored from its windows)", "",
-              "A fault is declared on the window that brings the exceedances among the last n "
-              "windows to m; the threshold as configured.  A main-detector window counts as "
-              "exceeded when H_m passes τ or it failed one of the other tests (plan, pointing, "
-              "Δv rate, NIS), which the ROC's scale does not move."]
-    old_rows = _information_only(runs)
-    if old_rows:
-        lines.append(f"**{old_rows} of {len(runs)} runs' summaries predate the other tests' "
-                     "record: in them the main detector's ROC and this table see the "
-                     "information test alone, and undercount what it detected.**")
-    lines += [""] + _persistence_table(runs)
+    lines = _head_lines(name, loaded, len(ids), hours["main"])
+    lines += _side_by_side_lines(rows, detectors, hours)
+    groups = list(dict.fromkeys(r.group for r in runs))
+    lines += _group_lines(runs, rows, detectors, groups)
+    lines += _magnitude_lines(rows, detectors, hours)
+    lines += _identification_lines(out, rows, hours["main"])
+    lines += _rescoring_lines(runs)
     lines += _threshold_lines(runs)
     margins = _margins(runs)
     lines += ["", "## Margins (main detector, H_m,i / τ_i per window)", "",
@@ -479,6 +459,96 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def _head_lines(name: str, loaded: list[CampaignRun], requested: int,
+                main_hours: float) -> list[str]:
+    """The title, the runs finished and failed, software versions and wall time."""
+    failed = [r.id for r in loaded if r.summary.status != "completed"]
+    return [f"# Campaign report: {name}", "",
+            f"{len(loaded)} of {requested} runs finished ({len(failed)} failed"
+            + (f": {', '.join(failed[:10])}{' ...' if len(failed) > 10 else ''}" if failed
+               else "") + "; failed runs are left out of every figure below); "
+            f"{main_hours:.1f} nominal spacecraft-hours judged by the main detector.", "",
+            _versions(loaded), "", _wall_time(loaded), ""]
+
+
+def _side_by_side_lines(rows: list[dict[str, Any]], detectors: list[str],
+                        hours: dict[str, float]) -> list[str]:
+    lines = ["## Detectors side by side", "",
+             "| detector | detected | isolated | identified | latency median / p90 / max (s) | "
+             "false alarms per nominal cycle | per hour |", "|---|---|---|---|---|---|---|"]
+    for d in detectors:
+        lines.append(f"| {d} | " + _cells(d, _stats([r for r in rows if r["detector"] == d],
+                                                      hours[d])))
+    return lines
+
+
+def _group_lines(runs: list[CampaignRun], rows: list[dict[str, Any]], detectors: list[str],
+                 groups: list[str]) -> list[str]:
+    lines = ["", "## Per campaign group", "",
+             "Each group of the campaign file (in paper.toml, one per paper figure); false "
+             "alarms are those on the group's unfaulted spacecraft.", "",
+             "| group | detector | detected | isolated | identified | latency median / p90 / "
+             "max (s) | false alarms per nominal cycle | per hour |",
+             "|---|---|---|---|---|---|---|---|"]
+    for g in groups:
+        mine = [r for r in runs if r.group == g]
+        for d in detectors:
+            st = _stats([r for r in rows if r["detector"] == d and r["group"] == g],
+                        _nominal_hours(mine, d))
+            lines.append(f"| {g} | {d} | " + _cells(d, st))
+    return lines
+
+
+def _magnitude_lines(rows: list[dict[str, Any]], detectors: list[str],
+                     hours: dict[str, float]) -> list[str]:
+    lines = ["", "## Per fault kind and magnitude", "",
+             "| kind | magnitude | detector | faults | detected | missed | isolated | "
+             "latency median / p90 / max (s) |", "|---|---|---|---|---|---|---|---|"]
+    bins = _magnitude_bins([r for r in rows if r["kind"] != "none" and r["detector"] == "main"])
+    for (kind, label), members in bins.items():
+        for d in detectors:
+            sel = [r for r in rows if r["detector"] == d and r["kind"] == kind
+                   and (r["run"], r["fault_index"]) in members]
+            st = _stats(sel, hours[d])
+            lines.append(f"| {kind} | {label} | {d} | {st['faults']} | "
+                         f"{_pct(st['detected'], st['faults'])} | "
+                         f"{st['faults'] - st['detected']} | "
+                         f"{_pct(st['isolated'], st['faults'])} | {st['latency']} |")
+    return lines
+
+
+def _identification_lines(out: Path, rows: list[dict[str, Any]], main_hours: float
+                          ) -> list[str]:
+    """The main detector's identification (confusion matrix) and its latency from onset."""
+    main_stats = _stats([r for r in rows if r["detector"] == "main"], main_hours)
+    lines = ["", "## Identification (main detector)", "",
+             "Identification may come a window after detection: latency from onset to the "
+             f"first report naming the right class, median / p90 / max: "
+             f"{main_stats['identification_latency']} s.", "",
+             "![confusion](confusion.png)", ""]
+    main_faults = [r for r in rows if r["detector"] == "main" and r["kind"] != "none"]
+    return lines + _confusion(out, main_faults) + _onset_lines(main_faults)
+
+
+def _rescoring_lines(runs: list[CampaignRun]) -> list[str]:
+    """The ROC and the main detector re-scored under other persistence rules, saying when
+    summaries predate the other tests' record."""
+    lines = ["", "![latency](latency.png)", "",
+             "## ROC (threshold scale swept, each detector with its persistence)", "",
+             "![roc](roc.png)", "",
+             "## Persistence (main detector re-scored from its windows)", "",
+             "A fault is declared on the window that brings the exceedances among the last n "
+             "windows to m; the threshold as configured.  A main-detector window counts as "
+             "exceeded when H_m passes τ or it failed one of the other tests (plan, pointing, "
+             "Δv rate, NIS), which the ROC's scale does not move."]
+    old_rows = _information_only(runs)
+    if old_rows:
+        lines.append(f"**{old_rows} of {len(runs)} runs' summaries predate the other tests' "
+                     "record: in them the main detector's ROC and this table see the "
+                     "information test alone, and undercount what it detected.**")
+    return lines + [""] + _persistence_table(runs)
 
 
 def _magnitude_bins(rows: list[dict[str, Any]], most: int = 4
@@ -568,7 +638,7 @@ def _latency_plot(out: Path, rows: list[dict[str, Any]], detectors: list[str],
     plt.close(fig)
 
 
-def _roc_plot(out: Path, runs: list[dict[str, Any]], detectors: list[str]) -> None:
+def _roc_plot(out: Path, runs: list[CampaignRun], detectors: list[str]) -> None:
     fig, ax = plt.subplots(figsize=(6, 5))
     for d in detectors:
         fa, det = _roc(runs, d)
@@ -616,26 +686,23 @@ def _margin_plot(out: Path, margins: dict[str, np.ndarray]) -> None:
     plt.close(fig)
 
 
-def _threshold_lines(runs: list[dict[str, Any]]) -> list[str]:
+def _threshold_lines(runs: list[CampaignRun]) -> list[str]:
     """What decided the main detector's nominal windows, summed over the runs'
-    ``fdir_thresholds`` (summary.json): which threshold was in force, how often the hardware
-    model's and Eq. 11-12's thresholds lay above the floor guard, which tests failed, and how
-    the nominal ratios sat in the hardware model's distribution."""
-    census = [s["fdir_thresholds"] for s in runs if "fdir_thresholds" in s]
+    ``fdir_thresholds`` (summary.json; a test older summaries lack counts none): which
+    threshold was in force, how often the hardware model's and Eq. 11-12's thresholds lay
+    above the floor guard, which tests failed, and how the nominal ratios sat in the hardware
+    model's distribution."""
+    census = [r.summary.fdir_thresholds for r in runs if r.summary.fdir_thresholds]
     if not census:
         return []
-    n = sum(c["nominal_windows"] for c in census)
-
-    def total(section: str, key: str) -> int:
-        return sum(c[section].get(key, 0) for c in census)  # older archives lack newer tests
-
-    by = ", ".join(f"{k} {_pct(total('threshold_by', k), n)}"
-                   for k in ("model", "sampled", "floor"))
-    above = sum(c["model_above_floor"] for c in census)
-    sampled = sum(c["sampled_above_floor"] for c in census)
-    failed = ", ".join(f"{k} {total('failed', k)}" for k in WINDOW_TESTS)
-    zn = total("model_z", "windows")
-    z = ", ".join(f"|z| > {k}: {_pct(total('model_z', f'over_{k}'), zn)}" for k in (2, 3, 4))
+    c = functools.reduce(operator.add, census)
+    n = c.nominal_windows
+    by = ", ".join(f"{k} {_pct(v, n)}" for k, v in c.threshold_by)
+    above, sampled = c.model_above_floor, c.sampled_above_floor
+    failed = ", ".join(f"{k} {v}" for k, v in c.failed)
+    zn = c.model_z.windows
+    z = ", ".join(f"|z| > {k}: {_pct(v, zn)}" for k, v in
+                  ((2, c.model_z.over_2), (3, c.model_z.over_3), (4, c.model_z.over_4)))
     return ["", "## Thresholds (main detector, nominal windows)", "",
             f"{n} nominal windows decided.  Threshold in force: {by}.  The hardware model's "
             f"threshold above the floor guard in {_pct(above, n)}; Eq. 11-12's sampled "

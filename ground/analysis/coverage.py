@@ -7,6 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from gnc.poi_map import PoiMap
+from ground.analysis.run_summary import BUS_HEADER, AssignmentRecord, CoverageSummary
 from ground.archive.reader import Record, RunArchive
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import AssignmentDecision, CameraImage
@@ -87,16 +88,16 @@ def coverage(archive: RunArchive, scenario: Scenario, mission: str,
     return fuser.finish(archive, mission)
 
 
-def coverage_summary(c: Coverage) -> dict[str, float | dict[str, float]]:
+def coverage_summary(c: Coverage) -> CoverageSummary:
     """summary.json ``coverage``: H_initial, H_final, fraction of POIs observed, each
     observer's last reported H_i, and the ground's information-driven orbit decisions."""
-    return {
-        "H_initial": c.h_initial,
-        "H_final": c.h[-1] if c.h else c.h_initial,
-        "fraction_observed": c.fraction_observed,
-        "H_i_final": {str(sc): hs[-1] for sc, (_, hs) in sorted(c.h_i.items()) if hs},
-        "H_reduction_fraction": float(1.0 - (c.h[-1] if c.h else c.h_initial) / c.h_initial),
-        "assignment_decisions": [d.model_dump(exclude={"sender", "seq", "t_wall"})
-                                 for d in c.decisions],
-    }
+    return CoverageSummary(
+        H_initial=c.h_initial,
+        H_final=c.h[-1] if c.h else c.h_initial,
+        fraction_observed=c.fraction_observed,
+        H_i_final={str(sc): hs[-1] for sc, (_, hs) in sorted(c.h_i.items()) if hs},
+        H_reduction_fraction=float(1.0 - (c.h[-1] if c.h else c.h_initial) / c.h_initial),
+        assignment_decisions=[AssignmentRecord.model_validate(d.model_dump(exclude=BUS_HEADER))
+                              for d in c.decisions],
+    )
 

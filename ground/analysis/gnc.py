@@ -19,6 +19,7 @@ from scipy.spatial.transform import Rotation
 
 from gnc import hcw
 from gnc.mission import MissionConstants
+from ground.analysis.run_summary import GncStats
 from ground.analysis.truth_table import TIME_DECIMALS, TruthTable
 from ground.archive.reader import RunArchive
 from interfaces.contracts import catalogue as cat
@@ -132,29 +133,29 @@ def _pointing(archive: RunArchive, scenario: Scenario, mission: str, truth: Trut
         s.modes.extend(e.mode for e in ests)
 
 
-def gnc_summary(series: dict[int, GncSeries]) -> dict[str, dict[str, float | int | None]]:
+def gnc_summary(series: dict[int, GncSeries]) -> dict[str, GncStats]:
     """summary.json ``gnc`` section: per observer Δv (m/s), PRO hold error (m), min range (m),
     pointing error in track mode (deg) and attitude knowledge error (arcsec)."""
-    out: dict[str, dict[str, float | int | None]] = {}
+    out: dict[str, GncStats] = {}
     for sc, s in series.items():
         track = np.array([m == "track" for m in s.modes], dtype=bool)
         pe = np.degrees(np.array(s.pointing_error_rad))[track] if track.size else np.array([])
         ke = np.degrees(np.array(s.knowledge_error_rad)) * 3600.0
         he = np.array(s.hold_error_m)
-        out[str(sc)] = {
-            "dv_delivered_l1_mps": s.dv_mps[-1] if s.dv_mps else 0.0,
-            "dv_commanded_l1_mps": s.dv_commanded_mps,
-            "dv_planned_l1_mps": s.dv_planned_mps,
-            "transfers": s.transfers,
-            "min_range_m": s.range_min_m if np.isfinite(s.range_min_m) else None,
-            "hold_samples": int(he.size),
-            "hold_error_rms_m": float(np.sqrt(np.mean(he**2))) if he.size else None,
-            "hold_error_max_m": float(he.max()) if he.size else None,
-            "pointing_samples_track": int(pe.size),
-            "pointing_error_mean_deg": float(pe.mean()) if pe.size else None,
-            "pointing_error_p95_deg": float(np.percentile(pe, 95)) if pe.size else None,
-            "pointing_error_max_deg": float(pe.max()) if pe.size else None,
-            "fraction_tracking": float(track.mean()) if track.size else 0.0,
-            "knowledge_error_rms_arcsec": float(np.sqrt(np.mean(ke**2))) if ke.size else None,
-        }
+        out[str(sc)] = GncStats(
+            dv_delivered_l1_mps=s.dv_mps[-1] if s.dv_mps else 0.0,
+            dv_commanded_l1_mps=s.dv_commanded_mps,
+            dv_planned_l1_mps=s.dv_planned_mps,
+            transfers=s.transfers,
+            min_range_m=s.range_min_m if np.isfinite(s.range_min_m) else None,
+            hold_samples=int(he.size),
+            hold_error_rms_m=float(np.sqrt(np.mean(he**2))) if he.size else None,
+            hold_error_max_m=float(he.max()) if he.size else None,
+            pointing_samples_track=int(pe.size),
+            pointing_error_mean_deg=float(pe.mean()) if pe.size else None,
+            pointing_error_p95_deg=float(np.percentile(pe, 95)) if pe.size else None,
+            pointing_error_max_deg=float(pe.max()) if pe.size else None,
+            fraction_tracking=float(track.mean()) if track.size else 0.0,
+            knowledge_error_rms_arcsec=float(np.sqrt(np.mean(ke**2))) if ke.size else None,
+        )
     return out

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import matplotlib
@@ -15,6 +14,7 @@ from ground.analysis.coverage import Coverage  # noqa: E402
 from ground.analysis.digest import RunDigest, digest_run  # noqa: E402
 from ground.analysis.gnc import GncSeries  # noqa: E402
 from ground.analysis.nav import NavErrors  # noqa: E402
+from ground.analysis.run_summary import RunSummary, Scores  # noqa: E402
 from ground.analysis.truth_table import TruthTable  # noqa: E402
 from ground.archive.reader import ArchiveError, RunArchive  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
@@ -27,16 +27,16 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     """Write ``<out>/report.md`` (and its plots) from ``run.mcap`` and ``summary.json``
     (``digest``: the run's archive already read for the summary, ``ground.analysis.digest``)."""
     mission = mission or scenario.name
-    summary = json.loads((out / "summary.json").read_text())
+    summary = RunSummary.read(out / "summary.json")
     lines = [f"# Run report: {scenario.name}", "",
-             f"Status **{summary['status']}**, seed {scenario.seed}, transport "
-             f"{summary['transport']}, {summary.get('t_sim_final_s', 0):.0f} s simulated in "
-             f"{summary['wall_s']:.1f} s wall"
-             + (f" ({summary['real_time_factor']:.0f}× real time)."
-                if summary.get("real_time_factor") else "."),
+             f"Status **{summary.status}**, seed {scenario.seed}, transport "
+             f"{summary.transport}, {summary.t_sim_final_s or 0:.0f} s simulated in "
+             f"{summary.wall_s:.1f} s wall"
+             + (f" ({summary.real_time_factor:.0f}× real time)."
+                if summary.real_time_factor else "."),
              ""]
-    if summary.get("error"):
-        lines += ["```", summary["error"], "```", ""]
+    if summary.error:
+        lines += ["```", summary.error, "```", ""]
     try:
         digest = digest or digest_run(out / "run.mcap", scenario, mission)
     except (ArchiveError, OSError) as e:
@@ -82,7 +82,7 @@ def _trajectory_section(out: Path, truth: TruthTable) -> list[str]:
     return ["## Relative trajectories", "", "![trajectories](trajectories.png)", ""]
 
 
-def _nav_section(out: Path, errs: dict[int, NavErrors], summary: dict) -> list[str]:
+def _nav_section(out: Path, errs: dict[int, NavErrors], summary: RunSummary) -> list[str]:
     if not errs:
         return ["No navigation estimates recorded.", ""]
     fig, axes = plt.subplots(len(errs), 1, figsize=(10, 2.2 * len(errs)), sharex=True,
@@ -103,16 +103,16 @@ def _nav_section(out: Path, errs: dict[int, NavErrors], summary: dict) -> list[s
     rows = ["| sc | pos RMS (m) | pos max (m) | vel RMS (m/s) | "
             "mean NEES (6 dof) | NEES in 95% | mean NIS |",
             "|---|---|---|---|---|---|---|"]
-    for sc, st in summary.get("nav", {}).items():
+    for sc, st in (summary.nav or {}).items():
         if st:
-            rows.append(f"| {sc} | {st['pos_rms_m']:.3f} | {st['pos_max_m']:.3f} | "
-                        f"{st['vel_rms_mps']:.4f} | {st['nees_mean']:.2f} | "
-                        f"{100 * st['nees_in_95_bounds']:.0f}% | "
-                        f"{st['nis_mean'] or float('nan'):.2f} |")
+            rows.append(f"| {sc} | {st.pos_rms_m:.3f} | {st.pos_max_m:.3f} | "
+                        f"{st.vel_rms_mps:.4f} | {st.nees_mean:.2f} | "
+                        f"{100 * st.nees_in_95_bounds:.0f}% | "
+                        f"{st.nis_mean or float('nan'):.2f} |")
     return ["## Navigation", "", "![nav error](nav_error.png)", "", *rows, ""]
 
 
-def _gnc_section(out: Path, series: dict[int, GncSeries], summary: dict) -> list[str]:
+def _gnc_section(out: Path, series: dict[int, GncSeries], summary: RunSummary) -> list[str]:
     if not any(s.dv_t_s or s.point_t_s for s in series.values()):
         return ["No guidance or attitude data recorded.", ""]
     fig, axes = plt.subplots(3, 1, figsize=(10, 8.5), sharex=True)
@@ -139,17 +139,17 @@ def _gnc_section(out: Path, series: dict[int, GncSeries], summary: dict) -> list
     rows = ["| sc | Δv delivered L1 (mm/s) | Δv planned L1 (mm/s) | transfers | min range (m) | "
             "hold error RMS / max (m) | pointing error mean / p95 (deg, tracking) | "
             "attitude knowledge RMS (arcsec) |", "|---|---|---|---|---|---|---|---|"]
-    for sc, g in summary.get("gnc", {}).items():
+    for sc, g in (summary.gnc or {}).items():
         rows.append(
-            f"| {sc} | {1e3 * g['dv_delivered_l1_mps']:.1f} | {1e3 * g['dv_planned_l1_mps']:.1f} | "
-            f"{g['transfers']} | {f(g['min_range_m'], '.1f')} | "
-            f"{f(g['hold_error_rms_m'], '.3f')} / {f(g['hold_error_max_m'], '.3f')} | "
-            f"{f(g['pointing_error_mean_deg'], '.3f')} / {f(g['pointing_error_p95_deg'], '.3f')} | "
-            f"{f(g['knowledge_error_rms_arcsec'], '.1f')} |")
+            f"| {sc} | {1e3 * g.dv_delivered_l1_mps:.1f} | {1e3 * g.dv_planned_l1_mps:.1f} | "
+            f"{g.transfers} | {f(g.min_range_m, '.1f')} | "
+            f"{f(g.hold_error_rms_m, '.3f')} / {f(g.hold_error_max_m, '.3f')} | "
+            f"{f(g.pointing_error_mean_deg, '.3f')} / {f(g.pointing_error_p95_deg, '.3f')} | "
+            f"{f(g.knowledge_error_rms_arcsec, '.1f')} |")
     return ["## Guidance and attitude", "", "![gnc](gnc.png)", "", *rows, ""]
 
 
-def _coverage_section(out: Path, c: Coverage, summary: dict) -> list[str]:
+def _coverage_section(out: Path, c: Coverage, summary: RunSummary) -> list[str]:
     if not c.h:
         return ["No camera images recorded.", ""]
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
@@ -168,11 +168,11 @@ def _coverage_section(out: Path, c: Coverage, summary: dict) -> list[str]:
     fig.tight_layout()
     fig.savefig(out / "coverage.png", dpi=110)
     plt.close(fig)
-    cov = summary.get("coverage", {})
+    cov = summary.coverage
     return ["## Inspection", "", "![coverage](coverage.png)", "",
-            f"H from {cov.get('H_initial', float('nan')):.4f} to "
-            f"{cov.get('H_final', float('nan')):.4f}; "
-            f"{100 * cov.get('fraction_observed', 0):.1f}% of the POIs observed.", ""] \
+            f"H from {cov.H_initial if cov else float('nan'):.4f} to "
+            f"{cov.H_final if cov else float('nan'):.4f}; "
+            f"{100 * (cov.fraction_observed if cov else 0):.1f}% of the POIs observed.", ""] \
         + _decision_rows(c)
 
 
@@ -193,7 +193,8 @@ def _decision_rows(c: Coverage) -> list[str]:
     return rows + [""]
 
 
-def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -> list[str]:
+def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: RunSummary
+                  ) -> list[str]:
     """Per observer: log10 of the metric H_m,i against log10 of the threshold τ_i (as the
     paper's Fig. 23-26, right), fault onsets (red) and declared faults (black)."""
     windows = archive.of(cat.FDIR_WINDOW, mission)
@@ -211,12 +212,12 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -
                 label="log H_m")
         ax.plot(t, np.log10([max(w.threshold, floor) for w in mine]), "--", lw=1.0,
                 label="log τ")
-        for f in summary.get("injected_faults", []):
-            if f["spacecraft"] == sc:
-                ax.axvline(f["start_s"], color="tab:red", lw=1.0)
-        for d in summary.get("detections", []):
-            if d["spacecraft"] == sc:
-                ax.axvline(d["time_s"], color="k", lw=1.0, ls=":")
+        for f in summary.injected_faults:
+            if f.spacecraft == sc:
+                ax.axvline(f.start_s, color="tab:red", lw=1.0)
+        for d in summary.detections or []:
+            if d.spacecraft == sc:
+                ax.axvline(d.time_s, color="k", lw=1.0, ls=":")
         ax.set_ylabel(f"sc{sc}")
         ax.grid(True, alpha=0.3)
     axes[0, 0].legend(fontsize=8, loc="upper right")
@@ -229,65 +230,64 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: dict) -
     rows = ["## FDIR", "", "![fdir](fdir.png)", "", "![fdir gain](fdir_gain.png)", "",
             "| fault | spacecraft | onset (s) | detected | isolated | latency (s) | class |",
             "|---|---|---|---|---|---|---|"]
-    scores = summary.get("scores", {})
-    for f in scores.get("per_fault", []):
-        lat = "-" if f["latency_s"] is None else f"{f['latency_s']:.0f}"
-        rows.append(f"| {f['kind']} | {f['spacecraft']} | {f['start_s']:.0f} | "
-                    f"{'yes' if f['detected'] else 'no'} | {'yes' if f['isolated'] else 'no'} | "
-                    f"{lat} | {f['identified_class'] or '-'} (expected {f['expected_class']}) |")
-    if not scores.get("per_fault"):
+    scores = summary.scores
+    for f in scores.per_fault if scores else []:
+        lat = "-" if f.latency_s is None else f"{f.latency_s:.0f}"
+        rows.append(f"| {f.kind} | {f.spacecraft} | {f.start_s:.0f} | "
+                    f"{'yes' if f.detected else 'no'} | {'yes' if f.isolated else 'no'} | "
+                    f"{lat} | {f.identified_class or '-'} (expected {f.expected_class}) |")
+    if not (scores and scores.per_fault):
         rows[-2:] = ["No fault injected."]
-    rows += ["", f"False alarms: {scores.get('false_alarms', 0)} in "
-                 f"{scores.get('nominal_cycles', 0)} nominal FDI cycles.", ""]
+    rows += ["", f"False alarms: {scores.false_alarms if scores else 0} in "
+                 f"{scores.nominal_cycles if scores else 0} nominal FDI cycles.", ""]
     return (rows + _identification_rows(summary) + _table4_rows(summary)
             + _detector_rows(summary) + _recovery_rows(summary))
 
 
-def _identification_rows(summary: dict) -> list[str]:
+def _identification_rows(summary: RunSummary) -> list[str]:
     """Each declared fault with the evidence its class rests on (ground/fdir/identify.py)."""
     rows = ["| declared (s) | spacecraft | class | H_m | τ | evidence |",
             "|---|---|---|---|---|---|"]
-    for d in summary.get("detections", []):
-        ev = ", ".join(f"{k} {v:.3g}" for k, v in d.get("evidence", {}).items()) or "-"
-        m = "-" if d.get("metric") is None else f"{d['metric']:.3g}"
-        tau = "-" if d.get("threshold") is None else f"{d['threshold']:.3g}"
-        rows.append(f"| {d['time_s']:.0f} | {d['spacecraft']} | {d['class'] or 'unidentified'} | "
+    for d in summary.detections or []:
+        ev = ", ".join(f"{k} {v:.3g}" for k, v in d.evidence.items()) or "-"
+        m = "-" if d.metric is None else f"{d.metric:.3g}"
+        tau = "-" if d.threshold is None else f"{d.threshold:.3g}"
+        rows.append(f"| {d.time_s:.0f} | {d.spacecraft} | {d.fault_class or 'unidentified'} | "
                     f"{m} | {tau} | {ev} |")
     return rows + [""] if len(rows) > 2 else []
 
 
-def _recovery_rows(summary: dict) -> list[str]:
+def _recovery_rows(summary: RunSummary) -> list[str]:
     """Recovery actions and, after --compare-recovery, final H with and without them."""
-    rec = summary.get("recovery")
-    acts = [d for d in summary.get("coverage", {}).get("assignment_decisions", [])
-            if d.get("reason") == "recovery"]
+    rec = summary.recovery
+    acts = [d for d in (summary.coverage.assignment_decisions if summary.coverage else [])
+            if d.reason == "recovery"]
     rows = [f"Recovery: {len(acts)} replan(s)"
-            + "".join(f"; {d['phase']} at {d['t_sim']:.0f} s (PROs {d['library_indices']})"
+            + "".join(f"; {d.phase} at {d.t_sim:.0f} s (PROs {d.library_indices})"
                       for d in acts) + "."]
-    if rec and None not in (rec.get("H_final_with_recovery"),
-                            rec.get("H_final_without_recovery")):
-        rows.append(f"Final H with recovery {rec['H_final_with_recovery']:.5g}, without "
-                    f"{rec['H_final_without_recovery']:.5g} (same scenario and seed; "
-                    f"{rec['counterfactual']}).")
+    if rec and None not in (rec.H_final_with_recovery, rec.H_final_without_recovery):
+        rows.append(f"Final H with recovery {rec.H_final_with_recovery:.5g}, without "
+                    f"{rec.H_final_without_recovery:.5g} (same scenario and seed; "
+                    f"{rec.counterfactual}).")
     elif rec:
-        rows.append(f"The counterfactual run ({rec['counterfactual']}) did not complete: "
-                    f"{rec.get('counterfactual_status')}.")
+        rows.append(f"The counterfactual run ({rec.counterfactual}) did not complete: "
+                    f"{rec.counterfactual_status}.")
     return rows + [""]
 
 
-def _table4_rows(summary: dict) -> list[str]:
+def _table4_rows(summary: RunSummary) -> list[str]:
     """The run's row of the paper's Table 4: faulty observers, the direction their information
     gain took, whether all were detected, and the average latency."""
-    per_fault = summary.get("scores", {}).get("per_fault", [])
+    per_fault = summary.scores.per_fault if summary.scores else []
     if not per_fault:
         return []
-    faulty = sorted({f["spacecraft"] for f in per_fault})
-    dirs = sorted({d["direction"] for d in summary.get("detections", [])
-                   if d["spacecraft"] in faulty and d.get("direction")})
-    lats = [f["latency_s"] for f in per_fault if f["isolated"]]
-    kinds = ", ".join(sorted({f["kind"] for f in per_fault}))
+    faulty = sorted({f.spacecraft for f in per_fault})
+    dirs = sorted({d.direction for d in summary.detections or []
+                   if d.spacecraft in faulty and d.direction})
+    lats = [f.latency_s for f in per_fault if f.isolated]
+    kinds = ", ".join(sorted({f.kind for f in per_fault}))
     observed = " / ".join(f"{d} information gain" for d in dirs) or "-"
-    detected = "Yes" if all(f["isolated"] for f in per_fault) else "No"
+    detected = "Yes" if all(f.isolated for f in per_fault) else "No"
     latency = f"{np.mean(lats):.0f} s" if lats else "-"
     return ["Table 4 row (paper Sec. IV.B):", "",
             "| Fault | Expected signature | Observed behavior | Fault detected | Avg. latency |",
@@ -296,19 +296,19 @@ def _table4_rows(summary: dict) -> list[str]:
             f"{detected} | {latency} |", ""]
 
 
-def _detector_rows(summary: dict) -> list[str]:
+def _detector_rows(summary: RunSummary) -> list[str]:
     """The main detector against each baseline, scored alike."""
-    detectors = {"information FDIR (this)": summary.get("scores", {}),
-                 **summary.get("baselines", {})}
+    detectors: dict[str, Scores | None] = {"information FDIR (this)": summary.scores,
+                                           **(summary.baselines or {})}
     rows = ["Detectors side by side (same run, same scoring):", "",
             "| detector | faults detected | isolated | latencies (s) | false alarms | "
             "nominal cycles |", "|---|---|---|---|---|---|"]
     for name, sc in detectors.items():
-        pf = sc.get("per_fault", [])
-        lats = ", ".join("-" if f["latency_s"] is None else f"{f['latency_s']:.0f}" for f in pf)
-        rows.append(f"| {name} | {sum(f['detected'] for f in pf)}/{len(pf)} | "
-                    f"{sum(f['isolated'] for f in pf)}/{len(pf)} | {lats or '-'} | "
-                    f"{sc.get('false_alarms', 0)} | {sc.get('nominal_cycles', 0)} |")
+        pf = sc.per_fault if sc else []
+        lats = ", ".join("-" if f.latency_s is None else f"{f.latency_s:.0f}" for f in pf)
+        rows.append(f"| {name} | {sum(f.detected for f in pf)}/{len(pf)} | "
+                    f"{sum(f.isolated for f in pf)}/{len(pf)} | {lats or '-'} | "
+                    f"{sc.false_alarms if sc else 0} | {sc.nominal_cycles if sc else 0} |")
     return rows + [""]
 
 
@@ -336,42 +336,42 @@ def _gain_plot(out: Path, judged: list[FdirWindow], ids: list[int]) -> None:
     plt.close(fig)
 
 
-def _links_section(summary: dict) -> list[str]:
+def _links_section(summary: RunSummary) -> list[str]:
     rows = ["## Links", "",
             "| link | sent | delivered | dropped (range) | dropped (loss) | dropped (cut) |",
             "|---|---|---|---|---|---|"]
-    for c in summary.get("links", []):
-        rows.append(f"| {c['src']} → {c['dst']} | {c['sent']} | {c['delivered']} | "
-                    f"{c['dropped_range']} | {c['dropped_loss']} | {c['dropped_cut']} |")
+    for c in summary.links or []:
+        rows.append(f"| {c.src} → {c.dst} | {c.sent} | {c.delivered} | "
+                    f"{c.dropped_range} | {c.dropped_loss} | {c.dropped_cut} |")
     return rows + [""]
 
 
-def _incidents_section(summary: dict) -> list[str]:
+def _incidents_section(summary: RunSummary) -> list[str]:
     """Processes lost from the lockstep and telemetry outages (a degraded run)."""
-    lost = summary.get("sim", {}).get("participants", {})
-    outages = {e["spacecraft"]: e.get("outages", []) for e in summary.get("telemetry", [])}
+    lost = summary.sim.participants if summary.sim else {}
+    outages = {e.spacecraft: e.outages for e in summary.telemetry or []}
     if not lost and not any(outages.values()):
         return []
-    rows = ["## Incidents", "", f"Run status: **{summary.get('status')}**"
-            + (f" ({summary['error']})" if summary.get("error") else ""), "",
+    rows = ["## Incidents", "", f"Run status: **{summary.status}**"
+            + (f" ({summary.error})" if summary.error else ""), "",
             "| node | lockstep (sim s) | telemetry outages (sim s) |", "|---|---|---|"]
     nodes = sorted(set(lost) | {f"sc{sc}" for sc, o in outages.items() if o})
     for node in nodes:
-        events = ", ".join(f"{e['what']} {e['t_sim']:.1f}" for e in lost.get(node, []))
+        events = ", ".join(f"{e.what} {e.t_sim:.1f}" for e in lost.get(node, []))
         sc = int(node[2:]) if node.startswith("sc") else None
         gaps = ", ".join(f"{a:.1f}-{b:.1f}" for a, b in outages.get(sc, []))
         rows.append(f"| {node} | {events or '-'} | {gaps or '-'} |")
     return rows + [""]
 
 
-def _exec_section(summary: dict) -> list[str]:
+def _exec_section(summary: RunSummary) -> list[str]:
     rows = ["## Executives", "",
             "| node | cycle slips (high/mid/low) | max exec ms (high/mid/low) | app errors "
             "| invalid msgs | refused msgs | barrier timeouts |",
             "|---|---|---|---|---|---|---|"]
-    for node, e in summary.get("exec", {}).items():
-        slips = "/".join(str(e["cycle_slips"].get(g, 0)) for g in ("high", "mid", "low"))
-        ms = "/".join(f"{e['max_exec_ms'].get(g, 0):.2f}" for g in ("high", "mid", "low"))
-        rows.append(f"| {node} | {slips} | {ms} | {e['app_errors']} | {e['invalid_dropped']} | "
-                    f"{e.get('refused', 0)} | {e['barrier_timeouts']} |")
+    for node, e in (summary.exec or {}).items():
+        slips = "/".join(str(e.cycle_slips.get(g, 0)) for g in ("high", "mid", "low"))
+        ms = "/".join(f"{e.max_exec_ms.get(g, 0):.2f}" for g in ("high", "mid", "low"))
+        rows.append(f"| {node} | {slips} | {ms} | {e.app_errors} | {e.invalid_dropped} | "
+                    f"{e.refused} | {e.barrier_timeouts} |")
     return rows + [""]

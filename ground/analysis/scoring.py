@@ -21,9 +21,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from ground.analysis.run_summary import FaultClass, FaultScore, Scores
 from interfaces.contracts.scenario import Fault
 
-EXPECTED_CLASS = {
+EXPECTED_CLASS: dict[str, FaultClass] = {
     "thruster_bias": "actuator", "pointing_actuator": "actuator",
     "camera_degradation": "camera", "camera_misalignment": "camera",
     "nav_sensor_bias": "state_sensor", "link_loss": "link", "packet_loss": "link",
@@ -38,7 +39,7 @@ class Alarm:
 
     spacecraft: int
     t_s: float
-    fault_class: str | None
+    fault_class: FaultClass | None
 
 
 @dataclass(frozen=True)
@@ -63,7 +64,7 @@ def overlaps_fault(faults: Sequence[Fault], spacecraft: int, t_start_s: float,
 
 
 def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Judged],
-          grace_s: float) -> dict[str, object]:
+          grace_s: float) -> Scores:
     """The ``scores`` section: ``per_fault`` (in scenario order) and the false-alarm figures."""
     per_fault = []
     for f in faults:
@@ -72,14 +73,14 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
         first = on_it[0] if on_it else (during[0] if during else None)
         classed = [a for a in on_it if a.fault_class is not None]
         identified = classed[0].fault_class if classed else None
-        per_fault.append({
-            "spacecraft": f.spacecraft, "kind": f.kind, "start_s": f.start_s,
-            "detected": bool(during), "isolated": bool(on_it),
-            "latency_s": None if first is None else first.t_s - f.start_s,
-            "identified_class": identified, "expected_class": EXPECTED_CLASS[f.kind],
-            "identified_correctly": identified == EXPECTED_CLASS[f.kind],
-            "identification_latency_s": classed[0].t_s - f.start_s if classed else None,
-        })
+        per_fault.append(FaultScore(
+            spacecraft=f.spacecraft, kind=f.kind, start_s=f.start_s,
+            detected=bool(during), isolated=bool(on_it),
+            latency_s=None if first is None else first.t_s - f.start_s,
+            identified_class=identified, expected_class=EXPECTED_CLASS[f.kind],
+            identified_correctly=identified == EXPECTED_CLASS[f.kind],
+            identification_latency_s=classed[0].t_s - f.start_s if classed else None,
+        ))
 
     def faulty(sc: int, t: float) -> bool:  # a common-mode fault (0) acts on every observer
         return any(f.spacecraft in (0, sc) and _active(f, t, grace_s) for f in faults)
@@ -90,10 +91,10 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
     false_alarms = [a for a in alarms if not faulty(a.spacecraft, a.t_s)]
     nominal = [j for j in judged if not overlaps(j)]
     hours = sum(j.t_end_s - j.t_start_s for j in nominal) / 3600.0
-    return {
-        "per_fault": per_fault,
-        "false_alarms": len(false_alarms),
-        "nominal_cycles": len(nominal),
-        "false_alarm_rate": len(false_alarms) / len(nominal) if nominal else None,
-        "false_alarms_per_hour": len(false_alarms) / hours if hours > 0 else None,
-    }
+    return Scores(
+        per_fault=per_fault,
+        false_alarms=len(false_alarms),
+        nominal_cycles=len(nominal),
+        false_alarm_rate=len(false_alarms) / len(nominal) if nominal else None,
+        false_alarms_per_hour=len(false_alarms) / hours if hours > 0 else None,
+    )

@@ -1,15 +1,41 @@
-"""summary.json of a run (docs/contracts.md), computed from the archive read back."""
+"""summary.json of a run (docs/contracts.md; its type: ``ground.analysis.run_summary``),
+computed from the archive read back."""
 
 from __future__ import annotations
 
-import json
-import math
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Literal, TypeVar
+
+from pydantic import BaseModel
 
 from ground.analysis.coverage import coverage_summary
 from ground.analysis.digest import RunDigest, digest_run
 from ground.analysis.gnc import gnc_summary
+from ground.analysis.run_summary import (
+    BUS_HEADER,
+    AccessAudit,
+    ArchiveInfo,
+    Detection,
+    ExecRecord,
+    FailedTests,
+    FaultEventRecord,
+    FdirResults,
+    FdirSeries,
+    MainWindow,
+    MessageCounts,
+    ModelZ,
+    NavStats,
+    RecoveryComparison,
+    RunFdirSettings,
+    RunSummary,
+    Scores,
+    SeriesWindow,
+    SimRecord,
+    ThresholdCensus,
+    ThresholdSources,
+)
 from ground.analysis.scoring import Alarm, Judged, overlaps_fault, score
 from ground.archive.reader import ArchiveError, RunArchive
 from interfaces.contracts import catalogue as cat
@@ -21,50 +47,95 @@ from interfaces.contracts.messages import (
     FdirWindow,
     LinkStats,
     Message,
+    SimStatus,
     Tick,
 )
 from interfaces.contracts.scenario import Scenario
 
 M = TypeVar("M", bound=Message)
+B = TypeVar("B", bound=BaseModel)
 
 NAV_SETTLE_S = 10.0
 """Nav statistics skip the filter's first seconds (initial transient)."""
 
 
-def build_summary(digest: RunDigest, scenario: Scenario, mission: str) -> dict[str, Any]:
-    """The run's figures from its archive (no transport or wall-clock information)."""
+@dataclass(frozen=True)
+class RunOutcome:
+    """How a run went, from outside its archive: its transport, wall time (s), status and
+    error (None if none)."""
+
+    transport: Literal["inproc", "zenoh"]
+    wall_s: float
+    status: Literal["completed", "degraded", "failed"]
+    error: str | None = None
+
+
+def summary_head(scenario: Scenario, outcome: RunOutcome) -> RunSummary:
+    """The fields every run's summary has, from its scenario and outcome."""
+    return RunSummary(scenario=scenario.name, seed=scenario.seed, transport=outcome.transport,
+                      duration_s=scenario.duration_s, wall_s=round(outcome.wall_s, 3),
+                      status=outcome.status, error=outcome.error,
+                      injected_faults=_copies(scenario.faults))
+
+
+def build_summary(digest: RunDigest, scenario: Scenario, mission: str,
+                  outcome: RunOutcome) -> RunSummary:
+    """The run's summary: its head, then its figures from its archive."""
     archive = digest.archive
     tick_key = (cat.TICK.key(mission), Tick.__name__)
     last_tick = digest.counters.last.get(tick_key)
     execs = _last_of(digest, ExecStats)
     links = _last_of(digest, LinkStats)
     tlm = archive.of(cat.TLM_STATUS, mission)
-    sim = archive.of(cat.SIM_STATUS, mission)
-    return {
-        "ticks": digest.counters.counts.get(tick_key, 0),
-        "t_sim_final_s": last_tick.decode(Tick).t_sim if last_tick is not None else 0.0,
-        "messages": {"total": len(archive), "by_type": _by_type(archive)},
-        "nav": {str(sc): e.stats(skip_s=NAV_SETTLE_S)
-                for sc, e in digest.nav_errors(mission).items()},
-        "gnc": gnc_summary(digest.gnc_series(scenario, mission)),
-        "coverage": coverage_summary(digest.coverage),
-        "links": [c.model_dump() for node in sorted(links) for c in links[node].links],
-        "exec": {node: {"cycle_slips": {g: s.cycle_slips for g, s in m.groups.items()},
-                        "max_exec_ms": {g: round(s.max_exec_ms, 3) for g, s in m.groups.items()},
-                        "app_errors": m.app_errors, "invalid_dropped": m.invalid_dropped,
-                        "refused": m.refused, "barrier_timeouts": m.barrier_timeouts}
-                 for node, m in sorted(execs.items())},
-        "telemetry": [e.model_dump() for e in tlm[-1].entries] if tlm else [],
-        "sim": {"rejected_commands": sim[-1].rejected_commands if sim else None,
-                "participants": ({n: [e.model_dump() for e in ev]
-                                  for n, ev in sim[-1].participants.items()} if sim else {})},
-        "fault_events": [e.model_dump(exclude={"sender", "seq", "t_wall"})
-                         for e in archive.of(cat.FAULT_EVENTS, mission)],
-        **fdir_summary(archive, scenario, mission),
-    }
+    summary = summary_head(scenario, outcome)
+    summary.archive = ArchiveInfo(truncated=archive.truncated)
+    summary.ticks = digest.counters.counts.get(tick_key, 0)
+    t_final = last_tick.decode(Tick).t_sim if last_tick is not None else 0.0
+    summary.t_sim_final_s = t_final
+    summary.messages = MessageCounts(total=len(archive), by_type=_by_type(archive))
+    summary.nav = {str(sc): _nav_stats(e.stats(skip_s=NAV_SETTLE_S))
+                   for sc, e in digest.nav_errors(mission).items()}
+    summary.gnc = gnc_summary(digest.gnc_series(scenario, mission))
+    summary.coverage = coverage_summary(digest.coverage)
+    summary.links = _copies([c for node in sorted(links) for c in links[node].links])
+    summary.exec = {node: _exec_record(m) for node, m in sorted(execs.items())}
+    summary.telemetry = _copies(tlm[-1].entries) if tlm else []
+    summary.sim = _sim_record(archive.of(cat.SIM_STATUS, mission))
+    summary.fault_events = [FaultEventRecord.model_validate(e.model_dump(exclude=BUS_HEADER))
+                            for e in archive.of(cat.FAULT_EVENTS, mission)]
+    summary.set_fdir(fdir_summary(archive, scenario, mission))
+    summary.real_time_factor = round(t_final / outcome.wall_s, 2) if outcome.wall_s > 0 else None
+    return summary
 
 
-def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[str, Any]:
+def _nav_stats(stats: dict[str, float]) -> NavStats | None:
+    """An observer's nav statistics (None: no estimate after the settling time)."""
+    return NavStats.model_validate(stats) if stats else None
+
+
+def _exec_record(m: ExecStats) -> ExecRecord:
+    return ExecRecord(cycle_slips={g: s.cycle_slips for g, s in m.groups.items()},
+                      max_exec_ms={g: round(s.max_exec_ms, 3) for g, s in m.groups.items()},
+                      app_errors=m.app_errors, invalid_dropped=m.invalid_dropped,
+                      refused=m.refused, barrier_timeouts=m.barrier_timeouts)
+
+
+def _sim_record(statuses: list[SimStatus]) -> SimRecord:
+    """``sim`` from the sim's last status (none: nothing rejected is known)."""
+    if not statuses:
+        return SimRecord(rejected_commands=None, participants={})
+    last = statuses[-1]
+    return SimRecord(rejected_commands=last.rejected_commands,
+                     participants={n: _copies(ev) for n, ev in last.participants.items()})
+
+
+def _copies(records: Sequence[B]) -> list[B]:
+    """Copies of ``records`` with every field given (as written: a message decoded from the
+    bus holds only the fields its sender gave, and a summary writes the fields given)."""
+    return [type(r).model_validate(r.model_dump()) for r in records]
+
+
+def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> FdirResults:
     """``detections`` (the ground FDIR's fault reports) and ``scores`` against the injected
     faults (ground/analysis/scoring.py; grace of one FDI window)."""
     return fdir_results(archive.of(cat.FAULT_REPORT, mission),
@@ -73,27 +144,26 @@ def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> dict[
 
 
 def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
-                 verdicts: list[BaselineVerdict], scenario: Scenario) -> dict[str, Any]:
+                 verdicts: list[BaselineVerdict], scenario: Scenario) -> FdirResults:
     """The FDIR part of summary.json from the ground's own output messages (a live run's
     archive or a replay): detections, scores, baselines, series and settings."""
     alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class) for r in reports]
     judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
               if w.exceeded is not None]
-    return {
-        "detections": [{"spacecraft": r.spacecraft, "time_s": r.t_sim, "class": r.fault_class,
-                        "direction": r.direction, "metric": r.metric, "threshold": r.threshold,
-                        "evidence": r.evidence}
-                       for r in reports],
-        "scores": score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
-        "baselines": baseline_scores(verdicts, scenario),
-        "fdir_series": _series(windows, verdicts),
-        "fdir_thresholds": threshold_census(windows, scenario),
-        "fdir_settings": {"fdi_period_s": scenario.rates.fdi_period_s,
-                          **scenario.fdir.model_dump()},
-    }
+    return FdirResults(
+        detections=[Detection(spacecraft=r.spacecraft, time_s=r.t_sim, fault_class=r.fault_class,
+                              direction=r.direction, metric=r.metric, threshold=r.threshold,
+                              evidence=dict(r.evidence))
+                    for r in reports],
+        scores=score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
+        baselines=baseline_scores(verdicts, scenario),
+        fdir_series=_series(windows, verdicts),
+        fdir_thresholds=threshold_census(windows, scenario),
+        fdir_settings=RunFdirSettings.model_validate(
+            {"fdi_period_s": scenario.rates.fdi_period_s, **scenario.fdir.model_dump()}))
 
 
-def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> dict[str, Any]:
+def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> ThresholdCensus:
     """``fdir_thresholds``: over the nominal windows the main detector decided (no fault of
     their spacecraft overlapping), what set the threshold in force (the hardware model, Eq.
     11-12's sampling, or the floor guard), how often each threshold lay above the floor, and
@@ -104,38 +174,38 @@ def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> dict[str,
                and not overlaps_fault(scenario.faults, w.spacecraft, w.t_start_s, w.t_end_s)]
     z = [abs((w.dh / w.dh_pred - w.ratio_mean) / w.ratio_std) for w in nominal
          if w.dh is not None and w.dh_pred and w.ratio_mean is not None and w.ratio_std]
-    return {
-        "nominal_windows": len(nominal),
-        "threshold_by": {k: sum(w.threshold_by == k for w in nominal)
-                         for k in ("model", "sampled", "floor")},
-        "model_above_floor": sum((w.threshold_model or 0.0) > floor for w in nominal),
-        "sampled_above_floor": sum((w.threshold_sampled or 0.0) > floor for w in nominal),
-        "failed": {k: sum(k in w.failed for w in nominal)
-                   for k in WINDOW_TESTS},
-        "model_z": {f"over_{k}": sum(v > k for v in z) for k in (2, 3, 4)} | {"windows": len(z)},
-    }
+    return ThresholdCensus(
+        nominal_windows=len(nominal),
+        threshold_by=ThresholdSources.model_validate(
+            {k: sum(w.threshold_by == k for w in nominal) for k in ("model", "sampled", "floor")}),
+        model_above_floor=sum((w.threshold_model or 0.0) > floor for w in nominal),
+        sampled_above_floor=sum((w.threshold_sampled or 0.0) > floor for w in nominal),
+        failed=FailedTests.model_validate({k: sum(k in w.failed for w in nominal)
+                                            for k in WINDOW_TESTS}),
+        model_z=ModelZ(over_2=sum(v > 2 for v in z), over_3=sum(v > 3 for v in z),
+                       over_4=sum(v > 4 for v in z), windows=len(z)))
 
 
-def _series(windows: list[FdirWindow], verdicts: list[BaselineVerdict]
-            ) -> dict[str, list[list[float]]]:
-    """``fdir_series``: every decided window of each detector as [spacecraft, t_start_s,
-    t_end_s, statistic, threshold] -- what a campaign needs to re-score at other threshold
-    scales (ROC) without the archives.  The main detector's rows carry a sixth value, 1 when
-    the window failed a test other than the information test (plan, pointing, Δv rate, NIS:
-    ``FdirWindow.failed``), which no threshold scale moves."""
-    out: dict[str, list[list[float]]] = {"main": [
-        [w.spacecraft, w.t_start_s, w.t_end_s, w.metric, w.threshold,
-         float(any(t != "information" for t in w.failed))] for w in windows
-        if w.metric is not None and w.threshold is not None]}
+def _series(windows: list[FdirWindow], verdicts: list[BaselineVerdict]) -> FdirSeries:
+    """``fdir_series``: every decided window of each detector (``run_summary.series``) --
+    what a campaign needs to re-score at other threshold scales (ROC) without the archives.
+    The main detector's windows record whether they failed a test other than the information
+    test (plan, pointing, Δv rate, NIS: ``FdirWindow.failed``), which no threshold scale
+    moves."""
+    main = [MainWindow(spacecraft=w.spacecraft, t_start_s=w.t_start_s, t_end_s=w.t_end_s,
+                       statistic=w.metric, threshold=w.threshold,
+                       other_tests_failed=any(t != "information" for t in w.failed))
+            for w in windows if w.metric is not None and w.threshold is not None]
+    baselines: dict[str, list[SeriesWindow]] = {}
     for v in verdicts:
         if v.statistic is not None and v.threshold is not None:
-            out.setdefault(v.detector, []).append(
-                [v.spacecraft, v.t_start_s, v.t_end_s, v.statistic, v.threshold])
-    return out
+            baselines.setdefault(v.detector, []).append(SeriesWindow(
+                spacecraft=v.spacecraft, t_start_s=v.t_start_s, t_end_s=v.t_end_s,
+                statistic=v.statistic, threshold=v.threshold))
+    return FdirSeries(main=main, baselines=baselines)
 
 
-def baseline_scores(verdicts: list[BaselineVerdict], scenario: Scenario
-                    ) -> dict[str, dict[str, Any]]:
+def baseline_scores(verdicts: list[BaselineVerdict], scenario: Scenario) -> dict[str, Scores]:
     """``baselines``: each baseline detector (ground/apps/baselines.py) scored like the main
     one, from its per-window verdicts."""
     out = {}
@@ -162,73 +232,46 @@ def _last_of(digest: RunDigest, model: type[M]) -> dict[str, M]:
     return {m.node: m for m in msgs}  # type: ignore[attr-defined]
 
 
-def write_summary(out: Path, scenario: Scenario, transport: str, wall_s: float, status: str,
+def write_summary(out: Path, scenario: Scenario, transport: Literal["inproc", "zenoh"],
+                  wall_s: float, status: Literal["completed", "degraded", "failed"],
                   error: str | None = None, mission: str | None = None,
                   digest: RunDigest | None = None,
-                  extra: dict[str, Any] | None = None) -> dict[str, Any]:
+                  access: AccessAudit | None = None) -> RunSummary:
     """Write ``<out>/summary.json`` and return it.  A damaged or missing archive is reported in
     the summary (``archive_error``), never hidden.  ``digest``: the run's archive already read
     (``ground.analysis.digest``; the report then reuses it), else ``<out>/run.mcap`` is read.
-    ``extra``: sections from outside the archive (the router's ``access`` audit)."""
-    summary: dict[str, Any] = {
-        "scenario": scenario.name,
-        "seed": scenario.seed,
-        "transport": transport,
-        "duration_s": scenario.duration_s,
-        "wall_s": round(wall_s, 3),
-        "status": status,
-        "error": error,
-        "injected_faults": [f.model_dump() for f in scenario.faults],
-    }
+    ``access``: the router's audit (from outside the archive)."""
+    outcome = RunOutcome(transport, wall_s, status, error)
     try:
-        mission = mission or scenario.name
-        digest = digest or digest_run(out / "run.mcap", scenario, mission)
-        summary["archive"] = {"truncated": digest.archive.truncated}
-        summary.update(build_summary(digest, scenario, mission))
-        t_final = summary["t_sim_final_s"]
-        summary["real_time_factor"] = round(t_final / wall_s, 2) if wall_s > 0 else None
+        digest = digest or digest_run(out / "run.mcap", scenario, mission or scenario.name)
+        summary = build_summary(digest, scenario, mission or scenario.name, outcome)
     except (ArchiveError, OSError) as e:
-        summary["archive_error"] = str(e)
-    summary.update(extra or {})
-    return _write_json(out, summary)
+        summary = summary_head(scenario, outcome)
+        if digest is not None:  # read, then found damaged
+            summary.archive = ArchiveInfo(truncated=digest.archive.truncated)
+        summary.archive_error = str(e)
+    if access is not None:
+        summary.access = access
+    summary.write(out / "summary.json")
+    return summary
 
 
-def add_recovery_comparison(out: Path, summary: dict[str, Any], counter: dict[str, Any],
-                            recovery: bool) -> dict[str, Any]:
+def add_recovery_comparison(out: Path, summary: RunSummary, counter: RunSummary,
+                            recovery: bool) -> RunSummary:
     """Add ``recovery`` to ``<out>/summary.json``: the recovery actions of the run that had
     recovery on, and the final H with and without recovery for the same scenario and seed
     (``counter``: the summary of the same scenario with recovery flipped)."""
     with_r, without = (summary, counter) if recovery else (counter, summary)
-
-    def final_h(s: dict[str, Any]) -> float | None:
-        return s.get("coverage", {}).get("H_final")
-
-    h_with, h_without = final_h(with_r), final_h(without)
-    summary["recovery"] = {
-        "enabled": recovery,
-        "actions": [d for d in with_r.get("coverage", {}).get("assignment_decisions", [])
-                    if d.get("reason") == "recovery"],
-        "H_final_with_recovery": h_with,
-        "H_final_without_recovery": h_without,
-        "H_final_ratio": h_with / h_without if h_with is not None and h_without else None,
-        "counterfactual": "counterfactual/summary.json",
-        "counterfactual_status": counter.get("status"),
-    }
-    return _write_json(out, summary)
-
-
-def _write_json(out: Path, summary: dict[str, Any]) -> dict[str, Any]:
-    summary = _finite(summary)
-    (out / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
+    h_with = with_r.coverage.H_final if with_r.coverage else None
+    h_without = without.coverage.H_final if without.coverage else None
+    summary.recovery = RecoveryComparison(
+        enabled=recovery,
+        actions=[d for d in (with_r.coverage.assignment_decisions if with_r.coverage else [])
+                 if d.reason == "recovery"],
+        H_final_with_recovery=h_with,
+        H_final_without_recovery=h_without,
+        H_final_ratio=h_with / h_without if h_with is not None and h_without else None,
+        counterfactual="counterfactual/summary.json",
+        counterfactual_status=counter.status)
+    summary.write(out / "summary.json")
     return summary
-
-
-def _finite(o: Any) -> Any:
-    """JSON has no NaN/inf: non-finite floats become null."""
-    if isinstance(o, float):
-        return o if math.isfinite(o) else None
-    if isinstance(o, dict):
-        return {k: _finite(v) for k, v in o.items()}
-    if isinstance(o, (list, tuple)):
-        return [_finite(v) for v in o]
-    return o

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ground.analysis.run_summary import ReplayResults
 from ground.analysis.summary import fdir_results
 from ground.archive.metadata import scenario_from_metadata
 from ground.archive.reader import ArchiveError, Record, RunArchive, load_run
@@ -119,22 +120,22 @@ class Replay:
             (self.live.verdicts, self.replayed.verdicts),
             (self.live.constellation, self.replayed.constellation)))
 
-    def results(self) -> dict[str, Any]:
+    def results(self) -> ReplayResults:
         """``summary.json``'s FDIR fields for the replay, with its faithfulness."""
         mine = self.replayed
         out = fdir_results(mine.reports, mine.windows, mine.verdicts, self.scenario)
         horizon = self.faithful_until_s()
-        for d in out["detections"]:
-            d["faithful"] = d["time_s"] <= horizon
+        for d in out.detections:
+            d.faithful = d.time_s <= horizon
         faithful = fdir_results([r for r in mine.reports if r.t_sim <= horizon],
                                 [w for w in mine.windows if w.t_end_s <= horizon],
                                 [v for v in mine.verdicts if v.t_end_s <= horizon],
                                 self.scenario)
-        return {"scenario": self.scenario.name, "seed": self.scenario.seed,
-                "replay_wall_s": round(self.wall_s, 3), "faithful_until_s": horizon,
-                "matches_live": self.matches_live(), **out,
-                "fdir_thresholds": faithful["fdir_thresholds"],  # the census: faithful span
-                "scores_faithful": faithful["scores"]}
+        census = {"fdir_thresholds": faithful.fdir_thresholds}  # the census: faithful span
+        return ReplayResults(scenario=self.scenario.name, seed=self.scenario.seed,
+                             replay_wall_s=round(self.wall_s, 3), faithful_until_s=horizon,
+                             matches_live=self.matches_live(), **(dict(out) | census),
+                             scores_faithful=faithful.scores)
 
 
 def _plan(msg: ProAssignments) -> tuple[float, list[dict[str, Any]]]:
@@ -290,14 +291,14 @@ def _write(replay: Replay, run: Path, out: Path | None) -> None:
     name = (run if run.is_dir() else run.parent).name or "run"
     dest = (out / f"{name}.replay.json") if out else _archive_path(run).parent / "replay.json"
     dest.parent.mkdir(parents=True, exist_ok=True)
-    dest.write_text(json.dumps(res, indent=1))
-    dets = ", ".join(f"sc{d['spacecraft']} {d['class'] or 'unidentified'} at {d['time_s']:.0f} s"
-                     + ("" if d["faithful"] else " (after divergence)")
-                     for d in res["detections"]) or "no detection"
+    dest.write_text(res.to_json(indent=1))
+    dets = ", ".join(f"sc{d.spacecraft} {d.fault_class or 'unidentified'} at {d.time_s:.0f} s"
+                     + ("" if d.faithful else " (after divergence)")
+                     for d in res.detections) or "no detection"
     print(f"{run}: {dets}; "
-          f"{'matches the live run' if res['matches_live'] else 'differs from the live run'}"
-          f"; faithful until {res['faithful_until_s']:.0f} s; "
-          f"{res['replay_wall_s']:.1f} s -> {dest}")
+          f"{'matches the live run' if res.matches_live else 'differs from the live run'}"
+          f"; faithful until {res.faithful_until_s:.0f} s; "
+          f"{res.replay_wall_s:.1f} s -> {dest}")
 
 
 if __name__ == "__main__":
