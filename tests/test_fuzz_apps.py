@@ -164,7 +164,7 @@ def test_fuzzed_inputs_never_stop_or_poison_an_app(app_cls: type[App], node: str
         assert _finite(app) == [], f"{app.NAME} holds non-finite state"
     stats, mine = bus.stats, {id(m) for m in own}
     received = [m for m in delivered if id(m) not in mine]
-    waiting = [e for e in bus._pending if not e.local]  # dated after the last tick: not yet due
+    waiting = [e for e in bus.inbox.pending if not e.local]  # after the last tick: not yet due
     assert stats.received == (len(received) + stats.invalid_dropped + stats.refused
                               + len(waiting))
     # the node goes on: a tick after the fuzz still runs (an app's errors are counted, never

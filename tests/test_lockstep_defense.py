@@ -98,7 +98,7 @@ def test_forged_and_absurd_messages_are_refused_and_counted(receiver) -> None:  
     assert bus.admission.highest_seq[HB_KEY] == 2  # the barrier saw only the genuine two
     assert bus.wait_for({HB_KEY: 2}, 0.01) == []
     assert bus.dispatch(20.0) == 2 and [m.seq for m in got] == [1, 2]
-    assert not bus._pending  # nothing left queued for a future that never comes
+    assert not bus.inbox.pending  # nothing left queued for a future that never comes
 
 
 def test_barrier_never_wakes_before_the_message_is_queued() -> None:

@@ -22,13 +22,16 @@ What the Bus guarantees, identically on every transport:
 * **Channel.** Messages between two different spacecraft/ground nodes pass the receiver's
   ``ChannelModel`` (range at send time, loss, cuts, delay) at dispatch.
 * **Barrier.** ``wait_for(expect)`` blocks until the messages announced in a Tick have arrived.
+
+The Bus's parts of their own: the subscription table (``interfaces.runtime.subscriptions``), the
+inbox of deferred messages with the delivery order and the barrier (``interfaces.runtime.inbox``),
+admission (``interfaces.runtime.admission``), the channel stage (``interfaces.runtime.channel``)
+and the schema service (``interfaces.runtime.schemas``).
 """
 
 from __future__ import annotations
 
-import json
 import logging
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -37,56 +40,16 @@ from typing import TypeVar
 from pydantic import ValidationError
 
 from interfaces.contracts import catalogue, topics
-from interfaces.contracts.messages import Message, TruthState, json_schema, registry, stamp
-from interfaces.contracts.timing import TIME_TOL_S
+from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
-from interfaces.runtime.channel import ChannelModel, Verdict, applies
+from interfaces.runtime.channel import ChannelModel, Verdict
+from interfaces.runtime.inbox import Envelope, Inbox
+from interfaces.runtime.schemas import serve_schemas
+from interfaces.runtime.subscriptions import Route, Sub, SubscriptionTable
 from interfaces.runtime.transport import LivenessHandler, RawHandler, Sample, Transport
 
 M = TypeVar("M", bound=Message)
 MAX_PAYLOAD_BYTES = 1 << 20
-_UNKNOWN = object()
-"""Marks a key not yet looked up in the catalogue."""
-
-
-@dataclass
-class _Sub:
-    key_expr: str
-    msg_type: type[Message]
-    handler: Callable[[Message], None]
-    immediate: bool
-
-
-class _Envelope:
-    """A message waiting in a node's inbox for its subscribers ``subs``; ``order`` is its place
-    in the delivery order, (send time, key, sequence)."""
-
-    __slots__ = ("msg", "key", "src", "local", "subs", "order")
-
-    def __init__(self, msg: Message, key: str, src: str | None, local: bool,
-                 subs: list[_Sub]) -> None:
-        self.msg, self.key, self.src, self.local, self.subs = msg, key, src, local, subs
-        self.order = (msg.t_sim, key, msg.seq)
-
-
-def _order(env: _Envelope) -> tuple[float, str, int]:
-    return env.order
-
-
-@dataclass
-class _Group:
-    """The subscriptions of one key expression, split for delivery of a message of ``kind``
-    (the type all of them take, or None when they take different types)."""
-
-    kind: type[Message] | None
-    immediate: list[_Sub]
-    deferred: list[_Sub]
-
-    @classmethod
-    def of(cls, subs: list[_Sub]) -> _Group:
-        kinds = {s.msg_type for s in subs}
-        return cls(kinds.pop() if len(kinds) == 1 else None,
-                   [s for s in subs if s.immediate], [s for s in subs if not s.immediate])
 
 
 @dataclass
@@ -101,33 +64,25 @@ class BusStats:
 
 @dataclass(eq=False)
 class Bus:
+    """Node ``node``'s side of the bus of ``mission`` (module docstring); its subscriptions are
+    in ``table`` (``interfaces.runtime.subscriptions``), the messages waiting for delivery and
+    the barrier in ``inbox`` (``interfaces.runtime.inbox``)."""
+
     node: str
     mission: str
     transport: Transport
     channel: ChannelModel | None = None
     log: logging.Logger = field(default=None)  # type: ignore[assignment]
     stats: BusStats = field(default_factory=BusStats)
+    admission: Admission = field(default_factory=Admission)
     _seq: dict[str, int] = field(default_factory=dict)
     _published_since: dict[str, int] = field(default_factory=dict)
-    _groups: dict[str, list[_Sub]] = field(default_factory=dict)
     _raw: dict[str, list[RawHandler]] = field(default_factory=dict)
-    _split: dict[str, _Group] = field(default_factory=dict)
-    _routes: dict[str, tuple[type[Message] | None, list[_Sub]]] = field(default_factory=dict)
-    """Per key published: its catalogue type (None: not catalogued) and this node's own
-    subscribers of it (resolved once per key)."""
-    _crosses: dict[str | None, bool] = field(default_factory=dict)
-    """Per source node: whether its messages to this node cross a modelled link."""
-    _pending: list[_Envelope] = field(default_factory=list)
-    admission: Admission = field(default_factory=Admission)
-    _await_cache: dict[str, bool] = field(default_factory=dict)
-    _key_types: dict[str, object] = field(default_factory=dict)
-    """Catalogue type of each key published or subscribed (None: not catalogued)."""
-    _cond: threading.Condition = field(default_factory=threading.Condition)
-    _waiting: int = 0
-    """Threads inside ``wait_for`` (changed and read under ``_cond``)."""
 
     def __post_init__(self) -> None:
         self.prefix = topics.node_prefix(self.mission, self.node)
+        self.table = SubscriptionTable(self.prefix)
+        self.inbox = Inbox(self.node)
         if self.log is None:
             self.log = logging.getLogger(f"insp.bus.{self.node}")
         if self.channel is not None and self.channel.truth.claim_feed():
@@ -142,7 +97,7 @@ class Bus:
         Sets ``sender``, ``seq`` and ``t_wall``.  Treat a published message as immutable.
         ``announce=False`` leaves the key out of ``published_since_last`` (lockstep control
         messages that nobody must wait for)."""
-        route = self._routes.get(key)
+        route = self.table.routes.get(key)
         if route is None:
             route = self._route(key)
         expected, local = route
@@ -155,33 +110,19 @@ class Bus:
         stamp(msg, self.node, seq, time.time())
         self.stats.published += 1
         if local:
-            with self._cond:
+            inbox = self.inbox
+            with inbox.lock:
                 for sub in local:
-                    self._pending.append(_Envelope(msg, key, self.node, True, [sub]))
+                    inbox.pending.append(Envelope(msg, key, self.node, True, [sub]))
         self.transport.send(Sample(key, type(msg).__name__, message=msg))
 
-    def _route(self, key: str) -> tuple[type[Message] | None, list[_Sub]]:
+    def _route(self, key: str) -> Route:
         """What publishing on ``key`` needs, checked and resolved once: the key is in this
         node's space, its catalogue type, this node's own subscribers of it."""
         if not key.startswith(self.prefix + "/"):
             raise ValueError(f"node {self.node} may not publish on {key!r} "
                              f"(own space: {self.prefix})")
-        route = self._routes[key] = (self._catalogue_type(key), self._local_subs(key))
-        return route
-
-    def _catalogue_type(self, key: str) -> type[Message] | None:
-        """The message type the catalogue gives ``key`` (None: not catalogued), cached."""
-        expected = self._key_types.get(key, _UNKNOWN)
-        if expected is _UNKNOWN:
-            topic = catalogue.topic_of(key)
-            self._key_types[key] = expected = None if topic is None else topic.type
-        return expected  # type: ignore[return-value]
-
-    def _check_type(self, key: str, msg_type: type[Message]) -> None:
-        """A catalogued key carries its catalogue type only (``interfaces.contracts.catalogue``)."""
-        expected = self._catalogue_type(key)
-        if expected is not None and msg_type is not expected:
-            raise TypeError(f"{key} carries {expected.__name__}, not {msg_type.__name__}")
+        return self.table.route(key)
 
     def published_since_last(self) -> dict[str, int]:
         """Keys published since the previous call, with their last sequence number."""
@@ -199,31 +140,21 @@ class Bus:
     ) -> None:
         """Deliver messages of ``msg_type`` on ``key_expr`` to ``handler``: at ``dispatch`` time
         (default) or at once on the transport thread (``immediate``)."""
-        self._check_type(key_expr, msg_type)
-        sub = _Sub(key_expr, msg_type, handler, immediate)  # type: ignore[arg-type]
-        group = self._groups.get(key_expr)
-        if group is None:
-            self._groups[key_expr] = group = []
+        self.table.check_type(key_expr, msg_type)
+        if key_expr not in self.table.groups:
             self.transport.subscribe_samples(
                 key_expr, lambda smp, e=key_expr: self._on_sample(e, smp),
                 made_here=lambda key, msg, e=key_expr: self._on_made_here(e, key, msg))
-        group.append(sub)
-        self._split[key_expr] = _Group.of(group)
-        self._routes.clear()
-        self._await_cache.clear()
+        self.table.add(Sub(key_expr, msg_type, handler, immediate))  # type: ignore[arg-type]
 
     def subscriptions(self) -> dict[str, list[type[Message]]]:
         """The typed subscriptions of this node: key expression -> subscribed message types."""
-        return {e: [s.msg_type for s in g] for e, g in self._groups.items()}
+        return self.table.types()
 
     def subscribe_raw(self, key_expr: str, handler: RawHandler) -> None:
         """Raw samples (key, type name, payload) at once, unvalidated (recorder, tools)."""
         self._raw.setdefault(key_expr, []).append(handler)
         self.transport.subscribe(key_expr, handler)
-
-    def _local_subs(self, key: str) -> list[_Sub]:
-        """This node's own subscribers of ``key`` (read once per key, by ``_route``)."""
-        return [s for e, g in self._groups.items() if topics.matches(e, key) for s in g]
 
     def _on_sample(self, key_expr: str, sample: Sample) -> None:
         """Transport callback (any thread): validate bytes (an object of the subscribed type is
@@ -236,8 +167,8 @@ class Bus:
                                f"{MAX_PAYLOAD_BYTES}")
             return
         decoded: dict[type[Message], Message] = {}
-        deferred: dict[int, tuple[Message, list[_Sub]]] = {}
-        for sub in self._groups.get(key_expr, []):
+        deferred: dict[int, tuple[Message, list[Sub]]] = {}
+        for sub in self.table.groups.get(key_expr, []):
             msg = decoded.get(sub.msg_type)
             if msg is None:
                 msg = self._admitted(key, sub.msg_type, sample)
@@ -251,35 +182,35 @@ class Bus:
         # One envelope per message, whatever the number of local subscribers: the channel
         # decides once, so every app of the node sees the same messages.
         src = self.admission.owner(key)
-        with self._cond:
+        inbox = self.inbox
+        with inbox.lock:
             for msg, group in deferred.values():
-                self._pending.append(_Envelope(msg, key, src, False, group))
+                inbox.pending.append(Envelope(msg, key, src, False, group))
             for msg in decoded.values():
                 self.admission.admit(key, msg)
-            if self._waiting:
-                self._cond.notify_all()
+            inbox.wake()
 
     def _on_made_here(self, key_expr: str, key: str, msg: Message) -> None:
         """In-process callback: a message another Bus of this process published.  It was
         made valid and its publisher's Bus set its sender and sequence number, so the admission
         checks cannot fail it and are skipped; it is delivered, queued and recorded for the
         barrier exactly as an admitted sample (``_on_sample``)."""
-        group = self._split[key_expr]
+        group = self.table.split[key_expr]
         if type(msg) is not group.kind:  # subscribed as other types: validate from JSON
             self._on_sample(key_expr, Sample(key, type(msg).__name__, message=msg))
             return
         self.stats.received += 1
         for sub in group.immediate:
             self._call(sub, msg, key)
-        with self._cond:
+        inbox = self.inbox
+        with inbox.lock:
             highest = self.admission.highest_seq
             if group.deferred:
-                self._pending.append(_Envelope(msg, key, self.admission.owner(key), False,
-                                               group.deferred))
+                inbox.pending.append(Envelope(msg, key, self.admission.owner(key), False,
+                                              group.deferred))
             if msg.seq > highest.get(key, 0):  # Admission.admit, inlined
                 highest[key] = msg.seq
-            if self._waiting:
-                self._cond.notify_all()
+            inbox.wake()
 
     def _admitted(self, key: str, msg_type: type[Message], sample: Sample) -> Message | None:
         """The sample as a ``msg_type`` that passes admission, or None (dropped, counted)."""
@@ -290,7 +221,7 @@ class Bus:
             except ValidationError as e:
                 self._invalid(key, f"not a valid {msg_type.__name__}: {_first_error(e)}")
                 return None
-        refusal = self.admission.check(key, msg, len(self._pending))
+        refusal = self.admission.check(key, msg, len(self.inbox.pending))
         if refusal is not None:
             self.refuse(key, *refusal)
             return None
@@ -311,7 +242,7 @@ class Bus:
         if n <= 5 or n % 100 == 0:
             self.log.warning("%s dropped invalid message #%d on %s: %s", self.node, n, key, why)
 
-    def _call(self, sub: _Sub, msg: Message, key: str) -> None:
+    def _call(self, sub: Sub, msg: Message, key: str) -> None:
         try:
             sub.handler(msg)
         except Exception:  # noqa: BLE001 - a handler's failure must not stop the node
@@ -325,20 +256,13 @@ class Bus:
 
         Messages from other spacecraft/ground nodes are due once sent strictly before ``t_now``
         (or at ``t_now`` with ``include_now``) and their channel delay has elapsed; local and sim
-        messages once their time is ``<= t_now``.  Returns the number of messages delivered."""
+        messages once their time is ``<= t_now`` (``Inbox.take_due``).  Returns the number of
+        messages delivered."""
         delay = self.channel.delay_s if self.channel is not None else 0.0
         self.admission.advance(t_now)
-        with self._cond:
-            if not self._pending:
-                return 0
-            due, keep = [], []
-            for env in self._pending:
-                (due if self._is_due(env, t_now, include_now, delay) else keep).append(env)
-            self._pending = keep
-        due.sort(key=_order)
         delivered = 0
-        for env in due:
-            if not env.local and self.channel is not None and self._crosses_link(env.src):
+        for env in self.inbox.take_due(t_now, include_now, delay):
+            if not env.local and self.channel is not None and self.inbox.crosses_link(env.src):
                 if self.channel.decide(env.src or "", env.msg.t_sim) is not Verdict.DELIVER:
                     self.stats.channel_dropped += 1
                     continue
@@ -347,21 +271,6 @@ class Bus:
             delivered += 1
         return delivered
 
-    def _is_due(self, env: _Envelope, t_now: float, include_now: bool, delay: float) -> bool:
-        t = env.msg.t_sim
-        if env.local or env.src == topics.SIM:
-            return t <= t_now + TIME_TOL_S
-        link_delay = delay if self._crosses_link(env.src) else 0.0
-        sent_before = t <= t_now + TIME_TOL_S if include_now else t < t_now - TIME_TOL_S
-        return sent_before and t + link_delay <= t_now + TIME_TOL_S
-
-    def _crosses_link(self, src: str | None) -> bool:
-        """Whether messages from node ``src`` cross a modelled link to this node (cached)."""
-        hit = self._crosses.get(src)
-        if hit is None:
-            hit = self._crosses[src] = applies(src, self.node)
-        return hit
-
     def wait_for(self, expect: dict[str, int], timeout_s: float) -> list[str]:
         """Block until every key of ``expect`` that this node subscribes to (and does not own)
         has arrived up to its sequence number; return the keys still missing at the timeout.
@@ -369,41 +278,15 @@ class Bus:
         is not waited for."""
         seen = self.admission.highest_seq
         wanted = {k: s for k, s in expect.items()
-                  if self._awaits(k) and s <= seen.get(k, 0) + MAX_SEQ_JUMP}
-        deadline = time.monotonic() + timeout_s
-        with self._cond:
-            self._waiting += 1  # receivers notify only while someone waits
-            try:
-                while True:
-                    missing = [k for k, s in wanted.items() if seen.get(k, 0) < s]
-                    left = deadline - time.monotonic()
-                    if not missing or left <= 0:
-                        return missing
-                    self._cond.wait(left)
-            finally:
-                self._waiting -= 1
-
-    def _awaits(self, key: str) -> bool:
-        """Whether ``key`` is another node's key that a deferred/immediate subscription covers."""
-        hit = self._await_cache.get(key)
-        if hit is None:
-            hit = not key.startswith(self.prefix + "/") and any(
-                topics.matches(e, key) for e in self._groups
-            )
-            self._await_cache[key] = hit
-        return hit
+                  if self.table.awaits(k) and s <= seen.get(k, 0) + MAX_SEQ_JUMP}
+        return self.inbox.wait(wanted, seen, timeout_s)
 
     # --- services --------------------------------------------------------------------------
 
     def serve_schemas(self) -> None:
-        """Answer ``<prefix>/schema/<Type>`` queries with the message type's JSON schema."""
-        reg = registry()
-
-        def respond(k: str) -> bytes | None:
-            t = reg.get(k.rsplit("/", 1)[-1])
-            return None if t is None else _json_bytes(json_schema(t))
-
-        self.transport.serve(topics.schema_queryable(self.mission, self.node), respond)
+        """Answer ``<prefix>/schema/<Type>`` queries with the message type's JSON schema
+        (``interfaces.runtime.schemas``)."""
+        serve_schemas(self.transport, self.mission, self.node)
 
     def declare_alive(self) -> None:
         """Announce this node (Zenoh liveliness token ``<prefix>/alive``)."""
@@ -420,7 +303,3 @@ def _first_error(e: ValidationError) -> str:
     err = e.errors()[0]
     where = ".".join(str(x) for x in err["loc"])
     return f"{where}: {err['msg']}" if where else err["msg"]
-
-
-def _json_bytes(obj: object) -> bytes:
-    return json.dumps(obj).encode()

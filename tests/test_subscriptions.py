@@ -1,0 +1,45 @@
+"""The Bus's subscription table on its own: typed topics, routes, awaited keys, their caches."""
+
+from __future__ import annotations
+
+import pytest
+
+from interfaces.contracts import catalogue, topics
+from interfaces.contracts.messages import Heartbeat, StateEstimate
+from interfaces.runtime.subscriptions import Group, Sub, SubscriptionTable
+
+M = "st"
+HB_1 = catalogue.HEARTBEAT.key(M, "sc1")
+HB_2 = catalogue.HEARTBEAT.key(M, "sc2")
+
+
+def _table() -> SubscriptionTable:
+    return SubscriptionTable(topics.node_prefix(M, "sc1"))
+
+
+def test_a_catalogued_key_takes_its_type_only() -> None:
+    table = _table()
+    table.check_type(HB_2, Heartbeat)
+    with pytest.raises(TypeError, match="carries Heartbeat"):
+        table.check_type(HB_2, StateEstimate)
+    assert table.catalogue_type(f"{topics.node_prefix(M, 'sc1')}/free/x") is None
+
+
+def test_routes_and_awaited_keys_follow_the_subscriptions() -> None:
+    table = _table()
+    assert table.route(HB_1) == (Heartbeat, []) and HB_1 in table.routes
+    assert not table.awaits(HB_2)
+    everyone = f"{topics.ROOT}/{M}/**/exec/heartbeat"
+    own, other = Sub(everyone, Heartbeat, print, False), Sub(everyone, Heartbeat, print, True)
+    table.add(own)
+    assert table.routes == {}  # resolved again after a subscription
+    assert table.route(HB_1) == (Heartbeat, [own])
+    assert table.awaits(HB_2) and not table.awaits(HB_1)  # its own keys are never awaited
+    table.add(other)
+    assert table.types() == {everyone: [Heartbeat, Heartbeat]}
+    assert table.split[everyone] == Group(Heartbeat, [other], [own])
+
+
+def test_a_group_of_mixed_types_has_no_kind() -> None:
+    subs = [Sub("a/**", Heartbeat, print, False), Sub("a/**", StateEstimate, print, False)]
+    assert Group.of(subs).kind is None
