@@ -45,6 +45,7 @@ from sim.camera import TruthCameras
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
 from faults.hardware import FaultInjector
 from sim.hardware import ObserverHardware
+from sim.lockstep import Lockstep
 from sim.sensors import RelNavSensor
 
 
@@ -77,7 +78,8 @@ class NodeInput:
 @dataclass(eq=False)
 class SimNode:
     """The sim's side of the bus: what it publishes, and its inputs, wired from these
-    declarations (``INPUTS``) as an app's are."""
+    declarations (``INPUTS``) as an app's are; the participants' answers and liveness are kept
+    by its ``lockstep`` (``sim.lockstep``)."""
 
     PUBLISHES: ClassVar[tuple[Topic, ...]] = (
         cat.TICK, cat.SIM_STATUS, cat.TRUTH, cat.FAULT_EVENTS,
@@ -124,17 +126,8 @@ class SimNode:
             "attitude": [cat.ATTITUDE_SENSORS.key(m, n) for n in nodes],
             "camera": [cat.CAMERA_IMAGE.key(m, n) for n in nodes],
         }
-        self._prefixes = {p: topics.node_prefix(m, p) + "/" for p in self.participants}
-        self._cond = threading.Condition()
-        self._answers: dict[str, dict[str, int]] = {}
-        self._answer_k = -1
-        self._alive: set[str] = set()
-        self._dead: set[str] = set()
-        self._rejoining: set[str] = set()
-        """Participants seen again after they were lost, until they answer a tick."""
-        self.events: dict[str, list[tuple[str, float]]] = {}
-        """Per participant, ("lost" | "rejoined", sim time s) in order."""
-        self.missed_answers = 0
+        self.lockstep = Lockstep(self.participants, m, sc.n_ticks - 1, lambda: self._t_now,
+                                 self.stop, self.log, realtime=bool(self.realtime_speed))
         self.rejected_commands = 0
         self._t_now = 0.0
         self._q_now = np.array([0.0, 0.0, 0.0, 1.0])  # ECI -> LVLH now (set each tick)
@@ -182,54 +175,19 @@ class SimNode:
         of the target now."""
         return quat.from_matrix(lvlh_basis(self.truth.chief_eci))
 
-    # --- lockstep bookkeeping -------------------------------------------------------------
+    # --- the lockstep (sim.lockstep) -------------------------------------------------------
 
     def _on_done(self, _index: int, msg: TickDone) -> None:
-        """A participant's answer to the current tick (its sender is the owner of the key it
-        came on: the Bus's admission).  Only keys of its own space count as announced."""
-        with self._cond:
-            if msg.k == self._answer_k and msg.sender in self._prefixes:
-                own = self._prefixes[msg.sender]
-                self._answers[msg.sender] = {k: s for k, s in msg.published.items()
-                                             if k.startswith(own)}
-                self._rejoining.discard(msg.sender)
-                self._cond.notify_all()
+        """A participant's answer to the current tick (``Lockstep.on_done``)."""
+        self.lockstep.on_done(msg)
 
     def on_liveness(self, node: str, alive: bool) -> None:
-        """Liveliness handler: a participant that disappears is not waited for any more (its
-        last commands are held by the hardware, within their own limits); one that comes back
-        (a stalled process resumed, a crashed one restarted) is waited for again from the next
-        tick, and named in the ticks' ``rejoin`` until it answers one (a node that never saw
-        the sim lost takes them as its present, ``TickClient``).  Both are recorded with their
-        sim time for the final status."""
-        with self._cond:
-            t = self._t_now
-            if alive:
-                self._alive.add(node)
-                if node in self._dead:
-                    self._dead.discard(node)
-                    self._rejoining.add(node)
-                    self.events.setdefault(node, []).append(("rejoined", t))
-                    self.log.warning("participant %s rejoined at t=%.1f s", node, t)
-            elif node in self.participants and node in self._alive:
-                self._alive.discard(node)
-                if self._answer_k < self.scenario.n_ticks - 1:
-                    self._dead.add(node)
-                    self.events.setdefault(node, []).append(("lost", t))
-                    self.log.error("participant %s lost at t=%.1f s (process died, stalled or "
-                                   "disconnected); flying on with its last commands", node, t)
-            self._cond.notify_all()
+        """Liveliness handler (``Lockstep.on_liveness``): a participant lost or back."""
+        self.lockstep.on_liveness(node, alive)
 
     def wait_for_participants(self, timeout_s: float) -> None:
         """Block until every participant has announced itself (Zenoh liveliness)."""
-        deadline = time.monotonic() + timeout_s
-        with self._cond:
-            while not set(self.participants) <= self._alive:
-                left = deadline - time.monotonic()
-                if left <= 0 or self.stop.is_set():
-                    missing = sorted(set(self.participants) - self._alive)
-                    raise TimeoutError(f"participants never joined: {', '.join(missing)}")
-                self._cond.wait(min(left, 0.2))
+        self.lockstep.wait_for_participants(timeout_s)
 
     # --- the run --------------------------------------------------------------------------
 
@@ -249,15 +207,13 @@ class SimNode:
                 _sleep_until(wall0 + t / self.realtime_speed)
             self._publish_hardware(k, t)
             expect.update(self.bus.published_since_last())
-            with self._cond:
-                self._answers, self._answer_k = {}, k
-                rejoin = sorted(self._rejoining)
+            rejoin = self.lockstep.open_tick(k)
             self.bus.publish(self._keys["tick"], Tick(
                 sender=topics.SIM, t_sim=t, k=k, dt_s=dt, expect=expect, final=k == n_ticks - 1,
                 rejoin=rejoin), announce=False)
             deadline = (wall0 + (t + dt) / self.realtime_speed if self.realtime_speed
                         else time.monotonic() + sc.sim.lockstep_timeout_s)
-            expect = self._collect_answers(k, deadline)
+            expect = self.lockstep.collect_answers(k, deadline)
             self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
             self.bus.dispatch(t, include_now=True)
             if k < n_ticks - 1:
@@ -268,16 +224,8 @@ class SimNode:
                 rate = (k + 1) / max(1e-9, time.monotonic() - wall0)
                 self.log.info("tick %d/%d  t=%.1f s  %.0f ticks/s", k, n_ticks, t, rate)
         self._status("finished", n_ticks - 1)
-        self._await_departure(timeout_s=10.0)
+        self.lockstep.await_departure(timeout_s=10.0)
         return True
-
-    def _await_departure(self, timeout_s: float) -> None:
-        """After ``finished``, wait until the participants have left (their liveliness tokens
-        gone), so none of them sees the sim vanish before it has read the status."""
-        deadline = time.monotonic() + timeout_s
-        with self._cond:
-            while self._alive & set(self.participants) and time.monotonic() < deadline:
-                self._cond.wait(0.1)
 
     def _publish_hardware(self, k: int, t: float) -> None:
         for s in self.faults.update(t):
@@ -313,32 +261,10 @@ class SimNode:
                     sender=topics.SIM, t_sim=t, spacecraft=self.ids[i], r_m=r.tolist(),
                     v_mps=v.tolist(), sigma_r_m=sensor.sigma_r_m, sigma_v_mps=sensor.sigma_v_mps))
 
-    def _collect_answers(self, k: int, deadline: float) -> dict[str, int]:
-        """Wait for TickDone(k) from every live participant; merge what they announced."""
-        with self._cond:
-            while True:
-                waiting = [p for p in self.participants
-                           if p not in self._answers and p not in self._dead]
-                left = deadline - time.monotonic()
-                if not waiting or left <= 0 or self.stop.is_set():
-                    break
-                self._cond.wait(left)
-            answers = dict(self._answers)
-        if waiting and not self.stop.is_set():
-            self.missed_answers += 1
-            if not self.realtime_speed:
-                self.log.warning("tick %d: no answer from %s; holding last commands",
-                                 k, ", ".join(waiting))
-        merged: dict[str, int] = {}
-        for published in answers.values():
-            merged.update(published)
-        return merged
-
     def _status(self, state: str, k: int, reason: str = "") -> None:
         t = k * self.scenario.rates.dt_s
-        with self._cond:
-            events = {n: [SimStatus.Event(what=w, t_sim=s) for w, s in e]
-                      for n, e in self.events.items()}
+        events = {n: [SimStatus.Event(what=w, t_sim=s) for w, s in e]
+                  for n, e in self.lockstep.events_now().items()}
         self.bus.publish(self._keys["status"], SimStatus(
             sender=topics.SIM, t_sim=t, state=state, k=k, reason=reason,
             rejected_commands=self.rejected_commands,

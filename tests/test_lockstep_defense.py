@@ -246,18 +246,18 @@ def test_the_sim_names_a_rejoined_participant_until_it_answers() -> None:
     for alive in (True, False, True):  # joined, lost, back
         sim.on_liveness("sc1", alive)
     sim.on_liveness("sc2", True)
-    assert sim._rejoining == {"sc1"}
-    sim._answer_k = 4
+    assert sim.lockstep.rejoining == {"sc1"}
+    assert sim.lockstep.open_tick(4) == ["sc1"]
     sim._on_done(0, TickDone(sender="sc1", t_sim=2.0, k=4, published={}))
-    assert sim._rejoining == set()
-    assert [e[0] for e in sim.events["sc1"]] == ["lost", "rejoined"]
+    assert sim.lockstep.rejoining == set()
+    assert [e[0] for e in sim.lockstep.events["sc1"]] == ["lost", "rejoined"]
 
 
 def test_tick_done_announces_only_the_senders_own_keys() -> None:
     sc = small_scenario("ld", observers={"count": 2})
     sim = SimNode(Bus("sim", M, InprocNetwork().endpoint()), sc, participants=["sc1", "sc2"])
-    sim._answer_k = 4
+    sim.lockstep.open_tick(4)
     own, foreign = topics.key(M, "sc1", "nav", "estimate"), topics.key(M, "sc2", "nav", "estimate")
     sim._on_done(0, TickDone(sender="sc1", t_sim=2.0, k=4, published={own: 9, foreign: 10**9}))
     sim._on_done(1, TickDone(sender="sc2", t_sim=2.0, k=3, published={foreign: 5}))  # old tick
-    assert sim._answers == {"sc1": {own: 9}}
+    assert sim.lockstep.answers == {"sc1": {own: 9}}

@@ -1,0 +1,142 @@
+"""The time master's side of the lockstep (docs/architecture.md, Runtime model): which
+participants are alive, lost or rejoining, their answers (TickDone) to the current tick, and the
+sim's waits on them.
+
+* A participant whose liveliness token goes before the last tick is lost: it is not waited for
+  any more, and the sim flies on with its last commands held.
+* One seen again is named in the ticks' ``rejoin`` until it answers a tick.
+* Both are recorded with their sim time (``events``) for the final status.
+* An answer counts only for the current tick, and announces only keys of its sender's own space.
+
+Thread-safe: the answers and the liveness changes come on transport threads.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from interfaces.contracts import topics
+from interfaces.contracts.messages import TickDone
+
+
+@dataclass(eq=False)
+class Lockstep:
+    """The lockstep bookkeeping of the ``participants`` of ``mission``, over ticks 0 to
+    ``last_tick``; ``now`` gives the sim time now (s), ``stop`` ends every wait, and with
+    ``realtime`` a missing answer is expected (counted, not logged)."""
+
+    participants: list[str]
+    mission: str
+    last_tick: int
+    now: Callable[[], float]
+    stop: threading.Event
+    log: logging.Logger
+    realtime: bool = False
+    events: dict[str, list[tuple[str, float]]] = field(default_factory=dict)
+    """Per participant, ("lost" | "rejoined", sim time s) in order."""
+    missed_answers: int = 0
+    """Ticks on which a live participant's answer did not come in time."""
+    answers: dict[str, dict[str, int]] = field(default_factory=dict)
+    """The current tick's answers: participant -> the keys it announced, with their numbers."""
+    rejoining: set[str] = field(default_factory=set)
+    """Participants seen again after they were lost, until they answer a tick."""
+    _answer_k: int = -1
+    _alive: set[str] = field(default_factory=set)
+    _dead: set[str] = field(default_factory=set)
+    _cond: threading.Condition = field(default_factory=threading.Condition)
+
+    def __post_init__(self) -> None:
+        self._prefixes = {p: topics.node_prefix(self.mission, p) + "/" for p in self.participants}
+
+    def on_done(self, msg: TickDone) -> None:
+        """A participant's answer to the current tick (its sender is the owner of the key it
+        came on: the Bus's admission).  Only keys of its own space count as announced."""
+        with self._cond:
+            if msg.k == self._answer_k and msg.sender in self._prefixes:
+                own = self._prefixes[msg.sender]
+                self.answers[msg.sender] = {k: s for k, s in msg.published.items()
+                                            if k.startswith(own)}
+                self.rejoining.discard(msg.sender)
+                self._cond.notify_all()
+
+    def on_liveness(self, node: str, alive: bool) -> None:
+        """Liveliness handler: a participant that disappears is not waited for any more (its
+        last commands are held by the hardware, within their own limits); one that comes back
+        (a stalled process resumed, a crashed one restarted) is waited for again from the next
+        tick, and named in the ticks' ``rejoin`` until it answers one (a node that never saw
+        the sim lost takes them as its present, ``TickClient``).  Both are recorded with their
+        sim time for the final status."""
+        with self._cond:
+            t = self.now()
+            if alive:
+                self._alive.add(node)
+                if node in self._dead:
+                    self._dead.discard(node)
+                    self.rejoining.add(node)
+                    self.events.setdefault(node, []).append(("rejoined", t))
+                    self.log.warning("participant %s rejoined at t=%.1f s", node, t)
+            elif node in self.participants and node in self._alive:
+                self._alive.discard(node)
+                if self._answer_k < self.last_tick:
+                    self._dead.add(node)
+                    self.events.setdefault(node, []).append(("lost", t))
+                    self.log.error("participant %s lost at t=%.1f s (process died, stalled or "
+                                   "disconnected); flying on with its last commands", node, t)
+            self._cond.notify_all()
+
+    def wait_for_participants(self, timeout_s: float) -> None:
+        """Block until every participant has announced itself (Zenoh liveliness)."""
+        deadline = time.monotonic() + timeout_s
+        with self._cond:
+            while not set(self.participants) <= self._alive:
+                left = deadline - time.monotonic()
+                if left <= 0 or self.stop.is_set():
+                    missing = sorted(set(self.participants) - self._alive)
+                    raise TimeoutError(f"participants never joined: {', '.join(missing)}")
+                self._cond.wait(min(left, 0.2))
+
+    def open_tick(self, k: int) -> list[str]:
+        """Tick ``k`` is about to be sent: forget the previous answers; return the participants
+        its ``rejoin`` names, sorted."""
+        with self._cond:
+            self.answers, self._answer_k = {}, k
+            return sorted(self.rejoining)
+
+    def collect_answers(self, k: int, deadline: float) -> dict[str, int]:
+        """Wait for TickDone(k) from every live participant until ``deadline`` (wall,
+        ``time.monotonic``); merge what they announced."""
+        with self._cond:
+            while True:
+                waiting = [p for p in self.participants
+                           if p not in self.answers and p not in self._dead]
+                left = deadline - time.monotonic()
+                if not waiting or left <= 0 or self.stop.is_set():
+                    break
+                self._cond.wait(left)
+            answers = dict(self.answers)
+        if waiting and not self.stop.is_set():
+            self.missed_answers += 1
+            if not self.realtime:
+                self.log.warning("tick %d: no answer from %s; holding last commands",
+                                 k, ", ".join(waiting))
+        merged: dict[str, int] = {}
+        for published in answers.values():
+            merged.update(published)
+        return merged
+
+    def await_departure(self, timeout_s: float) -> None:
+        """After the run, wait until the participants have left (their liveliness tokens
+        gone), so none of them sees the sim vanish before it has read the status."""
+        deadline = time.monotonic() + timeout_s
+        with self._cond:
+            while self._alive & set(self.participants) and time.monotonic() < deadline:
+                self._cond.wait(0.1)
+
+    def events_now(self) -> dict[str, list[tuple[str, float]]]:
+        """A copy of ``events``, taken under the lock."""
+        with self._cond:
+            return {n: list(e) for n, e in self.events.items()}

@@ -1,0 +1,67 @@
+"""The sim's lockstep bookkeeping on its own: answers of the current tick, lost and rejoining
+participants, the waits."""
+
+from __future__ import annotations
+
+import logging
+import threading
+
+import pytest
+
+from interfaces.contracts import topics
+from interfaces.contracts.messages import TickDone
+from sim.lockstep import Lockstep
+
+M = "sl"
+
+
+def _lockstep(now: list[float], last_tick: int = 9) -> Lockstep:
+    return Lockstep(["sc1", "sc2"], M, last_tick, lambda: now[0], threading.Event(),
+                    logging.getLogger("test.lockstep"), realtime=True)
+
+
+def _done(sender: str, k: int, published: dict[str, int]) -> TickDone:
+    return TickDone(sender=sender, t_sim=0.5 * k, k=k, published=published)
+
+
+def test_answers_of_the_current_tick_are_merged_own_keys_only() -> None:
+    ls = _lockstep([0.0])
+    own1, own2 = topics.key(M, "sc1", "nav", "estimate"), topics.key(M, "sc2", "nav", "estimate")
+    assert ls.open_tick(3) == []
+    ls.on_done(_done("sc1", 3, {own1: 4, own2: 99}))
+    ls.on_done(_done("sc2", 2, {own2: 7}))  # an old tick's answer: not counted
+    assert ls.answers == {"sc1": {own1: 4}}
+    ls.on_done(_done("sc2", 3, {own2: 8}))
+    assert ls.collect_answers(3, deadline=0.0) == {own1: 4, own2: 8}
+    assert ls.missed_answers == 0
+    ls.open_tick(4)
+    assert ls.collect_answers(4, deadline=0.0) == {} and ls.missed_answers == 1
+
+
+def test_a_lost_participant_is_not_waited_for_and_is_named_until_it_answers() -> None:
+    now = [1.0]
+    ls = _lockstep(now)
+    for node in ("sc1", "sc2"):
+        ls.on_liveness(node, True)
+    ls.wait_for_participants(0.0)
+    ls.on_liveness("sc2", False)
+    ls.open_tick(2)
+    ls.on_done(_done("sc1", 2, {}))
+    assert ls.collect_answers(2, deadline=float("inf")) == {}  # sc2 lost: not waited for
+    now[0] = 4.0
+    ls.on_liveness("sc2", True)
+    assert ls.open_tick(8) == ["sc2"]
+    ls.on_done(_done("sc2", 8, {}))
+    assert ls.rejoining == set() and ls.open_tick(9) == []
+    assert ls.events_now() == {"sc2": [("lost", 1.0), ("rejoined", 4.0)]}
+
+
+def test_leaving_after_the_last_tick_is_no_loss() -> None:
+    ls = _lockstep([0.0], last_tick=5)
+    ls.on_liveness("sc1", True)
+    with pytest.raises(TimeoutError, match="sc2"):
+        ls.wait_for_participants(0.0)
+    ls.open_tick(5)
+    ls.on_liveness("sc1", False)
+    ls.await_departure(timeout_s=0.0)
+    assert ls.events == {}
