@@ -37,7 +37,7 @@ from ground.fdir.link_checks import LinkChecks
 from ground.fdir.observer import ObserverState
 from ground.fdir.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.window import SettledMap, window_context
-from ground.planning.mission_plan import pro_of
+from ground.planning.pro_sets import pro_of
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
     AttitudeEstimate,

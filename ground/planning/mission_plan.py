@@ -34,20 +34,11 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-import numpy as np
-import numpy.typing as npt
-
 from gnc.mission import MissionConstants
 from gnc.poi_map import PoiMap
-from gnc.pro import Pro, min_distance_between, min_distance_to_origin
-from ground.planning.orbit_assignment import (
-    expected_precision,
-    gain_saturated,
-    greedy_assignment,
-    match_to_observers,
-    pro_library,
-    set_gain,
-)
+from gnc.pro import Pro, min_distance_to_origin
+from ground.planning.orbit_assignment import gain_saturated
+from ground.planning.pro_sets import ProSetPlanner, elements
 from interfaces.contracts.messages import ProElements
 from interfaces.contracts.scenario import Phase, Scenario
 from interfaces.contracts.timing import TIME_TOL_S
@@ -98,12 +89,6 @@ class Decision:
     switched: bool
 
 
-def elements(pro: Pro) -> ProElements:
-    """The uplink form of a PRO."""
-    return ProElements(rho_x_m=pro.rho_x_m, alpha_x_rad=pro.alpha_x_rad, rho_y_m=pro.rho_y_m,
-                       rho_z_m=pro.rho_z_m, alpha_z_rad=pro.alpha_z_rad)
-
-
 def _scenario_pros(phase: Phase, count: int) -> dict[int, ProElements]:
     return {i: elements(Pro(*phase.pro_of(i, count))) for i in range(1, count + 1)}
 
@@ -119,6 +104,9 @@ class MissionPlan:
             ``assignment.poi_stride``-th (expected gains are scaled accordingly).
         issued: every assignment issued so far, in order (the last one is current).
         decisions: every information-driven decision, in order.
+
+    Each assignment's PRO set is chosen by ``sets`` (:mod:`ground.planning.pro_sets`), whose
+    candidate ``library``, mean motion ``n`` and ``camera`` the plan shares.
     """
 
     scenario: Scenario
@@ -128,16 +116,9 @@ class MissionPlan:
 
     def __post_init__(self) -> None:
         sc = self.scenario
-        a = sc.assignment
-        self.n = self.constants.n_rad_s
+        self.sets = ProSetPlanner(sc, self.constants)
+        self.n, self.camera, self.library = self.sets.n, self.sets.camera, self.sets.library
         self.count = sc.observers.count
-        self.camera = self.constants.camera
-        self._stride = a.poi_stride
-        self._plan_pos = self.constants.poi_pos[::a.poi_stride]
-        self._plan_normal = self.constants.poi_normal[::a.poi_stride]
-        self.library = pro_library(
-            a.rho_x_m, a.rho_z_m, np.linspace(0.0, 2.0 * math.pi, a.phases, endpoint=False),
-            cross_phase_offsets_rad=[math.radians(d) for d in a.cross_phase_offsets_deg])
         self._next_phase = 0
         self._current_indices: tuple[int, ...] | None = None  # library PRO of each observer
         self._gains: list[float] = []
@@ -155,6 +136,12 @@ class MissionPlan:
     def current(self) -> PlannedAssignment | None:
         """The assignment being uplinked now (the latest issued)."""
         return self.issued[-1] if self.issued else None
+
+    @property
+    def _current_pros(self) -> dict[int, ProElements]:
+        """The current assignment's PROs by observer (none before the first)."""
+        cur = self.current
+        return cur.pros if cur is not None else {}
 
     def update(self, t: float, fused: PoiMap) -> None:
         """Issue every phase whose uplink time has come, then check the current information
@@ -214,14 +201,12 @@ class MissionPlan:
         the current set by the margin."""
         a = self.scenario.assignment
         t_arrive = t_depart + transfer_s
-        w, phi = self._weights(t_arrive, fused, self.dropped)
-        pros, per_observer, gain, bound = self._plan_set(t_depart, t_arrive, w, phi,
-                                                         self.dropped, self.impaired)
+        w, phi = self.sets.weights(t_arrive, fused, self.dropped, self._current_pros)
+        pros, per_observer, gain, bound = self.sets.plan_set(
+            t_depart, t_arrive, w, phi, self.dropped, self.impaired, self._current_pros)
         current_gain = None
         if self._current_indices is not None:
-            prec = np.array([self._expected(self.library[i], t_arrive)
-                             for i in self._current_indices if i >= 0])
-            current_gain = set_gain(prec, phi, w)
+            current_gain = self.sets.gain(self._current_indices, t_arrive, w, phi)
         switch = force or current_gain is None or gain > (1.0 + a.min_improvement) * current_gain
         self.decisions.append(Decision(t, phase, reason, per_observer, gain, bound, current_gain,
                                        tuple(self._gains), switch))
@@ -258,9 +243,9 @@ class MissionPlan:
         a = self.scenario.assignment
         t_depart = t + UPLINK_LEAD_S
         t_arrive = t_depart + a.transfer_s
-        w, phi = self._weights(t_arrive, fused, dropped)
-        pros, per_observer, gain, bound = self._plan_set(t_depart, t_arrive, w, phi, dropped,
-                                                         impaired)
+        w, phi = self.sets.weights(t_arrive, fused, dropped, self._current_pros)
+        pros, per_observer, gain, bound = self.sets.plan_set(t_depart, t_arrive, w, phi, dropped,
+                                                             impaired, self._current_pros)
         self.dropped, self.impaired = dropped, impaired
         self._recoveries += 1
         name = f"recovery-{self._recoveries}"
@@ -289,96 +274,3 @@ class MissionPlan:
             log.warning("an impaired observer needs %.1f m from the target; the farthest "
                         "candidate PRO keeps %.1f m", need, farthest)
         return min(need, farthest)
-
-    def _expected(self, pro: Pro, t_arrive: float) -> npt.NDArray[np.float64]:
-        a = self.scenario.assignment
-        return expected_precision(pro, self.n, t_arrive, a.window_s, a.samples, self._plan_pos,
-                                  self._plan_normal, self.camera)
-
-    def _weights(self, t_arrive: float, fused: PoiMap, dropped: set[int]
-                 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-        """(w⁻¹, φ) of the planning subsample (every ``poi_stride``-th POI standing for that
-        many): the fused precision now plus what the untasked (``dropped``) observers still
-        bring from their PROs over the planning window."""
-        k = self._stride
-        w = (fused.w_inv + fused.F.sum(axis=0))[::k]
-        cur = self.current
-        for i in sorted(dropped):
-            if cur is not None and i in cur.pros:
-                w = w + self._expected(pro_of(cur.pros[i]), t_arrive)
-        return w, fused.phi[::k] * k
-
-    def _plan_set(self, t_depart: float, t_arrive: float, w: npt.NDArray[np.float64],
-                  phi: npt.NDArray[np.float64], dropped: set[int], impaired: dict[int, float]
-                  ) -> tuple[dict[int, ProElements], tuple[int, ...], float, float]:
-        """Every observer's PRO for an assignment arriving at ``t_arrive``: the ``dropped``
-        ones keep theirs (untasked); the ``impaired`` ones, then the healthy ones, get the
-        greedy set of library PROs (``greedy_assignment``) clear of the keep-out they need and
-        separated from the PROs already fixed, matched to the observers by
-        ``match_to_observers``; ``w``, ``phi``: as :meth:`_weights` gives them.  Returns (PROs by
-        observer, library index per observer or -1, expected gain, online bound).  An impaired
-        group with no feasible set falls back to the nominal keep-out (logged)."""
-        a = self.scenario.assignment
-        nominal = self.scenario.guidance.keep_out_m + a.keep_out_margin_m
-        cur = self.current
-        fixed = {i: cur.pros[i] for i in sorted(dropped) if cur is not None and i in cur.pros}
-        chosen: dict[int, int] = {}
-        gain = bound = 0.0
-        tasked = [i for i in range(1, self.count + 1) if i not in fixed]
-        groups = ([i for i in tasked if i in impaired], [i for i in tasked if i not in impaired])
-        for group in groups:
-            if not group:
-                continue
-            keep_out = max([nominal] + [impaired.get(i, 0.0) for i in group])
-            around = ([pro_of(e) for e in fixed.values()]
-                      + [self.library[j] for j in chosen.values()])
-            try:
-                picks, g, ub = self._greedy_around(len(group), around, keep_out, t_arrive, w, phi)
-            except ValueError:
-                if keep_out <= nominal:
-                    raise
-                log.warning("no PRO set clears %.1f m for observers %s: nominal keep-out", keep_out,
-                            group)
-                picks, g, ub = self._greedy_around(len(group), around, nominal, t_arrive, w, phi)
-            for j in picks:
-                w = w + self._expected(self.library[j], t_arrive)
-            states = self._states_at(t_depart)[[i - 1 for i in group]]
-            order = match_to_observers(states, [self.library[j] for j in picks], self.n, t_depart)
-            chosen.update({sc: picks[j] for sc, j in zip(group, order)})
-            gain, bound = gain + g, bound + ub
-        pros = {**fixed, **{i: elements(self.library[j]) for i, j in chosen.items()}}
-        per_observer = tuple(chosen.get(i, -1) for i in range(1, self.count + 1))
-        return dict(sorted(pros.items())), per_observer, gain, max(bound, gain)
-
-    def _greedy_around(self, count: int, around: list[Pro], keep_out: float, t_arrive: float,
-                       w: npt.NDArray[np.float64], phi: npt.NDArray[np.float64]
-                       ) -> tuple[list[int], float, float]:
-        """Greedy set of ``count`` library PROs clear of ``keep_out`` and separated from the
-        PROs ``around`` (whose coverage ``w`` already counts): (library indices, gain,
-        bound)."""
-        a = self.scenario.assignment
-        free = [i for i, p in enumerate(self.library)
-                if all(min_distance_between(p, q, self.n)[0] >= a.min_separation_m
-                       for q in around)]
-        choice = greedy_assignment([self.library[i] for i in free], count, self.n, t_arrive,
-                                   a.window_s, a.samples, self._plan_pos, self._plan_normal,
-                                   phi, w, self.camera, a.min_separation_m, keep_out)
-        return [free[j] for j in choice.indices], choice.gain, choice.upper_bound
-
-    def _states_at(self, t: float) -> npt.NDArray[np.float64]:
-        """Where the plan has each observer at ``t``: on its current PRO (the target centre
-        before any assignment, i.e. right after deployment)."""
-        cur = self.current
-        out = np.zeros((self.count, 6))
-        if cur is None:
-            return out
-        for i in range(self.count):
-            e = cur.pros.get(i + 1)
-            if e is not None:
-                out[i] = pro_of(e).state(self.n, t)
-        return out
-
-
-def pro_of(e: ProElements) -> Pro:
-    """The PRO of an uplinked assignment (the inverse of :func:`elements`)."""
-    return Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)
