@@ -554,6 +554,77 @@ def _scp_values(
     return np.concatenate(vals), rhs
 
 
+class _SlewSubproblem:
+    """The convex subproblem of :func:`scp_slew` as OSQP holds it over the iterations: the cost
+    (:func:`_scp_cost`), the constraint sparsity (:func:`_scp_pattern`) and the fixed bounds
+    (interior norms, ``q_0``, the rate box and the boundary rates ``fixed_rates``, scaled, by
+    interval) are set once; each :meth:`solve` linearises about its iterate (:func:`_scp_values`),
+    updates the matrix values and vectors and warm-starts from the previous solution."""
+
+    def __init__(self, n: int, q0: FloatArray, fixed_rates: dict[int, FloatArray]) -> None:
+        self._p_mat = _scp_cost(n)
+        rows, cols, m = _scp_pattern(n)
+        # CSC structure once; `perm` maps pattern order to CSC data order
+        probe = sp.coo_matrix((np.arange(1.0, rows.size + 1.0), (rows, cols)),
+                              shape=(m, 4 * (n + 1) + 3 * n))
+        self._probe = probe = probe.tocsc()
+        if probe.nnz != rows.size:
+            raise RuntimeError("internal error: duplicate entries in the SCP constraint pattern")
+        self._perm = probe.data.astype(np.int64) - 1
+        self._lo, self._hi = lo, hi = np.zeros(m), np.zeros(m)
+        self._r_norm, r_q0, r_box = 4 * n, 5 * n - 1, 5 * n + 6
+        lo[self._r_norm:r_q0] = hi[self._r_norm:r_q0] = 1.0
+        lo[r_q0:r_q0 + 4] = hi[r_q0:r_q0 + 4] = q0
+        lo[r_box:] = -1.0
+        hi[r_box:] = 1.0
+        for k, ub in fixed_rates.items():
+            lo[r_box + 3 * k:r_box + 3 * k + 3] = hi[r_box + 3 * k:r_box + 3 * k + 3] = ub
+        self._solver: osqp.OSQP | None = None
+
+    def solve(self, q_ref: FloatArray, u_ref: FloatArray, q1: FloatArray, h: float,
+              w_max: float) -> tuple[str, FloatArray]:
+        """Solve the subproblem linearised about ``(q_ref, u_ref)`` (landing on ``q1``, intervals
+        of ``h`` s, rate limit ``w_max`` rad/s); return OSQP's status and its solution z."""
+        lo, hi, r_norm = self._lo, self._hi, self._r_norm
+        vals, rhs = _scp_values(q_ref, u_ref, q1, h, w_max)
+        lo[:r_norm] = hi[:r_norm] = rhs
+        c = -2.0 * _SCP_PROX_WEIGHT * np.concatenate([q_ref.ravel(), u_ref.ravel()])
+        if self._solver is None:
+            probe = self._probe
+            a_mat = sp.csc_matrix((vals[self._perm], probe.indices, probe.indptr),
+                                  shape=probe.shape)
+            self._solver = osqp.OSQP()
+            self._solver.setup(self._p_mat, c, a_mat, lo, hi, **dict(_OSQP_SETTINGS))
+        else:
+            self._solver.update(q=c, l=lo, u=hi, Ax=vals[self._perm])
+        res = self._solver.solve(raise_error=False)
+        return str(res.info.status), np.asarray(res.x, dtype=float)
+
+
+def _slew_inputs(
+    r0: Rotation, r1: Rotation, duration_s: float, n_nodes: int, w_max_radps: float,
+    w0: npt.ArrayLike | None, w1: npt.ArrayLike | None, max_iters: int, t0_s: float,
+) -> tuple[int, float, float, float, dict[int, FloatArray]]:
+    """:func:`scp_slew`'s arguments checked: (intervals N, duration s, rate limit rad/s, start
+    time s, the boundary rates given by interval, scaled by the limit).  Raises ValueError."""
+    _single_rotation("r0", r0)
+    _single_rotation("r1", r1)
+    duration = _positive("duration_s", duration_s)
+    w_max = _positive("w_max_radps", w_max_radps)
+    t0 = _finite("t0_s", t0_s)
+    for name, value in (("n_nodes", n_nodes), ("max_iters", max_iters)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise ValueError(f"{name} must be an integer, got {value!r}")
+    if n_nodes < 3 or max_iters < 1:
+        raise ValueError(f"need n_nodes >= 3 and max_iters >= 1, got {n_nodes}, {max_iters}")
+    n = int(n_nodes) - 1
+    fixed_rates: dict[int, FloatArray] = {}
+    for name, value, k in (("w0", w0, 0), ("w1", w1, n - 1)):
+        if value is not None:
+            fixed_rates[k] = finite_array(name, value, (3,)) / w_max
+    return n, duration, w_max, t0, fixed_rates
+
+
 def scp_slew(
     r0: Rotation,
     r1: Rotation,
@@ -630,21 +701,8 @@ def scp_slew(
             rate outside the rate limit is not an error: the plan comes back
             ``"infeasible"`` (e.g. when ``w0`` is a measured rate above the limit).
     """
-    _single_rotation("r0", r0)
-    _single_rotation("r1", r1)
-    duration = _positive("duration_s", duration_s)
-    w_max = _positive("w_max_radps", w_max_radps)
-    t0 = _finite("t0_s", t0_s)
-    for name, value in (("n_nodes", n_nodes), ("max_iters", max_iters)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise ValueError(f"{name} must be an integer, got {value!r}")
-    if n_nodes < 3 or max_iters < 1:
-        raise ValueError(f"need n_nodes >= 3 and max_iters >= 1, got {n_nodes}, {max_iters}")
-    n = int(n_nodes) - 1
-    fixed_rates: dict[int, FloatArray] = {}
-    for name, value, k in (("w0", w0, 0), ("w1", w1, n - 1)):
-        if value is not None:
-            fixed_rates[k] = finite_array(name, value, (3,)) / w_max
+    n, duration, w_max, t0, fixed_rates = _slew_inputs(
+        r0, r1, duration_s, n_nodes, w_max_radps, w0, w1, max_iters, t0_s)
     # a boundary rate outside the box makes every subproblem infeasible
     rates_ok = all(bool(np.all(np.abs(u) <= 1.0)) for u in fixed_rates.values())
 
@@ -660,26 +718,8 @@ def scp_slew(
     u_ref = np.tile(slerp_plan(r0, r1, t_nodes[0], t_nodes[-1]).at(t0)[1] / w_max, (n, 1))
     q_ref = _rollout(q0, u_ref * w_max, h)
 
-    p_mat = _scp_cost(n)
-    rows, cols, m = _scp_pattern(n)
-    # CSC structure once; `perm` maps pattern order to CSC data order
-    probe = sp.coo_matrix((np.arange(1.0, rows.size + 1.0), (rows, cols)), shape=(m, iu + 3 * n))
-    probe = probe.tocsc()
-    if probe.nnz != rows.size:
-        raise RuntimeError("internal error: duplicate entries in the SCP constraint pattern")
-    perm = probe.data.astype(np.int64) - 1
-    lo = np.zeros(m)
-    hi = np.zeros(m)
-    r_norm, r_q0, r_box = 4 * n, 5 * n - 1, 5 * n + 6
-    lo[r_norm:r_q0] = hi[r_norm:r_q0] = 1.0
-    lo[r_q0:r_q0 + 4] = hi[r_q0:r_q0 + 4] = q0
-    lo[r_box:] = -1.0
-    hi[r_box:] = 1.0
-    for k, ub in fixed_rates.items():
-        lo[r_box + 3 * k:r_box + 3 * k + 3] = hi[r_box + 3 * k:r_box + 3 * k + 3] = ub
-
+    subproblem = _SlewSubproblem(n, q0, fixed_rates)
     q_plan = q_ref
-    solver: osqp.OSQP | None = None
     status = ""
     converged = False
     iterations = 0
@@ -687,18 +727,7 @@ def scp_slew(
     if not rates_ok:
         status = "infeasible"
     for _ in range(int(max_iters) if rates_ok else 0):
-        vals, rhs = _scp_values(q_ref, u_ref, q1, h, w_max)
-        lo[:r_norm] = hi[:r_norm] = rhs
-        c = -2.0 * _SCP_PROX_WEIGHT * np.concatenate([q_ref.ravel(), u_ref.ravel()])
-        if solver is None:
-            a_mat = sp.csc_matrix((vals[perm], probe.indices, probe.indptr), shape=probe.shape)
-            solver = osqp.OSQP()
-            solver.setup(p_mat, c, a_mat, lo, hi, **dict(_OSQP_SETTINGS))
-        else:
-            solver.update(q=c, l=lo, u=hi, Ax=vals[perm])
-        res = solver.solve(raise_error=False)
-        osqp_status = str(res.info.status)
-        z = np.asarray(res.x, dtype=float)
+        osqp_status, z = subproblem.solve(q_ref, u_ref, q1, h, w_max)
         if osqp_status.startswith("primal infeasible"):
             status = "infeasible"
             break
