@@ -629,6 +629,56 @@ def _plan(pb: _Problem, x: FloatArray, u: FloatArray, iterations: int, status: s
         admm_iterations=stats.admm_iterations, lp_size=stats.lp_size)
 
 
+def _keep_out_points(pb: _Problem, sub_points: int) -> tuple[npt.NDArray[np.int_], FloatArray]:
+    """The first keep-out points, as (interval k, time tau into it, s): nodes 1..N-1 and
+    ``sub_points`` inside every interval, in time order (x_0 is fixed: no point at 0)."""
+    k_list = [k for k in range(pb.n_int) for _ in range(sub_points + 1)]
+    tau_list = [j * pb.h / (sub_points + 1) for _ in range(pb.n_int) for j in range(sub_points + 1)]
+    return np.array(k_list[1:], dtype=int), np.array(tau_list[1:])
+
+
+def _subproblem(pb: _Problem, pts_k: npt.NDArray[np.int_], pts_tau: FloatArray,
+                ref: tuple[FloatArray, FloatArray] | None, settings: ScpSettings) -> _LpData:
+    """The convex subproblem about the reference plan ``ref`` = (node states, inputs): the
+    keep-out linearised into half-spaces at the points (``pts_k``, ``pts_tau``), with the
+    proximal term about ``ref``; without a reference (or a keep-out) the plan without it."""
+    if ref is None or pb.d_min is None:
+        return _build_lp(pb, pts_k[:0], pts_tau[:0], np.zeros((0, 3)), np.zeros(0), None,
+                         settings.equality_row_weight)
+    x_ref, u_ref = ref
+    states = _states_in_intervals(pb, x_ref, u_ref, pts_k, pts_tau)
+    order = np.argsort(pts_k * pb.h + pts_tau, kind="stable")
+    normals = np.empty((len(pts_k), 3))
+    normals[order] = _keep_out_normals(states[order, :3], states[order, 3:], pb.d_min)
+    margin = _margins(pts_k * pb.h + pts_tau, states[:, 3:], pb.d_min, pb,
+                      settings.keep_out_margin_m)
+    prox = (_scaled(pb, x_ref, u_ref), settings.prox_state_weight, settings.prox_input_weight)
+    return _build_lp(pb, pts_k, pts_tau, normals, margin, prox, settings.equality_row_weight,
+                     settings.keep_out_row_weight)
+
+
+def _unsolved_status(osqp_status: str, with_keep_out: bool) -> str:
+    """The plan's status when a subproblem gave no usable iterate (OSQP's ``osqp_status``)."""
+    if "primal infeasible" in osqp_status:
+        return STATUS_INFEASIBLE_KEEP_OUT if with_keep_out else STATUS_INFEASIBLE_THRUST
+    return f"{STATUS_SOLVER_FAILED}: {osqp_status}"
+
+
+def _exact_answer(pb: _Problem, z: FloatArray, settings: ScpSettings
+                  ) -> tuple[FloatArray, FloatArray, str | None]:
+    """A subproblem's answer ``z`` made an exactly feasible plan: the inputs clipped to
+    ``u_max``, the terminal residual removed (:func:`_terminal_cleanup`), the nodes propagated
+    exactly.  Returns (node states, inputs, None), or a ``solver_failed`` status as the third
+    item when the terminal error is still above ``settings.terminal_tol_m``."""
+    u = z[pb.n_x:pb.n_x + pb.n_u].reshape(pb.n_int, 3) * pb.u_max
+    u = _terminal_cleanup(pb, np.clip(u, -pb.u_max, pb.u_max))
+    x = _propagate_nodes(pb, u)
+    term = np.abs(x[-1] - pb.xf) / pb.dscale
+    if np.max(term) > settings.terminal_tol_m / pb.length:
+        return x, u, f"{STATUS_SOLVER_FAILED}: terminal error {np.max(term) * pb.length:.3g}"
+    return x, u, None
+
+
 def plan_transfer(
     n: float,
     x0: npt.ArrayLike,
@@ -683,12 +733,7 @@ def plan_transfer(
     if d_min_m is not None and min(np.linalg.norm(a0[:3]), np.linalg.norm(af[:3])) < d_min_m:
         return failed(STATUS_INFEASIBLE_ENDPOINT, 0)
 
-    # keep-out points: nodes 1..N-1 and sub_points inside every interval, in time order
-    m_sub = settings.sub_points
-    k_list = [k for k in range(pb.n_int) for _ in range(m_sub + 1)]
-    tau_list = [j * pb.h / (m_sub + 1) for _ in range(pb.n_int) for j in range(m_sub + 1)]
-    pts_k = np.array(k_list[1:], dtype=int)  # drop (0, 0): x_0 is fixed
-    pts_tau = np.array(tau_list[1:])
+    pts_k, pts_tau = _keep_out_points(pb, settings.sub_points)
 
     u_ref: FloatArray | None = None
     x_ref: FloatArray | None = None
@@ -698,42 +743,22 @@ def plan_transfer(
     best: tuple[float, FloatArray, FloatArray, float] | None = None  # cheapest safe iterate
     for it in range(1, max_iters + 1):
         with_keep_out = d_min_m is not None and x_ref is not None
-        if with_keep_out:
-            assert x_ref is not None and u_ref is not None and d_min_m is not None
-            ref = _states_in_intervals(pb, x_ref, u_ref, pts_k, pts_tau)
-            order = np.argsort(pts_k * pb.h + pts_tau, kind="stable")
-            normals = np.empty((len(pts_k), 3))
-            normals[order] = _keep_out_normals(ref[order, :3], ref[order, 3:], d_min_m)
-            margin = _margins(pts_k * pb.h + pts_tau, ref[:, 3:], d_min_m, pb,
-                              settings.keep_out_margin_m)
-            prox = (_scaled(pb, x_ref, u_ref), settings.prox_state_weight,
-                    settings.prox_input_weight)
-            data = _build_lp(pb, pts_k, pts_tau, normals, margin, prox,
-                             settings.equality_row_weight, settings.keep_out_row_weight)
-        else:
-            data = _build_lp(pb, pts_k[:0], pts_tau[:0], np.zeros((0, 3)), np.zeros(0),
-                             None, settings.equality_row_weight)
+        ref = (x_ref, u_ref) if x_ref is not None and u_ref is not None else None
+        data = _subproblem(pb, pts_k, pts_tau, ref, settings)
         sol = _solve_lp(data, settings, warm, settings.eps_ladder_keep_out if with_keep_out
                         else settings.eps_ladder)
         stats.admm_iterations += sol.admm_iterations
         stats.lp_size = (data[2].shape[1], data[2].shape[0], data[2].nnz)
         if sol.z is None:
-            if "primal infeasible" in sol.status:
-                status = STATUS_INFEASIBLE_KEEP_OUT if with_keep_out else STATUS_INFEASIBLE_THRUST
-            else:
-                status = f"{STATUS_SOLVER_FAILED}: {sol.status}"
+            status = _unsolved_status(sol.status, with_keep_out)
             if x_ref is not None and u_ref is not None and with_keep_out:
                 # keep the last plan for information, but it is not a solution
                 return _plan(pb, x_ref, u_ref, it, status, min_range, t_start, stats)
             return failed(status, it)
         warm = sol
-        u_new = sol.z[pb.n_x:pb.n_x + pb.n_u].reshape(pb.n_int, 3) * pb.u_max
-        u_new = _terminal_cleanup(pb, np.clip(u_new, -pb.u_max, pb.u_max))
-        x_new = _propagate_nodes(pb, u_new)
-        term = np.abs(x_new[-1] - pb.xf) / pb.dscale
-        if np.max(term) > settings.terminal_tol_m / pb.length:
-            status = f"{STATUS_SOLVER_FAILED}: terminal error {np.max(term) * pb.length:.3g}"
-            return failed(status, it)
+        x_new, u_new, failure = _exact_answer(pb, sol.z, settings)
+        if failure is not None:
+            return failed(failure, it)
         min_range, viol = _dense_check(pb, x_new, u_new, settings.check_points, d_min_m)
         cost = float(np.sum(np.abs(u_new)) * pb.h)
         moved = math.inf if x_ref is None else float(np.max(np.abs(x_new[:, :3] - x_ref[:, :3])))
