@@ -99,9 +99,8 @@ class MissionPlan:
 
     Attributes:
         scenario: the mission.
-        constants: the mission's constants (``gnc/mission.py``): mean motion, the camera
-            model, the target's POIs, of which the planner sees every
-            ``assignment.poi_stride``-th (expected gains are scaled accordingly).
+        constants: the mission's constants (``gnc/mission.py``), handed to its PRO-set
+            planner (``ground/planning/pro_sets.py``).
         issued: every assignment issued so far, in order (the last one is current).
         decisions: every information-driven decision, in order.
 
