@@ -8,9 +8,9 @@ disk) instead of numpy's blocked temporaries: the FDIR's twin, hardware threshol
 11-12 sampling image thousands of poses a window, and there numpy's arithmetic on
 temporaries, not the work, set the cost (≈60 ns per camera-POI pair, a few ns compiled).
 
-The numpy version stays the tested reference (``tests/test_infocost_kernels.py``): values equal
-to rounding, a visibility decided differently only on a pair within rounding of the cone, range
-or horizon boundary.  The sim's cameras use it too (``sim.camera.TruthCameras``, whose
+The numpy version stays the tested reference (``tests/gnc/test_infocost_kernels.py``): values
+equal to rounding, a visibility decided differently only on a pair within rounding of the cone,
+range or horizon boundary.  The sim's cameras use it too (``sim.camera.TruthCameras``, whose
 ``compiled=False`` runs the numpy version).
 """
 

@@ -15,7 +15,7 @@ The precision of every camera-POI pair is computed by the compiled kernel
 (``gnc.infocost_kernels.precision``, ``compiled=True``, the default) or by the numpy
 reference (``gnc.infocost.precision``).  They agree to rounding; after quantisation the
 images are the same unless a pair lies within rounding of the cone, range or horizon boundary
-or a value within rounding of a quantisation step (``tests/test_truth_camera.py``).
+or a value within rounding of a quantisation step (``tests/sim/test_truth_camera.py``).
 """
 
 from __future__ import annotations

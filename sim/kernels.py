@@ -12,7 +12,7 @@
   floating-point operations in the same order as their numpy references, so the results are
   the same bits (numpy's clip, minimum and maximum written out as it computes them).
 
-The numpy implementations in those classes stay the reference; ``tests/test_sim_kernels.py``
+The numpy implementations in those classes stay the reference; ``tests/sim/test_kernels.py``
 checks these against them on random states.  Inputs are float64 arrays, already validated by
 the calling class.
 """

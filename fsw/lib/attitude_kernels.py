@@ -17,8 +17,8 @@ set the cost (≈0.5 ms per spacecraft step with numpy, tens of µs compiled):
 
 Inputs are float64 arrays already validated (finite, unit quaternions where stated): the
 attitude app feeds them from validated messages and its own state.  The numpy versions stay
-the tested reference; ``tests/test_attitude_kernels.py`` checks these against them on random
-inputs.  Quaternions are scalar last [x, y, z, w], as in :mod:`gnc.quat`.
+the tested reference; ``tests/fsw/lib/test_attitude_kernels.py`` checks these against them on
+random inputs.  Quaternions are scalar last [x, y, z, w], as in :mod:`gnc.quat`.
 """
 
 from __future__ import annotations

@@ -11,7 +11,8 @@ dropped.
 
 A one-process run builds the same digest as it goes (:class:`LiveDigest`, fed the samples the
 recorder is given): no second read of the file, and the images fused from the message objects
-rather than their JSON.  ``tests/test_digest.py`` checks that both give the same summary.
+rather than their JSON.  ``tests/missions/test_digest_run.py`` checks that both give the same
+summary.
 """
 
 from __future__ import annotations

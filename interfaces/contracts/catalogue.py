@@ -13,8 +13,8 @@ and so who may publish it:
 
 Apps declare their inputs and outputs from these topics (``interfaces.runtime.app``), the sim and
 the executive declare theirs (``PUBLISHES``), the bus refuses to publish a message of the wrong type
-on a catalogued key, and ``tests/test_catalogue.py`` checks that every input has exactly one
-producer of its type.
+on a catalogued key, and ``tests/interfaces/contracts/test_catalogue.py`` checks that every input
+has exactly one producer of its type.
 """
 
 from __future__ import annotations

@@ -86,7 +86,8 @@ class CameraImage(PoiPrecisions):
         Validated on the arrays: the schema's rules checked with numpy (POIs integers ≥ 0,
         precisions finite in [0, MAX_PRECISION], equal lengths within the bound, the header's
         ranges), ~20× cheaper than pydantic on a 2,500-POI image; whatever those checks do not
-        pass is validated by pydantic, which raises (``tests/test_encoding.py``)."""
+        pass is validated by pydantic, which raises
+        (``tests/interfaces/runtime/test_encoding.py``)."""
         idx, prec = np.asarray(poi), np.asarray(precision)
         fields = {"sender": sender, "t_sim": t_sim, "spacecraft": spacecraft,
                   "poi": idx.tolist(), "precision": prec.tolist()}

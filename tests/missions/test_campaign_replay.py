@@ -15,7 +15,7 @@ from deploy.run_campaign import main as run_campaign
 from ground.analysis.campaign_report import detector_figures
 from ground.analysis.run_summary import FdirResults
 from tests.conftest import dask_cluster
-from tests.test_campaign import BASE, CAMPAIGN
+from tests.deploy.test_campaign import BASE, CAMPAIGN
 
 
 FDIR_FIELDS = tuple(FdirResults.model_fields)

@@ -35,8 +35,8 @@ from interfaces.contracts.messages import (
     json_schema,
     registry,
 )
+from tests.conftest import REPO
 
-REPO = Path(__file__).resolve().parents[1]
 M = "m1"
 
 

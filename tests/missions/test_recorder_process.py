@@ -18,8 +18,7 @@ from ground.archive.recorder import McapRecorder
 from ground.archive.recorder_process import BATCH, RecorderDied, RecorderProcess
 from interfaces.contracts.messages import Heartbeat
 from interfaces.runtime.transport import Sample
-
-REPO = Path(__file__).resolve().parent.parent
+from tests.conftest import REPO
 
 
 def _samples(n: int) -> list[Sample]:
@@ -51,7 +50,7 @@ def test_a_killed_run_leaves_a_complete_archive_of_what_it_sent(tmp_path: Path) 
     script = textwrap.dedent(f"""
         import os, signal, sys
         sys.path.insert(0, {str(REPO)!r})
-        from tests.test_recorder_process import _samples
+        from tests.missions.test_recorder_process import _samples
         from ground.archive.recorder_process import BATCH, RecorderProcess
         rec = RecorderProcess({str(path)!r})
         for s in _samples(3 * BATCH)[:3 * BATCH]:

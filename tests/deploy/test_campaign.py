@@ -19,9 +19,7 @@ import pytest
 from deploy.campaign import CampaignError, load_campaign
 from deploy.run_campaign import main as run_campaign
 from ground.archive.metadata import software_version
-from tests.conftest import dask_cluster
-
-REPO = Path(__file__).resolve().parent.parent
+from tests.conftest import REPO, dask_cluster
 
 BASE = """name = "cb"
 seed = 1

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -14,8 +12,9 @@ from sim.actuators import WheelArray
 from sim.attitude import AttitudeTruth
 from sim.dynamics import RelativeTruth, circular_chief_eci
 from sim.hardware import ObserverHardware
+from tests.conftest import REPO
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "deploy" / "scenarios"
+SCENARIOS = REPO / "deploy" / "scenarios"
 
 
 @pytest.mark.parametrize("seed", range(8))

@@ -25,8 +25,8 @@ from interfaces.contracts.messages import StateEstimate
 from interfaces.contracts.scenario import Scenario, load_scenario
 from interfaces.runtime.encoding import encode
 from interfaces.runtime.transport import Sample
+from tests.conftest import REPO
 
-REPO = Path(__file__).resolve().parent.parent
 OUTCOME = RunOutcome("inproc", 1.0, "completed")
 
 
