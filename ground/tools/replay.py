@@ -64,7 +64,7 @@ UNREAD = (cat.CAMERA_IMAGE, cat.RELNAV, cat.ATTITUDE_SENSORS, cat.THRUST, cat.WH
           cat.POINTING, cat.TICK_DONE, cat.EXEC_STATS, cat.LINK_STATS, cat.DECISIONS,
           cat.TLM_STATUS)
 """Topics no ground app subscribes to and the comparison does not read: counted and dropped as
-the archive is read (``tests/missions/test_replay.py`` checks the ground reads none of them)."""
+the archive is read (``tests/ground/tools/test_replay.py`` checks the ground reads none of them)."""
 
 
 @dataclass

@@ -4,8 +4,8 @@
 pydantic stays the schema of record: the models, their JSON Schemas in MCAP and the validation
 where bytes come in are unchanged.  Only the encoding of a message already valid is done by
 orjson, which writes the same JSON for the values messages hold (field order, floats in the
-shortest round-trip form, strings with the same escapes;
-``tests/interfaces/runtime/test_encoding.py`` compares the two on every message type of a run and
+shortest round-trip form, strings with the same escapes; ``tests/missions/test_encoding_run.py``
+compares the two on every message type of a run, ``tests/interfaces/runtime/test_encoding.py``
 on floats across the whole exponent range).  Anything
 orjson does not write the same way (an integer beyond 64 bits, a value of a type it does not
 know) makes it raise, and pydantic's encoder is used for that message.

@@ -15,25 +15,9 @@ from ground.analysis.summary import write_summary
 from ground.archive.metadata import archived_scenario, run_metadata
 from ground.archive.reader import ArchiveError, load_run
 from ground.archive.recorder import McapRecorder
-from ground.tools.replay import UNREAD, GroundOutput, main, replay_run, with_settings
-from interfaces.contracts import catalogue as cat
-from interfaces.contracts.scenario import Scenario, ScenarioError
-from interfaces.contracts.topology import GROUND_APPS
-from interfaces.runtime.assembly import app_class
-from tests.conftest import small_scenario
-
-
-def _scenario(**fdir: object) -> Scenario:
-    return small_scenario(
-        "replay", duration_s=400.0, target={"pois": 1000},
-        rates={"high_hz": 5.0, "fdi_period_s": 50.0},
-        observers={"count": 3, "initial_attitude": "lvlh"},
-        comms={"range_m": 39.0, "packet_loss": 0.15, "burst": {"mean_length_packets": 3.0},
-               "cuts": [{"a": "sc3", "b": "ground", "start_s": 120.0, "end_s": 180.0}]},
-        faults=[{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0, "magnitude": 0.5},
-                {"spacecraft": 1, "kind": "faulty_data", "start_s": 150.0, "magnitude": 2.0},
-                {"spacecraft": 3, "kind": "link_loss", "start_s": 250.0, "end_s": 330.0}],
-        fdir=fdir)
+from ground.tools.replay import GroundOutput, main, replay_run
+from interfaces.contracts.scenario import Scenario
+from tests.ground.tools.test_replay import _scenario
 
 
 def _record(scenario: Scenario, out: Path) -> RunSummary:
@@ -100,24 +84,6 @@ def test_another_setting_replays_as_the_live_run_with_it(
             if w.t_sim <= horizon]
     assert mine == [w.model_dump(exclude={"t_wall"}) for w in other_windows
                     if w.t_sim <= horizon]
-
-
-def test_what_a_replay_drops_unread_no_ground_app_reads() -> None:
-    ground_inputs = {i.topic for app in map(app_class, GROUND_APPS) for i in app.INPUTS}
-    assert ground_inputs and not ground_inputs & set(UNREAD)
-    assert cat.TRUTH not in UNREAD and cat.TICK not in UNREAD
-
-
-def test_settings_that_change_the_flight_are_refused() -> None:
-    sc = _scenario()
-    assert with_settings(sc, {"fdir.floor": "0.07"}).fdir.floor == 0.07
-    assert with_settings(sc, {"rates.fdi_period_s": "25"}).rates.fdi_period_s == 25.0
-    with pytest.raises(ScenarioError, match="changes what was flown"):
-        with_settings(sc, {"comms.packet_loss": "0.5"})
-    with pytest.raises(ScenarioError, match="no such setting"):
-        with_settings(sc, {"fdir.nope": "1"})
-    with pytest.raises(ScenarioError, match="greater than or equal"):
-        with_settings(sc, {"fdir.floor": "-1"})
 
 
 def test_command_line_writes_the_replay_and_refuses_an_archive_without_scenario(

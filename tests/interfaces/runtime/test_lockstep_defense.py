@@ -1,6 +1,7 @@
 """The lockstep defends itself (issue 16): admission rules of the Bus (sender from the key space,
-sane sequence numbers and dates, bounded queue), plausible ticks only, TickDone announcing only
-its own keys, and the barrier never waking for a message not yet queued.
+sane sequence numbers and dates, bounded queue), plausible ticks only, a node cut off rejoining
+at the sim's present, and the barrier never waking for a message not yet queued (the sim's side,
+TickDone announcing only its sender's keys: tests/sim/test_node.py).
 
 Hostile messages are injected as raw bytes by a foreign endpoint on both transports, the way a
 stranger on the network would send them."""
@@ -16,14 +17,13 @@ import pytest
 
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
-from interfaces.contracts.messages import Heartbeat, Message, Tick, TickDone
+from interfaces.contracts.messages import Heartbeat, Message, Tick
 from interfaces.runtime import admission
 from interfaces.runtime.admission import Admission
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.transport import InprocNetwork
 from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
-from sim.node import SimNode
 from tests.conftest import settle, small_scenario
 
 M = "ld"
@@ -238,26 +238,3 @@ def test_a_node_the_sim_names_rejoining_takes_the_sims_present() -> None:
     assert bus.admission.refused["tick"] == 3
     assert client.executive.ticks == 6  # 0-3, then 302 and 303
     assert bus.admission.clock_s == 303 * 0.5
-
-
-def test_the_sim_names_a_rejoined_participant_until_it_answers() -> None:
-    sc = small_scenario("ld", observers={"count": 2})
-    sim = SimNode(Bus("sim", M, InprocNetwork().endpoint()), sc, participants=["sc1", "sc2"])
-    for alive in (True, False, True):  # joined, lost, back
-        sim.on_liveness("sc1", alive)
-    sim.on_liveness("sc2", True)
-    assert sim.lockstep.rejoining == {"sc1"}
-    assert sim.lockstep.open_tick(4) == ["sc1"]
-    sim._on_done(0, TickDone(sender="sc1", t_sim=2.0, k=4, published={}))
-    assert sim.lockstep.rejoining == set()
-    assert [e[0] for e in sim.lockstep.events["sc1"]] == ["lost", "rejoined"]
-
-
-def test_tick_done_announces_only_the_senders_own_keys() -> None:
-    sc = small_scenario("ld", observers={"count": 2})
-    sim = SimNode(Bus("sim", M, InprocNetwork().endpoint()), sc, participants=["sc1", "sc2"])
-    sim.lockstep.open_tick(4)
-    own, foreign = topics.key(M, "sc1", "nav", "estimate"), topics.key(M, "sc2", "nav", "estimate")
-    sim._on_done(0, TickDone(sender="sc1", t_sim=2.0, k=4, published={own: 9, foreign: 10**9}))
-    sim._on_done(1, TickDone(sender="sc2", t_sim=2.0, k=3, published={foreign: 5}))  # old tick
-    assert sim.lockstep.answers == {"sc1": {own: 9}}

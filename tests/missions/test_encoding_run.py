@@ -1,0 +1,37 @@
+"""Message bytes (interfaces/runtime/encoding.py) in a real (in-process) run: every message type
+a run publishes, and the two it does not, encoded as pydantic does, and the Bus's own bytes."""
+
+from __future__ import annotations
+
+from deploy.inproc import run_inproc
+from interfaces.contracts.messages import AssignmentDecision, FaultReport, Message, registry
+from interfaces.runtime.encoding import encode
+from interfaces.runtime.transport import Sample
+from tests.conftest import small_scenario
+from tests.interfaces.runtime.test_encoding import _pydantic
+
+
+def test_every_message_type_of_a_run_is_encoded_as_pydantic_does() -> None:
+    """A short run with faults and FDIR windows: every message it publishes, then the two
+    types it does not (a fault report, an assignment decision)."""
+    scenario = small_scenario(
+        "enc", duration_s=100.0, rates={"fdi_period_s": 10.0},
+        faults=[{"spacecraft": 1, "kind": "pointing_actuator", "start_s": 5.0, "magnitude": 20.0},
+                {"spacecraft": 2, "kind": "thruster_bias", "start_s": 5.0, "magnitude": 0.5}],
+        phases=[{"name": "p", "start_s": 1.0, "transfer_s": 30.0}])
+    samples: list[Sample] = []
+    run_inproc(scenario, sample_tap=samples.append)
+    extra: list[Message] = [
+        FaultReport(sender="ground", t_sim=40.0, spacecraft=2, fault_class="actuator",
+                    direction="degraded", metric=0.3, threshold=0.01, window_end_s=40.0,
+                    evidence={"dv_rate": 1.5e-5, "beta": 0.98}),
+        AssignmentDecision(sender="ground", t_sim=900.0, phase="inspection", reason="saturated",
+                           library_indices=[3, -1, 17], expected_gain=0.25, upper_bound=0.5,
+                           ratio_bound=0.5, current_gain=None, measured_gains=[0.1, 2e-9],
+                           switched=True),
+    ]
+    messages = [s.message for s in samples if s.message is not None] + extra
+    assert {type(m).__name__ for m in messages} == set(registry())  # every type is here
+    for msg in messages:
+        assert encode(msg) == _pydantic(msg), type(msg).__name__
+    assert all(s.payload == _pydantic(s.message) for s in samples[:2000])  # the Bus's bytes
