@@ -28,11 +28,6 @@ FLIES = frozenset({"run_inproc", "recorded_run", "dask_cluster", "RecorderProces
                    "ProcessPoolExecutor", "Popen"})
 """Callables that fly a run or start a process, by name (a call of ``x.name`` counts too)."""
 
-AWAITING_PLACE = {"tests/test_run_summary.py"}
-"""Test files added flat while the tests moved into folders, to be placed (and their runs moved
-to tests/missions/) on their own; each leaves this set when it is."""
-
-
 def mission_code(path: Path) -> list[str]:
     """What in ``path`` flies a run or starts processes: ``line: what``, in line order."""
     found: list[tuple[int, str]] = []
@@ -56,8 +51,7 @@ def mission_code(path: Path) -> list[str]:
 
 def _unit_test_files() -> list[Path]:
     return sorted(p for p in (REPO / "tests").rglob("test_*.py")
-                  if MISSIONS not in p.parents and "__pycache__" not in p.parts
-                  and p.relative_to(REPO).as_posix() not in AWAITING_PLACE)
+                  if MISSIONS not in p.parents and "__pycache__" not in p.parts)
 
 
 def test_no_unit_test_flies_a_mission_or_starts_a_process() -> None:
@@ -65,10 +59,6 @@ def test_no_unit_test_flies_a_mission_or_starts_a_process() -> None:
     assert len(files) > 50
     found = [f"{p.relative_to(REPO)}:{what}" for p in files for what in mission_code(p)]
     assert found == [], "move these tests to tests/missions/"
-
-
-def test_what_awaits_its_place_is_still_flat() -> None:
-    assert [f for f in sorted(AWAITING_PLACE) if not (REPO / f).is_file()] == []
 
 
 def test_the_reader_sees_runs_and_processes(tmp_path: Path) -> None:
