@@ -9,7 +9,6 @@ import copy
 import functools
 import json
 import operator
-import typing
 from pathlib import Path
 from typing import Any
 
@@ -18,15 +17,11 @@ from pydantic import ValidationError
 
 from ground.analysis.run_summary import (
     OTHER_TESTS_FLAG,
-    FailedTests,
-    FaultClass,
-    MainWindow,
     RunSummary,
     SeriesWindow,
     SummaryError,
     ThresholdCensus,
 )
-from interfaces.contracts.messages import WINDOW_TESTS, FaultReport
 from tests.conftest import recorded_run, small_scenario
 
 OLDER = {OTHER_TESTS_FLAG, "fdir_thresholds.failed.nis",
@@ -151,18 +146,6 @@ def test_reading_a_malformed_file_names_the_file(run: tuple[Path, RunSummary],
         RunSummary.read(bad)
 
 
-def test_a_failed_runs_summary_has_the_head_alone(tmp_path: Path) -> None:
-    """deploy.campaign.record_failure's summary: no archive, so no figures; written back
-    without the absent sections."""
-    text = json.dumps({"scenario": "x", "seed": 1, "status": "failed", "error": "killed",
-                       "injected_faults": []}, indent=2) + "\n"
-    (tmp_path / "summary.json").write_text(text)
-    s = RunSummary.read(tmp_path / "summary.json")
-    assert s.scores is None and s.fdir_series is None and s.wall_s is None and s.filled == []
-    s.write(tmp_path / "again.json")
-    assert (tmp_path / "again.json").read_text() == text
-
-
 def test_threshold_censuses_add_up_field_by_field(run: tuple[Path, RunSummary]) -> None:
     _, summary = run
     c = summary.fdir_thresholds
@@ -172,19 +155,3 @@ def test_threshold_censuses_add_up_field_by_field(run: tuple[Path, RunSummary]) 
     assert total.nominal_windows == 3 * c.nominal_windows
     assert total.threshold_by.model == 3 * c.threshold_by.model
     assert total.model_z.windows == 3 * c.model_z.windows
-
-
-def test_the_records_follow_the_messages() -> None:
-    """The census counts each test of the main detector; the classes are the FDIR's."""
-    assert tuple(FailedTests.model_fields) == WINDOW_TESTS
-    assert set(typing.get_args(FaultClass)) == set(typing.get_args(
-        typing.get_args(FaultReport.model_fields["fault_class"].annotation)[0]))
-
-
-def test_a_main_window_from_a_five_value_row() -> None:
-    old = MainWindow.model_validate([2, 0.0, 30.0, 0.2, 0.05])
-    assert old.other_tests_failed is False and "other_tests_failed" not in old.model_fields_set
-    assert old.exceeded() and not old.exceeded(scale=10.0)
-    assert old.model_dump() == [2, 0.0, 30.0, 0.2, 0.05]
-    new = MainWindow.model_validate([2, 0.0, 30.0, 0.01, 0.05, 1.0])
-    assert new.exceeded(scale=10.0) and new.model_dump() == [2, 0.0, 30.0, 0.01, 0.05, 1.0]
