@@ -79,7 +79,12 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--seed", type=int, help="override the scenario seed")
     p.add_argument("--duration", type=float, help="override duration_s (s)")
     p.add_argument("--realtime", type=float, metavar="SPEED",
-                   help="pace the sim to the wall clock times SPEED (default: lockstep, max speed)")
+                   help="run at most SPEED times real time, still in lockstep: a host that "
+                        "cannot hold it runs slower, never differently (default: as fast as "
+                        "the lockstep goes)")
+    p.add_argument("--hard-deadline", action="store_true",
+                   help="with --realtime: keep the wall clock; an answer later than the next "
+                        "tick is a missed tick of its node (hardware-in-the-loop style)")
     p.add_argument("--endpoint", default=DEFAULT_ENDPOINT,
                    help="Zenoh endpoint of the run's router (default %(default)s; tls/HOST:PORT "
                         "for TLS)")
@@ -123,6 +128,10 @@ def main(argv: list[str] | None = None) -> int:
     except ScenarioError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    if args.realtime is not None and not args.realtime > 0.0:
+        print(f"error: --realtime takes a positive speed (times real time), not {args.realtime}",
+              file=sys.stderr)
+        return 2
     known = set(topology(scenario).participants)
     if set(args.external) - known or (args.external and args.transport == "inproc"):
         print(f"error: --external takes nodes of a Zenoh run ({', '.join(sorted(known))}), not "
@@ -156,7 +165,9 @@ def main(argv: list[str] | None = None) -> int:
     rtf = summary.real_time_factor
     print(f"{status}: {scenario.name} seed {scenario.seed}, "
           f"{scenario.duration_s:.0f} s simulated in "
-          f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time)" if rtf else "")
+          f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time" if rtf else "")
+          + (f", at most {args.realtime:g}x" if rtf and args.realtime else "")
+          + (")" if rtf else "")
           + f"\n  {out}/run.mcap"
           f"\n  {out}/summary.json" + ("" if args.no_report else f"\n  {out}/report.md"))
     if error:
@@ -329,8 +340,9 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         sup.stop_all(exclude={ROUTER.name})
         return "failed", (f"recorder did not start ({recorder.describe_exit()}):\n"
                           f"{recorder.log_tail()}")
-    sim_argv = [*SIM.command, *account(SIM.name)] + (["--realtime", str(args.realtime)]
-                                                    if args.realtime else [])
+    sim_argv = [*SIM.command, *account(SIM.name)] + (
+        ["--realtime", str(args.realtime)] if args.realtime is not None else []) + (
+        ["--hard-deadline"] if args.realtime is not None and args.hard_deadline else [])
     sup.start(Child(SIM.name, sim_argv, logs / "sim.log"))
     topo = topology(scenario)
     commands = {n.name: [*n.command, *account(n.name)] for n in topo.nodes}

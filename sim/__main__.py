@@ -17,15 +17,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-ground", action="store_true",
                         help="do not wait for a ground node (spacecraft only)")
     parser.add_argument("--realtime", type=float, metavar="SPEED",
-                        help="pace ticks to the wall clock times SPEED instead of lockstep")
+                        help="run at most SPEED times real time, still in lockstep "
+                             "(sim/pacing.py)")
+    parser.add_argument("--hard-deadline", action="store_true",
+                        help="with --realtime: wait for answers only until the next tick is "
+                             "due; a late node misses the tick (hardware-in-the-loop style)")
     args = parser.parse_args(argv)
     start = start_node(args, topics.SIM)
     log, scenario = start.log, start.scenario
     participants = topology(scenario, ground=not args.no_ground).participants
     bus = Bus(topics.SIM, start.mission, open_zenoh(args))
     try:
-        sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime, log=log,
-                      stop=start.stop)
+        sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime,
+                      hard_deadline=args.hard_deadline, log=log, stop=start.stop)
         bus.watch_alive(sim.on_liveness)
         bus.serve_schemas()
         bus.declare_alive()

@@ -40,6 +40,8 @@ class Lockstep:
     """Per participant, ("lost" | "rejoined", sim time s) in order."""
     missed_answers: int = 0
     """Ticks on which a live participant's answer did not come in time."""
+    late: dict[str, int] = field(default_factory=dict)
+    """Per participant, the ticks its answer did not come in time for."""
     answers: dict[str, dict[str, int]] = field(default_factory=dict)
     """The current tick's answers: participant -> the keys it announced, with their numbers."""
     rejoining: set[str] = field(default_factory=set)
@@ -120,6 +122,8 @@ class Lockstep:
             answers = dict(self.answers)
         if waiting and not self.stop.is_set():
             self.missed_answers += 1
+            for p in waiting:
+                self.late[p] = self.late.get(p, 0) + 1
             if not self.realtime:
                 self.log.warning("tick %d: no answer from %s; holding last commands",
                                  k, ", ".join(waiting))

@@ -46,6 +46,7 @@ from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
 from faults.hardware import FaultInjector
 from sim.hardware import ObserverHardware
 from sim.lockstep import Lockstep
+from sim.pacing import Pacer
 from sim.sensors import RelNavSensor
 
 
@@ -95,6 +96,9 @@ class SimNode:
     scenario: Scenario
     participants: list[str]
     realtime_speed: float | None = None
+    """``--realtime SPEED``: at most this many times real time (``sim/pacing.py``)"""
+    hard_deadline: bool = False
+    """with ``realtime_speed``: answers waited for only until the next tick is due"""
     log: logging.Logger = field(default_factory=lambda: logging.getLogger("insp.sim"))
     stop: threading.Event = field(default_factory=threading.Event)
 
@@ -126,8 +130,11 @@ class SimNode:
             "attitude": [cat.ATTITUDE_SENSORS.key(m, n) for n in nodes],
             "camera": [cat.CAMERA_IMAGE.key(m, n) for n in nodes],
         }
+        self.pacer = (Pacer(self.realtime_speed, self.hard_deadline, self.log)
+                      if self.realtime_speed is not None else None)
         self.lockstep = Lockstep(self.participants, m, sc.n_ticks - 1, lambda: self._t_now,
-                                 self.stop, self.log, realtime=bool(self.realtime_speed))
+                                 self.stop, self.log,
+                                 realtime=self.pacer is not None and self.pacer.hard)
         self.rejected_commands = 0
         self._t_now = 0.0
         self._q_now = np.array([0.0, 0.0, 0.0, 1.0])  # ECI -> LVLH now (set each tick)
@@ -198,20 +205,23 @@ class SimNode:
         self._status("running", 0)
         expect: dict[str, int] = {}
         wall0 = time.monotonic()
+        if self.pacer is not None:
+            self.pacer.start()
         for k in range(n_ticks):
             if self.stop.is_set():
                 self._status("aborted", k, "stopped by signal")
                 return False
             t = self._t_now = k * dt
-            if self.realtime_speed:
-                _sleep_until(wall0 + t / self.realtime_speed)
+            if self.pacer is not None:
+                self.pacer.wait(t)
             self._publish_hardware(k, t)
             expect.update(self.bus.published_since_last())
             rejoin = self.lockstep.open_tick(k)
             self.bus.publish(self._keys["tick"], Tick(
                 sender=topics.SIM, t_sim=t, k=k, dt_s=dt, expect=expect, final=k == n_ticks - 1,
                 rejoin=rejoin), announce=False)
-            deadline = (wall0 + (t + dt) / self.realtime_speed if self.realtime_speed
+            deadline = (self.pacer.answer_deadline(t, dt, sc.sim.lockstep_timeout_s)
+                        if self.pacer is not None
                         else time.monotonic() + sc.sim.lockstep_timeout_s)
             expect = self.lockstep.collect_answers(k, deadline)
             self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
@@ -265,13 +275,10 @@ class SimNode:
         t = k * self.scenario.rates.dt_s
         events = {n: [SimStatus.Event(what=w, t_sim=s) for w, s in e]
                   for n, e in self.lockstep.events_now().items()}
+        pace = {} if self.pacer is None else {
+            "pace_ceiling": self.pacer.speed, "hard_deadline": self.pacer.hard,
+            "late_ticks": dict(self.lockstep.late)}
         self.bus.publish(self._keys["status"], SimStatus(
             sender=topics.SIM, t_sim=t, state=state, k=k, reason=reason,
             rejected_commands=self.rejected_commands,
-            participants=events), announce=False)  # type: ignore[arg-type]
-
-
-def _sleep_until(wall: float) -> None:
-    left = wall - time.monotonic()
-    if left > 0:
-        time.sleep(left)
+            participants=events, **pace), announce=False)  # type: ignore[arg-type]

@@ -32,6 +32,7 @@ from ground.analysis.run_summary import (
     RunSummary,
     Scores,
     SeriesWindow,
+    PaceRecord,
     SimRecord,
     ThresholdCensus,
     ThresholdSources,
@@ -125,8 +126,12 @@ def _sim_record(statuses: list[SimStatus]) -> SimRecord:
     if not statuses:
         return SimRecord(rejected_commands=None, participants={})
     last = statuses[-1]
-    return SimRecord(rejected_commands=last.rejected_commands,
-                     participants={n: _copies(ev) for n, ev in last.participants.items()})
+    record = SimRecord(rejected_commands=last.rejected_commands,
+                       participants={n: _copies(ev) for n, ev in last.participants.items()})
+    if last.pace_ceiling is not None:
+        record.pace = PaceRecord(ceiling=last.pace_ceiling, hard_deadline=last.hard_deadline,
+                                 late_ticks=dict(last.late_ticks))
+    return record
 
 
 def _copies(records: Sequence[B]) -> list[B]:

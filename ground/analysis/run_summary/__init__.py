@@ -38,6 +38,7 @@ from ground.analysis.run_summary.figures import (
     GncStats,
     MessageCounts,
     NavStats,
+    PaceRecord,
     RecoveryComparison,
     SimRecord,
 )
@@ -49,6 +50,6 @@ __all__ = [
     "CoverageSummary", "Detection", "ExecRecord", "FailedTests", "FaultClass", "FaultEventRecord",
     "FaultScore", "FdirResults", "FdirSeries", "Figure", "GncStats", "MainWindow", "MessageCounts",
     "ModelZ", "NavStats", "RecoveryComparison", "ReplayResults", "ReplaySection",
-    "RunFdirSettings", "RunSummary", "Scores", "SeriesWindow", "SimRecord", "SummaryError",
-    "SummaryRecord", "ThresholdCensus", "ThresholdSources",
+    "PaceRecord", "RunFdirSettings", "RunSummary", "Scores", "SeriesWindow", "SimRecord",
+    "SummaryError", "SummaryRecord", "ThresholdCensus", "ThresholdSources",
 ]

@@ -116,6 +116,16 @@ class ExecRecord(SummaryRecord):
     barrier_timeouts: int = Field(ge=0)
 
 
+class PaceRecord(SummaryRecord):
+    """``sim.pace``: how a ``--realtime`` run was paced (``sim/pacing.py``); the factor it
+    achieved is the summary's ``real_time_factor``."""
+
+    ceiling: float = Field(gt=0.0, description="--realtime SPEED, × real time")
+    hard_deadline: bool = Field(description="answers waited for only until the next tick")
+    late_ticks: dict[str, int] = Field(
+        default_factory=dict, description="per node, the ticks its answer came too late for")
+
+
 class SimRecord(SummaryRecord):
     """``sim``: the sim's last status."""
 
@@ -125,6 +135,8 @@ class SimRecord(SummaryRecord):
         description="actuator commands refused (null: no status received)")
     participants: dict[str, list[SimStatus.Event]] = Field(
         default_factory=dict, description="nodes lost from the lockstep and rejoined, by node")
+    pace: PaceRecord | None = Field(
+        default=None, description="a --realtime run's pacing (absent: lockstep alone)")
 
 
 class FaultEventRecord(SummaryRecord):

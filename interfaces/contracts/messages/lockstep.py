@@ -38,7 +38,7 @@ class TickDone(Message):
 class SimStatus(Message):
     """Lifecycle of the run, from the sim: ``running`` then ``finished`` (nodes then exit);
     ``participants``: the nodes lost from the lockstep (process died, stalled, disconnected) and
-    rejoined, with their sim times."""
+    rejoined, with their sim times; with ``--realtime``, the pacing (``sim/pacing.py``)."""
 
     class Event(BaseModel):
         model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
@@ -51,6 +51,15 @@ class SimStatus(Message):
     rejected_commands: int = Field(
         default=0, ge=0, description="actuator commands refused (stale, future or wrong sender)")
     participants: dict[str, list[Event]] = Field(default_factory=dict, max_length=64)
+    pace_ceiling: float | None = Field(
+        default=None, gt=0.0, description="--realtime SPEED: the most the sim runs, × real time "
+                                           "(None: lockstep alone)")
+    hard_deadline: bool = Field(
+        default=False, description="paced with hard deadlines: an answer later than the next "
+                                   "tick's due time is a missed tick of its node")
+    late_ticks: dict[str, int] = Field(
+        default_factory=dict, max_length=64,
+        description="per node, the ticks its answer came too late for")
 
 
 class Heartbeat(Message):
