@@ -133,6 +133,10 @@ class Supervisor:
     def named(self, name: str) -> Child:
         return next(c for c in self.children if c.name == name)
 
+    def find(self, name: str) -> Child | None:
+        """The child called ``name``, or None when none was started."""
+        return next((c for c in self.children if c.name == name), None)
+
     def stop_all(self, order: list[str] | None = None, exclude: set[str] | None = None,
                  timeout_s: float = 5.0) -> None:
         """Stop children (those named in ``order`` first, in that order), except ``exclude``."""

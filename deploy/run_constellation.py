@@ -378,8 +378,9 @@ MAX_RESTARTS = 3
 
 
 class _Watch:
-    """The launcher's watch over a running constellation.  The sim or the recorder stopping
-    early ends the run at once (no time, or no record, without them); a flight or ground process
+    """The launcher's watch over a running constellation.  The router, the sim or the recorder
+    stopping early ends the run at once (no bus, no time, or no record, without them), naming it
+    and the sim time it stopped at; a flight or ground process
     stopping early is an incident: the sim flies on with its last commands, the ground declares
     the silent spacecraft a link fault, and with ``restart`` the process is started again (up to
     ``MAX_RESTARTS`` times) and rejoins the lockstep."""
@@ -418,9 +419,14 @@ class _Watch:
 
     def _essential_stopped(self) -> str | None:
         sim, recorder = self.sup.named(SIM.name), self.sup.named(RECORDER.name)
-        for child, consequence in ((recorder, "nothing after it is recorded; stopping the run"),
-                                   (sim, "no time without it; stopping the constellation")):
-            if child.returncode is not None and (child is recorder or child.returncode != 0):
+        router = self.sup.find(ROUTER.name)
+        essential = [(recorder, "nothing after it is recorded; stopping the run"),
+                     (sim, "no time without it; stopping the constellation")]
+        if router is not None:
+            essential.insert(0, (router, "the bus is down: no process reaches another, and "
+                                         "nothing after it is recorded; stopping the run"))
+        for child, consequence in essential:
+            if child.returncode is not None and (child is not sim or child.returncode != 0):
                 return (f"{child.name} (pid {child.proc.pid if child.proc else '?'}) "
                         f"{child.describe_exit()} at sim t≈{self.progress.t_sim:.1f} s: "
                         f"{consequence}.\n--- last lines of {child.log_path}:\n"

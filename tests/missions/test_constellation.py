@@ -173,7 +173,8 @@ def test_recorder_death_stops_the_run_at_once(tmp_path: Path, free_port: int) ->
     p = _launch(path, out, free_port, "--realtime", "10")
     try:
         _under_way(out, "norec", estimates=40)  # 4 s of wall: the recorder has flushed
-        os.kill(_wait_pid(["ground.archive.record"], 10.0), signal.SIGKILL)
+        os.kill(_wait_pid(["ground.archive.record", "--scenario", str(path)], 10.0),
+                signal.SIGKILL)
         killed = time.monotonic()
     finally:
         stdout, stderr = p.communicate(timeout=120)
@@ -182,6 +183,29 @@ def test_recorder_death_stops_the_run_at_once(tmp_path: Path, free_port: int) ->
     assert summary["status"] == "failed" and "recorder" in summary["error"]
     assert "nothing after it is recorded" in summary["error"]
     assert summary["archive"]["truncated"]
+    assert 0.0 < summary["t_sim_final_s"] < sc.duration_s  # what was recorded is kept
+
+
+def test_router_death_stops_the_run_at_once_naming_it(tmp_path: Path, free_port: int) -> None:
+    sc = small_scenario("norouter", duration_s=400.0)
+    path = write_scenario(tmp_path / "norouter.toml", sc)
+    out = tmp_path / "out"
+    p = _launch(path, out, free_port, "--realtime", "10")
+    try:
+        _under_way(out, "norouter", estimates=40)
+        os.kill(_wait_pid(["deploy.router", "--config", str(out / "access" / "router.json5")],
+                          10.0), signal.SIGKILL)
+        killed = time.monotonic()
+    finally:
+        stdout, stderr = p.communicate(timeout=120)
+    assert p.returncode == 1 and time.monotonic() - killed < 20.0  # not the 40 s of the run
+    deadline = time.monotonic() + 10.0
+    while _pids_with(str(path)) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert _pids_with(str(path)) == []  # nothing left running without its bus
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and summary["error"].startswith("router")
+    assert "the bus is down" in summary["error"] and "at sim t≈" in summary["error"]
     assert 0.0 < summary["t_sim_final_s"] < sc.duration_s  # what was recorded is kept
 
 
