@@ -342,7 +342,8 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
                           f"{recorder.log_tail()}")
     sim_argv = [*SIM.command, *account(SIM.name)] + (
         ["--realtime", str(args.realtime)] if args.realtime is not None else []) + (
-        ["--hard-deadline"] if args.realtime is not None and args.hard_deadline else [])
+        ["--hard-deadline"] if args.realtime is not None and args.hard_deadline else []) + (
+        ["--hold-lost", str(RESTART_HOLD_S)] if args.restart_on_crash else [])
     sup.start(Child(SIM.name, sim_argv, logs / "sim.log"))
     topo = topology(scenario)
     commands = {n.name: [*n.command, *account(n.name)] for n in topo.nodes}
@@ -375,6 +376,9 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
 
 MAX_RESTARTS = 3
 """Restarts of one process (--restart-on-crash) before it is left down."""
+RESTART_HOLD_S = 60.0
+"""With --restart-on-crash: how long the sim holds the clock for a lost participant to come
+back (its restart: a process start, the compiled kernels from their cache, the bus), wall s."""
 
 
 class _Watch:

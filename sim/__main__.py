@@ -22,6 +22,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--hard-deadline", action="store_true",
                         help="with --realtime: wait for answers only until the next tick is "
                              "due; a late node misses the tick (hardware-in-the-loop style)")
+    parser.add_argument("--hold-lost", type=float, default=0.0, metavar="SECONDS",
+                        help="wait up to SECONDS of wall time for a lost participant to come "
+                             "back (its restart) before the next tick (default: fly on)")
     args = parser.parse_args(argv)
     start = start_node(args, topics.SIM)
     log, scenario = start.log, start.scenario
@@ -29,7 +32,8 @@ def main(argv: list[str] | None = None) -> int:
     bus = Bus(topics.SIM, start.mission, open_zenoh(args))
     try:
         sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime,
-                      hard_deadline=args.hard_deadline, log=log, stop=start.stop)
+                      hard_deadline=args.hard_deadline, hold_lost_s=args.hold_lost, log=log,
+                      stop=start.stop)
         bus.watch_alive(sim.on_liveness)
         bus.serve_schemas()
         bus.declare_alive()

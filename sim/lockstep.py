@@ -36,6 +36,9 @@ class Lockstep:
     stop: threading.Event
     log: logging.Logger
     realtime: bool = False
+    hold_s: float = 0.0
+    """With restarts supervised: how long a lost participant is waited for before the next
+    tick, wall s (0: the sim flies on at once)."""
     events: dict[str, list[tuple[str, float]]] = field(default_factory=dict)
     """Per participant, ("lost" | "rejoined", sim time s) in order."""
     missed_answers: int = 0
@@ -49,6 +52,8 @@ class Lockstep:
     _answer_k: int = -1
     _alive: set[str] = field(default_factory=set)
     _dead: set[str] = field(default_factory=set)
+    _lost_at: dict[str, float] = field(default_factory=dict)
+    """wall time (``time.monotonic``) each participant now lost was lost at"""
     _cond: threading.Condition = field(default_factory=threading.Condition)
 
     def __post_init__(self) -> None:
@@ -78,6 +83,7 @@ class Lockstep:
                 self._alive.add(node)
                 if node in self._dead:
                     self._dead.discard(node)
+                    self._lost_at.pop(node, None)
                     self.rejoining.add(node)
                     self.events.setdefault(node, []).append(("rejoined", t))
                     self.log.warning("participant %s rejoined at t=%.1f s", node, t)
@@ -85,10 +91,30 @@ class Lockstep:
                 self._alive.discard(node)
                 if self._answer_k < self.last_tick:
                     self._dead.add(node)
+                    self._lost_at[node] = time.monotonic()
                     self.events.setdefault(node, []).append(("lost", t))
                     self.log.error("participant %s lost at t=%.1f s (process died, stalled or "
                                    "disconnected); flying on with its last commands", node, t)
             self._cond.notify_all()
+
+    def hold_for_lost(self) -> None:
+        """Before the next tick: wait while a participant lost less than ``hold_s`` ago (wall)
+        may still come back (its process restarted by the launcher), so the clock does not run
+        on without it; it is named in the next tick's ``rejoin``."""
+        with self._cond:
+            held = False
+            while not self.stop.is_set():
+                waiting = {p: w + self.hold_s - time.monotonic()
+                           for p, w in self._lost_at.items() if p in self._dead}
+                waiting = {p: left for p, left in waiting.items() if left > 0.0}
+                if not waiting:
+                    break
+                if not held:
+                    held = True
+                    self.log.warning("holding the clock at t=%.1f s for %s (up to %.0f s of "
+                                     "wall time each) while it restarts", self.now(),
+                                     ", ".join(sorted(waiting)), self.hold_s)
+                self._cond.wait(min(min(waiting.values()), 0.5))
 
     def wait_for_participants(self, timeout_s: float) -> None:
         """Block until every participant has announced itself (Zenoh liveliness)."""

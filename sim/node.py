@@ -99,6 +99,8 @@ class SimNode:
     """``--realtime SPEED``: at most this many times real time (``sim/pacing.py``)"""
     hard_deadline: bool = False
     """with ``realtime_speed``: answers waited for only until the next tick is due"""
+    hold_lost_s: float = 0.0
+    """how long a lost participant is waited for before the next tick (its restart), wall s"""
     log: logging.Logger = field(default_factory=lambda: logging.getLogger("insp.sim"))
     stop: threading.Event = field(default_factory=threading.Event)
 
@@ -134,7 +136,8 @@ class SimNode:
                       if self.realtime_speed is not None else None)
         self.lockstep = Lockstep(self.participants, m, sc.n_ticks - 1, lambda: self._t_now,
                                  self.stop, self.log,
-                                 realtime=self.pacer is not None and self.pacer.hard)
+                                 realtime=self.pacer is not None and self.pacer.hard,
+                                 hold_s=self.hold_lost_s)
         self.rejected_commands = 0
         self._t_now = 0.0
         self._q_now = np.array([0.0, 0.0, 0.0, 1.0])  # ECI -> LVLH now (set each tick)
@@ -214,6 +217,7 @@ class SimNode:
             t = self._t_now = k * dt
             if self.pacer is not None:
                 self.pacer.wait(t)
+            self.lockstep.hold_for_lost()
             self._publish_hardware(k, t)
             expect.update(self.bus.published_since_last())
             rejoin = self.lockstep.open_tick(k)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 
 import pytest
 
@@ -65,3 +66,24 @@ def test_leaving_after_the_last_tick_is_no_loss() -> None:
     ls.on_liveness("sc1", False)
     ls.await_departure(timeout_s=0.0)
     assert ls.events == {}
+
+
+def test_a_lost_participant_holds_the_clock_until_it_is_back_or_the_bound() -> None:
+    ls = _lockstep([12.0])
+    ls.hold_s = 5.0
+    for node in ("sc1", "sc2"):
+        ls.on_liveness(node, True)
+    ls.on_liveness("sc2", False)  # its process died: the launcher restarts it
+    back = threading.Timer(0.2, ls.on_liveness, ("sc2", True))
+    back.start()
+    t0 = time.monotonic()
+    ls.hold_for_lost()  # returns when sc2 is back, long before the bound
+    assert 0.15 <= time.monotonic() - t0 < 4.0
+    assert ls.rejoining == {"sc2"} and [w for w, _ in ls.events["sc2"]] == ["lost", "rejoined"]
+    ls.hold_s = 0.3
+    ls.on_liveness("sc1", False)  # never back: held for the bound, then the sim flies on
+    t0 = time.monotonic()
+    ls.hold_for_lost()
+    assert time.monotonic() - t0 >= 0.25
+    ls.hold_for_lost()  # past its bound: no second hold
+    assert time.monotonic() - t0 < 1.0
