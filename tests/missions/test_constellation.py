@@ -10,7 +10,9 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -167,47 +169,49 @@ def test_restart_on_crash_rejoins_the_lockstep(tmp_path: Path, free_port: int) -
     assert (out / "logs" / "sc2.restart1.log").is_file()
 
 
-def test_recorder_death_stops_the_run_at_once(tmp_path: Path, free_port: int) -> None:
-    sc = small_scenario("norec", duration_s=400.0)
-    path = write_scenario(tmp_path / "norec.toml", sc)
+def _killed_mid_run(tmp_path: Path, port: int, name: str, victim: Callable[[Path, Path],
+                    list[str]]) -> tuple[dict[str, Any], float, Path]:
+    """A 400 s run paced at 10x (40 s of wall time) whose process ``victim(scenario, out)``
+    names (its command line) is killed once the run is under way; the summary, the wall time
+    from the kill to the launcher's exit, and the scenario's path."""
+    sc = small_scenario(name, duration_s=400.0)
+    path = write_scenario(tmp_path / f"{name}.toml", sc)
     out = tmp_path / "out"
-    p = _launch(path, out, free_port, "--realtime", "10")
+    p = _launch(path, out, port, "--realtime", "10")
+    killed = time.monotonic()
     try:
-        _under_way(out, "norec", estimates=40)  # 4 s of wall: the recorder has flushed
-        os.kill(_wait_pid(["ground.archive.record", "--scenario", str(path)], 10.0),
-                signal.SIGKILL)
+        _under_way(out, name, estimates=40)  # 4 s of wall: the recorder has flushed
+        os.kill(_wait_pid(victim(path, out), 10.0), signal.SIGKILL)
         killed = time.monotonic()
     finally:
-        stdout, stderr = p.communicate(timeout=120)
-    assert p.returncode == 1 and time.monotonic() - killed < 15.0  # not the 40 s of the run
+        p.communicate(timeout=120)
+    assert p.returncode == 1
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["status"] == "failed" and "recorder" in summary["error"]
-    assert "nothing after it is recorded" in summary["error"]
-    assert summary["archive"]["truncated"]
+    assert summary["status"] == "failed"
     assert 0.0 < summary["t_sim_final_s"] < sc.duration_s  # what was recorded is kept
+    return summary, time.monotonic() - killed, path
+
+
+def test_recorder_death_stops_the_run_at_once(tmp_path: Path, free_port: int) -> None:
+    summary, after_s, _ = _killed_mid_run(
+        tmp_path, free_port, "norec",
+        lambda path, _: ["ground.archive.record", "--scenario", str(path)])
+    assert after_s < 15.0  # not the 40 s of the run
+    assert "recorder" in summary["error"] and "nothing after it is recorded" in summary["error"]
+    assert summary["archive"]["truncated"]
 
 
 def test_router_death_stops_the_run_at_once_naming_it(tmp_path: Path, free_port: int) -> None:
-    sc = small_scenario("norouter", duration_s=400.0)
-    path = write_scenario(tmp_path / "norouter.toml", sc)
-    out = tmp_path / "out"
-    p = _launch(path, out, free_port, "--realtime", "10")
-    try:
-        _under_way(out, "norouter", estimates=40)
-        os.kill(_wait_pid(["deploy.router", "--config", str(out / "access" / "router.json5")],
-                          10.0), signal.SIGKILL)
-        killed = time.monotonic()
-    finally:
-        stdout, stderr = p.communicate(timeout=120)
-    assert p.returncode == 1 and time.monotonic() - killed < 20.0  # not the 40 s of the run
+    summary, after_s, path = _killed_mid_run(
+        tmp_path, free_port, "norouter",
+        lambda _, out: ["deploy.router", "--config", str(out / "access" / "router.json5")])
+    assert after_s < 20.0  # not the 40 s of the run
+    assert summary["error"].startswith("router") and "the bus is down" in summary["error"]
+    assert "at sim t≈" in summary["error"]
     deadline = time.monotonic() + 10.0
     while _pids_with(str(path)) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert _pids_with(str(path)) == []  # nothing left running without its bus
-    summary = json.loads((out / "summary.json").read_text())
-    assert summary["status"] == "failed" and summary["error"].startswith("router")
-    assert "the bus is down" in summary["error"] and "at sim t≈" in summary["error"]
-    assert 0.0 < summary["t_sim_final_s"] < sc.duration_s  # what was recorded is kept
 
 
 def test_malformed_messages_are_dropped_and_the_app_goes_on(tmp_path: Path, free_port: int) -> None:
