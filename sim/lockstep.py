@@ -97,10 +97,12 @@ class Lockstep:
                                    "disconnected); flying on with its last commands", node, t)
             self._cond.notify_all()
 
-    def hold_for_lost(self) -> None:
+    def hold_for_lost(self) -> float:
         """Before the next tick: wait while a participant lost less than ``hold_s`` ago (wall)
         may still come back (its process restarted by the launcher), so the clock does not run
-        on without it; it is named in the next tick's ``rejoin``."""
+        on without it; it is named in the next tick's ``rejoin``.  Returns the wall time held,
+        s (the pacing slips by it)."""
+        t0 = time.monotonic()
         with self._cond:
             held = False
             while not self.stop.is_set():
@@ -115,6 +117,7 @@ class Lockstep:
                                      "wall time each) while it restarts", self.now(),
                                      ", ".join(sorted(waiting)), self.hold_s)
                 self._cond.wait(min(min(waiting.values()), 0.5))
+        return time.monotonic() - t0 if held else 0.0
 
     def wait_for_participants(self, timeout_s: float) -> None:
         """Block until every participant has announced itself (Zenoh liveliness)."""

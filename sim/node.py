@@ -217,7 +217,12 @@ class SimNode:
             t = self._t_now = k * dt
             if self.pacer is not None:
                 self.pacer.wait(t)
-            self.lockstep.hold_for_lost()
+            held_s = self.lockstep.hold_for_lost()
+            if self.stop.is_set():  # stopped while holding: this tick is not run
+                self._status("aborted", k, "stopped by signal")
+                return False
+            if held_s and self.pacer is not None:
+                self.pacer.slip(held_s)
             self._publish_hardware(k, t)
             expect.update(self.bus.published_since_last())
             rejoin = self.lockstep.open_tick(k)

@@ -60,6 +60,11 @@ class Pacer:
             self._wall0 += late
         self._judge(now, t_s)
 
+    def slip(self, wall_s: float) -> None:
+        """Move the schedule ``wall_s`` later: the sim held the clock that long on purpose (a
+        participant restarting), in either mode; no tick is late for it."""
+        self._wall0 += wall_s
+
     def _judge(self, now: float, t_s: float) -> None:
         """Every ``BEHIND_LOG_S`` of wall time, log the pace achieved over it when below the
         ceiling."""

@@ -60,3 +60,15 @@ def test_a_pace_below_the_ceiling_is_logged_once_per_interval(
 def test_a_speed_that_is_not_positive_and_finite_is_refused(speed: float) -> None:
     with pytest.raises(ValueError, match="positive speed"):
         Pacer(speed, hard=False, log=LOG)
+
+
+def test_a_hold_slips_the_schedule_in_either_mode() -> None:
+    """A restart the sim waited for is no lateness: after the hold, the next tick is not due at
+    once, even with hard deadlines (no burst of unanswered ticks)."""
+    for hard in (False, True):
+        pacer = Pacer(10.0, hard=hard, log=LOG)
+        pacer.start()
+        before = pacer.due(1.0)
+        pacer.slip(30.0)
+        assert pacer.due(1.0) == pytest.approx(before + 30.0)
+        assert pacer.answer_deadline(1.0, 0.5, 60.0) > time.monotonic() + 29.0 or not hard
