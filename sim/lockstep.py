@@ -102,6 +102,8 @@ class Lockstep:
         may still come back (its process restarted by the launcher), so the clock does not run
         on without it; it is named in the next tick's ``rejoin``.  Returns the wall time held,
         s (the pacing slips by it)."""
+        if self.hold_s <= 0.0:  # no restarts supervised: nothing to hold for (every tick)
+            return 0.0
         t0 = time.monotonic()
         with self._cond:
             held = False

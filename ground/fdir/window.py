@@ -58,6 +58,8 @@ class WindowContext:
     nav: np.ndarray | None
     seen: list[Observation]
     """each image's observed POIs and their precisions σ⁻¹"""
+    h_prev: float
+    """the observer's contribution H_i at a (Eq. 8)"""
 
     @property
     def psi(self) -> np.ndarray:
@@ -67,9 +69,6 @@ class WindowContext:
     def phi(self) -> np.ndarray:
         return self.settled.phi
 
-    @property
-    def h_prev(self) -> float:
-        return self.settled.h_prev(self.spacecraft)
 
 
 def window_context(spacecraft: int, obs: ObserverState, images: list[PoiObservations],
@@ -92,4 +91,5 @@ def window_context(spacecraft: int, obs: ObserverState, images: list[PoiObservat
     times = np.array([m.image_t_s for m in images])
     return WindowContext(spacecraft, a, b, settled, images, times, pos[known],
                          bool(moving[known].any()), obs.attitude.at(times),
-                         obs.nav.at(times), [m.arrays() for m in images]), len(images)
+                         obs.nav.at(times), [m.arrays() for m in images],
+                         settled.h_prev(spacecraft)), len(images)
