@@ -282,6 +282,12 @@ class MpcTracker:
             adaptive_rho_interval=25, check_termination=5,
         )
         self._warm: tuple[FloatArray, FloatArray] | None = None
+        self._rho0 = float(self._solver.settings.rho)
+        # Whether the last solve adapted ρ.  OSQP keeps an adapted ρ for the next solve, a
+        # state no warm start carries: it is set back first, so that a solve depends on its
+        # inputs and warm start alone (a restarted process, its warm start restored, solves
+        # as the one that stopped would have).
+        self._rho_moved = False
         self._shift_x = self._shift_index(
             [(0, h + 1, _NX), (self._ix_v, h, _NU), (self._ix_t, h, _NU)], self._nz)
         self._shift_y = self._shift_index(
@@ -373,7 +379,10 @@ class MpcTracker:
         else:
             self._solver.warm_start(x=self._warm[0], y=self._warm[1])
 
+        if self._rho_moved:  # each solve starts from the same ρ: see __init__
+            self._solver.update_settings(rho=self._rho0)
         res = self._solver.solve(raise_error=False)
+        self._rho_moved = int(res.info.rho_updates) > 0
         status = str(res.info.status)
         iters = int(res.info.iter)
         run_time = float(res.info.run_time)
