@@ -94,7 +94,7 @@ class Child:
         return "\n".join(text[-lines:])
 
 
-@dataclass(frozen=True)
+@dataclass
 class Incident:
     """A process that stopped before the end of the run: which, how, when (sim time, s), and
     whether it was started again."""
@@ -103,10 +103,13 @@ class Incident:
     what: str
     t_sim: float
     restarted: bool
+    came_back: str = ""
+    """How the restarted process came back (``StartRecord.describe``), once known."""
 
     def __str__(self) -> str:
         return (f"{self.node} {self.what} at t≈{self.t_sim:.1f} s"
-                + (" (restarted)" if self.restarted else ""))
+                + (f" (restarted: {self.came_back})" if self.came_back else
+                   " (restarted)" if self.restarted else ""))
 
 
 @dataclass

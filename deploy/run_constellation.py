@@ -60,6 +60,7 @@ from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
 from interfaces.contracts.topology import RECORDER, ROUTER, SIM, topology  # noqa: E402
+from interfaces.runtime.cds import read_starts, write_run_key  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
 
@@ -346,7 +347,8 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         ["--hold-lost", str(RESTART_HOLD_S)] if args.restart_on_crash else [])
     sup.start(Child(SIM.name, sim_argv, logs / "sim.log"))
     topo = topology(scenario)
-    commands = {n.name: [*n.command, *account(n.name)] for n in topo.nodes}
+    cds = _store_args(out, args.restart_on_crash)
+    commands = {n.name: [*n.command, *account(n.name), *cds] for n in topo.nodes}
     for node, argv in commands.items():
         if node in args.external:
             log.info("%s runs elsewhere: on its host, with this run's scenario and %s there, "
@@ -358,6 +360,7 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
                    restart=args.restart_on_crash)
     error = watch.run()
     progress.report(final=True)
+    watch.read_restores(out / "cds")
     # Stop the flight side first, then the recorder, so the archive holds everything sent.
     sup.stop_all(order=[SIM.name, *topo.participants], exclude={RECORDER.name, ROUTER.name})
     time.sleep(0.2)
@@ -372,6 +375,16 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     if watch.incidents or lost:
         return "degraded", "; ".join([*(str(i) for i in watch.incidents), *lost])
     return "completed", None
+
+
+def _store_args(out: Path, restart: bool) -> list[str]:
+    """With restarts supervised: the nodes' critical-data stores go to ``<out>/cds/`` under a
+    key made for the run (``interfaces/runtime/cds.py``); a restarted node restores from its
+    own."""
+    if not restart:
+        return []
+    write_run_key(out / "cds")
+    return ["--cds", str(out / "cds")]
 
 
 MAX_RESTARTS = 3
@@ -420,6 +433,18 @@ class _Watch:
                 self.progress.report()
         except KeyboardInterrupt:
             return "interrupted by the user"
+
+    def read_restores(self, directory: Path) -> None:
+        """Name in each restart's incident how the process came back (restored from its
+        critical-data store, or cold and why), from the nodes' starts records."""
+        seen: dict[str, int] = {}
+        for incident in self.incidents:
+            if not incident.restarted:
+                continue
+            n = seen[incident.node] = seen.get(incident.node, 0) + 1
+            starts = read_starts(directory / f"{incident.node}.starts")
+            if n < len(starts):
+                incident.came_back = starts[n].describe()
 
     def _essential_stopped(self) -> str | None:
         sim, recorder = self.sup.named(SIM.name), self.sup.named(RECORDER.name)

@@ -38,7 +38,8 @@ class LinkFaults:
     receiver: str
     seed: int
     faults: Sequence[Fault] = ()
-    _rngs: dict[str, np.random.Generator] = field(default_factory=dict)
+    streams: dict[str, np.random.Generator] = field(default_factory=dict)
+    """The loss draws' random stream of each source node, made on first use."""
 
     def __post_init__(self) -> None:
         self._loss = [(sc_node(f.spacecraft), f.start_s, end_s(f), float(f.magnitude or 0.0))
@@ -56,9 +57,9 @@ class LinkFaults:
         lost = False
         for node, start, end, p in self._loss:
             if start <= t_send < end and node in (src, self.receiver):
-                rng = self._rngs.get(src)
+                rng = self.streams.get(src)
                 if rng is None:
-                    rng = self._rngs[src] = stream(self.seed,
+                    rng = self.streams[src] = stream(self.seed,
                                                    f"link-fault:{src}->{self.receiver}")
                 lost = (rng.random() < p) or lost
         return lost

@@ -8,6 +8,7 @@ from interfaces.contracts import topics
 from interfaces.contracts.topology import topology
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import add_node_args, open_zenoh, start_node
+from interfaces.runtime.recent import depth_for
 from sim.node import SimNode
 
 
@@ -29,13 +30,15 @@ def main(argv: list[str] | None = None) -> int:
     start = start_node(args, topics.SIM)
     log, scenario = start.log, start.scenario
     participants = topology(scenario, ground=not args.no_ground).participants
-    bus = Bus(topics.SIM, start.mission, open_zenoh(args))
+    bus = Bus(topics.SIM, start.mission, open_zenoh(args),
+              recent_ticks=depth_for(scenario.rates.ticks_per("mid")))
     try:
         sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime,
                       hard_deadline=args.hard_deadline, hold_lost_s=args.hold_lost, log=log,
                       stop=start.stop)
         bus.watch_alive(sim.on_liveness)
         bus.serve_schemas()
+        bus.serve_recent()
         bus.declare_alive()
         try:
             sim.wait_for_participants(scenario.sim.startup_timeout_s)

@@ -3,7 +3,9 @@ participants are alive, lost or rejoining, their answers (TickDone) to the curre
 sim's waits on them.
 
 * A participant whose liveliness token goes before the last tick is lost: it is not waited for
-  any more, and the sim flies on with its last commands held.
+  any more, and the sim flies on with its last commands held; unless restarts are supervised
+  (``hold_s``): then the open tick waits for it up to ``hold_s``, and is sent again when it is
+  back (restored from its critical-data store, it runs the tick as if nothing happened).
 * One seen again is named in the ticks' ``rejoin`` until it answers a tick.
 * Both are recorded with their sim time (``events``) for the final status.
 * An answer counts only for the current tick, and announces only keys of its sender's own space.
@@ -37,8 +39,8 @@ class Lockstep:
     log: logging.Logger
     realtime: bool = False
     hold_s: float = 0.0
-    """With restarts supervised: how long a lost participant is waited for before the next
-    tick, wall s (0: the sim flies on at once)."""
+    """With restarts supervised: how long a lost participant (or the recorder) is waited for,
+    wall s (0: the sim flies on at once)."""
     events: dict[str, list[tuple[str, float]]] = field(default_factory=dict)
     """Per participant, ("lost" | "rejoined", sim time s) in order."""
     missed_answers: int = 0
@@ -54,6 +56,12 @@ class Lockstep:
     _dead: set[str] = field(default_factory=set)
     _lost_at: dict[str, float] = field(default_factory=dict)
     """wall time (``time.monotonic``) each participant now lost was lost at"""
+    _back: set[str] = field(default_factory=set)
+    """Participants that came back since the open tick was sent: they are sent it again."""
+    _recorder_lost_at: float | None = None
+    """wall time the recorder was lost at, while it is gone"""
+    held_s: float = 0.0
+    """Wall time the open tick waited for lost participants, s."""
     _cond: threading.Condition = field(default_factory=threading.Condition)
 
     def __post_init__(self) -> None:
@@ -72,19 +80,26 @@ class Lockstep:
 
     def on_liveness(self, node: str, alive: bool) -> None:
         """Liveliness handler: a participant that disappears is not waited for any more (its
-        last commands are held by the hardware, within their own limits); one that comes back
-        (a stalled process resumed, a crashed one restarted) is waited for again from the next
-        tick, and named in the ticks' ``rejoin`` until it answers one (a node that never saw
-        the sim lost takes them as its present, ``TickClient``).  Both are recorded with their
-        sim time for the final status."""
+        last commands are held by the hardware, within their own limits), unless restarts are
+        supervised (``hold_s``): then the tick waits for it; one that comes back (a stalled
+        process resumed, a crashed one restarted) is waited for again, sent the open tick
+        again if it came back during it, and named in the ticks' ``rejoin`` until it answers one
+        (a node that never saw the sim lost takes them as its present, ``TickClient``).  Both are
+        recorded with their sim time for the final status.  The recorder (``topics.RECORDER``) is
+        watched too: with ``hold_s``, the clock waits for it (``hold_for_services``)."""
         with self._cond:
             t = self.now()
-            if alive:
+            if node == topics.RECORDER:
+                self._recorder_lost_at = None if alive else time.monotonic()
+                if not alive and self.hold_s > 0.0:
+                    self.log.error("the recorder is gone at t=%.1f s", t)
+            elif alive:
                 self._alive.add(node)
                 if node in self._dead:
                     self._dead.discard(node)
                     self._lost_at.pop(node, None)
                     self.rejoining.add(node)
+                    self._back.add(node)
                     self.events.setdefault(node, []).append(("rejoined", t))
                     self.log.warning("participant %s rejoined at t=%.1f s", node, t)
             elif node in self.participants and node in self._alive:
@@ -94,31 +109,30 @@ class Lockstep:
                     self._lost_at[node] = time.monotonic()
                     self.events.setdefault(node, []).append(("lost", t))
                     self.log.error("participant %s lost at t=%.1f s (process died, stalled or "
-                                   "disconnected); flying on with its last commands", node, t)
+                                   "disconnected); %s", node, t,
+                                   f"holding the clock up to {self.hold_s:.0f} s for its restart"
+                                   if self.hold_s > 0.0 else "flying on with its last commands")
             self._cond.notify_all()
 
-    def hold_for_lost(self) -> float:
-        """Before the next tick: wait while a participant lost less than ``hold_s`` ago (wall)
-        may still come back (its process restarted by the launcher), so the clock does not run
-        on without it; it is named in the next tick's ``rejoin``.  Returns the wall time held,
-        s (the pacing slips by it)."""
+    def hold_for_services(self) -> float:
+        """Before the next tick, with restarts supervised (``hold_s``): wait while the recorder,
+        lost less than ``hold_s`` ago (wall), may still come back (the launcher restarts it), so
+        that nothing is sent that no one records.  Returns the wall time held, s (the pacing
+        slips by it)."""
         if self.hold_s <= 0.0:  # no restarts supervised: nothing to hold for (every tick)
             return 0.0
         t0 = time.monotonic()
         with self._cond:
             held = False
-            while not self.stop.is_set():
-                waiting = {p: w + self.hold_s - time.monotonic()
-                           for p, w in self._lost_at.items() if p in self._dead}
-                waiting = {p: left for p, left in waiting.items() if left > 0.0}
-                if not waiting:
+            while not self.stop.is_set() and self._recorder_lost_at is not None:
+                left = self._recorder_lost_at + self.hold_s - time.monotonic()
+                if left <= 0.0:
                     break
                 if not held:
                     held = True
-                    self.log.warning("holding the clock at t=%.1f s for %s (up to %.0f s of "
-                                     "wall time each) while it restarts", self.now(),
-                                     ", ".join(sorted(waiting)), self.hold_s)
-                self._cond.wait(min(min(waiting.values()), 0.5))
+                    self.log.warning("holding the clock at t=%.1f s while the recorder restarts "
+                                     "(up to %.0f s of wall time)", self.now(), self.hold_s)
+                self._cond.wait(min(left, 0.5))
         return time.monotonic() - t0 if held else 0.0
 
     def wait_for_participants(self, timeout_s: float) -> None:
@@ -137,20 +151,55 @@ class Lockstep:
         its ``rejoin`` names, sorted."""
         with self._cond:
             self.answers, self._answer_k = {}, k
+            self._back.clear()  # named in this tick's rejoin: no need to send it again
+            self.held_s = 0.0
             return sorted(self.rejoining)
 
-    def collect_answers(self, k: int, deadline: float) -> dict[str, int]:
+    def collect_answers(self, k: int, deadline: float,
+                        resend: Callable[[list[str]], None] | None = None,
+                        answer_timeout_s: float = 30.0) -> dict[str, int]:
         """Wait for TickDone(k) from every live participant until ``deadline`` (wall,
-        ``time.monotonic``); merge what they announced."""
+        ``time.monotonic``), and from one lost less than ``hold_s`` ago until it comes back:
+        then ``resend`` (called with the rejoining participants, sorted) sends it the tick
+        again, and its answer is waited for ``answer_timeout_s`` more.  Merge what they
+        announced.  The wall time spent waiting for lost participants is ``held_s``."""
+        t0, held = time.monotonic(), False
+        while True:
+            with self._cond:
+                back = sorted(self._back)
+                self._back.clear()
+                if not back:
+                    waiting, holding = self._unanswered()
+                    left = deadline - time.monotonic()
+                    if (not waiting or left <= 0) and not holding or self.stop.is_set():
+                        break
+                    if holding and not held:
+                        held = True
+                        self.log.warning("tick %d: holding the clock for %s", k,
+                                         ", ".join(sorted(holding)))
+                    waits = [*holding.values(), *([left] if waiting and left > 0 else [])]
+                    self._cond.wait(min([*waits, 0.5]))
+                    continue
+            if resend is not None:  # outside the lock: the answers come on other threads
+                resend(back)
+            deadline = max(deadline, time.monotonic() + answer_timeout_s)
+        self.held_s = time.monotonic() - t0 if held else 0.0
+        return self._merge(k, waiting)
+
+    def _unanswered(self) -> tuple[list[str], dict[str, float]]:
+        """Under the lock: the live participants yet to answer, and the lost ones still held
+        for, with the wall time left of their hold, s."""
+        waiting = [p for p in self.participants if p not in self.answers and p not in self._dead]
+        now = time.monotonic()
+        holding = {p: self._lost_at[p] + self.hold_s - now for p in self.participants
+                   if p not in self.answers and p in self._lost_at}
+        return waiting, {p: left for p, left in holding.items() if left > 0.0}
+
+    def _merge(self, k: int, waiting: list[str]) -> dict[str, int]:
+        """Count the answers that did not come (``waiting``), merge those that did."""
         with self._cond:
-            while True:
-                waiting = [p for p in self.participants
-                           if p not in self.answers and p not in self._dead]
-                left = deadline - time.monotonic()
-                if not waiting or left <= 0 or self.stop.is_set():
-                    break
-                self._cond.wait(left)
             answers = dict(self.answers)
+            waiting = [p for p in waiting if p not in answers]
         if waiting and not self.stop.is_set():
             self.missed_answers += 1
             for p in waiting:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import partial
 from typing import ClassVar, Literal
@@ -217,7 +218,7 @@ class SimNode:
             t = self._t_now = k * dt
             if self.pacer is not None:
                 self.pacer.wait(t)
-            held_s = self.lockstep.hold_for_lost()
+            held_s = self.lockstep.hold_for_services()
             if self.stop.is_set():  # stopped while holding: this tick is not run
                 self._status("aborted", k, "stopped by signal")
                 return False
@@ -225,14 +226,18 @@ class SimNode:
                 self.pacer.slip(held_s)
             self._publish_hardware(k, t)
             expect.update(self.bus.published_since_last())
-            rejoin = self.lockstep.open_tick(k)
-            self.bus.publish(self._keys["tick"], Tick(
-                sender=topics.SIM, t_sim=t, k=k, dt_s=dt, expect=expect, final=k == n_ticks - 1,
-                rejoin=rejoin), announce=False)
+            tick = partial(Tick, sender=topics.SIM, t_sim=t, k=k, dt_s=dt, expect=expect,
+                           final=k == n_ticks - 1)
+            self.bus.publish(self._keys["tick"], tick(rejoin=self.lockstep.open_tick(k)),
+                             announce=False)
             deadline = (self.pacer.answer_deadline(t, dt, sc.sim.lockstep_timeout_s)
                         if self.pacer is not None
                         else time.monotonic() + sc.sim.lockstep_timeout_s)
-            expect = self.lockstep.collect_answers(k, deadline)
+            expect = self.lockstep.collect_answers(
+                k, deadline, lambda back, tick=tick: self._send_again(tick, back),
+                sc.sim.lockstep_timeout_s)
+            if self.lockstep.held_s and self.pacer is not None:
+                self.pacer.slip(self.lockstep.held_s)
             self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
             self.bus.dispatch(t, include_now=True)
             if k < n_ticks - 1:
@@ -245,6 +250,13 @@ class SimNode:
         self._status("finished", n_ticks - 1)
         self.lockstep.await_departure(timeout_s=10.0)
         return True
+
+    def _send_again(self, tick: Callable[..., Tick], back: list[str]) -> None:
+        """Send the open tick again, for the participants ``back`` that came back while it
+        was open (their restart); the others take it as a tick they have run."""
+        self.log.warning("sending tick again for %s", ", ".join(back))
+        self.bus.publish(self._keys["tick"], tick(rejoin=sorted(self.lockstep.rejoining)),
+                         announce=False)
 
     def _publish_hardware(self, k: int, t: float) -> None:
         for s in self.faults.update(t):

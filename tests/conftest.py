@@ -12,6 +12,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from ground.analysis.run_summary import RunSummary
@@ -137,3 +138,24 @@ def dask_cluster() -> Iterator[str]:
             p.terminate()
         for p in procs:
             p.wait(timeout=30)
+
+
+def canonical(obj: object, inside: frozenset[int] = frozenset()) -> object:
+    """A node's state as plain values to compare (sets sorted, arrays as bytes, objects as
+    their pickled state): a pickle's bytes follow a set's history and the objects' sharing,
+    not only their values."""
+    if isinstance(obj, np.ndarray):
+        return ("array", obj.dtype.str, obj.shape, obj.tobytes())
+    if obj is None or isinstance(obj, (str, int, float, bytes)):
+        return obj
+    if id(obj) in inside:  # a cycle (a part pointing back at its owner)
+        return ("cycle", type(obj).__qualname__)
+    inside = inside | {id(obj)}
+    if isinstance(obj, (set, frozenset)):
+        return ("set", sorted((canonical(x, inside) for x in obj), key=repr))
+    if isinstance(obj, dict):
+        return {k: canonical(v, inside) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return type(obj)(canonical(x, inside) for x in obj)
+    state = obj.__getstate__() if hasattr(obj, "__getstate__") else vars(obj)
+    return (type(obj).__qualname__, canonical(state, inside))

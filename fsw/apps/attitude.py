@@ -59,6 +59,9 @@ class AttitudeApp(App):
         Input(cat.POINTING, "on_target"),
     )
     OUTPUTS = (Output("wheels", cat.WHEELS), Output("estimate", cat.ATTITUDE_ESTIMATE))
+    CRITICAL = ("q", "b", "P", "nis", "h_wheels", "tau", "w_est", "target", "target_rate",
+                "target_accel", "target_t", "slew", "slew_t0", "slew_end", "q_point", "mode",
+                "_meas", "t_att", "_est", "_x_est")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

@@ -50,6 +50,8 @@ class CameraApp(App):
         Input(cat.ATTITUDE_ESTIMATE, "on_attitude"),
     )
     OUTPUTS = (Output("observations", cat.OBSERVATIONS), Output("pointing", cat.POINTING))
+    CRITICAL = ("map", "aim_start", "aim_goal", "aim_t", "next_retarget", "_images", "_est",
+                "_tracking")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

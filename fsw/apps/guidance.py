@@ -66,6 +66,8 @@ class GuidanceApp(App):
         Output("plan", cat.TRANSFER_PLAN),
         Output("status", cat.GUIDANCE_STATUS),
     )
+    CRITICAL = ("assignment", "pending", "previous", "refused_id", "pro", "plan", "plan_t0",
+                "planned_id", "dv_commanded", "_est", "_att", "mpc._warm")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

@@ -23,6 +23,8 @@ class InfoCostApp(App):
     RATE = "mid"
     INPUTS = (Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),)
     OUTPUTS = (Output("telemetry", cat.INFO_COST),)
+    CRITICAL = ("map", "last_boundary", "images", "shared", "rejected")
+    REBUILT = ("report_factor",)  # the software-fault hook, set at start (fsw/spacecraft.py)
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

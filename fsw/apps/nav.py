@@ -41,6 +41,8 @@ class NavApp(App):
     RATE = "mid"
     INPUTS = (Input(cat.RELNAV, "on_relnav"), Input(cat.GUIDANCE_STATUS, "on_guidance"))
     OUTPUTS = (Output("estimate", cat.NAV_ESTIMATE),)
+    CRITICAL = ("x", "P", "t_est", "nis", "resets", "_cmd", "_meas")
+    REBUILT = ("_models",)  # the discrete models by step, a cache
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

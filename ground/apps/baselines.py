@@ -30,6 +30,7 @@ class BaselinesApp(App):
         Input(cat.NAV_ESTIMATE, "on_nav", every_spacecraft=True),
     )
     OUTPUTS = (Output("verdict", cat.BASELINE),)
+    CRITICAL = ("nis", "windows", "cusum", "chi2_persistence", "fixed_persistence")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

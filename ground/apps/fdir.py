@@ -32,6 +32,7 @@ class FdirApp(App):
     )
     OUTPUTS = (Output("window", cat.FDIR_WINDOW), Output("report", cat.FAULT_REPORT),
                Output("constellation", cat.CONSTELLATION_WINDOW))
+    CRITICAL = ("pipeline",)
     PORTS: dict[type[Message], str] = {FdirWindow: "window", FaultReport: "report",
                                         ConstellationWindow: "constellation"}
     """the output each of the pipeline's messages goes out on"""

@@ -37,6 +37,7 @@ class MissionPlanner(App):
         Input(cat.FAULT_REPORT, "on_fault"),
     )
     OUTPUTS = (Output("assignments", cat.ASSIGNMENTS), Output("decisions", cat.DECISIONS))
+    CRITICAL = ("plan", "map", "_decisions_sent", "_faults")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

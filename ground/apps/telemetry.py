@@ -36,6 +36,7 @@ class TelemetryMonitor(App):
         Input(cat.HEARTBEAT, "on_tlm", every_spacecraft=True),
     )
     OUTPUTS = (Output("status", cat.TLM_STATUS),)
+    CRITICAL = ("tracks",)
     STALE_AFTER_S = 10.0
     """A spacecraft silent for longer than this (sim seconds) is reported stale."""
 

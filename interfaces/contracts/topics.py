@@ -81,6 +81,11 @@ def schema_queryable(mission: str, node: str) -> str:
     return f"{node_prefix(mission, node)}/schema/*"
 
 
+def recent_queryable(mission: str, node: str) -> str:
+    """Queryable serving what ``node`` sent in its last ticks (``interfaces.runtime.recent``)."""
+    return f"{node_prefix(mission, node)}/bus/recent"
+
+
 def matches(key_expr: str, concrete: str) -> bool:
     """Whether a concrete key matches a key expression with ``*`` (one chunk) and ``**`` (any
     number of chunks, including none), as Zenoh defines them.  Used by the in-process transport
@@ -107,6 +112,10 @@ def _check_segment(s: str) -> None:
         raise ValueError(f"invalid key segment {s!r}: use letters, digits, '_' or '-'")
 
 
+RECORDER = "recorder"
+"""The recorder, as its liveliness token names it (not a lockstep node: no key space)."""
+
+
 def recorder_token(mission: str) -> str:
     """Liveliness token of the recorder (not a lockstep node)."""
-    return key(mission, GROUND, "recorder", "alive")
+    return key(mission, GROUND, RECORDER, "alive")

@@ -8,7 +8,12 @@ A message that passed its schema can still be hostile or broken in ways only the
   body whose ``sender`` names another node is refused.
 * **Sequence.** A key's sequence count grows by one per message.  A first message numbered above
   ``MAX_FIRST_SEQ`` or a jump of more than ``MAX_SEQ_JUMP`` past the highest seen is refused: it
-  would make the barrier believe that messages arrived which never will.
+  would make the barrier believe that messages arrived which never will.  A number already seen
+  is a duplicate (a message sent again: a publisher restored from its critical-data store
+  running its interrupted tick again, or an answer to a resend request that this node did not
+  need), dropped and counted apart (``Admission.duplicates``), not refused; a 1 below a higher
+  number, or after its publisher's liveliness came back (``Admission.restarted``), is the key's
+  publisher started afresh (it numbers from 1 again), and starts the count anew.
 * **Time.** Once the bus has a clock (the lockstep's tick time, ``Admission.advance``), a message
   dated more than ``MAX_AHEAD_S`` after it is refused instead of queued for a future that may
   never come.
@@ -27,6 +32,7 @@ from __future__ import annotations
 
 from collections import Counter
 from dataclasses import dataclass, field
+from typing import Any
 
 from interfaces.contracts import topics
 from interfaces.contracts.messages import Message
@@ -55,9 +61,13 @@ class Admission:
     highest_seq: dict[str, int] = field(default_factory=dict)
     refused: Counter[str] = field(default_factory=Counter)
     """Refusals so far, by kind (counted by ``Bus.refuse``)."""
+    duplicates: int = 0
+    """Messages dropped as already seen (their key's number not above the highest)."""
     judged_by_subscriber: set[str] = field(default_factory=set)
     """Keys exempt from the sequence and time rules: their subscriber judges them (the tick)."""
     _owner: dict[str, str | None] = field(default_factory=dict)
+    _may_restart: set[str] = field(default_factory=set)
+    """Keys whose publisher came back, until their next message: a 1 starts the count anew."""
 
     def advance(self, t_s: float) -> None:
         """The lockstep has reached ``t_s`` (a tick arrived or was dispatched)."""
@@ -68,6 +78,22 @@ class Admission:
         """Why ``msg`` received on ``key`` must be refused, or None to admit it (the Bus counts
         a refusal; an admitted message is recorded by ``admit`` once it is queued)."""
         return self._why(key, msg, pending)
+
+    def duplicate(self, key: str, msg: Message) -> bool:
+        """Whether ``msg`` was seen already (its number not above the key's highest, and not
+        the 1 of a publisher started afresh); counted.  The lockstep's tick is judged by its
+        subscriber."""
+        last = self.highest_seq.get(key)
+        came_back = key in self._may_restart
+        if came_back:
+            self._may_restart.discard(key)
+        if last is None or msg.seq > last or key in self.judged_by_subscriber:
+            return False
+        if msg.seq == 1 and (last > 1 or came_back):
+            del self.highest_seq[key]  # its publisher started afresh: count from 1 again
+            return False
+        self.duplicates += 1
+        return True
 
     def owner(self, key: str) -> str | None:
         """The node whose key space ``key`` is in (``topics.node_of_key``, cached per key)."""
@@ -106,6 +132,24 @@ class Admission:
                             if prefix and not k.startswith(prefix)}
         if not prefix:
             self.clock_s = None
+
+    def restarted(self, prefix: str) -> None:
+        """The publisher of the keys under ``prefix`` came back (its liveliness token): from
+        a process started afresh, its keys count from 1 again; restored from its critical-data
+        store, they go on, and what it sends again is a duplicate."""
+        self._may_restart.update(k for k in self.highest_seq if k.startswith(prefix))
+
+    def checkpoint(self) -> dict[str, object]:
+        """The clock, the highest numbers seen and the counts (for a node's store)."""
+        return {"clock_s": self.clock_s, "highest_seq": self.highest_seq,
+                "refused": self.refused, "duplicates": self.duplicates,
+                "may_restart": self._may_restart}
+
+    def restore(self, saved: dict[str, Any]) -> None:
+        """Take back a ``checkpoint``."""
+        self.clock_s, self.highest_seq = saved["clock_s"], saved["highest_seq"]
+        self.refused, self.duplicates = saved["refused"], saved["duplicates"]
+        self._may_restart = saved["may_restart"]
 
     def admit(self, key: str, msg: Message) -> None:
         """Record an admitted message's sequence number (the barrier waits on it)."""

@@ -78,12 +78,22 @@ class Output:
 
 
 class App:
-    """Base of every app.  Subclasses set NAME, RATE, INPUTS, OUTPUTS and implement step()."""
+    """Base of every app.  Subclasses set NAME, RATE, INPUTS, OUTPUTS and implement step(), and
+    declare in CRITICAL the state a restart restores (``checkpoint``, ``restore``)."""
 
     NAME: ClassVar[str]
     RATE: ClassVar[RateGroupName]
     INPUTS: ClassVar[tuple[Input, ...]] = ()
     OUTPUTS: ClassVar[tuple[Output, ...]] = ()
+    CRITICAL: ClassVar[tuple[str, ...]] = ()
+    """The attributes (dotted: of a part) that hold what the app learnt while running: written
+    to the node's critical-data store each tick (``interfaces.runtime.cds``) and restored by a
+    restarted process, so that it goes on as if it had not stopped.  Everything else an app
+    holds must be rebuilt identically from the scenario at start."""
+    REBUILT: ClassVar[tuple[str, ...]] = ()
+    """Attributes that change while running but are rebuilt identically on demand (caches),
+    or hooks set at start: not in the store (``tests/interfaces/runtime/test_checkpoint.py``
+    checks that every attribute that changes is in CRITICAL or here)."""
 
     def __init__(self, ctx: AppContext) -> None:
         self.ctx = ctx
@@ -107,3 +117,24 @@ class App:
     def step(self, t: float) -> None:
         """Run one cycle at simulation time ``t`` (s)."""
         raise NotImplementedError
+
+    def checkpoint(self) -> dict[str, object]:
+        """The CRITICAL attributes and the app's random stream's state (to be pickled at once:
+        the values are the app's own, not copies)."""
+        return {"rng": self.ctx.rng.bit_generator.state,
+                "state": {name: attrgetter(name)(self) for name in self.CRITICAL}}
+
+    def restore(self, saved: dict[str, object]) -> None:
+        """Take back a ``checkpoint``.  A part the bus delivers to (a dotted input handler) is
+        updated in place: its methods were subscribed at wiring."""
+        state = saved["state"]
+        assert isinstance(state, dict) and set(state) == set(self.CRITICAL)
+        self.ctx.rng.bit_generator.state = saved["rng"]
+        wired = {i.handler.split(".")[0] for i in self.INPUTS if "." in i.handler}
+        for name, value in state.items():
+            owner_path, _, attr = name.rpartition(".")
+            owner = attrgetter(owner_path)(self) if owner_path else self
+            if attr in wired and not owner_path:
+                vars(getattr(self, attr)).update(vars(value))
+            else:
+                setattr(owner, attr, value)

@@ -14,6 +14,7 @@ What the Bus guarantees, identically on every transport:
 * **Admission.** A valid message is then held to the plausibility rules of
   ``interfaces.runtime.admission`` (its sender owns the key, a sane sequence number and date, a
   bounded queue); a refused one is counted in ``refused`` and logged, and never reaches the barrier.
+  One already seen (same key and number) is a duplicate: dropped, counted, not logged.
 * **Deterministic delivery.** Deferred subscriptions (the default) are delivered by
   ``dispatch(t_now)`` on the caller's thread, sorted by (send time, key, sequence).  Messages of
   other flight/ground nodes become eligible one tick after they were sent (at the earliest) and
@@ -22,6 +23,8 @@ What the Bus guarantees, identically on every transport:
 * **Channel.** Messages between two different spacecraft/ground nodes pass the receiver's
   ``ChannelModel`` (range at send time, loss, cuts, delay) at dispatch.
 * **Barrier.** ``wait_for(expect)`` blocks until the messages announced in a Tick have arrived.
+* **Recovery.** Each node keeps what it sent in its last ticks and sends it again to a node that
+  asks (``interfaces.runtime.recent``): ``recover`` fetches what a tick announced and never came.
 
 The Bus's parts of their own: the subscription table (``interfaces.runtime.subscriptions``), the
 inbox of deferred messages with the delivery order and the barrier (``interfaces.runtime.inbox``),
@@ -35,7 +38,7 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from pydantic import ValidationError
 
@@ -44,6 +47,7 @@ from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
 from interfaces.runtime.channel import ChannelModel, Verdict
 from interfaces.runtime.inbox import Envelope, Inbox
+from interfaces.runtime.recent import RECENT_TICKS, RecentSent, parse_reply
 from interfaces.runtime.schemas import serve_schemas
 from interfaces.runtime.subscriptions import Route, Sub, SubscriptionTable
 from interfaces.runtime.transport import LivenessHandler, RawHandler, Sample, Transport
@@ -75,6 +79,8 @@ class Bus:
     log: logging.Logger = field(default=None)  # type: ignore[assignment]
     stats: BusStats = field(default_factory=BusStats)
     admission: Admission = field(default_factory=Admission)
+    recent_ticks: int = RECENT_TICKS
+    """Ticks of sent messages kept for resend requests (``interfaces.runtime.recent``)."""
     _seq: dict[str, int] = field(default_factory=dict)
     _published_since: dict[str, int] = field(default_factory=dict)
     _raw: dict[str, list[RawHandler]] = field(default_factory=dict)
@@ -83,6 +89,7 @@ class Bus:
         self.prefix = topics.node_prefix(self.mission, self.node)
         self.table = SubscriptionTable(self.prefix)
         self.inbox = Inbox(self.node)
+        self.recent = RecentSent(self.recent_ticks)
         if self.log is None:
             self.log = logging.getLogger(f"insp.bus.{self.node}")
         if self.channel is not None and self.channel.truth.claim_feed():
@@ -114,7 +121,9 @@ class Bus:
             with inbox.lock:
                 for sub in local:
                     inbox.pending.append(Envelope(msg, key, self.node, True, [sub]))
-        self.transport.send(Sample(key, type(msg).__name__, message=msg))
+        sample = Sample(key, type(msg).__name__, message=msg)
+        self.recent.add(sample)
+        self.transport.send(sample)
 
     def _route(self, key: str) -> Route:
         """What publishing on ``key`` needs, checked and resolved once: the key is in this
@@ -127,6 +136,7 @@ class Bus:
     def published_since_last(self) -> dict[str, int]:
         """Keys published since the previous call, with their last sequence number."""
         out, self._published_since = self._published_since, {}
+        self.recent.next_tick()
         return out
 
     # --- subscribing -----------------------------------------------------------------------
@@ -225,6 +235,8 @@ class Bus:
         if refusal is not None:
             self.refuse(key, *refusal)
             return None
+        if self.admission.duplicate(key, msg):
+            return None
         return msg
 
     def refuse(self, key: str, kind: str, why: str) -> None:
@@ -281,7 +293,79 @@ class Bus:
                   if self.table.awaits(k) and s <= seen.get(k, 0) + MAX_SEQ_JUMP}
         return self.inbox.wait(wanted, seen, timeout_s)
 
+    def recover(self, keys: list[str], timeout_s: float = 2.0) -> int:
+        """Ask the publishers of ``keys`` (announced, not arrived) for what they sent in their
+        last ticks, and take it in as if it had just arrived (``take_in``).  Returns the
+        samples taken in."""
+        owners = sorted({o for k in keys if (o := self.admission.owner(k)) and o != self.node})
+        taken = sum(self.take_in(s) for o in owners for s in self.fetch_recent(o, timeout_s))
+        if owners:
+            self.log.warning("%s asked %s for %d announced key(s) that never came; %d "
+                             "message(s) taken in", self.node, ", ".join(owners), len(keys), taken)
+        return taken
+
+    def fetch_recent(self, owner: str, timeout_s: float = 2.0) -> list[Sample]:
+        """What node ``owner`` sent in its last ticks (``interfaces.runtime.recent``), its own
+        keys only, oldest first; a malformed reply is counted as invalid and skipped."""
+        where = topics.recent_queryable(self.mission, owner)
+        out: list[Sample] = []
+        for _key, payload in self.transport.query(where, timeout_s):
+            try:
+                samples = parse_reply(payload)
+            except ValueError as e:
+                self._invalid(where, str(e))
+                continue
+            out += [s for s in samples if self.admission.owner(s.key) == owner]
+        return out
+
+    def take_in(self, sample: Sample) -> int:
+        """Receive ``sample`` as if it had just arrived, on each subscription it matches
+        (validated, admitted: one already held is a duplicate).  Returns 1 if any matched."""
+        exprs = [e for e in self.table.groups if topics.matches(e, sample.key)]
+        for e in exprs:
+            self._on_sample(e, sample)
+        return 1 if exprs else 0
+
+    # --- restarts --------------------------------------------------------------------------
+
+    def checkpoint(self) -> dict[str, Any]:
+        """What this Bus learnt while running, for the node's critical-data store
+        (``interfaces.runtime.checkpoint``): its sequence counts and statistics, admission's
+        state (highest numbers seen, clock, counts), the messages waiting in the inbox (their
+        subscribers by key expression and place) and the channel stage's (the truth it judges
+        ranges on from the oldest message waiting or the clock, whichever is earlier: nothing
+        sent before either is still to come).  The values are the Bus's own: pickle them at
+        once."""
+        index = {id(s): (e, i) for e, group in self.table.groups.items()
+                 for i, s in enumerate(group)}
+        with self.inbox.lock:
+            pending = [(e.msg, e.key, e.src, e.local, [index[id(s)] for s in e.subs])
+                       for e in self.inbox.pending]
+            admission = self.admission.checkpoint()
+        since = min([self.admission.clock_s or 0.0, *(e.msg.t_sim for e in self.inbox.pending)])
+        return {"seq": self._seq, "stats": self.stats, "admission": admission,
+                "pending": pending,
+                "channel": None if self.channel is None else self.channel.checkpoint(since)}
+
+    def restore(self, saved: dict[str, Any]) -> None:
+        """Take back a ``checkpoint`` into a Bus wired as the one that took it."""
+        if (saved["channel"] is None) != (self.channel is None):
+            raise ValueError("the store's channel stage does not match the node's")
+        groups = self.table.groups
+        self._seq, self.stats = saved["seq"], saved["stats"]
+        with self.inbox.lock:
+            self.admission.restore(saved["admission"])
+            self.inbox.pending = [
+                Envelope(msg, key, src, local, [groups[e][i] for e, i in which])
+                for msg, key, src, local, which in saved["pending"]]
+        if self.channel is not None:
+            self.channel.restore(saved["channel"])
+
     # --- services --------------------------------------------------------------------------
+
+    def serve_recent(self) -> None:
+        """Answer ``<prefix>/bus/recent`` with what this node sent in its last ticks."""
+        self.transport.serve(topics.recent_queryable(self.mission, self.node), self.recent.reply)
 
     def serve_schemas(self) -> None:
         """Answer ``<prefix>/schema/<Type>`` queries with the message type's JSON schema

@@ -32,6 +32,7 @@ import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import Any
 
 import numpy as np
 
@@ -130,6 +131,18 @@ class TruthHistory:
             if old > 0:
                 del self._t[:old]
                 del self._pos[:old]
+
+    def checkpoint(self, since_s: float) -> tuple[list[float], list[object]]:
+        """The history (times, positions) that ``positions_at`` reads for times from
+        ``since_s`` (s) on, for a node's critical-data store."""
+        with self._lock:
+            i = max(0, bisect.bisect_right(self._t, since_s + 1e-6) - 1)
+            return self._t[i:], self._pos[i:]
+
+    def restore(self, saved: tuple[list[float], list[object]]) -> None:
+        """Take back a ``checkpoint``."""
+        with self._lock:
+            self._t, self._pos = list(saved[0]), list(saved[1])  # type: ignore[arg-type]
 
     def positions_at(self, t: float) -> dict[str, np.ndarray] | None:
         """Positions by node (the ground at the origin) at the latest truth time <= t
@@ -250,6 +263,19 @@ class ChannelModel:
             link = _Link(rng, LinkCounter(src=src, dst=self.receiver))
             self._links[src] = link
         return link
+
+    def checkpoint(self, since_s: float) -> dict[str, object]:
+        """What this model learnt while running (each link's random stream, burst state and
+        counters, the cuts, the link-fault streams, the truth history from ``since_s`` on), for
+        a node's critical-data store; the values are the model's own (pickle them at once)."""
+        return {"links": self._links, "cuts": self._cuts,
+                "fault_streams": self._faults.streams, "truth": self.truth.checkpoint(since_s)}
+
+    def restore(self, saved: dict[str, Any]) -> None:
+        """Take back a ``checkpoint``."""
+        self._links, self._cuts = saved["links"], saved["cuts"]
+        self._faults.streams = saved["fault_streams"]
+        self.truth.restore(saved["truth"])
 
     def counters(self) -> list[LinkCounter]:
         """Copies of the per-link counters, sorted by source."""

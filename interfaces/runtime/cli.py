@@ -8,11 +8,17 @@ import signal
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
+from interfaces.contracts import topics
+from interfaces.contracts.topology import topology
 from interfaces.runtime.bus import Bus
+from interfaces.runtime.cds import CriticalDataStore
 from interfaces.runtime.channel import ChannelModel
 from interfaces.runtime.executive import Executive, TickClient
+from interfaces.runtime.recent import depth_for
+from interfaces.runtime.restart import resume
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
 
 
@@ -25,6 +31,10 @@ def add_node_args(parser: argparse.ArgumentParser) -> None:
                         help=f"Zenoh endpoint to join (default {DEFAULT_ENDPOINT})")
     parser.add_argument("--zenoh-config", help="Zenoh JSON5 config file (overrides --connect)")
     parser.add_argument("--log-level", default="INFO")
+    parser.add_argument("--cds", type=Path, metavar="DIR",
+                        help="keep this node's critical-data store in DIR (made by the launcher "
+                             "with the run's key) and restore from it when started again "
+                             "(interfaces/runtime/cds.py)")
 
 
 def load_node_scenario(args: argparse.Namespace) -> Scenario:
@@ -88,16 +98,25 @@ def run_participant(
 ) -> int:
     """Main loop of a lockstep node process (a spacecraft or the ground) over Zenoh.
 
-    Joins the network, wires the executive (with the channel model of ``node``), serves the
-    message schemas, announces itself, and runs ticks until the sim finishes (exit 0), the sim
-    disappears (exit 3) or a signal stops it (exit 0).  The Zenoh session is always closed."""
+    Joins the network, wires the executive (with the channel model of ``node``), restores it
+    from its critical-data store when started again (``--cds``), serves the message schemas
+    and what it sent lately, announces itself, and runs ticks until the sim finishes (exit 0),
+    the sim disappears (exit 3) or a signal stops it (exit 0).  The Zenoh session is always
+    closed."""
     start = start_node(args, node)
     bus = Bus(node, start.mission, open_zenoh(args),
-              channel=ChannelModel.of(node, start.scenario))
+              channel=ChannelModel.of(node, start.scenario),
+              recent_ticks=depth_for(start.scenario.rates.ticks_per("mid")))
     try:
         client = TickClient(build(bus, start.scenario))
+        if args.cds is not None:
+            others = [topics.SIM, *(n for n in topology(start.scenario).participants
+                                    if n != node)]
+            resume(client, CriticalDataStore.open(args.cds, start.mission, node, start.scenario),
+                   others, start.log)
         bus.watch_alive(client.on_liveness)
         bus.serve_schemas()
+        bus.serve_recent()
         bus.declare_alive()
         start.log.info("ready")
         client.serve(start.stop)

@@ -16,6 +16,7 @@ import logging
 import queue
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -67,6 +68,14 @@ class Executive:
     """How long a tick waits for the messages it announces (s, wall).  They were all sent before
     the sim sent the tick, so they arrive in milliseconds; only a message lost in a reconnection
     (a node rejoining) is waited for this long."""
+    at_tick_end: Callable[[], None] | None = None
+    """Called after a tick's groups ran, before the answer is sent (the critical-data store
+    is written there: ``interfaces.runtime.cli``)."""
+    last_done: TickDone | None = None
+    """The answer to the last tick run."""
+    recover_after_s: float = 1.0
+    """After this long (s, wall) the messages a tick still misses are asked of their
+    publishers again (``Bus.recover``)."""
 
     def __post_init__(self) -> None:
         rates = self.scenario.rates
@@ -93,7 +102,10 @@ class Executive:
         sim's publish on the in-process transport: every message was delivered as it was
         published)."""
         t, k = tick.t_sim, tick.k
-        missing = self.bus.wait_for(tick.expect, self.barrier_timeout_s) if barrier else []
+        if self.last_done is not None and k == self.last_done.k:
+            self._answer_again()
+            return
+        missing = self._barrier(tick) if barrier else []
         if missing:
             self.barrier_timeouts += 1
             self.log.warning("%s tick %d: announced messages missing after %.1f s: %s",
@@ -104,9 +116,42 @@ class Executive:
         self.ticks += 1
         if k % self.period["mid"] == 0:
             self._publish_housekeeping(t, k)
-        done = TickDone(sender=self.bus.node, t_sim=t, k=k,
-                        published=self.bus.published_since_last())
-        self.bus.publish(self._keys["done"], done, announce=False)
+        self.last_done = TickDone(sender=self.bus.node, t_sim=t, k=k,
+                                  published=self.bus.published_since_last())
+        if self.at_tick_end is not None:
+            self.at_tick_end()
+        self.bus.publish(self._keys["done"], self.last_done, announce=False)
+
+    def _answer_again(self) -> None:
+        """The sim sent the tick this node last ran again (it lost the node while the tick
+        was open, and sees it back): answer it again.  Restored from the critical-data store,
+        the answer has the number it had, and the sim drops it if the first one reached it."""
+        assert self.last_done is not None
+        self.log.warning("%s: the sim sent tick %d again; answering it again", self.bus.node,
+                         self.last_done.k)
+        self.bus.publish(self._keys["done"], self.last_done.model_copy(), announce=False)
+
+    def checkpoint(self) -> dict[str, object]:
+        """The counters and the last answer (for the node's critical-data store)."""
+        return {"stats": self.stats, "app_errors": self.app_errors,
+                "barrier_timeouts": self.barrier_timeouts, "ticks": self.ticks,
+                "last_done": self.last_done}
+
+    def restore(self, saved: dict[str, object]) -> None:
+        """Take back a ``checkpoint``."""
+        for name in ("stats", "app_errors", "barrier_timeouts", "ticks", "last_done"):
+            setattr(self, name, saved[name])
+
+    def _barrier(self, tick: Tick) -> list[str]:
+        """Wait for the messages ``tick`` announces; those still missing after
+        ``recover_after_s`` are asked of their publishers again (``Bus.recover``: they were
+        sent while this process restarted, or lost with the network), then waited for up to
+        ``barrier_timeout_s``.  Returns the keys still missing."""
+        missing = self.bus.wait_for(tick.expect, self.recover_after_s)
+        if missing:
+            self.bus.recover(missing)
+            missing = self.bus.wait_for(tick.expect, self.barrier_timeout_s)
+        return missing
 
     def _run_group(self, g: str, t: float) -> None:
         self.bus.dispatch(t)
@@ -159,8 +204,8 @@ class TickClient:
     in a tick's ``rejoin`` while that tick is too far ahead of its own (the sim lost it and
     sees it again, though the node never saw the sim lost, or it took a tick of the lost epoch
     after rejoining).  Ticks are queued with their epoch; those of a lost epoch are dropped,
-    not run.  A node whose token comes back (a restarted process numbers its messages from 1
-    again) has its sequence numbers forgotten."""
+    not run.  A node whose token comes back may number its messages from 1 again
+    (``Admission.restarted``)."""
 
     SUBSCRIBES: ClassVar[tuple[Topic, ...]] = (cat.TICK, cat.SIM_STATUS)
 
@@ -186,7 +231,27 @@ class TickClient:
         bus.subscribe(cat.TICK.key(bus.mission), Tick, self._on_tick, immediate=True)
         bus.subscribe(cat.SIM_STATUS.key(bus.mission), SimStatus, self._on_status, immediate=True)
 
+    @property
+    def last_k(self) -> int:
+        """The last tick this node took (-1: none yet in this epoch)."""
+        return self._last_k
+
+    def resume_after(self, k: int) -> None:
+        """Go on after tick ``k`` (restored from the critical-data store)."""
+        self._last_k = k
+
+    def catch_up(self, tick: Tick) -> None:
+        """Run ``tick``, one the sim sent while this process was down, now, on this thread
+        (``interfaces.runtime.restart``)."""
+        self._last_k = tick.k
+        self.executive.bus.admission.advance(tick.t_sim)
+        self.executive.run_tick(tick)
+
     def _on_tick(self, tick: Tick) -> None:
+        if tick.k == self._last_k >= 0:  # the open tick sent again, for a node back
+            if self.executive.bus.node in tick.rejoin:
+                self._take(tick)  # ours: answer it again (``Executive.run_tick``)
+            return
         why = self._implausible(tick)
         if why and self.executive.bus.node in tick.rejoin:
             self._lose_epoch(f"the sim names it rejoining at tick {tick.k}, past its tick "
@@ -198,6 +263,10 @@ class TickClient:
             return
         self._last_k = tick.k
         self.executive.bus.admission.advance(tick.t_sim)
+        self._take(tick)
+
+    def _take(self, tick: Tick) -> None:
+        """Run ``tick`` now (synchronous) or queue it for ``serve``."""
         if self.synchronous:
             self.executive.run_tick(tick, barrier=not self.executive.bus.transport.synchronous)
         else:
@@ -225,15 +294,15 @@ class TickClient:
 
     def on_liveness(self, node: str, alive: bool) -> None:
         """Liveliness handler: the sim lost (see the class docstring), the sim back (rejoin),
-        another node back (its sequence numbers start again)."""
+        another node back (its sequence numbers may start again: ``Admission.restarted``)."""
         bus = self.executive.bus
         if node == topics.SIM and not alive:
             self.sim_lost, self._lost_at = True, time.monotonic()
             self._ticks.put(None)
         elif node == topics.SIM and self.sim_lost:
             self._lose_epoch("the sim is back")
-        elif alive and node != bus.node:
-            bus.admission.forget(topics.node_prefix(bus.mission, node) + "/")
+        elif alive and node not in (bus.node, topics.RECORDER):
+            bus.admission.restarted(topics.node_prefix(bus.mission, node) + "/")
 
     def _lose_epoch(self, why: str) -> None:
         """Rejoin the lockstep at the next tick: the ticks queued so far belong to a lost epoch

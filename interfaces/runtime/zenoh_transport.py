@@ -23,6 +23,7 @@ from typing import Any, Literal
 
 import zenoh
 
+from interfaces.contracts import topics
 from interfaces.runtime.transport import (
     LivenessHandler,
     MadeHereHandler,
@@ -165,7 +166,8 @@ class ZenohTransport:
 
 
 def _node_from_token(token_key: str) -> str | None:
-    """Liveliness tokens are ``<node prefix>/alive``: recover the node name."""
+    """Liveliness tokens are ``<node prefix>/alive`` (the recorder's ``topics.recorder_token``):
+    recover the node name (``topics.RECORDER`` for the recorder)."""
     parts = token_key.split("/")
     if parts[-1] != "alive":
         return None
@@ -173,4 +175,6 @@ def _node_from_token(token_key: str) -> str | None:
         return f"sc{int(parts[3])}"
     if len(parts) == 4 and parts[2] in ("sim", "ground"):
         return parts[2]
+    if len(parts) == 5 and parts[2:4] == ["ground", topics.RECORDER]:
+        return topics.RECORDER
     return None

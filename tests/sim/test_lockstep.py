@@ -68,22 +68,46 @@ def test_leaving_after_the_last_tick_is_no_loss() -> None:
     assert ls.events == {}
 
 
-def test_a_lost_participant_holds_the_clock_until_it_is_back_or_the_bound() -> None:
+def test_a_lost_participant_holds_the_tick_until_it_is_back_and_is_sent_it_again() -> None:
     ls = _lockstep([12.0])
     ls.hold_s = 5.0
     for node in ("sc1", "sc2"):
         ls.on_liveness(node, True)
-    ls.on_liveness("sc2", False)  # its process died: the launcher restarts it
-    back = threading.Timer(0.2, ls.on_liveness, ("sc2", True))
-    back.start()
+    ls.open_tick(5)
+    ls.on_done(_done("sc1", 5, {}))
+    ls.on_liveness("sc2", False)  # its process died mid-tick: the launcher restarts it
+    sent_again: list[list[str]] = []
+
+    def resend(back: list[str]) -> None:  # the sim sends the tick again; sc2 runs it, answers
+        sent_again.append(back)
+        threading.Timer(0.05, ls.on_done, (_done("sc2", 5, {}),)).start()
+
+    threading.Timer(0.2, ls.on_liveness, ("sc2", True)).start()
     t0 = time.monotonic()
-    held = ls.hold_for_lost()  # returns when sc2 is back, long before the bound
-    assert 0.15 <= held <= time.monotonic() - t0 < 4.0
-    assert ls.rejoining == {"sc2"} and [w for w, _ in ls.events["sc2"]] == ["lost", "rejoined"]
+    ls.collect_answers(5, deadline=time.monotonic() + 0.01, resend=resend,
+                       answer_timeout_s=2.0)  # returns on sc2's answer, long before the bound
+    assert sent_again == [["sc2"]] and set(ls.answers) == {"sc1", "sc2"}
+    assert 0.2 <= ls.held_s <= time.monotonic() - t0 < 4.0 and ls.missed_answers == 0
+    assert [w for w, _ in ls.events["sc2"]] == ["lost", "rejoined"]
     ls.hold_s = 0.3
+    ls.open_tick(6)
     ls.on_liveness("sc1", False)  # never back: held for the bound, then the sim flies on
     t0 = time.monotonic()
-    ls.hold_for_lost()
-    assert time.monotonic() - t0 >= 0.25
-    assert ls.hold_for_lost() == 0.0  # past its bound: no second hold
-    assert time.monotonic() - t0 < 1.0
+    ls.collect_answers(6, deadline=time.monotonic(), resend=resend)
+    assert 0.25 <= time.monotonic() - t0 < 1.0 and ls.late == {"sc2": 1}
+    ls.open_tick(7)
+    t0 = time.monotonic()
+    ls.on_done(_done("sc2", 7, {}))
+    ls.collect_answers(7, deadline=time.monotonic() + 5.0)  # past its bound: not held again
+    assert time.monotonic() - t0 < 0.2 and ls.held_s == 0.0
+
+
+def test_the_clock_holds_while_the_recorder_restarts() -> None:
+    ls = _lockstep([3.0])
+    assert ls.hold_for_services() == 0.0  # no restarts supervised
+    ls.hold_s = 5.0
+    ls.on_liveness(topics.RECORDER, True)
+    assert ls.hold_for_services() == 0.0 and "recorder" not in ls.events
+    ls.on_liveness(topics.RECORDER, False)
+    threading.Timer(0.2, ls.on_liveness, (topics.RECORDER, True)).start()
+    assert 0.15 <= ls.hold_for_services() < 4.0

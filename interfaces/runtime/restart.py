@@ -1,0 +1,96 @@
+"""A node process's restart: restored from its critical-data store when it can be, started cold
+(and the reason recorded) when not, and the store kept from then on (docs/architecture.md,
+"Restarts").
+
+The store holds the node's state at its last ω_mid boundary, tick m.  A restored node first
+runs again, before it announces itself, every tick the sim sent since, up to the one the sim
+holds open for it: the ticks and everything the tick announce come from what the sim and the
+other nodes keep of their last ticks (``interfaces.runtime.recent``).  What it sends again is
+dropped by its receivers as duplicates.  Then it is where it was when it stopped, and the sim's
+tick sent again on its return is the next it runs.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+from pydantic import ValidationError
+
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import Tick
+from interfaces.runtime.cds import CriticalDataStore, StartRecord, StoreRefused
+from interfaces.runtime.checkpoint import capture, restore
+from interfaces.runtime.executive import TickClient
+
+
+def resume(client: TickClient, store: CriticalDataStore, others: list[str],
+           log: logging.Logger) -> StartRecord:
+    """Restore the node of ``client`` from ``store`` if this process is a restart and run
+    again the ticks since (from the sim and the ``others`` nodes), or start cold (logged with
+    the reason); record how it started; write the store at every ω_mid boundary from now on.
+    Call before the node announces itself."""
+    ex = client.executive
+    every = ex.period["mid"]
+
+    def save() -> None:
+        done = ex.last_done
+        if done is not None and done.k % every == 0:
+            store.save(capture(ex), done.k, done.t_sim)
+
+    ex.at_tick_end = save
+    record = _start(client, store, log)
+    if record.outcome == "restored":
+        record = _catch_up(client, others, record, log)
+    store.record_start(record)
+    return record
+
+
+def _start(client: TickClient, store: CriticalDataStore, log: logging.Logger) -> StartRecord:
+    node = store.identity.node
+    if not store.restarted():
+        log.info("%s: first start; critical-data store %s", node, store.path)
+        return StartRecord("fresh", wall_time=time.time())
+    try:
+        state, header = store.load()
+        restore(client, state)
+    except (StoreRefused, ValueError) as e:
+        log.error("%s: restarted cold (%s)", node, e)
+        return StartRecord("cold", reason=str(e), wall_time=time.time())
+    tick, t_sim = int(header["tick"]), float(header["t_sim"])  # type: ignore[arg-type]
+    log.warning("%s: restored from %s after tick %d (t=%.1f s)", node, store.path, tick, t_sim)
+    return StartRecord("restored", tick=tick, t_sim=t_sim, wall_time=time.time())
+
+
+def _catch_up(client: TickClient, others: list[str], record: StartRecord,
+              log: logging.Logger) -> StartRecord:
+    """Take in what the sim and ``others`` sent lately and run the sim's ticks after the
+    restored one, in order; the record says how far it got (and why not further)."""
+    bus = client.executive.bus
+    tick_key = cat.TICK.key(bus.mission)
+    ticks: dict[int, Tick] = {}
+    for owner in others:
+        for sample in bus.fetch_recent(owner):
+            if sample.key != tick_key:
+                bus.take_in(sample)
+                continue
+            try:
+                tick = Tick.model_validate_json(sample.payload)
+            except ValidationError:
+                continue
+            if tick.k > record.tick:
+                ticks.setdefault(tick.k, tick)
+    run = sorted(ticks)
+    gap = bool(run) and run[0] != record.tick + 1
+    if gap:  # the others no longer keep what followed the store: go on from where it is
+        log.error("%s: the sim's ticks %d-%d are no longer kept; rejoining with the state of "
+                  "tick %d", bus.node, record.tick + 1, run[0] - 1, record.tick)
+        run = []
+    for k in run:
+        client.catch_up(ticks[k])
+    log.warning("%s: ran again ticks %s since the store", bus.node,
+                f"{run[0]}-{run[-1]}" if run else "(none)")
+    return StartRecord("restored", reason="the ticks since were no longer kept" if gap else "",
+                       tick=run[-1] if run else record.tick,
+                       t_sim=ticks[run[-1]].t_sim if run else record.t_sim,
+                       wall_time=record.wall_time)
