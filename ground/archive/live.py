@@ -3,11 +3,12 @@
 :class:`LiveArchive` takes the samples the recorder is given, prepared once for both
 (:func:`ground.archive.recorder.prepare_sample`), and keeps the records a read of the finished
 file would give (:func:`ground.archive.reader.load_run`): the same keys, type names, log times
-(the message's sim time in ns, or the last one for a message without), payloads and order, and
-the same streaming of chosen keys to sinks.  A streamed record still holds its message object,
-so a sink reads it without decoding its JSON (the camera images are most of a run's bytes);
-a kept record holds only its bytes, as read from the file.  Only the wall-clock publish times
-differ from the file's (the recorder stamps its own; nothing reads them).
+(the message's sim time in ns, or the last one for a message without), payloads and order, the
+same streaming of chosen keys to sinks and the same sequence accounting.  A streamed record
+still holds its message object, so a sink reads it without decoding its JSON (the camera
+images are most of a run's bytes); a kept record holds only its bytes, as read from the file.
+Only the wall-clock publish times differ from the file's (the recorder stamps its own; nothing
+reads them).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from pathlib import Path
 
 from mcap.records import Header, Schema
 
-from ground.archive.reader import Record, RecordLoader, RecordSink, RunArchive
+from ground.archive.reader import Record, RecordLoader, RecordSink, RunArchive, SegmentInfo
 from ground.archive.recorder import (
     LIBRARY,
     PROFILE,
@@ -52,6 +53,7 @@ class LiveArchive:
                  stream: Mapping[str, RecordSink]) -> None:
         self._path = path
         self._loader = RecordLoader(stream)
+        self._loader.begin_segment(more_follow=False)
         self._loader.metadata = {name: dict(data) for name, data in metadata.items()}
         self._channels: dict[tuple[str, str], RecordSink | None] = {}
         self._last_log_ns = 0
@@ -62,7 +64,7 @@ class LiveArchive:
 
     def take(self, pending: Pending, message: Message | None = None) -> None:
         """Take one prepared sample (and its message object, if the sample carried one)."""
-        key, type_name, payload, log_time_ns, _obj, t_ns, _seq, publish_ns = pending
+        key, type_name, payload, log_time_ns, _obj, t_ns, seq, publish_ns = pending
         if t_ns is not None:
             self._last_log_ns = t_ns
         log_ns = self._last_log_ns if log_time_ns is None else log_time_ns
@@ -79,7 +81,7 @@ class LiveArchive:
             record = Record(key, type_name, log_ns, publish_ns, payload)
         else:
             record = HeldRecord(key, type_name, log_ns, publish_ns, payload, message)
-        self._loader.take(record, sink)
+        self._loader.take(record, sink, seq)
 
     def finish(self) -> RunArchive:
         """The archive as a read of the complete file gives it."""
@@ -92,4 +94,4 @@ class LiveArchive:
             loader.schemas_by_id[i] = Schema(id=i, name=name, encoding=SCHEMA_ENCODING,
                                              data=data)
         loader.header, loader.footer_seen = Header(profile=PROFILE, library=LIBRARY), True
-        return loader.archive(self._path, truncated=False, stop_reason=None)
+        return loader.archive(self._path, [SegmentInfo(self._path, False, None)])

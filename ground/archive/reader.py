@@ -23,6 +23,15 @@ file order, to a sink as they are read (a two-orbit run's camera images alone ar
 JSON); they are counted all the same.  Records are filtered by key expression with
 :func:`interfaces.contracts.topics.matches` (``*`` one chunk, ``**`` any number) and decoded
 through the message registry on demand.
+
+A run whose recorder was restarted is archived in segments (``run.mcap``, ``run-1.mcap``, ...:
+:mod:`ground.archive.segments`); :func:`load_run` given the first reads them all, in order, as
+one run.  Each segment is read as above (a killed recorder's is truncated, and a later one
+that is not MCAP at all is reported, not raised); the records of every segment are merged in
+log-time order, ties in segment then file order; a message a later segment repeats (its key,
+sequence number and sim time) is kept once; the messages lost between (in flight when the
+recorder died, sent while it was down) are counted per key from the gaps in the sequence
+numbers (:mod:`ground.archive.sequences`).
 """
 
 from __future__ import annotations
@@ -52,6 +61,8 @@ from mcap.records import Message as McapMessage
 from mcap.stream_reader import StreamReader, get_chunk_data_stream
 from pydantic import ValidationError
 
+from ground.archive.segments import SEGMENT_RECORD, segment_paths
+from ground.archive.sequences import SequenceLedger
 from interfaces.contracts.catalogue import Topic
 from interfaces.contracts.messages import Message, registry
 from interfaces.contracts.topics import matches
@@ -102,6 +113,17 @@ class SchemaInfo:
     data: bytes
 
 
+@dataclass(frozen=True, slots=True)
+class SegmentInfo:
+    """One file of a run's archive as read back (``ground/archive/segments.py``)."""
+
+    path: Path
+    truncated: bool
+    """It ends before its footer, or in a damaged record (what precedes is kept)."""
+    stop_reason: str | None
+    """Why reading it stopped early (None: read to its footer)."""
+
+
 def _decode(record: Record, model: type[M]) -> M:
     """``model.model_validate_json(record.payload)``, with errors as :class:`ArchiveError`."""
     try:
@@ -117,12 +139,24 @@ RecordSink = Callable[["Record"], None]
 """Receives a streamed record (``load_run(stream=...)``)."""
 
 
-class RunArchive:
-    """The content of one run archive (see the module docstring).
+def _stop_reason(segments: list[SegmentInfo]) -> str | None:
+    """Why the first truncated segment stopped early, naming it when there are several."""
+    cut = next((s for s in segments if s.truncated), None)
+    if cut is None or len(segments) == 1:
+        return None if cut is None else cut.stop_reason
+    return f"{cut.path.name}: {cut.stop_reason}"
 
-    Attributes: ``path``, ``metadata`` (name -> {key: value}; a later record with the same name
-    replaces an earlier one), ``schemas`` (name -> :class:`SchemaInfo`), ``truncated``,
-    ``stop_reason`` (None for a complete file), ``library`` and ``profile`` of the header.
+
+class RunArchive:
+    """The content of one run archive, every segment of it (see the module docstring).
+
+    Attributes: ``path`` (the first segment), ``metadata`` (name -> {key: value}; a later
+    record with the same name replaces an earlier one; a later segment adds only the names the
+    earlier lack), ``schemas`` (name -> :class:`SchemaInfo`), ``segments`` (each file read,
+    :class:`SegmentInfo`), ``truncated`` (some segment is), ``stop_reason`` (the first
+    truncated segment's, named when there are several; None when none is), ``lost`` (messages
+    lost per key, from the sequence numbers: ``ground/archive/sequences.py``), ``duplicates``
+    (messages a later segment repeated, kept once), ``library`` and ``profile`` of the header.
     """
 
     def __init__(
@@ -132,19 +166,23 @@ class RunArchive:
         channel_types: dict[str, list[str]],
         metadata: dict[str, dict[str, str]],
         schemas: dict[str, SchemaInfo],
-        truncated: bool,
-        stop_reason: str | None,
+        segments: list[SegmentInfo],
         library: str,
         profile: str,
         streamed: dict[str, int] | None = None,
+        lost: dict[str, int] | None = None,
+        duplicates: int = 0,
     ) -> None:
         """Build from parsed content; ``records`` must already be in log-time order;
         ``streamed``: records per key handed to a sink at load and not held."""
         self.path = path
         self.metadata = metadata
         self.schemas = schemas
-        self.truncated = truncated
-        self.stop_reason = stop_reason
+        self.segments = segments
+        self.truncated = any(s.truncated for s in segments)
+        self.stop_reason = _stop_reason(segments)
+        self.lost = dict(lost or {})
+        self.duplicates = duplicates
         self.library = library
         self.profile = profile
         self._records = records
@@ -300,8 +338,9 @@ _U64 = struct.Struct("<Q")
 _MESSAGE_HEAD = struct.Struct("<HIQQ")
 """A Message record's fixed fields: channel id, sequence, log time, publish time (MCAP spec)."""
 
-_ChunkItem = tuple[int, int, int, bytes] | Channel | Schema
-"""What a chunk holds: a message as (channel id, log time, publish time, data), or a record."""
+_ChunkItem = tuple[int, int, int, int, bytes] | Channel | Schema
+"""What a chunk holds: a message as (channel id, sequence, log time, publish time, data), or a
+record."""
 
 
 def _chunk_items(chunk: Chunk) -> list[_ChunkItem]:
@@ -320,8 +359,8 @@ def _chunk_items(chunk: Chunk) -> list[_ChunkItem]:
         if pos > size:
             raise McapError("a record overruns its chunk")
         if opcode == Opcode.MESSAGE:
-            channel_id, _, log_time, publish_time = _MESSAGE_HEAD.unpack_from(data, start)
-            items.append((channel_id, log_time, publish_time,
+            channel_id, sequence, log_time, publish_time = _MESSAGE_HEAD.unpack_from(data, start)
+            items.append((channel_id, sequence, log_time, publish_time,
                           data[start + _MESSAGE_HEAD.size:pos]))
         elif opcode in (Opcode.CHANNEL, Opcode.SCHEMA):
             body = ReadDataStream(io.BytesIO(data[start:pos]))
@@ -330,32 +369,51 @@ def _chunk_items(chunk: Chunk) -> list[_ChunkItem]:
 
 
 class RecordLoader:
-    """The state of one archive read: channels, schemas, kept records and streamed counts
-    (fed record by record from the file here, or sample by sample as a run is recorded:
-    ``ground.archive.live``)."""
+    """The state of one archive read: channels, schemas, kept records, streamed counts and the
+    sequence accounting (fed record by record from the files of a run here, segment by segment,
+    or sample by sample as a run is recorded: ``ground.archive.live``)."""
 
     def __init__(self, sinks: Mapping[str, RecordSink]) -> None:
         self.sinks = dict(sinks)
         self.schemas_by_id: dict[int, Schema] = {}
+        """The schemas of the segment being read, by their id in it."""
+        self.schemas: dict[str, SchemaInfo] = {}
+        """The schemas of the segments read before, by name."""
         self.channels: dict[int, tuple[str, str, RecordSink | None]] = {}
         self.channel_types: dict[str, list[str]] = {}
         self.metadata: dict[str, dict[str, str]] = {}
         self.records: list[Record] = []
         self.streamed: dict[str, int] = {}
+        self.sequences = SequenceLedger()
         self.header: Header | None = None
         self.footer_seen = False
+        self.segment = -1
+        """Index of the segment being read (-1 before the first)."""
 
-    def message(self, channel_id: int, log_time: int, publish_time: int, data: bytes
-                ) -> str | None:
+    def begin_segment(self, more_follow: bool) -> None:
+        """Start reading the next file of the run (its channel and schema ids are its own);
+        ``more_follow``: another file comes after it."""
+        self.schemas.update(self._schema_infos())
+        self.schemas_by_id, self.channels = {}, {}
+        self.footer_seen = False
+        self.segment += 1
+        self.sequences.begin_segment(more_follow)
+
+    def message(self, channel_id: int, sequence: int, log_time: int, publish_time: int,
+                data: bytes) -> str | None:
         """Keep or stream one message; a stop reason if its channel is unknown."""
         channel = self.channels.get(channel_id)
         if channel is None:  # a message before its channel: not MCAP-conformant
             return f"message on unknown channel {channel_id}"
-        self.take(Record(channel[0], channel[1], log_time, publish_time, data), channel[2])
+        self.take(Record(channel[0], channel[1], log_time, publish_time, data), channel[2],
+                  sequence)
         return None
 
-    def take(self, record: Record, sink: RecordSink | None) -> None:
-        """Keep ``record``, or hand it to its key's ``sink`` (counted, not kept)."""
+    def take(self, record: Record, sink: RecordSink | None, sequence: int = 0) -> None:
+        """Keep ``record``, or hand it to its key's ``sink`` (counted, not kept); a duplicate of
+        a record of an earlier segment (its key, ``sequence`` and log time) is dropped."""
+        if not self.sequences.admit(record.key, sequence, record.log_time_ns):
+            return
         if sink is None:
             self.records.append(record)
         else:
@@ -366,40 +424,58 @@ class RecordLoader:
         """The sink of ``key`` (the first matching expression), or None to keep its records."""
         return next((f for e, f in self.sinks.items() if matches(e, key)), None)
 
-    def archive(self, path: Path, truncated: bool, stop_reason: str | None
-                ) -> RunArchive:
-        """The archive read so far (records put in log-time order, ties in file order)."""
+    def _schema_infos(self) -> dict[str, SchemaInfo]:
+        return {s.name: SchemaInfo(s.name, s.encoding, s.data)
+                for s in self.schemas_by_id.values()}
+
+    def archive(self, path: Path, segments: list[SegmentInfo]) -> RunArchive:
+        """The archive read so far (records put in log-time order, ties in file order);
+        ``path``: its first segment; ``segments``: the files read."""
         self.records.sort(key=attrgetter("log_time_ns"))
-        schemas = {s.name: SchemaInfo(s.name, s.encoding, s.data)
-                   for s in self.schemas_by_id.values()}
         header = self.header
         return RunArchive(
             path=path, records=self.records, channel_types=self.channel_types,
-            metadata=self.metadata, schemas=schemas, truncated=truncated,
-            stop_reason=stop_reason, library=header.library if header is not None else "",
-            profile=header.profile if header is not None else "", streamed=self.streamed)
+            metadata=self.metadata, schemas={**self.schemas, **self._schema_infos()},
+            segments=segments, library=header.library if header is not None else "",
+            profile=header.profile if header is not None else "", streamed=self.streamed,
+            lost=self.sequences.lost, duplicates=self.sequences.duplicates)
 
     def item(self, rec: object) -> str | None:
         """Take one record or chunk item; a stop reason if reading must stop."""
         if isinstance(rec, tuple):
             return self.message(*rec)
         if isinstance(rec, McapMessage):
-            return self.message(rec.channel_id, rec.log_time, rec.publish_time, rec.data)
+            return self.message(rec.channel_id, rec.sequence, rec.log_time, rec.publish_time,
+                                rec.data)
         if isinstance(rec, Channel):
-            schema = self.schemas_by_id.get(rec.schema_id)
-            type_name = schema.name if schema is not None else ""
-            if rec.id not in self.channels:
-                self.channel_types.setdefault(rec.topic, []).append(type_name)
-            self.channels[rec.id] = (rec.topic, type_name, self.sink_of(rec.topic))
+            self._channel(rec)
         elif isinstance(rec, Schema):
             self.schemas_by_id[rec.id] = rec
         elif isinstance(rec, Metadata):
-            self.metadata[rec.name] = dict(rec.metadata)
+            self._metadata(rec)
         elif isinstance(rec, Header):
-            self.header = rec
+            self.header = self.header or rec
         elif isinstance(rec, Footer):
             self.footer_seen = True
         return None
+
+    def _channel(self, rec: Channel) -> None:
+        """Register a channel of the segment (its key's type names are the run's)."""
+        schema = self.schemas_by_id.get(rec.schema_id)
+        type_name = schema.name if schema is not None else ""
+        if rec.id not in self.channels:
+            types = self.channel_types.setdefault(rec.topic, [])
+            if self.segment <= 0 or type_name not in types:
+                types.append(type_name)
+        self.channels[rec.id] = (rec.topic, type_name, self.sink_of(rec.topic))
+
+    def _metadata(self, rec: Metadata) -> None:
+        """The first segment's records, then only the names a later one adds (its own
+        ``segment`` record aside)."""
+        if self.segment <= 0:
+            self.metadata[rec.name] = dict(rec.metadata)
+        elif rec.name != SEGMENT_RECORD:
+            self.metadata.setdefault(rec.name, dict(rec.metadata))
 
 
 def _read_records(reader: StreamReader, loader: RecordLoader) -> str | None:
@@ -422,16 +498,9 @@ def _read_records(reader: StreamReader, loader: RecordLoader) -> str | None:
                 return stop
 
 
-def load_run(path: str | Path, stream: Mapping[str, RecordSink] | None = None) -> RunArchive:
-    """Read a run archive (complete or cut short by a kill); see the module docstring.
-
-    ``stream`` maps key expressions to sinks: a record of a matching key (the first matching
-    expression decides) goes to its sink as it is read, in file order, and is not kept.
-
-    Raises :class:`ArchiveError` if the file is not MCAP, ``OSError`` if it cannot be read.
-    """
-    path = Path(path)
-    loader = RecordLoader(stream or {})
+def _read_segment(path: Path, loader: RecordLoader) -> SegmentInfo:
+    """Read one file of a run into ``loader``.  Raises :class:`ArchiveError` if it is not
+    MCAP, ``OSError`` if it cannot be read."""
     with open(path, "rb") as file:
         head = file.read(len(MCAP_MAGIC))
         if head != MCAP_MAGIC:
@@ -448,11 +517,40 @@ def load_run(path: str | Path, stream: Mapping[str, RecordSink] | None = None) -
             record_size_limit=max(size, 1),
         )
         stop_reason = _read_records(reader, loader)
-    truncated = stop_reason is not None or not loader.footer_seen
-    if truncated and stop_reason is None:  # pragma: no cover - StreamReader stops at the footer
-        stop_reason = "no footer"
-    return loader.archive(path, truncated, stop_reason)
+    if stop_reason is None and not loader.footer_seen:  # pragma: no cover - StreamReader
+        stop_reason = "no footer"  # stops at the footer
+    return SegmentInfo(path, stop_reason is not None, stop_reason)
+
+
+def _read_later_segment(path: Path, loader: RecordLoader) -> SegmentInfo:
+    """:func:`_read_segment` for a segment after the first: one that is not MCAP (a recorder
+    that died before writing its header) or cannot be read is reported, not raised."""
+    try:
+        return _read_segment(path, loader)
+    except (ArchiveError, OSError) as exc:
+        return SegmentInfo(path, True, str(exc))
+
+
+def load_run(path: str | Path, stream: Mapping[str, RecordSink] | None = None) -> RunArchive:
+    """Read a run archive (complete or cut short by a kill), every segment of it: ``path``
+    (``run.mcap``) and the segments after it (``run-1.mcap``, ...:
+    :func:`ground.archive.segments.segment_paths`), as one run; see the module docstring.
+
+    ``stream`` maps key expressions to sinks: a record of a matching key (the first matching
+    expression decides) goes to its sink as it is read, in file order, and is not kept.
+
+    Raises :class:`ArchiveError` if the (first) file is not MCAP, ``OSError`` if it cannot be
+    read.
+    """
+    paths = segment_paths(path)
+    loader = RecordLoader(stream or {})
+    segments = []
+    for index, segment in enumerate(paths):
+        loader.begin_segment(more_follow=index + 1 < len(paths))
+        read = _read_segment if index == 0 else _read_later_segment
+        segments.append(read(segment, loader))
+    return loader.archive(paths[0], segments)
 
 
 __all__ = ["ArchiveError", "MCAP_MAGIC", "Record", "RecordLoader", "RecordSink", "RunArchive",
-           "SchemaInfo", "load_run"]
+           "SchemaInfo", "SegmentInfo", "load_run"]

@@ -1,0 +1,100 @@
+"""Sequence accounting of a run's archive: which messages were lost, and which a later segment
+repeats (docs/campaigns-and-replay.md, "Segments and lost messages").
+
+Every bus message carries its key's sequence number ``seq``: 1 for the first message its
+publisher sends on the key, one more for each after (``interfaces/runtime/bus.py``; the
+recorder stores it as the MCAP sequence).  Read in archive order over every segment of the run:
+
+* a number one above the key's last is the next message;
+* a number further above skips messages: those between were **lost** (sent, never archived:
+  in flight when the recorder died, or sent while it was down);
+* a number at or below the key's last starts a **new incarnation** of its publisher (a process
+  restarted cold counts from 1 again): the messages before it in that incarnation were lost
+  (none when it is 1);
+* a key's first number n says that the n - 1 before it were lost;
+* 0 is no number (a payload without a usable ``seq``): not counted.
+
+A message a later segment holds again (the same key, sequence number and sim time as one of an
+earlier segment) is a **duplicate**, kept once.  To know them without holding every number, the
+ledger keeps, per key, the runs of consecutive numbers each earlier segment held, with their sim
+times (a few per key: one, plus one per gap or incarnation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(slots=True)
+class _Run:
+    """Consecutive sequence numbers of one key in one segment, and their sim times (ns)."""
+
+    first_seq: int
+    last_seq: int
+    first_ns: int
+    last_ns: int
+
+    def holds(self, seq: int, log_ns: int) -> bool:
+        """Whether the message numbered ``seq`` at sim time ``log_ns`` is one of this run."""
+        return (self.first_seq <= seq <= self.last_seq
+                and self.first_ns <= log_ns <= self.last_ns)
+
+
+class SequenceLedger:
+    """The sequence accounting of one archive read (see the module docstring): fed every
+    message in archive order (:meth:`admit`), segment by segment (:meth:`begin_segment`)."""
+
+    def __init__(self) -> None:
+        self._last: dict[str, int] = {}
+        self._lost: dict[str, int] = {}
+        self._earlier: dict[str, list[_Run]] = {}
+        self._current: dict[str, list[_Run]] = {}
+        self._track = False
+        self.duplicates = 0
+        """Messages dropped because an earlier segment holds them."""
+
+    def begin_segment(self, more_follow: bool) -> None:
+        """Start the next segment; ``more_follow``: another segment comes after it (its runs
+        are then kept to find the messages that one repeats)."""
+        for key, runs in self._current.items():
+            self._earlier.setdefault(key, []).extend(runs)
+        self._current = {}
+        self._track = more_follow
+
+    def admit(self, key: str, seq: int, log_ns: int) -> bool:
+        """Account for the message numbered ``seq`` of ``key`` at sim time ``log_ns`` (ns);
+        False if it is a duplicate (to drop)."""
+        last = self._last.get(key, 0)
+        if seq == last + 1 and not self._earlier and not self._track:  # the common case
+            self._last[key] = seq
+            return True
+        if seq <= 0:
+            return True
+        if self._earlier and self._repeats(key, seq, log_ns):
+            self.duplicates += 1
+            return False
+        if seq != last + 1:
+            missed = seq - last - 1 if seq > last else seq - 1
+            if missed:
+                self._lost[key] = self._lost.get(key, 0) + missed
+        self._last[key] = seq
+        if self._track:
+            self._extend(key, seq, log_ns)
+        return True
+
+    def _repeats(self, key: str, seq: int, log_ns: int) -> bool:
+        """Whether an earlier segment holds this message."""
+        return any(run.holds(seq, log_ns) for run in self._earlier.get(key, ()))
+
+    def _extend(self, key: str, seq: int, log_ns: int) -> None:
+        """Add the message to its key's current run, or start a new run with it."""
+        runs = self._current.setdefault(key, [])
+        if runs and runs[-1].last_seq + 1 == seq and runs[-1].last_ns <= log_ns:
+            runs[-1].last_seq, runs[-1].last_ns = seq, log_ns
+        else:
+            runs.append(_Run(seq, seq, log_ns, log_ns))
+
+    @property
+    def lost(self) -> dict[str, int]:
+        """Messages lost per key (keys with none left out), keys sorted."""
+        return dict(sorted(self._lost.items()))
