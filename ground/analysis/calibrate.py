@@ -4,10 +4,10 @@ nominal runs for a chosen false-alarm rate").
     python -m ground.analysis.calibrate runs/nominal [runs/nominal-seed2 ...] [--rate 1e-3]
         [--persistence 2] [--skip-s 0]
 
-Reads every ``ground/fdir/window`` verdict of the given run directories (``run.mcap``; windows
-overlapping a fault of their spacecraft, as listed in the run's ``summary.json``, are left
-out), prints the distribution of the nominal metric H_m,i, the floor that gives the chosen
-false-alarm probability per FDI window under the persistence rule
+Reads every ``ground/fdir/window`` verdict of the given run directories (``run.mcap`` and the
+segments after it; windows overlapping a fault of their spacecraft, as listed in the run's
+``summary.json``, are left out), prints the distribution of the nominal metric H_m,i, the
+floor that gives the chosen false-alarm probability per FDI window under the persistence rule
 (:func:`threshold.calibrate_floor`), and how far the largest nominal metric is below each
 run's configured floor.
 """
@@ -22,6 +22,7 @@ import numpy as np
 
 from ground.analysis.run_summary import RunSummary
 from ground.archive.reader import ArchiveError, load_run
+from ground.archive.segments import run_archive
 from ground.fdir.threshold import calibrate_floor
 from interfaces.contracts.messages import FdirWindow
 from interfaces.contracts.scenario import Fault
@@ -30,7 +31,7 @@ from interfaces.contracts.scenario import Fault
 def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[FdirWindow]:
     """The judged FDIR windows of a run that end after ``skip_s`` and overlap no fault of
     their spacecraft (``summary.json`` ``injected_faults``, when the run has one)."""
-    archive = load_run(run_dir / "run.mcap")
+    archive = load_run(run_archive(run_dir))
     faults: list[Fault] = []
     if (run_dir / "summary.json").exists():
         faults = RunSummary.read(run_dir / "summary.json").injected_faults

@@ -17,6 +17,7 @@ from ground.analysis.nav import NavErrors  # noqa: E402
 from ground.analysis.run_summary import RunSummary, Scores  # noqa: E402
 from ground.analysis.truth_table import TruthTable  # noqa: E402
 from ground.archive.reader import ArchiveError, RunArchive  # noqa: E402
+from ground.archive.segments import run_archive  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts.messages import FdirWindow  # noqa: E402
 from interfaces.contracts.scenario import Scenario  # noqa: E402
@@ -24,7 +25,8 @@ from interfaces.contracts.scenario import Scenario  # noqa: E402
 
 def write_report(out: Path, scenario: Scenario, mission: str | None = None,
                  digest: RunDigest | None = None) -> Path:
-    """Write ``<out>/report.md`` (and its plots) from ``run.mcap`` and ``summary.json``
+    """Write ``<out>/report.md`` (and its plots) from ``run.mcap`` (every segment of the
+    archive) and ``summary.json``
     (``digest``: the run's archive already read for the summary, ``ground.analysis.digest``)."""
     mission = mission or scenario.name
     summary = RunSummary.read(out / "summary.json")
@@ -38,7 +40,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     if summary.error:
         lines += ["```", summary.error, "```", ""]
     try:
-        digest = digest or digest_run(out / "run.mcap", scenario, mission)
+        digest = digest or digest_run(run_archive(out), scenario, mission)
     except (ArchiveError, OSError) as e:
         lines.append(f"The archive could not be read: {e}")
         return _write(out, lines)
@@ -49,6 +51,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     lines += _coverage_section(out, digest.coverage, summary)
     lines += _fdir_section(out, archive, mission, summary)
     lines += _links_section(summary) + _exec_section(summary) + _incidents_section(summary)
+    lines += _archive_section(summary)
     return _write(out, lines)
 
 
@@ -362,6 +365,21 @@ def _incidents_section(summary: RunSummary) -> list[str]:
         gaps = ", ".join(f"{a:.1f}-{b:.1f}" for a, b in outages.get(sc, []))
         rows.append(f"| {node} | {events or '-'} | {gaps or '-'} |")
     return rows + [""]
+
+
+def _archive_section(summary: RunSummary) -> list[str]:
+    """The archive's segments (a restarted recorder) and the messages lost, by topic; nothing
+    for a run archived whole in one file."""
+    info = summary.archive
+    if info is None or info.segments is None or info.lost is None:
+        return []
+    files = ", ".join(s.file + (" (truncated)" if s.truncated else "") for s in info.segments)
+    rows = ["## Archive", "", f"Segments: {files}.", "",
+            f"Messages lost (sent, never archived): {info.lost.total}.", ""]
+    if info.lost.by_topic:
+        rows += ["| topic | lost |", "|---|---|",
+                 *(f"| {t} | {n} |" for t, n in info.lost.by_topic.items()), ""]
+    return rows
 
 
 def _exec_section(summary: RunSummary) -> list[str]:

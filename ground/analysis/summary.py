@@ -23,6 +23,7 @@ from ground.analysis.run_summary import (
     FaultEventRecord,
     FdirResults,
     FdirSeries,
+    LostMessages,
     MainWindow,
     MessageCounts,
     ModelZ,
@@ -31,6 +32,7 @@ from ground.analysis.run_summary import (
     RunFdirSettings,
     RunSummary,
     Scores,
+    SegmentRecord,
     SeriesWindow,
     PaceRecord,
     SimRecord,
@@ -39,6 +41,8 @@ from ground.analysis.run_summary import (
 )
 from ground.analysis.scoring import Alarm, Judged, overlaps_fault, score
 from ground.archive.reader import ArchiveError, RunArchive
+from ground.archive.segments import run_archive
+from ground.archive.sequences import by_topic
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     WINDOW_TESTS,
@@ -89,7 +93,7 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str,
     links = _last_of(digest, LinkStats)
     tlm = archive.of(cat.TLM_STATUS, mission)
     summary = summary_head(scenario, outcome)
-    summary.archive = ArchiveInfo(truncated=archive.truncated)
+    summary.archive = archive_info(archive)
     summary.ticks = digest.counters.counts.get(tick_key, 0)
     t_final = last_tick.decode(Tick).t_sim if last_tick is not None else 0.0
     summary.t_sim_final_s = t_final
@@ -107,6 +111,19 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str,
     summary.set_fdir(fdir_summary(archive, scenario, mission))
     summary.real_time_factor = round(t_final / outcome.wall_s, 2) if outcome.wall_s > 0 else None
     return summary
+
+
+def archive_info(archive: RunArchive) -> ArchiveInfo:
+    """``archive``: whether a file of it is truncated; its segments and the messages lost,
+    only when it has several segments or lost messages (a clean run of one file says
+    nothing more than it always did)."""
+    info = ArchiveInfo(truncated=archive.truncated)
+    if len(archive.segments) > 1 or archive.lost:
+        lost = by_topic(archive.lost)
+        info.segments = [SegmentRecord(file=s.path.name, truncated=s.truncated)
+                         for s in archive.segments]
+        info.lost = LostMessages(total=sum(lost.values()), by_topic=lost)
+    return info
 
 
 def _nav_stats(stats: dict[str, float]) -> NavStats | None:
@@ -244,16 +261,17 @@ def write_summary(out: Path, scenario: Scenario, transport: Literal["inproc", "z
                   access: AccessAudit | None = None) -> RunSummary:
     """Write ``<out>/summary.json`` and return it.  A damaged or missing archive is reported in
     the summary (``archive_error``), never hidden.  ``digest``: the run's archive already read
-    (``ground.analysis.digest``; the report then reuses it), else ``<out>/run.mcap`` is read.
+    (``ground.analysis.digest``; the report then reuses it), else ``<out>/run.mcap`` (and the
+    segments after it) is read.
     ``access``: the router's audit (from outside the archive)."""
     outcome = RunOutcome(transport, wall_s, status, error)
     try:
-        digest = digest or digest_run(out / "run.mcap", scenario, mission or scenario.name)
+        digest = digest or digest_run(run_archive(out), scenario, mission or scenario.name)
         summary = build_summary(digest, scenario, mission or scenario.name, outcome)
     except (ArchiveError, OSError) as e:
         summary = summary_head(scenario, outcome)
         if digest is not None:  # read, then found damaged
-            summary.archive = ArchiveInfo(truncated=digest.archive.truncated)
+            summary.archive = archive_info(digest.archive)
         summary.archive_error = str(e)
     if access is not None:
         summary.access = access

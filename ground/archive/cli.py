@@ -12,7 +12,9 @@ fields flattened (``r_m.0``, ``P.2.3``), to ``--out`` or stdout; an ``--out`` en
 ``.parquet`` (or ``.pq``) gets instead the topic's DataFrame (ground/archive/frame.py: indexed
 by sim time ``t_sim_s``, lists of varying length kept whole) as Parquet, which
 ``pandas.read_parquet`` reads back as it was.  A damaged archive is read up to its last
-complete chunk (ground/archive/reader.py) and said so.
+complete chunk (ground/archive/reader.py) and said so.  ``RUN.mcap`` is a run's first segment:
+the segments after it (``run-1.mcap``, ...: a restarted recorder's) are read with it as one
+run, and ``list`` and ``summary`` name them and the messages lost, by topic.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from typing import Any, TextIO
 
 from ground.archive.frame import topic_frame
 from ground.archive.reader import ArchiveError, RunArchive, load_run
+from ground.archive.sequences import by_topic
 
 PARQUET_SUFFIXES = (".parquet", ".pq")
 """``export --out`` file suffixes that choose Parquet over CSV."""
@@ -49,9 +52,21 @@ def _span(archive: RunArchive, key: str) -> tuple[float, float]:
     return (min(times) / 1e9, max(times) / 1e9) if times else (0.0, 0.0)
 
 
+def _continuity(archive: RunArchive, out: TextIO) -> None:
+    """The archive's segments and the messages lost, when it has several or lost some."""
+    if len(archive.segments) == 1 and not archive.lost:
+        return
+    out.write("  segments: " + ", ".join(s.path.name + (" (truncated)" if s.truncated else "")
+                                         for s in archive.segments) + "\n")
+    lost = by_topic(archive.lost)
+    out.write(f"  lost: {sum(lost.values())} messages"
+              + "".join(f", {t} {n}" for t, n in lost.items()) + "\n")
+
+
 def list_topics(archive: RunArchive, out: TextIO) -> None:
     out.write(f"{archive.path}: {len(archive)} messages"
               + (f", TRUNCATED ({archive.stop_reason})" if archive.truncated else "") + "\n")
+    _continuity(archive, out)
     for key, (type_name, count) in archive.topics().items():
         t0, t1 = _span(archive, key)
         out.write(f"  {key}  {type_name}  {count}  [{t0:.1f}, {t1:.1f}] s\n")
@@ -61,6 +76,7 @@ def summarize(archive: RunArchive, out: TextIO) -> None:
     out.write(f"{archive.path}: {len(archive)} messages, "
               + ("truncated: " + str(archive.stop_reason) if archive.truncated else "complete")
               + "\n")
+    _continuity(archive, out)
     run = archive.metadata.get("run", {})
     for k in ("scenario", "seed", "transport", "duration_s", "software_version", "started_utc"):
         out.write(f"  {k}: {run.get(k, '-')}\n")

@@ -13,7 +13,9 @@ message registry (``ground.archive.reader``).  The index is the message header's
 describes (``x.0`` ... ``x.5``, ``P.2.3``, ``groups.high.runs``; lists of varying length kept
 whole) minus ``t_sim`` (the index); a ``key`` column leads when several keys match and a
 ``type`` column when several message types do; ``spacecraft`` comes next when the message has
-one.  Reading a file holds in memory only the records of the matching keys.
+one.  Reading a file holds in memory only the records of the matching keys.  A ``run.mcap``
+path reads the run's segments after it too (a restarted recorder's: ``run-1.mcap``, ...,
+``ground.archive.segments``), as one run.
 """
 
 from __future__ import annotations
@@ -113,8 +115,9 @@ def _rows(decoded: list[tuple[Record, Message]]) -> list[dict[str, Any]]:
 
 def topic_frame(source: str | Path | RunArchive, pattern: str, *,
                 skip_invalid: bool = False) -> pd.DataFrame:
-    """The messages of the keys matching ``pattern`` in an archive (a ``run.mcap`` path or a
-    loaded :class:`RunArchive`) as a DataFrame indexed by sim time, s (module docstring).
+    """The messages of the keys matching ``pattern`` in an archive (a ``run.mcap`` path, with
+    its later segments, or a loaded :class:`RunArchive`) as a DataFrame indexed by sim time, s
+    (module docstring).
 
     Raises ``ValueError`` for a malformed pattern, ``FileNotFoundError`` for a missing file,
     :class:`ArchiveError` for a file that is not an archive, a pattern matching no key, or

@@ -22,7 +22,10 @@ times (a few per key: one, plus one per gap or incarnation).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+
+from interfaces.contracts.catalogue import topic_of
 
 
 @dataclass(slots=True)
@@ -98,3 +101,21 @@ class SequenceLedger:
     def lost(self) -> dict[str, int]:
         """Messages lost per key (keys with none left out), keys sorted."""
         return dict(sorted(self._lost.items()))
+
+
+def topic_name(key: str) -> str:
+    """The catalogue topic of ``key`` as ``app/name`` (``nav/estimate``), or the key itself
+    when it is outside the catalogue."""
+    topic = topic_of(key)
+    return key if topic is None else f"{topic.app}/{topic.name}"
+
+
+def by_topic(per_key: Mapping[str, int]) -> dict[str, int]:
+    """Counts per key summed per catalogue topic (:func:`topic_name`), names sorted, zeros
+    left out."""
+    out: dict[str, int] = {}
+    for key, n in per_key.items():
+        if n:
+            name = topic_name(key)
+            out[name] = out.get(name, 0) + n
+    return dict(sorted(out.items()))

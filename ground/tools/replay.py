@@ -3,7 +3,8 @@ other detector settings.
 
     python -m ground.tools.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR]
 
-RUN is a run directory (holding ``run.mcap``) or an archive.  The ground node itself, built
+RUN is a run directory (holding ``run.mcap``) or an archive (its first segment: the segments
+after it, a restarted recorder's, are read with it as one run).  The ground node itself, built
 from the declared topology as a run builds it (``interfaces.contracts.topology``: planner,
 telemetry monitor, FDIR, baselines -- the code the live ground runs, not a copy) is fed, on
 the in-process bus, every archived message of the other nodes that the ground subscribes to,
@@ -39,6 +40,7 @@ from ground.analysis.run_summary import ReplayResults
 from ground.analysis.summary import fdir_results
 from ground.archive.metadata import scenario_from_metadata
 from ground.archive.reader import ArchiveError, Record, RunArchive, load_run
+from ground.archive.segments import run_archive
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.topology import topology
@@ -246,7 +248,7 @@ def _send_group(group: list[Record], player: Any) -> None:
 
 
 def _archive_path(run: Path) -> Path:
-    return run / "run.mcap" if run.is_dir() else run
+    return run_archive(run) if run.is_dir() else run
 
 
 def parse_settings(pairs: list[str]) -> dict[str, str]:

@@ -36,10 +36,12 @@ from ground.analysis.run_summary.figures import (
     ExecRecord,
     FaultEventRecord,
     GncStats,
+    LostMessages,
     MessageCounts,
     NavStats,
     PaceRecord,
     RecoveryComparison,
+    SegmentRecord,
     SimRecord,
 )
 from ground.analysis.run_summary.records import Figure, SummaryRecord
@@ -48,8 +50,9 @@ from ground.analysis.run_summary.series import FdirSeries, MainWindow, SeriesWin
 __all__ = [
     "BUS_HEADER", "OTHER_TESTS_FLAG", "AccessAudit", "ArchiveInfo", "AssignmentRecord",
     "CoverageSummary", "Detection", "ExecRecord", "FailedTests", "FaultClass", "FaultEventRecord",
-    "FaultScore", "FdirResults", "FdirSeries", "Figure", "GncStats", "MainWindow", "MessageCounts",
-    "ModelZ", "NavStats", "RecoveryComparison", "ReplayResults", "ReplaySection",
-    "PaceRecord", "RunFdirSettings", "RunSummary", "Scores", "SeriesWindow", "SimRecord",
-    "SummaryError", "SummaryRecord", "ThresholdCensus", "ThresholdSources",
+    "FaultScore", "FdirResults", "FdirSeries", "Figure", "GncStats", "LostMessages", "MainWindow",
+    "MessageCounts", "ModelZ", "NavStats", "RecoveryComparison", "ReplayResults",
+    "ReplaySection", "PaceRecord", "RunFdirSettings", "RunSummary", "Scores", "SegmentRecord",
+    "SeriesWindow", "SimRecord", "SummaryError", "SummaryRecord", "ThresholdCensus",
+    "ThresholdSources",
 ]

@@ -16,10 +16,35 @@ BUS_HEADER = frozenset({"sender", "seq", "t_wall"})
 """A message's fields the bus stamps: the summary's copies of messages leave them out."""
 
 
-class ArchiveInfo(SummaryRecord):
-    """``archive``: the state of the run's archive as read back."""
+class SegmentRecord(SummaryRecord):
+    """One file of a run's archive (``ground/archive/segments.py``)."""
 
-    truncated: bool = Field(description="it ends in a damaged record (what precedes is kept)")
+    file: str = Field(description="its name, beside summary.json")
+    truncated: bool = Field(description="it ends in a damaged record or before its footer "
+                                        "(its recorder died; what precedes is kept)")
+
+
+class LostMessages(SummaryRecord):
+    """Messages sent and never archived, from the gaps in each key's sequence numbers
+    (``ground/archive/sequences.py``)."""
+
+    total: int = Field(ge=0)
+    by_topic: dict[str, int] = Field(
+        description="by catalogue topic (app/name, every publisher's keys together; a key "
+                    "outside the catalogue by itself), in name order, topics with none left out")
+
+
+class ArchiveInfo(SummaryRecord):
+    """``archive``: the state of the run's archive as read back.  ``segments`` and ``lost``
+    are given together, only when the archive has several segments (the recorder was
+    restarted) or lost messages: absent, the run is one file, run.mcap, and nothing sent is
+    missing from it."""
+
+    truncated: bool = Field(description="a file of it ends in a damaged record (what precedes "
+                                        "is kept)")
+    segments: list[SegmentRecord] | None = Field(
+        default=None, description="each file, in order (absent: run.mcap alone)")
+    lost: LostMessages | None = Field(default=None, description="(absent: none lost)")
 
 
 class MessageCounts(SummaryRecord):

@@ -3,7 +3,7 @@ on real archives in segments: tests/ground/archive/test_segments.py."""
 
 from __future__ import annotations
 
-from ground.archive.sequences import SequenceLedger
+from ground.archive.sequences import SequenceLedger, by_topic, topic_name
 
 K, L = "insp/m/sc/1/nav/estimate", "insp/m/sim/clock/tick"
 S = 1_000_000_000  # ns per s
@@ -64,3 +64,10 @@ def test_one_segment_repeats_nothing() -> None:
     ledger.begin_segment(more_follow=False)
     assert all(_admit(ledger, K, [1, 2, 2]))
     assert ledger.duplicates == 0 and ledger.lost == {K: 1}
+
+
+def test_lost_messages_add_up_by_catalogue_topic() -> None:
+    lost = {K: 2, "insp/m/sc/2/nav/estimate": 3, L: 1, "insp/m/sc/1/exec/heartbeat": 0,
+            "insp/m/sc/1/nope/thing": 4}
+    assert topic_name("insp/m/sim/sensors/sc3/camera") == "sensors/camera"
+    assert by_topic(lost) == {"clock/tick": 1, "insp/m/sc/1/nope/thing": 4, "nav/estimate": 5}
