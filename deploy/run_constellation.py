@@ -28,7 +28,8 @@ With --compare-recovery the same scenario and seed is run a second time, in-proc
 ground's fault recovery switched the other way ([fdir] recovery), into <out>/counterfactual/,
 and summary.json's ``recovery`` section compares the final H of the two.
 Exits 0 when the run completed; 1, with the reason, when it ended degraded (a flight or ground
-process lost, see _Watch) or failed (the sim or recorder died, the run could not start).
+process lost, or with --restart-on-crash the recorder restarted: see _Watch) or failed (the
+sim or recorder died, the run could not start).
 """
 
 from __future__ import annotations
@@ -39,8 +40,11 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+import zenoh
 
 REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # run as a script from a checkout
@@ -55,6 +59,7 @@ from ground.analysis.summary import add_recovery_comparison, write_summary  # no
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.reader import ArchiveError  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
+from ground.archive.segments import remove_segments, run_archive  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
@@ -99,7 +104,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                         "nodes on other hosts); repeatable")
     p.add_argument("--restart-on-crash", action="store_true",
                    help="start a flight or ground process again if it dies (it rejoins the "
-                        "lockstep)")
+                        "lockstep), or the recorder (the archive continues in run-1.mcap, ...)")
     p.add_argument("--audit-access", action="store_true",
                    help="count the router's refusals into logs/access.json and the summary "
                         "(traces every routed message: slower)")
@@ -195,6 +200,7 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
         log.warning("--realtime is ignored with --transport inproc (lockstep only)")
     live = _live_view(args)
     metadata = run_metadata(scenario, "inproc", scenario_text)
+    remove_segments(run_archive(out))  # an earlier run's in this directory: not this run's
     digest = LiveDigest(scenario, mission, out / "run.mcap", metadata)
     with RecorderProcess(out / "run.mcap", metadata) as rec:
         record = digest.tap(rec)
@@ -333,11 +339,13 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         return [*common, "--zenoh-config", str(access.client_config(name))]
 
     logs = out / "logs"
+    remove_segments(run_archive(out))  # else the recorder continues an earlier run's archive
+    recorder_up = _Appearances(hub, topics.recorder_token(mission))
     recorder = sup.start(Child(RECORDER.name, [*RECORDER.command, *account(RECORDER.name),
-                                               "--out", str(out / "run.mcap"),
+                                               "--out", str(run_archive(out)),
                                                "--transport-name", "zenoh"],
                                logs / "recorder.log"))
-    if not _wait_token(hub, topics.recorder_token(mission), recorder, timeout_s=30.0):
+    if not _wait_token(hub, topics.recorder_token(mission), recorder, timeout_s=RECORDER_READY_S):
         sup.stop_all(exclude={ROUTER.name})
         return "failed", (f"recorder did not start ({recorder.describe_exit()}):\n"
                           f"{recorder.log_tail()}")
@@ -357,7 +365,7 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         else:
             sup.start(Child(node, argv, logs / f"{node}.log"))
     watch = _Watch(sup, progress, flight=[n for n in topo.participants if n not in args.external],
-                   restart=args.restart_on_crash)
+                   restart=args.restart_on_crash, recorder_up=recorder_up.count)
     error = watch.run()
     progress.report(final=True)
     watch.read_restores(out / "cds")
@@ -388,37 +396,51 @@ def _store_args(out: Path, restart: bool) -> list[str]:
 
 
 MAX_RESTARTS = 3
-"""Restarts of one process (--restart-on-crash) before it is left down."""
+"""Restarts of one process (--restart-on-crash) before it is left down (the recorder: before
+the run stops)."""
+RECORDER_READY_S = 30.0
+"""How long the recorder, started or restarted, has to announce it records (its liveliness
+token), wall s."""
 RESTART_HOLD_S = 60.0
 """With --restart-on-crash: how long the sim holds the clock for a lost participant to come
 back (its restart: a process start, the compiled kernels from their cache, the bus), wall s."""
 
 
 class _Watch:
-    """The launcher's watch over a running constellation.  The router, the sim or the recorder
-    stopping early ends the run at once (no bus, no time, or no record, without them), naming it
-    and the sim time it stopped at; a flight or ground process
-    stopping early is an incident: the sim flies on with its last commands, the ground declares
-    the silent spacecraft a link fault, and with ``restart`` the process is started again (up to
-    ``MAX_RESTARTS`` times) and rejoins the lockstep."""
+    """The launcher's watch over a running constellation.  The router or the sim stopping
+    early ends the run at once (no bus, or no time, without them), naming it and the sim time
+    it stopped at; so does the recorder (no record without it) unless ``restart``.  A flight
+    or ground process stopping early is an incident: the sim flies on with its last commands,
+    the ground declares the silent spacecraft a link fault, and with ``restart`` the process
+    is started again (up to ``MAX_RESTARTS`` times) and rejoins the lockstep.
+
+    With ``restart`` the recorder's death is an incident too: it is started again with the
+    same command (it continues the archive in the next segment, ``run-1.mcap``, ...), and the
+    run stops, naming it, only when it cannot come back: dead again after ``MAX_RESTARTS``
+    restarts, dead once the sim has finished, or silent (``recorder_up``, the count of its
+    liveliness token's appearances, not grown) ``RECORDER_READY_S`` after a restart."""
 
     def __init__(self, sup: Supervisor, progress: _Progress, flight: list[str],
-                 restart: bool) -> None:
+                 restart: bool, recorder_up: Callable[[], int] = lambda: 0) -> None:
         self.sup, self.progress, self.flight, self.restart = sup, progress, flight, restart
+        self.recorder_up = recorder_up
         self.incidents: list[Incident] = []
         self.restarts: dict[str, int] = {}
         self.down: set[str] = set()
+        self._recorder_back: tuple[int, float] | None = None
+        """After a recorder restart: the count of its token's appearances before it, and the
+        wall time (monotonic s) by which it must have grown."""
 
     def run(self) -> str | None:
         """Watch until every process has finished; the error that ended the run, or None."""
         done_since: float | None = None
         try:
             while True:
-                error = self._essential_stopped()
-                if error is not None:
-                    return error
                 sim_done = (self.progress.finished.is_set()
                             or self.sup.named(SIM.name).returncode == 0)
+                error = self._essential_stopped() or self._recorder_stopped(sim_done)
+                if error is not None:
+                    return error
                 self._flight_stopped(sim_done)
                 running = [n for n in self.flight
                            if n not in self.down and self.sup.named(n).returncode is None]
@@ -447,19 +469,56 @@ class _Watch:
                 incident.came_back = starts[n].describe()
 
     def _essential_stopped(self) -> str | None:
-        sim, recorder = self.sup.named(SIM.name), self.sup.named(RECORDER.name)
+        sim = self.sup.named(SIM.name)
         router = self.sup.find(ROUTER.name)
-        essential = [(recorder, "nothing after it is recorded; stopping the run"),
-                     (sim, "no time without it; stopping the constellation")]
+        essential = [(sim, "no time without it; stopping the constellation")]
+        if not self.restart:
+            essential.insert(0, (self.sup.named(RECORDER.name), _NO_RECORD))
         if router is not None:
             essential.insert(0, (router, "the bus is down: no process reaches another, and "
                                          "nothing after it is recorded; stopping the run"))
         for child, consequence in essential:
             if child.returncode is not None and (child is not sim or child.returncode != 0):
-                return (f"{child.name} (pid {child.proc.pid if child.proc else '?'}) "
-                        f"{child.describe_exit()} at sim t≈{self.progress.t_sim:.1f} s: "
-                        f"{consequence}.\n--- last lines of {child.log_path}:\n"
-                        f"{child.log_tail()}")
+                return self._stopped(child, consequence)
+        return None
+
+    def _stopped(self, child: Child, consequence: str) -> str:
+        """The error naming ``child``, how it stopped, when, and what follows."""
+        return (f"{child.name} (pid {child.proc.pid if child.proc else '?'}) "
+                f"{child.describe_exit()} at sim t≈{self.progress.t_sim:.1f} s: "
+                f"{consequence}.\n--- last lines of {child.log_path}:\n{child.log_tail()}")
+
+    def _recorder_stopped(self, sim_done: bool) -> str | None:
+        """With ``restart``: start a dead recorder again, or the error if it cannot come back
+        (see the class docstring)."""
+        if not self.restart:
+            return None
+        recorder = self.sup.named(RECORDER.name)
+        if recorder.returncode is None:
+            return self._recorder_silent(recorder)
+        n = self.restarts.get(RECORDER.name, 0)
+        if sim_done or n >= MAX_RESTARTS:
+            return self._stopped(recorder, _NO_RECORD + (f" (restarted {n} times)" if n else ""))
+        incident = Incident(RECORDER.name, recorder.describe_exit(), self.progress.t_sim, True)
+        self.incidents.append(incident)
+        log.error("%s; starting it again: the archive continues in its next segment", incident)
+        self.restarts[RECORDER.name] = n + 1
+        self._recorder_back = (self.recorder_up(), time.monotonic() + RECORDER_READY_S)
+        self.sup.restart(recorder, n + 1)
+        return None
+
+    def _recorder_silent(self, recorder: Child) -> str | None:
+        """The error if the restarted recorder, running, has not announced itself in time."""
+        if self._recorder_back is None:
+            return None
+        seen, deadline = self._recorder_back
+        if self.recorder_up() > seen:
+            log.info("recorder restarted, recording again (pid %s)",
+                     recorder.proc.pid if recorder.proc else "?")
+            self._recorder_back = None
+        elif time.monotonic() > deadline:
+            return self._stopped(recorder, f"restarted, it did not announce itself within "
+                                           f"{RECORDER_READY_S:.0f} s; {_NO_RECORD}")
         return None
 
     def _flight_stopped(self, sim_done: bool) -> None:
@@ -480,6 +539,30 @@ class _Watch:
                 self.sup.restart(child, n + 1)
             else:
                 self.down.add(name)
+
+
+_NO_RECORD = "nothing after it is recorded; stopping the run"
+"""What follows the recorder's death when it is not (or cannot be) started again."""
+
+
+class _Appearances:
+    """Counts the appearances of a liveliness token on the run's bus (the recorder's, seen
+    from the launcher's session): a restarted recorder is back when the count grows."""
+
+    def __init__(self, hub: ZenohTransport, token: str) -> None:
+        self._count = 0
+        self._lock = threading.Lock()
+        hub.session.liveliness().declare_subscriber(token, self._on_sample)
+
+    def _on_sample(self, sample: zenoh.Sample) -> None:
+        if sample.kind == zenoh.SampleKind.PUT:
+            with self._lock:
+                self._count += 1
+
+    def count(self) -> int:
+        """Appearances so far."""
+        with self._lock:
+            return self._count
 
 
 def _wait_token(hub: ZenohTransport, token: str, child: Child, timeout_s: float) -> bool:

@@ -16,8 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from mcap.reader import make_reader
+
 from deploy.inproc import run_inproc
-from ground.archive.reader import load_run
+from ground.archive.reader import RunArchive, load_run
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry
@@ -170,36 +172,87 @@ def test_restart_on_crash_rejoins_the_lockstep(tmp_path: Path, free_port: int) -
     assert (out / "logs" / "sc2.restart1.log").is_file()
 
 
-def _killed_mid_run(tmp_path: Path, port: int, name: str, victim: Callable[[Path, Path],
-                    list[str]]) -> tuple[dict[str, Any], float, Path]:
-    """A 400 s run paced at 10x (40 s of wall time) whose process ``victim(scenario, out)``
-    names (its command line) is killed once the run is under way; the summary, the wall time
-    from the kill to the launcher's exit, and the scenario's path."""
-    sc = small_scenario(name, duration_s=400.0)
+def _killed_mid_run(tmp_path: Path, port: int, name: str,
+                    victim: Callable[[Path, Path], list[str]], *extra: str,
+                    duration_s: float = 400.0, status: str = "failed",
+                    ) -> tuple[dict[str, Any], float, Path]:
+    """A run of ``duration_s`` (400 s) paced at 10x (40 s of wall time) with the launcher's
+    ``extra`` options, whose process ``victim(scenario, out)`` names (its command line) is
+    killed once the run is under way; it ends with ``status`` (a failed run keeps what was
+    recorded).  The summary, the wall time from the kill to the launcher's exit, and the
+    scenario's path."""
+    sc = small_scenario(name, duration_s=duration_s)
     path = write_scenario(tmp_path / f"{name}.toml", sc)
     out = tmp_path / "out"
-    p = _launch(path, out, port, "--realtime", "10")
+    p = _launch(path, out, port, "--realtime", "10", *extra)
     killed = time.monotonic()
     try:
         _under_way(out, name, estimates=40)  # 4 s of wall: the recorder has flushed
         os.kill(_wait_pid(victim(path, out), 10.0), signal.SIGKILL)
         killed = time.monotonic()
     finally:
-        p.communicate(timeout=120)
-    assert p.returncode == 1
+        _, stderr = p.communicate(timeout=120)
+    assert p.returncode == 1, stderr
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["status"] == "failed"
-    assert 0.0 < summary["t_sim_final_s"] < sc.duration_s  # what was recorded is kept
+    assert summary["status"] == status, summary["error"]
+    if status == "failed":
+        assert 0.0 < summary["t_sim_final_s"] < sc.duration_s  # what was recorded is kept
     return summary, time.monotonic() - killed, path
 
 
+def _recorder(path: Path, _out: Path) -> list[str]:
+    """The recorder's command line (of the run of scenario ``path``)."""
+    return ["ground.archive.record", "--scenario", str(path)]
+
+
 def test_recorder_death_stops_the_run_at_once(tmp_path: Path, free_port: int) -> None:
-    summary, after_s, _ = _killed_mid_run(
-        tmp_path, free_port, "norec",
-        lambda path, _: ["ground.archive.record", "--scenario", str(path)])
+    summary, after_s, _ = _killed_mid_run(tmp_path, free_port, "norec", _recorder)
     assert after_s < 15.0  # not the 40 s of the run
     assert "recorder" in summary["error"] and "nothing after it is recorded" in summary["error"]
     assert summary["archive"]["truncated"]
+
+
+def _seqs(archive: RunArchive) -> dict[str, list[int]]:
+    """Each key's sequence numbers, in archive order."""
+    out: dict[str, list[int]] = {}
+    for r in archive.held():
+        out.setdefault(r.key, []).append(json.loads(r.payload)["seq"])
+    return out
+
+
+def test_restarted_recorder_continues_the_archive_in_a_next_segment(tmp_path: Path,
+                                                                    free_port: int) -> None:
+    """With --restart-on-crash a killed recorder is an incident, not the end: started again,
+    it writes run-1.mcap, which the summary reads with run.mcap as one run to the end; the
+    messages lost are those sent between the first segment's last complete chunk and the
+    restarted recorder's first message, counted by topic, and no other."""
+    summary, _, _ = _killed_mid_run(tmp_path, free_port, "rerec", _recorder,
+                                    "--restart-on-crash", duration_s=200.0, status="degraded")
+    out = tmp_path / "out"
+    assert "recorder killed by SIGKILL" in summary["error"] and "(restarted)" in summary["error"]
+    assert (out / "logs" / "recorder.restart1.log").is_file()
+    assert summary["t_sim_final_s"] == 200.0  # read to the end, in the second segment
+    info = summary["archive"]
+    assert info["segments"] == [{"file": "run.mcap", "truncated": True},
+                                {"file": "run-1.mcap", "truncated": False}]
+    with open(out / "run-1.mcap", "rb") as f:
+        meta = {m.name: dict(m.metadata) for m in make_reader(f).iter_metadata()}
+    assert meta["segment"] == {"index": "1", "first": "run.mcap"}
+    assert meta["run"]["scenario"] == "rerec" and "resolved_json" in meta["scenario"]
+    # lost: exactly the gap between the segments, key by key
+    first_alone = tmp_path / "first" / "run.mcap"
+    first_alone.parent.mkdir()
+    first_alone.write_bytes((out / "run.mcap").read_bytes())
+    first = load_run(first_alone)
+    run = load_run(out / "run.mcap")
+    assert first.lost == {} and len(run) == summary["messages"]["total"]
+    before, merged = _seqs(first), _seqs(run)
+    gaps = {k: s[len(before.get(k, []))] - (before[k][-1] if k in before else 0) - 1
+            for k, s in merged.items() if len(s) > len(before.get(k, []))}
+    assert run.lost == {k: n for k, n in gaps.items() if n}
+    lost = info["lost"]
+    assert lost["total"] == sum(run.lost.values()) > 0
+    assert lost["by_topic"]["clock/tick"] > 0 and lost["by_topic"]["nav/estimate"] > 0
 
 
 def test_router_death_stops_the_run_at_once_naming_it(tmp_path: Path, free_port: int) -> None:
