@@ -552,7 +552,7 @@ class _Appearances:
     def __init__(self, hub: ZenohTransport, token: str) -> None:
         self._count = 0
         self._lock = threading.Lock()
-        hub.session.liveliness().declare_subscriber(token, self._on_sample)
+        self._subscriber = hub.session.liveliness().declare_subscriber(token, self._on_sample)
 
     def _on_sample(self, sample: zenoh.Sample) -> None:
         if sample.kind == zenoh.SampleKind.PUT:

@@ -20,6 +20,7 @@ from mcap.reader import make_reader
 
 from deploy.inproc import run_inproc
 from ground.archive.reader import RunArchive, load_run
+from ground.archive.sequences import by_topic
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry
@@ -250,9 +251,9 @@ def test_restarted_recorder_continues_the_archive_in_a_next_segment(tmp_path: Pa
     gaps = {k: s[len(before.get(k, []))] - (before[k][-1] if k in before else 0) - 1
             for k, s in merged.items() if len(s) > len(before.get(k, []))}
     assert run.lost == {k: n for k, n in gaps.items() if n}
-    lost = info["lost"]
-    assert lost["total"] == sum(run.lost.values()) > 0
-    assert lost["by_topic"]["clock/tick"] > 0 and lost["by_topic"]["nav/estimate"] > 0
+    # by topic in the summary (how many depends on when the kill fell between two flushes of
+    # the recorder, and on how long the sim flew on without it)
+    assert info["lost"] == {"total": sum(run.lost.values()), "by_topic": by_topic(run.lost)}
 
 
 def test_router_death_stops_the_run_at_once_naming_it(tmp_path: Path, free_port: int) -> None:

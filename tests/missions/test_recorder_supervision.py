@@ -1,0 +1,58 @@
+"""The launcher's watch over the recorder with --restart-on-crash (deploy/run_constellation.py,
+``_Watch``), on real child processes standing in for the sim and the recorder: a recorder that
+cannot come back -- dead again after every restart, or silent after one -- stops the run,
+named.  The recorder killed in a whole run and restarted: test_constellation.py."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+import deploy.run_constellation as launcher
+from deploy.processes import Child, Supervisor
+from interfaces.contracts.topology import RECORDER, SIM
+from tests.conftest import REPO, small_scenario
+
+
+def _watch(tmp_path: Path, recorder_code: str, recorder_up: int = 0) -> launcher._Watch:
+    """A watch with --restart-on-crash over a recorder running ``recorder_code`` and a sim
+    that waits, whose recorder token has appeared ``recorder_up`` times (never again)."""
+    sup = Supervisor(REPO)
+    sup.start(Child(RECORDER.name, ["-c", recorder_code], tmp_path / "recorder.log"))
+    sup.start(Child(SIM.name, ["-c", "import time; time.sleep(60)"], tmp_path / "sim.log"))
+    return launcher._Watch(sup, launcher._Progress(small_scenario("sup")), flight=[],
+                           restart=True, recorder_up=lambda: recorder_up)
+
+
+def test_a_recorder_dead_after_every_restart_stops_the_run(tmp_path: Path) -> None:
+    watch = _watch(tmp_path, "raise SystemExit(3)")
+    try:
+        error = watch.run()
+    finally:
+        watch.sup.stop_all()
+    assert error is not None and error.startswith("recorder (pid ")
+    assert (f"exited with code 3 at sim t≈0.0 s: nothing after it is recorded; stopping the "
+            f"run (restarted {launcher.MAX_RESTARTS} times)") in error
+    assert [str(i) for i in watch.incidents] == (
+        ["recorder exited with code 3 at t≈0.0 s (restarted)"] * launcher.MAX_RESTARTS)
+    assert (tmp_path / f"recorder.restart{launcher.MAX_RESTARTS}.log").is_file()
+
+
+def test_a_restarted_recorder_that_never_announces_itself_stops_the_run(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The first recorder dies; its successor runs but declares no token in time."""
+    monkeypatch.setattr(launcher, "RECORDER_READY_S", 1.0)
+    first_dies = ("import pathlib, sys, time\n"
+                  f"if not pathlib.Path({str(tmp_path / 'recorder.restart1.log')!r}).exists():\n"
+                  "    sys.exit(1)\n"
+                  "time.sleep(60)\n")
+    watch = _watch(tmp_path, first_dies, recorder_up=1)
+    try:
+        error = watch.run()
+    finally:
+        watch.sup.stop_all()
+    assert error is not None and "did not announce itself within 1 s" in error
+    assert "nothing after it is recorded" in error and "still running" in error
+    assert len(watch.incidents) == 1 and watch.restarts == {RECORDER.name: 1}
+
