@@ -10,7 +10,6 @@ from pathlib import Path
 import pytest
 
 import deploy.run_constellation as launcher
-from deploy.processes import Child, Supervisor
 from interfaces.contracts.topology import RECORDER, SIM
 from tests.conftest import REPO, small_scenario
 
@@ -18,9 +17,9 @@ from tests.conftest import REPO, small_scenario
 def _watch(tmp_path: Path, recorder_code: str, recorder_up: int = 0) -> launcher._Watch:
     """A watch with --restart-on-crash over a recorder running ``recorder_code`` and a sim
     that waits, whose recorder token has appeared ``recorder_up`` times (never again)."""
-    sup = Supervisor(REPO)
-    sup.start(Child(RECORDER.name, ["-c", recorder_code], tmp_path / "recorder.log"))
-    sup.start(Child(SIM.name, ["-c", "import time; time.sleep(60)"], tmp_path / "sim.log"))
+    sup = launcher.Supervisor(REPO)
+    sup.start(launcher.Child(RECORDER.name, ["-c", recorder_code], tmp_path / "recorder.log"))
+    sup.start(launcher.Child(SIM.name, ["-c", "import time; time.sleep(60)"], tmp_path / "sim.log"))
     return launcher._Watch(sup, launcher._Progress(small_scenario("sup")), flight=[],
                            restart=True, recorder_up=lambda: recorder_up)
 
