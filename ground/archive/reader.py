@@ -142,9 +142,9 @@ RecordSink = Callable[["Record"], None]
 def _stop_reason(segments: list[SegmentInfo]) -> str | None:
     """Why the first truncated segment stopped early, naming it when there are several."""
     cut = next((s for s in segments if s.truncated), None)
-    if cut is None or len(segments) == 1:
-        return None if cut is None else cut.stop_reason
-    return f"{cut.path.name}: {cut.stop_reason}"
+    if cut is None:
+        return None
+    return cut.stop_reason if len(segments) == 1 else f"{cut.path.name}: {cut.stop_reason}"
 
 
 class RunArchive:
