@@ -12,7 +12,12 @@ recorder stores it as the MCAP sequence).  Read in archive order over every segm
   restarted cold counts from 1 again): the messages before it in that incarnation were lost
   (none when it is 1);
 * a key's first number n says that the n - 1 before it were lost;
-* 0 is no number (a payload without a usable ``seq``): not counted.
+* 0 is no number (a payload without a usable ``seq``): not counted;
+* a number the Bus itself would refuse (a first one above ``MAX_FIRST_SEQ``, or a jump of more
+  than ``MAX_SEQ_JUMP`` past the key's last: ``interfaces/runtime/admission.py``) is not a
+  loss but a forged or broken message: archived as evidence, not counted, and the key's last
+  number stays.  (So a recorder down for more than ``MAX_SEQ_JUMP`` messages of a key would
+  not see that key's loss; the sim holds the clock while it is down.)
 
 A message a later segment holds again (the same key, sequence number and sim time as one of an
 earlier segment) is a **duplicate**, kept once.  To know them without holding every number, the
@@ -26,6 +31,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from interfaces.contracts.catalogue import topic_of
+from interfaces.runtime.admission import MAX_FIRST_SEQ, MAX_SEQ_JUMP
 
 
 @dataclass(slots=True)
@@ -71,8 +77,8 @@ class SequenceLedger:
         if seq == last + 1 and not self._earlier and not self._track:  # the common case
             self._last[key] = seq
             return True
-        if seq <= 0:
-            return True
+        if seq <= 0 or seq > (last + MAX_SEQ_JUMP if key in self._last else MAX_FIRST_SEQ):
+            return True  # no number, or one the Bus would refuse: not accounted
         if self._earlier and self._repeats(key, seq, log_ns):
             self.duplicates += 1
             return False

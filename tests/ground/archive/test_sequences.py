@@ -4,6 +4,7 @@ on real archives in segments: tests/ground/archive/test_segments.py."""
 from __future__ import annotations
 
 from ground.archive.sequences import SequenceLedger, by_topic, topic_name
+from interfaces.runtime.admission import MAX_FIRST_SEQ, MAX_SEQ_JUMP
 
 K, L = "insp/m/sc/1/nav/estimate", "insp/m/sim/clock/tick"
 S = 1_000_000_000  # ns per s
@@ -36,11 +37,14 @@ def test_a_number_back_to_one_is_a_new_incarnation_and_back_above_one_lost_its_s
     assert ledger.lost == {K: 2}  # 3 of the second incarnation, 1 of the third
 
 
-def test_no_number_is_not_counted() -> None:
+def test_no_number_and_numbers_the_bus_would_refuse_are_not_counted() -> None:
+    """A forger with a node's credentials jumping its key's count (the Bus refuses the jump,
+    the recorder keeps it as evidence) makes no loss, and the key's count goes on."""
     ledger = SequenceLedger()
     ledger.begin_segment(more_follow=False)
-    assert all(_admit(ledger, K, [0, 0, 1, 0, 2]))
-    assert ledger.lost == {}
+    assert all(_admit(ledger, K, [0, 0, 1, 0, 2, 2 + MAX_SEQ_JUMP + 1, 10**6, 3, 4]))
+    assert all(_admit(ledger, L, [MAX_FIRST_SEQ + 1, 1, 1 + MAX_SEQ_JUMP]))
+    assert ledger.lost == {L: MAX_SEQ_JUMP - 1}  # a jump the Bus admits is a loss
 
 
 def test_a_later_segment_repeating_a_message_has_it_dropped_once() -> None:
