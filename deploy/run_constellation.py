@@ -103,8 +103,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help="another name or address of this host in the TLS certificate (for "
                         "nodes on other hosts); repeatable")
     p.add_argument("--restart-on-crash", action="store_true",
-                   help="start a flight or ground process again if it dies (it rejoins the "
-                        "lockstep), or the recorder (the archive continues in run-1.mcap, ...)")
+                   help="start a process again if it dies, the sim holding the clock: a flight "
+                        "or ground process restores its critical-data store, the router comes "
+                        "back on its endpoint, the recorder continues in run-1.mcap, ...")
     p.add_argument("--audit-access", action="store_true",
                    help="count the router's refusals into logs/access.json and the summary "
                         "(traces every routed message: slower)")
@@ -365,7 +366,8 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         else:
             sup.start(Child(node, argv, logs / f"{node}.log"))
     watch = _Watch(sup, progress, flight=[n for n in topo.participants if n not in args.external],
-                   restart=args.restart_on_crash, recorder_up=recorder_up.count)
+                   restart=args.restart_on_crash, recorder_up=recorder_up.count,
+                   sim_up=_Appearances(hub, topics.alive_token(mission, SIM.name)).count)
     error = watch.run()
     progress.report(final=True)
     watch.read_restores(out / "cds")
@@ -399,37 +401,43 @@ MAX_RESTARTS = 3
 """Restarts of one process (--restart-on-crash) before it is left down (the recorder: before
 the run stops)."""
 RECORDER_READY_S = 30.0
-"""How long the recorder, started or restarted, has to announce it records (its liveliness
-token), wall s."""
+"""How long the recorder, started, has to announce it records (its liveliness token), wall s."""
+SERVICE_READY_S = 30.0
+"""How long a restarted router or recorder has to be back, wall s: the recorder announcing it
+records, the router carrying the sim's token to the launcher again."""
 RESTART_HOLD_S = 60.0
 """With --restart-on-crash: how long the sim holds the clock for a lost participant to come
 back (its restart: a process start, the compiled kernels from their cache, the bus), wall s."""
 
 
 class _Watch:
-    """The launcher's watch over a running constellation.  The router or the sim stopping
-    early ends the run at once (no bus, or no time, without them), naming it and the sim time
-    it stopped at; so does the recorder (no record without it) unless ``restart``.  A flight
-    or ground process stopping early is an incident: the sim flies on with its last commands,
-    the ground declares the silent spacecraft a link fault, and with ``restart`` the process
-    is started again (up to ``MAX_RESTARTS`` times) and rejoins the lockstep.
+    """The launcher's watch over a running constellation.  The sim stopping early ends the
+    run at once (no time without it), naming it and the sim time it stopped at; so do the
+    router (no bus) and the recorder (no record) unless ``restart``.  A flight or ground
+    process stopping early is an incident: the sim flies on with its last commands, the ground
+    declares the silent spacecraft a link fault, and with ``restart`` the process is started
+    again (up to ``MAX_RESTARTS`` times), restored from its critical-data store, while the sim
+    holds the clock.
 
-    With ``restart`` the recorder's death is an incident too: it is started again with the
-    same command (it continues the archive in the next segment, ``run-1.mcap``, ...), and the
-    run stops, naming it, only when it cannot come back: dead again after ``MAX_RESTARTS``
-    restarts, dead once the sim has finished, or silent (``recorder_up``, the count of its
-    liveliness token's appearances, not grown) ``RECORDER_READY_S`` after a restart."""
+    With ``restart`` the router's and the recorder's deaths are incidents too: each is started
+    again with the same command (the router on the same endpoint with the same accounts, and
+    the clients reconnect, the sim holding the clock; the recorder continues the archive in the
+    next segment, ``run-1.mcap``, ...).  The run stops, naming it, only when one cannot come
+    back: dead again after ``MAX_RESTARTS`` restarts, dead once the sim has finished, or not
+    back ``SERVICE_READY_S`` after a restart (the count of appearances of its token,
+    ``recorder_up``, or of the sim's through it, ``sim_up``, not grown)."""
 
     def __init__(self, sup: Supervisor, progress: _Progress, flight: list[str],
-                 restart: bool, recorder_up: Callable[[], int] = lambda: 0) -> None:
+                 restart: bool, recorder_up: Callable[[], int] = lambda: 0,
+                 sim_up: Callable[[], int] = lambda: 0) -> None:
         self.sup, self.progress, self.flight, self.restart = sup, progress, flight, restart
-        self.recorder_up = recorder_up
+        self.recorder_up, self.sim_up = recorder_up, sim_up
         self.incidents: list[Incident] = []
         self.restarts: dict[str, int] = {}
         self.down: set[str] = set()
-        self._recorder_back: tuple[int, float] | None = None
-        """After a recorder restart: the count of its token's appearances before it, and the
-        wall time (monotonic s) by which it must have grown."""
+        self._back: dict[str, tuple[int, float]] = {}
+        """Per service restarted and not yet back: the count of its appearances before the
+        restart, and the wall time (monotonic s) by which it must have grown."""
 
     def run(self) -> str | None:
         """Watch until every process has finished; the error that ended the run, or None."""
@@ -438,7 +446,7 @@ class _Watch:
             while True:
                 sim_done = (self.progress.finished.is_set()
                             or self.sup.named(SIM.name).returncode == 0)
-                error = self._essential_stopped() or self._recorder_stopped(sim_done)
+                error = self._essential_stopped() or self._services_stopped(sim_done)
                 if error is not None:
                     return error
                 self._flight_stopped(sim_done)
@@ -470,17 +478,23 @@ class _Watch:
 
     def _essential_stopped(self) -> str | None:
         sim = self.sup.named(SIM.name)
-        router = self.sup.find(ROUTER.name)
         essential = [(sim, "no time without it; stopping the constellation")]
         if not self.restart:
-            essential.insert(0, (self.sup.named(RECORDER.name), _NO_RECORD))
-        if router is not None:
-            essential.insert(0, (router, "the bus is down: no process reaches another, and "
-                                         "nothing after it is recorded; stopping the run"))
+            essential += [(c, consequence) for c, _, consequence in self._services()]
         for child, consequence in essential:
             if child.returncode is not None and (child is not sim or child.returncode != 0):
                 return self._stopped(child, consequence)
         return None
+
+    def _services(self) -> list[tuple[Child, Callable[[], int], str]]:
+        """The services a run cannot go on without, each with the count of appearances that
+        says it is back after a restart, and what follows its loss: the router (back when the
+        sim's token reappears, seen through it) and the recorder (its own token)."""
+        out = [(self.sup.named(RECORDER.name), self.recorder_up, _NO_RECORD)]
+        router = self.sup.find(ROUTER.name)
+        if router is not None:
+            out.insert(0, (router, self.sim_up, _NO_BUS))
+        return out
 
     def _stopped(self, child: Child, consequence: str) -> str:
         """The error naming ``child``, how it stopped, when, and what follows."""
@@ -488,37 +502,45 @@ class _Watch:
                 f"{child.describe_exit()} at sim t≈{self.progress.t_sim:.1f} s: "
                 f"{consequence}.\n--- last lines of {child.log_path}:\n{child.log_tail()}")
 
-    def _recorder_stopped(self, sim_done: bool) -> str | None:
-        """With ``restart``: start a dead recorder again, or the error if it cannot come back
-        (see the class docstring)."""
+    def _services_stopped(self, sim_done: bool) -> str | None:
+        """With ``restart``: start a dead router or recorder again, or the error if it cannot
+        come back (see the class docstring)."""
         if not self.restart:
             return None
-        recorder = self.sup.named(RECORDER.name)
-        if recorder.returncode is None:
-            return self._recorder_silent(recorder)
-        n = self.restarts.get(RECORDER.name, 0)
-        if sim_done or n >= MAX_RESTARTS:
-            return self._stopped(recorder, _NO_RECORD + (f" (restarted {n} times)" if n else ""))
-        incident = Incident(RECORDER.name, recorder.describe_exit(), self.progress.t_sim, True)
-        self.incidents.append(incident)
-        log.error("%s; starting it again: the archive continues in its next segment", incident)
-        self.restarts[RECORDER.name] = n + 1
-        self._recorder_back = (self.recorder_up(), time.monotonic() + RECORDER_READY_S)
-        self.sup.restart(recorder, n + 1)
+        for child, up, consequence in self._services():
+            error = (self._service_silent(child, up, consequence) if child.returncode is None
+                     else self._service_restart(child, up, consequence, sim_done))
+            if error is not None:
+                return error
         return None
 
-    def _recorder_silent(self, recorder: Child) -> str | None:
-        """The error if the restarted recorder, running, has not announced itself in time."""
-        if self._recorder_back is None:
+    def _service_restart(self, child: Child, up: Callable[[], int], consequence: str,
+                         sim_done: bool) -> str | None:
+        n = self.restarts.get(child.name, 0)
+        if sim_done or n >= MAX_RESTARTS:
+            return self._stopped(child, consequence + (f" (restarted {n} times)" if n else ""))
+        incident = Incident(child.name, child.describe_exit(), self.progress.t_sim, True)
+        self.incidents.append(incident)
+        log.error("%s; starting it again (%s)", incident, _AGAIN[child.name])
+        self.restarts[child.name] = n + 1
+        self._back[child.name] = (up(), time.monotonic() + SERVICE_READY_S)
+        self.sup.restart(child, n + 1)
+        return None
+
+    def _service_silent(self, child: Child, up: Callable[[], int],
+                        consequence: str) -> str | None:
+        """The error if a restarted service, running, is not back in time."""
+        back = self._back.get(child.name)
+        if back is None:
             return None
-        seen, deadline = self._recorder_back
-        if self.recorder_up() > seen:
-            log.info("recorder restarted, recording again (pid %s)",
-                     recorder.proc.pid if recorder.proc else "?")
-            self._recorder_back = None
+        seen, deadline = back
+        if up() > seen:
+            log.info("%s restarted and back (pid %s)", child.name,
+                     child.proc.pid if child.proc else "?")
+            del self._back[child.name]
         elif time.monotonic() > deadline:
-            return self._stopped(recorder, f"restarted, it did not announce itself within "
-                                           f"{RECORDER_READY_S:.0f} s; {_NO_RECORD}")
+            return self._stopped(child, f"restarted, it was not back within "
+                                        f"{SERVICE_READY_S:.0f} s; {consequence}")
         return None
 
     def _flight_stopped(self, sim_done: bool) -> None:
@@ -543,6 +565,12 @@ class _Watch:
 
 _NO_RECORD = "nothing after it is recorded; stopping the run"
 """What follows the recorder's death when it is not (or cannot be) started again."""
+_NO_BUS = ("the bus is down: no process reaches another, and nothing after it is recorded; "
+           "stopping the run")
+"""What follows the router's death when it is not (or cannot be) started again."""
+_AGAIN = {RECORDER.name: "the archive continues in its next segment",
+          ROUTER.name: "same endpoint and accounts; the clients reconnect, the sim holds the "
+                       "clock meanwhile"}
 
 
 class _Appearances:

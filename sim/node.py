@@ -238,7 +238,7 @@ class SimNode:
                 sc.sim.lockstep_timeout_s)
             if self.lockstep.held_s and self.pacer is not None:
                 self.pacer.slip(self.lockstep.held_s)
-            self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
+            self._commands_in(expect, deadline)
             self.bus.dispatch(t, include_now=True)
             if k < n_ticks - 1:
                 accel = self.hw.accel_lvlh(t, self._q_now)
@@ -250,6 +250,15 @@ class SimNode:
         self._status("finished", n_ticks - 1)
         self.lockstep.await_departure(timeout_s=10.0)
         return True
+
+    def _commands_in(self, expect: dict[str, int], deadline: float) -> None:
+        """Wait until ``deadline`` (wall) for the commands the answers announce; those still
+        missing after a second (lost with the network while the router restarted) are asked
+        of their senders again (``Bus.recover``)."""
+        missing = self.bus.wait_for(expect, max(0.0, min(1.0, deadline - time.monotonic())))
+        if missing:
+            self.bus.recover(missing)
+            self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
 
     def _send_again(self, tick: Callable[..., Tick], back: list[str]) -> None:
         """Send the open tick again, for the participants ``back`` that came back while it

@@ -10,23 +10,28 @@ what exists, with the same run metadata and a ``segment`` record.  Restarted, it
 what every node still keeps of its last ticks (``interfaces.runtime.recent``): the chunk in
 progress when it was killed, at most one ω_mid period of sim time (a chunk is closed at every
 period), is among it.  It declares its liveliness token (``topics.recorder_token``) once
-subscribed, ready to record (the sim holds the clock until then).
+subscribed, ready to record (the sim holds the clock until then).  When the network goes down
+(the sim's token gone: the router died) it takes the token back, and once the sim is seen again
+records what the nodes still keep of their last ticks before it declares it again.
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import threading
+import time
+from typing import Any
 
 from ground.archive.metadata import run_metadata
-from ground.archive.recorder import McapRecorder
+from ground.archive.mcap_file import Pending
+from ground.archive.recorder import McapRecorder, prepare_raw
 from ground.archive.segments import claim_segment, with_segment
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.topology import topology
 from interfaces.runtime.cli import add_node_args, open_zenoh, start_node
 from interfaces.runtime.recent import parse_reply
-from interfaces.runtime.transport import RawHandler
 from interfaces.runtime.zenoh_transport import ZenohTransport
 
 
@@ -44,46 +49,129 @@ def main(argv: list[str] | None = None) -> int:
     path, segment = claim_segment(args.out)
     rec = McapRecorder(path, with_segment(meta, args.out, segment))
     transport = open_zenoh(args)
+    nodes = [topics.SIM, *topology(start.scenario).participants]
+    gate = _Gate(rec, cat.TICK.key(mission), start.scenario.rates.ticks_per("mid"))
     try:
-        transport.subscribe(topics.mission_wildcard(mission),
-                            _flushing(rec, cat.TICK.key(mission),
-                                      start.scenario.rates.ticks_per("mid")))
-        if segment:  # restarted: what the nodes still keep of their last ticks
-            _take_recent(transport, rec, mission, [topics.SIM, *topology(start.scenario)
-                                                   .participants], log)
-        transport.declare_alive("recorder", topics.recorder_token(mission))
+        if segment:  # restarted: what the nodes still keep of their last ticks, in order
+            gate.hold()
+        transport.subscribe(topics.mission_wildcard(mission), gate.record)
+        if segment:
+            gate.release(_recent(transport, mission, nodes, log))
+        presence = _Presence(transport, topics.recorder_token(mission), gate)
+        transport.watch_alive(topics.alive_token(mission, topics.SIM), presence.on_sim)
         log.info("recording %s to %s", topics.mission_wildcard(mission), path)
-        while not start.stop.wait(2.0):
-            rec.flush()  # and at least every 2 s of wall time
+        flushed = time.monotonic()
+        while not start.stop.wait(0.1):
+            if presence.sim_back.is_set():  # the network is back (the router restarted)
+                presence.sim_back.clear()
+                gate.release(_recent(transport, mission, nodes, log))
+                presence.announce()
+            if time.monotonic() - flushed > 2.0:
+                rec.flush()  # and at least every 2 s of wall time
+                flushed = time.monotonic()
     finally:
         transport.close()  # no callback can write after this
+        gate.release([])
         rec.close()
     log.info("archive closed: %d messages recorded, %d invalid", rec.recorded, rec.invalid)
     return 0
 
 
-def _flushing(rec: McapRecorder, tick_key: str, every: int) -> RawHandler:
-    """``rec.record``, closing the chunk in progress at every ``every``-th tick (each ω_mid
-    period of sim time): a killed recorder loses at most the period it was writing, which the
-    nodes still keep of their last ticks (``interfaces.runtime.recent``) for its restart."""
-    ticks = [0]
+class _Gate:
+    """What the recorder writes, in order.  Live samples go to the file as they come, and a
+    chunk is closed at every ``every``-th tick (each ω_mid period of sim time: a killed
+    recorder loses at most the period it was writing, which the nodes still keep of their last
+    ticks, ``interfaces.runtime.recent``).  While the network is down, or while a restarted
+    recorder takes what the nodes kept, live samples wait (``hold``); ``release`` then writes
+    those kept that were not written yet and the waiting ones, sorted by sim time, so that
+    every key's messages stay in order in the archive."""
 
-    def record(key: str, type_name: str, payload: bytes) -> None:
-        rec.record(key, type_name, payload)
-        if key == tick_key:
-            ticks[0] += 1
-            if ticks[0] % every == 0:
-                rec.flush()
+    def __init__(self, rec: McapRecorder, tick_key: str, every: int) -> None:
+        self._rec, self._tick_key, self._every = rec, tick_key, every
+        self._lock = threading.Lock()
+        self._held = False
+        self._waiting: list[Pending] = []
+        self._last: dict[str, tuple[int, int]] = {}
+        """Per key, the (sim time ns, number) of the last sample written."""
+        self._ticks = 0
 
-    return record
+    def record(self, key: str, type_name: str, payload: bytes) -> None:
+        """Transport callback: one live sample."""
+        pending = prepare_raw(key, type_name, payload)
+        with self._lock:
+            if self._held:
+                self._waiting.append(pending)
+            else:
+                self._write(pending)
+
+    def hold(self) -> None:
+        """Let live samples wait (the network is down, or the nodes' recent ticks come)."""
+        with self._lock:
+            self._held = True
+
+    def release(self, recent: list[Pending]) -> int:
+        """Write ``recent`` and the waiting samples, sorted by sim time, leaving out those
+        written already (a key's sample not after its last written); write live ones again.
+        Returns the samples written."""
+        with self._lock:
+            merged = sorted([*recent, *self._waiting], key=_order)
+            self._waiting, self._held = [], False
+            written = 0
+            for pending in merged:
+                if (pending[5] or 0, pending[6]) > self._last.get(pending[0], (-1, -1)):
+                    self._write(pending)
+                    written += 1
+            return written
+
+    def _write(self, pending: Pending) -> None:
+        self._rec.take(pending)
+        self._last[pending[0]] = (pending[5] or 0, pending[6])
+        if pending[0] == self._tick_key:
+            self._ticks += 1
+            if self._ticks % self._every == 0:
+                self._rec.flush()
 
 
-def _take_recent(transport: ZenohTransport, rec: McapRecorder, mission: str,
-                 nodes: list[str], log: logging.Logger) -> None:
-    """Record what ``nodes`` sent in their last ticks (the restarted recorder's first act: the
-    messages its predecessor had not written yet; the archive reader keeps a message twice
-    recorded once)."""
-    taken = 0
+def _order(pending: Pending) -> tuple[int, str, int]:
+    """A sample's place in the archive: sim time, key, number."""
+    return pending[5] or 0, pending[0], pending[6]
+
+
+class _Presence:
+    """The recorder's liveliness token, taken back while the network is down: the sim holds
+    the clock until it is declared again, once the recorder has recorded what the nodes sent
+    while the router was away (still kept of their last ticks)."""
+
+    def __init__(self, transport: ZenohTransport, token_key: str, gate: _Gate) -> None:
+        self._session, self._key, self._gate = transport.session, token_key, gate
+        self._token: Any = None
+        self._sim_lost = False
+        self.sim_back = threading.Event()
+        self.announce()
+
+    def announce(self) -> None:
+        """Declare the token (ready to record)."""
+        if self._token is None:
+            self._token = self._session.liveliness().declare_token(self._key)
+
+    def on_sim(self, _node: str, alive: bool) -> None:
+        """Liveliness of the sim's token, as this session sees it: gone means the network is
+        down (or the sim ended): live samples wait; back after that, the router is back."""
+        if not alive:
+            self._sim_lost = True
+            self._gate.hold()
+            if self._token is not None:
+                self._token.undeclare()
+                self._token = None
+        elif self._sim_lost:
+            self._sim_lost = False
+            self.sim_back.set()
+
+
+def _recent(transport: ZenohTransport, mission: str, nodes: list[str],
+            log: logging.Logger) -> list[Pending]:
+    """What ``nodes`` sent in their last ticks, ready to write (their own keys only)."""
+    out: list[Pending] = []
     for node in nodes:
         for _key, payload in transport.query(topics.recent_queryable(mission, node)):
             try:
@@ -91,11 +179,10 @@ def _take_recent(transport: ZenohTransport, rec: McapRecorder, mission: str,
             except ValueError as e:
                 log.warning("%s answered what it sent lately with a malformed reply: %s", node, e)
                 continue
-            for s in samples:
-                if topics.node_of_key(s.key) == node:
-                    rec.record(s.key, s.type_name, s.payload)
-                    taken += 1
-    log.warning("restarted: recorded %d messages the nodes kept of their last ticks", taken)
+            out += [prepare_raw(s.key, s.type_name, s.payload) for s in samples
+                    if topics.node_of_key(s.key) == node]
+    log.warning("took %d messages the nodes kept of their last ticks", len(out))
+    return out
 
 
 if __name__ == "__main__":

@@ -19,19 +19,27 @@ recorder stores it as the MCAP sequence).  Read in archive order over every segm
   number stays.  (So a recorder down for more than ``MAX_SEQ_JUMP`` messages of a key would
   not see that key's loss; the sim holds the clock while it is down.)
 
-A message a later segment holds again (the same key, sequence number and sim time as one of an
-earlier segment) is a **duplicate**, kept once.  To know them without holding every number, the
-ledger keeps, per key, the runs of consecutive numbers each earlier segment held, with their sim
-times (a few per key: one, plus one per gap or incarnation).
+A message recorded again (the same key, sequence number and sim time as one of the key's last
+``RECENT`` messages, or as one of an earlier segment) is a **duplicate**, kept once.  A number
+counted lost that comes after all (recorded late, out of order: what a recorder took from the
+nodes' last ticks once the network was back) is no longer lost.  To know the repeats of
+earlier segments without holding every number, the ledger keeps, per key, the runs of
+consecutive numbers each earlier segment held, with their sim times (a few per key: one, plus
+one per gap or incarnation).
 """
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 from interfaces.contracts.catalogue import topic_of
 from interfaces.runtime.admission import MAX_FIRST_SEQ, MAX_SEQ_JUMP
+
+RECENT = 512
+"""Messages of each key remembered to know one recorded twice in a segment (a recorder that
+takes what the nodes kept of their last ticks records some it had: at most a few ticks')."""
 
 
 @dataclass(slots=True)
@@ -56,6 +64,10 @@ class SequenceLedger:
     def __init__(self) -> None:
         self._last: dict[str, int] = {}
         self._lost: dict[str, int] = {}
+        self._seen: dict[str, deque[tuple[int, int]]] = {}
+        """Per key, the (number, sim time) of its last ``RECENT`` messages."""
+        self._missing: dict[str, set[int]] = {}
+        """Per key, the numbers counted lost in its current incarnation."""
         self._earlier: dict[str, list[_Run]] = {}
         self._current: dict[str, list[_Run]] = {}
         self._track = False
@@ -74,22 +86,47 @@ class SequenceLedger:
         """Account for the message numbered ``seq`` of ``key`` at sim time ``log_ns`` (ns);
         False if it is a duplicate (to drop)."""
         last = self._last.get(key, 0)
+        seen = self._seen.get(key)
+        if seen is None:
+            seen = self._seen[key] = deque(maxlen=RECENT)
         if seq == last + 1 and not self._earlier and not self._track:  # the common case
             self._last[key] = seq
+            seen.append((seq, log_ns))
             return True
         if seq <= 0 or seq > (last + MAX_SEQ_JUMP if key in self._last else MAX_FIRST_SEQ):
             return True  # no number, or one the Bus would refuse: not accounted
-        if self._earlier and self._repeats(key, seq, log_ns):
+        if (seq, log_ns) in seen or (self._earlier and self._repeats(key, seq, log_ns)):
             self.duplicates += 1
             return False
+        seen.append((seq, log_ns))
+        if self._late(key, seq):
+            return True
         if seq != last + 1:
-            missed = seq - last - 1 if seq > last else seq - 1
-            if missed:
-                self._lost[key] = self._lost.get(key, 0) + missed
+            self._count_lost(key, range(last + 1, seq) if seq > last else range(1, seq),
+                             new_incarnation=seq <= last)
         self._last[key] = seq
         if self._track:
             self._extend(key, seq, log_ns)
         return True
+
+    def _late(self, key: str, seq: int) -> bool:
+        """Whether ``seq`` is one counted lost that came after all (recorded late: what a
+        recorder took from the nodes' recent ticks after the network came back)."""
+        missing = self._missing.get(key)
+        if not missing or seq not in missing:
+            return False
+        missing.discard(seq)
+        self._lost[key] -= 1
+        return True
+
+    def _count_lost(self, key: str, numbers: range, new_incarnation: bool) -> None:
+        """Count ``numbers`` lost for ``key`` (those of a former incarnation can no longer
+        come late)."""
+        if new_incarnation:
+            self._missing.pop(key, None)
+        if numbers:
+            self._lost[key] = self._lost.get(key, 0) + len(numbers)
+            self._missing.setdefault(key, set()).update(numbers)
 
     def _repeats(self, key: str, seq: int, log_ns: int) -> bool:
         """Whether an earlier segment holds this message."""
@@ -106,7 +143,7 @@ class SequenceLedger:
     @property
     def lost(self) -> dict[str, int]:
         """Messages lost per key (keys with none left out), keys sorted."""
-        return dict(sorted(self._lost.items()))
+        return dict(sorted((k, n) for k, n in self._lost.items() if n))
 
 
 def topic_name(key: str) -> str:

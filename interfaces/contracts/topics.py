@@ -112,6 +112,11 @@ def _check_segment(s: str) -> None:
         raise ValueError(f"invalid key segment {s!r}: use letters, digits, '_' or '-'")
 
 
+def alive_token(mission: str, node: str) -> str:
+    """Liveliness token of a lockstep node (the sim, a spacecraft, the ground)."""
+    return f"{node_prefix(mission, node)}/alive"
+
+
 RECORDER = "recorder"
 """The recorder, as its liveliness token names it (not a lockstep node: no key space)."""
 

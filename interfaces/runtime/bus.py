@@ -374,7 +374,7 @@ class Bus:
 
     def declare_alive(self) -> None:
         """Announce this node (Zenoh liveliness token ``<prefix>/alive``)."""
-        self.transport.declare_alive(self.node, f"{self.prefix}/alive")
+        self.transport.declare_alive(self.node, topics.alive_token(self.mission, self.node))
 
     def watch_alive(self, handler: LivenessHandler) -> None:
         self.transport.watch_alive(f"{topics.ROOT}/{self.mission}/**/alive", handler)

@@ -198,13 +198,16 @@ class TickClient:
     ``synchronous`` (in-process transport): a tick runs inside the sim's publish call.
     Otherwise ticks queue up and ``serve()`` runs them on the calling (main) thread until the sim
     reports the run finished, or the sim's liveliness token has been gone for
-    ``rejoin_grace_s`` (wall).  A node cut off from the sim (its process stalled, its link
-    lost) that sees the sim again within that time rejoins: it forgets its tick count, clock
-    and sequence numbers and runs the next tick it receives.  So does a node that the sim names
-    in a tick's ``rejoin`` while that tick is too far ahead of its own (the sim lost it and
-    sees it again, though the node never saw the sim lost, or it took a tick of the lost epoch
-    after rejoining).  Ticks are queued with their epoch; those of a lost epoch are dropped,
-    not run.  A node whose token comes back may number its messages from 1 again
+    ``rejoin_grace_s`` (wall).  A node cut off from the sim (its process stalled, its link or
+    the router lost) that sees the sim again within that time goes on from its own tick: the
+    sim may have held the clock for it (restarts supervised), and its next tick is then the
+    open one, sent again (answered again if the node ran it, ``Executive.run_tick``), or the
+    one after.  If instead the sim flew on, its present is too far ahead: the node rejoins, it
+    forgets its tick count, clock and sequence numbers and runs that tick.  So does a node that
+    the sim names in a tick's ``rejoin`` while that tick is too far ahead of its own (the sim
+    lost it and sees it again, though the node never saw the sim lost, or it took a tick of the
+    lost epoch after rejoining).  Ticks are queued with their epoch; those of a lost epoch are
+    dropped, not run.  A node whose token comes back may number its messages from 1 again
     (``Admission.restarted``)."""
 
     SUBSCRIBES: ClassVar[tuple[Topic, ...]] = (cat.TICK, cat.SIM_STATUS)
@@ -221,6 +224,8 @@ class TickClient:
     """How many times this node lost the lockstep and rejoined it."""
     _served_epoch: int = 0
     _lost_at: float = 0.0
+    _sim_back: bool = False
+    """The sim was lost and is back, and no tick was taken since."""
 
     def __post_init__(self) -> None:
         bus = self.executive.bus
@@ -253,15 +258,16 @@ class TickClient:
                 self._take(tick)  # ours: answer it again (``Executive.run_tick``)
             return
         why = self._implausible(tick)
-        if why and self.executive.bus.node in tick.rejoin:
-            self._lose_epoch(f"the sim names it rejoining at tick {tick.k}, past its tick "
-                             f"{self._last_k}")
+        if why and (self.executive.bus.node in tick.rejoin or self._sim_back):
+            self._lose_epoch(f"the sim's tick {tick.k} is past its tick {self._last_k} ("
+                             + ("the sim flew on while it was cut off)" if self._sim_back
+                                else "the sim names it rejoining)"))
             why = self._implausible(tick)
         if why:
             bus = self.executive.bus
             bus.refuse(cat.TICK.key(bus.mission), "tick", f"tick k={tick.k}: {why}")
             return
-        self._last_k = tick.k
+        self._last_k, self._sim_back = tick.k, False
         self.executive.bus.admission.advance(tick.t_sim)
         self._take(tick)
 
@@ -300,7 +306,8 @@ class TickClient:
             self.sim_lost, self._lost_at = True, time.monotonic()
             self._ticks.put(None)
         elif node == topics.SIM and self.sim_lost:
-            self._lose_epoch("the sim is back")
+            self.sim_lost, self._sim_back = False, True
+            self.executive.log.warning("%s: the sim is back", self.executive.bus.node)
         elif alive and node not in (bus.node, topics.RECORDER):
             bus.admission.restarted(topics.node_prefix(bus.mission, node) + "/")
 

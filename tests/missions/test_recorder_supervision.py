@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import deploy.run_constellation as launcher
-from interfaces.contracts.topology import RECORDER, SIM
+from interfaces.contracts.topology import RECORDER, ROUTER, SIM
 from tests.conftest import REPO, small_scenario
 
 
@@ -41,7 +41,7 @@ def test_a_recorder_dead_after_every_restart_stops_the_run(tmp_path: Path) -> No
 def test_a_restarted_recorder_that_never_announces_itself_stops_the_run(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """The first recorder dies; its successor runs but declares no token in time."""
-    monkeypatch.setattr(launcher, "RECORDER_READY_S", 1.0)
+    monkeypatch.setattr(launcher, "SERVICE_READY_S", 1.0)
     first_dies = ("import pathlib, sys, time\n"
                   f"if not pathlib.Path({str(tmp_path / 'recorder.restart1.log')!r}).exists():\n"
                   "    sys.exit(1)\n"
@@ -51,7 +51,20 @@ def test_a_restarted_recorder_that_never_announces_itself_stops_the_run(
         error = watch.run()
     finally:
         watch.sup.stop_all()
-    assert error is not None and "did not announce itself within 1 s" in error
+    assert error is not None and "it was not back within 1 s" in error
     assert "nothing after it is recorded" in error and "still running" in error
     assert len(watch.incidents) == 1 and watch.restarts == {RECORDER.name: 1}
 
+
+
+def test_a_router_dead_after_every_restart_stops_the_run_naming_it(tmp_path: Path) -> None:
+    watch = _watch(tmp_path, "import time; time.sleep(60)")
+    watch.sup.start(launcher.Child(ROUTER.name, ["-c", "raise SystemExit(4)"],
+                                   tmp_path / "router.log"))
+    try:
+        error = watch.run()
+    finally:
+        watch.sup.stop_all()
+    assert error is not None and error.startswith("router (pid ")
+    assert "the bus is down" in error and f"(restarted {launcher.MAX_RESTARTS} times)" in error
+    assert [i.node for i in watch.incidents] == [ROUTER.name] * launcher.MAX_RESTARTS

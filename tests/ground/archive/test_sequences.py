@@ -75,3 +75,17 @@ def test_lost_messages_add_up_by_catalogue_topic() -> None:
             "insp/m/sc/1/nope/thing": 4}
     assert topic_name("insp/m/sim/sensors/sc3/camera") == "sensors/camera"
     assert by_topic(lost) == {"clock/tick": 1, "insp/m/sc/1/nope/thing": 4, "nav/estimate": 5}
+
+
+def test_a_message_recorded_twice_is_kept_once_and_one_recorded_late_is_not_lost() -> None:
+    """After the network came back the recorder records live messages, then what the nodes
+    kept of their last ticks: some it had (duplicates), some it missed (late, not lost)."""
+    ledger = SequenceLedger()
+    ledger.begin_segment(more_follow=False)
+    times = {n: round(n * 0.1 * S) for n in range(1, 20)}
+    live = [ledger.admit(K, n, times[n]) for n in (1, 2, 3, 4, 8, 9)]  # 5-7 sent while down
+    assert all(live) and ledger.lost == {K: 3}
+    kept = [ledger.admit(K, n, times[n]) for n in (3, 4, 5, 6, 7)]  # the nodes' last ticks
+    assert kept == [False, False, True, True, True]
+    assert ledger.lost == {} and ledger.duplicates == 2
+    assert ledger.admit(K, 10, times[10]) and ledger.lost == {}
