@@ -69,8 +69,8 @@ class Executive:
     the sim sent the tick, so they arrive in milliseconds; only a message lost in a reconnection
     (a node rejoining) is waited for this long."""
     at_tick_end: Callable[[], None] | None = None
-    """Called after a tick's groups ran, before the answer is sent (the critical-data store
-    is written there: ``interfaces.runtime.cli``)."""
+    """Called at the end of a tick, its answer sent (the critical-data store is written there:
+    ``interfaces.runtime.restart``)."""
     last_done: TickDone | None = None
     """The answer to the last tick run."""
     recover_after_s: float = 1.0
@@ -118,14 +118,14 @@ class Executive:
             self._publish_housekeeping(t, k)
         self.last_done = TickDone(sender=self.bus.node, t_sim=t, k=k,
                                   published=self.bus.published_since_last())
+        self.bus.publish(self._keys["done"], self.last_done, announce=False)
         if self.at_tick_end is not None:
             self.at_tick_end()
-        self.bus.publish(self._keys["done"], self.last_done, announce=False)
 
     def _answer_again(self) -> None:
         """The sim sent the tick this node last ran again (it lost the node while the tick
-        was open, and sees it back): answer it again.  Restored from the critical-data store,
-        the answer has the number it had, and the sim drops it if the first one reached it."""
+        was open, and sees it back): answer it again (the first answer may have been lost with
+        the network)."""
         assert self.last_done is not None
         self.log.warning("%s: the sim sent tick %d again; answering it again", self.bus.node,
                          self.last_done.k)

@@ -1,0 +1,105 @@
+"""Host faults that change no result (issue 27): over Zenoh with --restart-on-crash, a flight
+process, the ground, the router and the recorder killed in turn mid-run, each restarted (the
+nodes restored from their critical-data stores, the router on its endpoint, the recorder in a
+next segment) while the sim holds the clock: every message of the clean run of the same
+scenario and seed is in the killed run's archive, with the same content, and none is lost."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+from ground.archive.reader import load_run
+from interfaces.contracts import topics
+from interfaces.contracts.messages import StateEstimate, registry
+from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
+from tests.conftest import small_scenario, write_scenario
+from tests.missions.test_constellation import _launch, _wait_pid
+
+M = "chaos"
+SC = small_scenario(M, duration_s=300.0, phases=[
+    {"name": "move", "start_s": 100.0, "transfer_s": 600.0, "rho_x_m": 22.0, "rho_z_m": 20.0}])
+NOT_COMPARED = {"Tick", "TickDone", "SimStatus", "ExecStats"}
+"""The sim's ticks and the nodes' answers (the open tick is sent again after each kill, and
+answered again), the sim's status (it names the participants lost and back) and the
+executives' statistics (wall-clock execution times)."""
+
+
+def _run(tmp_path: Path, port: int, name: str, kills: list[tuple[float, list[str]]]
+         ) -> tuple[dict[str, Any], Path]:
+    """Fly SC with --restart-on-crash, killing at each sim time (s) the process whose command
+    line holds the given parts; the summary and the run's folder."""
+    path = write_scenario(tmp_path / f"{M}.toml", SC)
+    out = tmp_path / name
+    p = _launch(path, out, port, "--realtime", "10", "--restart-on-crash")
+    try:
+        for t_kill, argv in kills:
+            _until(out, t_kill)
+            own = (["--config", str(out / "access" / "router.json5")]
+                   if argv == ["deploy.router"] else ["--scenario", str(path)])
+            os.kill(_wait_pid([*argv, *own], 10.0), signal.SIGKILL)
+    finally:
+        stdout, stderr = p.communicate(timeout=240)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["t_sim_final_s"] == SC.duration_s, stderr
+    return summary, out
+
+
+def _until(out: Path, t_sim: float) -> None:
+    """Block until sc1's nav estimate of ``t_sim`` (s) is on the bus."""
+    reached = threading.Event()
+    deadline = time.monotonic() + 60.0
+    while True:
+        try:
+            watcher = ZenohTransport(ZenohSettings(config_file=str(out / "access" / "tlm.json5")))
+            break
+        except Exception:  # noqa: BLE001 - the launcher is still writing the accounts
+            assert time.monotonic() < deadline, "the run never started"
+            time.sleep(0.2)
+    try:
+        watcher.subscribe(topics.key(M, "sc1", "nav", "estimate"), lambda _k, _t, p: (
+            reached.set() if StateEstimate.model_validate_json(p).t_sim >= t_sim else None))
+        assert reached.wait(90.0), f"the run never reached t={t_sim} s"
+    finally:
+        watcher.close()
+
+
+def _messages(out: Path) -> dict[tuple[str, int], dict[str, Any]]:
+    """Every compared message of the run's archive by (key, number), without wall-clock
+    fields."""
+    got = {}
+    for r in load_run(out / "run.mcap").records():
+        if r.type_name in NOT_COMPARED:
+            continue
+        d = json.loads(r.payload)
+        for f in registry()[r.type_name].WALL_CLOCK_FIELDS:
+            d.pop(f)
+        got[(r.key, d["seq"])] = d
+    return got
+
+
+def test_killed_and_restarted_processes_change_no_result(tmp_path: Path, free_port: int) -> None:
+    clean, clean_out = _run(tmp_path, free_port, "clean", [])
+    assert clean["status"] == "completed"
+    kills = [(60.0, ["fsw", "--spacecraft", "2"]), (110.0, ["ground"]),
+             (160.0, ["deploy.router"]), (210.0, ["ground.archive.record"])]
+    chaos, chaos_out = _run(tmp_path, free_port, "chaos", kills)
+    assert chaos["status"] == "degraded"
+    for name in ("sc2", "ground", "router", "recorder"):
+        assert f"{name} killed by SIGKILL" in chaos["error"]
+    assert "sc2 killed by SIGKILL at" in chaos["error"] and "restored after tick" in chaos["error"]
+    assert chaos["archive"]["lost"]["total"] == 0
+    assert len(chaos["archive"]["segments"]) == 2
+    assert _messages(chaos_out) == _messages(clean_out)
+    volatile = {"status", "error", "wall_s", "real_time_factor", "archive", "messages", "sim",
+                "exec", "ticks"}
+    assert {k: v for k, v in chaos.items() if k not in volatile} == \
+        {k: v for k, v in clean.items() if k not in volatile}
+    assert chaos["detections"] == clean["detections"] and chaos["gnc"] == clean["gnc"]
+    assert subprocess.run(["pgrep", "-f", str(tmp_path)], capture_output=True).stdout == b""
