@@ -23,8 +23,14 @@ from tests.conftest import small_scenario, write_scenario
 from tests.missions.test_constellation import _launch, _wait_pid
 
 M = "chaos"
-SC = small_scenario(M, duration_s=300.0, phases=[
-    {"name": "move", "start_s": 100.0, "transfer_s": 600.0, "rho_x_m": 22.0, "rho_z_m": 20.0}])
+SC = small_scenario(
+    M, duration_s=300.0, target={"pois": 1000}, rates={"high_hz": 5.0, "fdi_period_s": 50.0},
+    observers={"count": 3, "initial_attitude": "lvlh"},
+    phases=[{"name": "move", "start_s": 100.0, "transfer_s": 600.0, "rho_x_m": 22.0,
+             "rho_z_m": 20.0}],
+    faults=[{"spacecraft": 3, "kind": "camera_degradation", "start_s": 130.0, "magnitude": 0.5},
+            {"spacecraft": 1, "kind": "faulty_data", "start_s": 220.0, "magnitude": 2.0}])
+"""A transfer, and two faults, each injected after a kill."""
 NOT_COMPARED = {"Tick", "TickDone", "SimStatus", "ExecStats"}
 """The sim's ticks and the nodes' answers (the open tick is sent again after each kill, and
 answered again), the sim's status (it names the participants lost and back) and the
@@ -37,7 +43,7 @@ def _run(tmp_path: Path, port: int, name: str, kills: list[tuple[float, list[str
     line holds the given parts; the summary and the run's folder."""
     path = write_scenario(tmp_path / f"{M}.toml", SC)
     out = tmp_path / name
-    p = _launch(path, out, port, "--realtime", "10", "--restart-on-crash")
+    p = _launch(path, out, port, "--realtime", "20", "--restart-on-crash")
     try:
         for t_kill, argv in kills:
             _until(out, t_kill)
@@ -101,5 +107,7 @@ def test_killed_and_restarted_processes_change_no_result(tmp_path: Path, free_po
                 "exec", "ticks"}
     assert {k: v for k, v in chaos.items() if k not in volatile} == \
         {k: v for k, v in clean.items() if k not in volatile}
-    assert chaos["detections"] == clean["detections"] and chaos["gnc"] == clean["gnc"]
+    assert {(d["spacecraft"], d["class"]) for d in clean["detections"]} >= {(3, "camera")}
+    assert chaos["detections"] == clean["detections"] and chaos["scores"] == clean["scores"]
+    assert chaos["gnc"] == clean["gnc"] and chaos["coverage"] == clean["coverage"]
     assert subprocess.run(["pgrep", "-f", str(tmp_path)], capture_output=True).stdout == b""
