@@ -360,9 +360,10 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     commands = {n.name: [*n.command, *account(n.name), *cds] for n in topo.nodes}
     for node, argv in commands.items():
         if node in args.external:
+            config = access.client_config(node)
+            there = [config.name if a == str(config) else a for a in argv]
             log.info("%s runs elsewhere: on its host, with this run's scenario and %s there, "
-                     "run: python %s", node, access.client_config(node), " ".join(argv[:-2] + [
-                         "--zenoh-config", access.client_config(node).name]))
+                     "run: python %s", node, config, " ".join(there))
         else:
             sup.start(Child(node, argv, logs / f"{node}.log"))
     watch = _Watch(sup, progress, flight=[n for n in topo.participants if n not in args.external],
@@ -393,6 +394,9 @@ def _store_args(out: Path, restart: bool) -> list[str]:
     own."""
     if not restart:
         return []
+    for old in [*(out / "cds").glob("*.cds"), *(out / "cds").glob("*.starts"),
+                *(out / "cds").glob(".*.tmp")]:  # an earlier run's, in a reused folder
+        old.unlink()
     write_run_key(out / "cds")
     return ["--cds", str(out / "cds")]
 

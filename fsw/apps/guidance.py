@@ -67,7 +67,7 @@ class GuidanceApp(App):
         Output("status", cat.GUIDANCE_STATUS),
     )
     CRITICAL = ("assignment", "pending", "previous", "refused_id", "pro", "plan", "plan_t0",
-                "planned_id", "dv_commanded", "_est", "_att", "mpc._warm")
+                "planned_id", "dv_commanded", "_est", "_att", "mpc.warm")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)

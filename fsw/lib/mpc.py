@@ -303,6 +303,16 @@ class MpcTracker:
         """Drop the warm start (e.g. after a new plan); the next solve starts cold."""
         self._warm = None
 
+    @property
+    def warm(self) -> tuple[FloatArray, FloatArray] | None:
+        """The warm start of the next solve (primal, dual), None for a cold one: with it, a
+        rebuilt tracker solves as this one would (a restart's critical data)."""
+        return self._warm
+
+    @warm.setter
+    def warm(self, value: tuple[FloatArray, FloatArray] | None) -> None:
+        self._warm = value
+
     @staticmethod
     def _shift_index(blocks: list[tuple[int, int, int]], size: int) -> npt.NDArray[np.intp]:
         """Gather index that shifts each block of ``count`` steps of width ``width`` (starting at

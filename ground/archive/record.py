@@ -8,8 +8,8 @@ When ``--out`` exists already (the recorder was restarted, by the launcher's
 free segment, ``run-1.mcap``, ``run-2.mcap``, ... (``ground/archive/segments.py``): never over
 what exists, with the same run metadata and a ``segment`` record.  Restarted, it first records
 what every node still keeps of its last ticks (``interfaces.runtime.recent``): the chunk in
-progress when it was killed, at most one ω_mid period of sim time (a chunk is closed at every
-period), is among it.  It declares its liveliness token (``topics.recorder_token``) once
+progress when it was killed, at most one ω_mid period's worth of ticks (a chunk is closed
+after each), is among it.  It declares its liveliness token (``topics.recorder_token``) once
 subscribed, ready to record (the sim holds the clock until then).  When the network goes down
 (the sim's token gone: the router died) it takes the token back, and once the sim is seen again
 records what the nodes still keep of their last ticks before it declares it again.
@@ -64,7 +64,8 @@ def main(argv: list[str] | None = None) -> int:
         while not start.stop.wait(0.1):
             if presence.sim_back.is_set():  # the network is back (the router restarted)
                 presence.sim_back.clear()
-                gate.release(_recent(transport, mission, nodes, log))
+                holds = gate.holds
+                gate.release(_recent(transport, mission, nodes, log), ending=holds)
                 presence.announce()
             if time.monotonic() - flushed > 2.0:
                 rec.flush()  # and at least every 2 s of wall time
@@ -94,6 +95,7 @@ class _Gate:
         self._last: dict[str, tuple[int, int]] = {}
         """Per key, the (sim time ns, number) of the last sample written."""
         self._ticks = 0
+        self._holds = 0
 
     def record(self, key: str, type_name: str, payload: bytes) -> None:
         """Transport callback: one live sample."""
@@ -104,32 +106,49 @@ class _Gate:
             else:
                 self._write(pending)
 
+    @property
+    def holds(self) -> int:
+        """How many times live samples were made to wait (``release`` names the one it ends)."""
+        return self._holds
+
     def hold(self) -> None:
         """Let live samples wait (the network is down, or the nodes' recent ticks come)."""
         with self._lock:
             self._held = True
+            self._holds += 1
 
-    def release(self, recent: list[Pending]) -> int:
+    def release(self, recent: list[Pending], ending: int | None = None) -> int:
         """Write ``recent`` and the waiting samples, sorted by sim time, leaving out those
-        written already (a key's sample not after its last written); write live ones again.
-        Returns the samples written."""
+        written already (a key's sample not after its last written); write live ones again,
+        unless a hold came after ``ending`` (the ``holds`` count when the recent ones were
+        asked for: the network went down again meanwhile).  Returns the samples written."""
         with self._lock:
             merged = sorted([*recent, *self._waiting], key=_order)
-            self._waiting, self._held = [], False
+            self._waiting = []
+            self._held = ending is not None and ending != self._holds
             written = 0
             for pending in merged:
-                if (pending[5] or 0, pending[6]) > self._last.get(pending[0], (-1, -1)):
+                if _place(pending) > self._last.get(_key(pending), (-1, -1)):
                     self._write(pending)
                     written += 1
             return written
 
     def _write(self, pending: Pending) -> None:
         self._rec.take(pending)
-        self._last[pending[0]] = (pending[5] or 0, pending[6])
-        if pending[0] == self._tick_key:
+        self._last[_key(pending)] = _place(pending)
+        if _key(pending) == self._tick_key:
             self._ticks += 1
             if self._ticks % self._every == 0:
                 self._rec.flush()
+
+
+def _key(pending: Pending) -> str:
+    return pending[0]
+
+
+def _place(pending: Pending) -> tuple[int, int]:
+    """A sample's place among its key's: (sim time ns, number)."""
+    return pending[5] or 0, pending[6]
 
 
 def _order(pending: Pending) -> tuple[int, str, int]:
@@ -146,26 +165,29 @@ class _Presence:
         self._session, self._key, self._gate = transport.session, token_key, gate
         self._token: Any = None
         self._sim_lost = False
+        self._lock = threading.Lock()
         self.sim_back = threading.Event()
         self.announce()
 
     def announce(self) -> None:
-        """Declare the token (ready to record)."""
-        if self._token is None:
-            self._token = self._session.liveliness().declare_token(self._key)
+        """Declare the token (ready to record), unless the network is down again."""
+        with self._lock:
+            if self._token is None and not self._sim_lost:
+                self._token = self._session.liveliness().declare_token(self._key)
 
     def on_sim(self, _node: str, alive: bool) -> None:
         """Liveliness of the sim's token, as this session sees it: gone means the network is
         down (or the sim ended): live samples wait; back after that, the router is back."""
-        if not alive:
-            self._sim_lost = True
-            self._gate.hold()
-            if self._token is not None:
-                self._token.undeclare()
-                self._token = None
-        elif self._sim_lost:
-            self._sim_lost = False
-            self.sim_back.set()
+        with self._lock:
+            if not alive:
+                self._sim_lost = True
+                self._gate.hold()
+                if self._token is not None:
+                    self._token.undeclare()
+                    self._token = None
+            elif self._sim_lost:
+                self._sim_lost = False
+                self.sim_back.set()
 
 
 def _recent(transport: ZenohTransport, mission: str, nodes: list[str],

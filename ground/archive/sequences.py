@@ -57,6 +57,25 @@ class _Run:
                 and self.first_ns <= log_ns <= self.last_ns)
 
 
+class _Recent:
+    """The (number, sim time) of a key's last ``RECENT`` messages: in order, and as a set."""
+
+    __slots__ = ("_order", "_set")
+
+    def __init__(self) -> None:
+        self._order: deque[tuple[int, int]] = deque()
+        self._set: set[tuple[int, int]] = set()
+
+    def add(self, item: tuple[int, int]) -> None:
+        if len(self._order) == RECENT:
+            self._set.discard(self._order.popleft())
+        self._order.append(item)
+        self._set.add(item)
+
+    def __contains__(self, item: object) -> bool:
+        return item in self._set
+
+
 class SequenceLedger:
     """The sequence accounting of one archive read (see the module docstring): fed every
     message in archive order (:meth:`admit`), segment by segment (:meth:`begin_segment`)."""
@@ -64,7 +83,7 @@ class SequenceLedger:
     def __init__(self) -> None:
         self._last: dict[str, int] = {}
         self._lost: dict[str, int] = {}
-        self._seen: dict[str, deque[tuple[int, int]]] = {}
+        self._seen: dict[str, _Recent] = {}
         """Per key, the (number, sim time) of its last ``RECENT`` messages."""
         self._missing: dict[str, set[int]] = {}
         """Per key, the numbers counted lost in its current incarnation."""
@@ -88,17 +107,17 @@ class SequenceLedger:
         last = self._last.get(key, 0)
         seen = self._seen.get(key)
         if seen is None:
-            seen = self._seen[key] = deque(maxlen=RECENT)
+            seen = self._seen[key] = _Recent()
         if seq == last + 1 and not self._earlier and not self._track:  # the common case
             self._last[key] = seq
-            seen.append((seq, log_ns))
+            seen.add((seq, log_ns))
             return True
         if seq <= 0 or seq > (last + MAX_SEQ_JUMP if key in self._last else MAX_FIRST_SEQ):
             return True  # no number, or one the Bus would refuse: not accounted
         if (seq, log_ns) in seen or (self._earlier and self._repeats(key, seq, log_ns)):
             self.duplicates += 1
             return False
-        seen.append((seq, log_ns))
+        seen.add((seq, log_ns))
         if self._late(key, seq):
             return True
         if seq != last + 1:

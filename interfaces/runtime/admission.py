@@ -11,8 +11,8 @@ A message that passed its schema can still be hostile or broken in ways only the
   would make the barrier believe that messages arrived which never will.  A number already seen
   is a duplicate (a message sent again: a publisher restored from its critical-data store
   running its interrupted tick again, or an answer to a resend request that this node did not
-  need), dropped and counted apart (``Admission.duplicates``), not refused; a 1 below a higher
-  number, or after its publisher's liveliness came back (``Admission.restarted``), is the key's
+  need), dropped and counted apart (``Admission.duplicates``), not refused; a 1 as the first
+  message after its publisher's liveliness came back (``Admission.restarted``) is the key's
   publisher started afresh (it numbers from 1 again), and starts the count anew.
 * **Time.** Once the bus has a clock (the lockstep's tick time, ``Admission.advance``), a message
   dated more than ``MAX_AHEAD_S`` after it is refused instead of queued for a future that may
@@ -81,16 +81,16 @@ class Admission:
 
     def duplicate(self, key: str, msg: Message) -> bool:
         """Whether ``msg`` was seen already (its number not above the key's highest, and not
-        the 1 of a publisher started afresh); counted.  The lockstep's tick is judged by its
-        subscriber."""
+        the 1 of a publisher that came back); counted.  The lockstep's tick is judged by its
+        subscriber.  Call under the inbox's lock, with ``admit``."""
         last = self.highest_seq.get(key)
         came_back = key in self._may_restart
         if came_back:
             self._may_restart.discard(key)
         if last is None or msg.seq > last or key in self.judged_by_subscriber:
             return False
-        if msg.seq == 1 and (last > 1 or came_back):
-            del self.highest_seq[key]  # its publisher started afresh: count from 1 again
+        if msg.seq == 1 and came_back:
+            self.highest_seq.pop(key, None)  # its publisher started afresh: count from 1 again
             return False
         self.duplicates += 1
         return True
@@ -137,13 +137,13 @@ class Admission:
         """The publisher of the keys under ``prefix`` came back (its liveliness token): from
         a process started afresh, its keys count from 1 again; restored from its critical-data
         store, they go on, and what it sends again is a duplicate."""
-        self._may_restart.update(k for k in self.highest_seq if k.startswith(prefix))
+        self._may_restart.update(k for k in list(self.highest_seq) if k.startswith(prefix))
 
     def checkpoint(self) -> dict[str, object]:
         """The clock, the highest numbers seen and the counts (for a node's store)."""
-        return {"clock_s": self.clock_s, "highest_seq": self.highest_seq,
-                "refused": self.refused, "duplicates": self.duplicates,
-                "may_restart": self._may_restart}
+        return {"clock_s": self.clock_s, "highest_seq": dict(self.highest_seq),
+                "refused": Counter(self.refused), "duplicates": self.duplicates,
+                "may_restart": set(self._may_restart)}
 
     def restore(self, saved: dict[str, Any]) -> None:
         """Take back a ``checkpoint``."""

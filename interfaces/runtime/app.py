@@ -87,13 +87,13 @@ class App:
     OUTPUTS: ClassVar[tuple[Output, ...]] = ()
     CRITICAL: ClassVar[tuple[str, ...]] = ()
     """The attributes (dotted: of a part) that hold what the app learnt while running: written
-    to the node's critical-data store each tick (``interfaces.runtime.cds``) and restored by a
-    restarted process, so that it goes on as if it had not stopped.  Everything else an app
-    holds must be rebuilt identically from the scenario at start."""
+    to the node's critical-data store at every ω_mid boundary (``interfaces.runtime.cds``) and
+    restored by a restarted process, so that it goes on as if it had not stopped.  Everything
+    else an app holds must be rebuilt identically from the scenario at start."""
     REBUILT: ClassVar[tuple[str, ...]] = ()
     """Attributes that change while running but are rebuilt identically on demand (caches),
-    or hooks set at start: not in the store (``tests/interfaces/runtime/test_checkpoint.py``
-    checks that every attribute that changes is in CRITICAL or here)."""
+    or hooks set at start: not in the store (``tests/missions/test_restore.py`` checks, after a
+    real run, that every attribute that changes is in CRITICAL or here)."""
 
     def __init__(self, ctx: AppContext) -> None:
         self.ctx = ctx

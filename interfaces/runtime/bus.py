@@ -34,6 +34,7 @@ and the schema service (``interfaces.runtime.schemas``).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from collections.abc import Callable
@@ -177,28 +178,37 @@ class Bus:
                                f"{MAX_PAYLOAD_BYTES}")
             return
         decoded: dict[type[Message], Message] = {}
-        deferred: dict[int, tuple[Message, list[Sub]]] = {}
-        for sub in self.table.groups.get(key_expr, []):
-            msg = decoded.get(sub.msg_type)
-            if msg is None:
+        group = self.table.groups.get(key_expr, [])
+        for sub in group:
+            if sub.msg_type not in decoded:
                 msg = self._admitted(key, sub.msg_type, sample)
                 if msg is None:
                     return
                 decoded[sub.msg_type] = msg
-            if sub.immediate:
-                self._call(sub, msg, key)
-            else:
-                deferred.setdefault(id(msg), (msg, []))[1].append(sub)
         # One envelope per message, whatever the number of local subscribers: the channel
-        # decides once, so every app of the node sees the same messages.
+        # decides once, so every app of the node sees the same messages.  A duplicate is known,
+        # and the number recorded, in the same step (a resent copy and the late original may
+        # come on two threads).
+        if not decoded:
+            return
         src = self.admission.owner(key)
         inbox = self.inbox
         with inbox.lock:
-            for msg, group in deferred.values():
-                inbox.pending.append(Envelope(msg, key, src, False, group))
+            if self.admission.duplicate(key, next(iter(decoded.values()))):
+                return
+            deferred: dict[int, tuple[Message, list[Sub]]] = {}
+            for sub in group:
+                if not sub.immediate:
+                    msg = decoded[sub.msg_type]
+                    deferred.setdefault(id(msg), (msg, []))[1].append(sub)
+            for msg, subs in deferred.values():
+                inbox.pending.append(Envelope(msg, key, src, False, subs))
             for msg in decoded.values():
                 self.admission.admit(key, msg)
             inbox.wake()
+        for sub in group:
+            if sub.immediate:
+                self._call(sub, decoded[sub.msg_type], key)
 
     def _on_made_here(self, key_expr: str, key: str, msg: Message) -> None:
         """In-process callback: a message another Bus of this process published.  It was
@@ -234,8 +244,6 @@ class Bus:
         refusal = self.admission.check(key, msg, len(self.inbox.pending))
         if refusal is not None:
             self.refuse(key, *refusal)
-            return None
-        if self.admission.duplicate(key, msg):
             return None
         return msg
 
@@ -319,12 +327,17 @@ class Bus:
         return out
 
     def take_in(self, sample: Sample) -> int:
-        """Receive ``sample`` as if it had just arrived, on each subscription it matches
-        (validated, admitted: one already held is a duplicate).  Returns 1 if any matched."""
-        exprs = [e for e in self.table.groups if topics.matches(e, sample.key)]
-        for e in exprs:
-            self._on_sample(e, sample)
-        return 1 if exprs else 0
+        """Receive ``sample`` as if it had just arrived (validated, admitted: one already held
+        is a duplicate), unless it is the lockstep's tick (its subscriber judges ticks as they
+        come; old ones are no news).  Returns 1 if it was new to this node."""
+        if sample.key in self.admission.judged_by_subscriber:
+            return 0
+        expr = next((e for e in self.table.groups if topics.matches(e, sample.key)), None)
+        if expr is None:
+            return 0
+        before = self.admission.duplicates
+        self._on_sample(expr, sample)
+        return 1 if self.admission.duplicates == before else 0
 
     # --- restarts --------------------------------------------------------------------------
 
@@ -338,12 +351,13 @@ class Bus:
         once."""
         index = {id(s): (e, i) for e, group in self.table.groups.items()
                  for i, s in enumerate(group)}
-        with self.inbox.lock:
+        with self.inbox.lock:  # the receiving threads queue and admit under it: copies
             pending = [(e.msg, e.key, e.src, e.local, [index[id(s)] for s in e.subs])
                        for e in self.inbox.pending]
             admission = self.admission.checkpoint()
-        since = min([self.admission.clock_s or 0.0, *(e.msg.t_sim for e in self.inbox.pending)])
-        return {"seq": self._seq, "stats": self.stats, "admission": admission,
+            stats = dataclasses.replace(self.stats)
+        since = min([admission["clock_s"] or 0.0, *(m[0].t_sim for m in pending)])
+        return {"seq": dict(self._seq), "stats": stats, "admission": admission,
                 "pending": pending,
                 "channel": None if self.channel is None else self.channel.checkpoint(since)}
 
@@ -362,6 +376,17 @@ class Bus:
             self.channel.restore(saved["channel"])
 
     # --- services --------------------------------------------------------------------------
+
+    def number_afresh(self) -> None:
+        """Number this node's messages from 1 again on every key (a restored node that could
+        not run again every tick since its store: its receivers saw higher numbers, and take
+        its new ones as a publisher started afresh, ``Admission.restarted``)."""
+        self._seq = {}
+
+    def send_again(self, key: str, msg: Message) -> None:
+        """Send a message this node published already, as it was (same number): a receiver
+        that had it drops it as a duplicate, one that missed it takes it."""
+        self.transport.send(Sample(key, type(msg).__name__, message=msg))
 
     def serve_recent(self) -> None:
         """Answer ``<prefix>/bus/recent`` with what this node sent in its last ticks."""

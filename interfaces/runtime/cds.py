@@ -1,6 +1,6 @@
 """A node process's critical-data store (after cFS's CDS): the file its state is written to at
-the end of every tick, and restored from when the launcher starts the process again
-(docs/architecture.md, "Restarts").
+every ω_mid boundary (``interfaces.runtime.restart``), and restored from when the launcher
+starts the process again (docs/architecture.md, "Restarts").
 
 * **Where.** ``<run>/cds/<node>.cds``, beside the run's key ``<run>/cds/key`` (made by the
   launcher: ``write_run_key``).  The folder is the owner's only (0700), the files too (0600).
@@ -51,9 +51,10 @@ def write_run_key(directory: Path) -> Path:
     directory.mkdir(parents=True, exist_ok=True)
     directory.chmod(0o700)
     path = directory / KEY_FILE
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o600)
     with os.fdopen(fd, "wb") as f:
         f.write(secrets.token_bytes(KEY_BYTES))
+    path.chmod(0o600)  # an existing file keeps its mode through O_TRUNC
     return path
 
 

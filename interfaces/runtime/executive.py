@@ -124,12 +124,12 @@ class Executive:
 
     def _answer_again(self) -> None:
         """The sim sent the tick this node last ran again (it lost the node while the tick
-        was open, and sees it back): answer it again (the first answer may have been lost with
-        the network)."""
+        was open, and sees it back): send the answer again, as it was (the first may have been
+        lost with the network; if not, the sim drops this one as a duplicate)."""
         assert self.last_done is not None
         self.log.warning("%s: the sim sent tick %d again; answering it again", self.bus.node,
                          self.last_done.k)
-        self.bus.publish(self._keys["done"], self.last_done.model_copy(), announce=False)
+        self.bus.send_again(self._keys["done"], self.last_done)
 
     def checkpoint(self) -> dict[str, object]:
         """The counters and the last answer (for the node's critical-data store)."""

@@ -4,20 +4,24 @@
 
 The store holds the node's state at its last ω_mid boundary, tick m.  A restored node first
 runs again, before it announces itself, every tick the sim sent since, up to the one the sim
-holds open for it: the ticks and everything the tick announce come from what the sim and the
+holds open for it: the ticks and everything they announce come from what the sim and the
 other nodes keep of their last ticks (``interfaces.runtime.recent``).  What it sends again is
 dropped by its receivers as duplicates.  Then it is where it was when it stopped, and the sim's
-tick sent again on its return is the next it runs.
+tick sent again on its return is the next it runs.  If the ticks since are no longer kept (or
+the sim's cannot be read), it goes on with the state of tick m, numbering its messages afresh,
+and its start record says why: the mission goes on, no longer as if nothing happened.
 """
 
 from __future__ import annotations
 
 import logging
+import pickle
 import time
 
 from pydantic import ValidationError
 
 from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
 from interfaces.contracts.messages import Tick
 from interfaces.runtime.cds import CriticalDataStore, StartRecord, StoreRefused
 from interfaces.runtime.checkpoint import capture, restore
@@ -33,10 +37,20 @@ def resume(client: TickClient, store: CriticalDataStore, others: list[str],
     ex = client.executive
     every = ex.period["mid"]
 
+    failed: list[int] = [0]
+
     def save() -> None:
         done = ex.last_done
-        if done is not None and done.k % every == 0:
+        if done is None or done.k % every:
+            return
+        try:
             store.save(capture(ex), done.k, done.t_sim)
+        except (OSError, pickle.PicklingError, TypeError) as e:  # the node flies on
+            failed[0] += 1
+            if failed[0] == 1 or failed[0] % 100 == 0:
+                log.error("%s: critical-data store not written at tick %d (%s; failure #%d): "
+                          "a restart would restore an older one", store.identity.node, done.k,
+                          e, failed[0])
 
     ex.at_tick_end = save
     record = _start(client, store, log)
@@ -69,8 +83,11 @@ def _catch_up(client: TickClient, others: list[str], record: StartRecord,
     bus = client.executive.bus
     tick_key = cat.TICK.key(bus.mission)
     ticks: dict[int, Tick] = {}
+    heard_sim = False
     for owner in others:
-        for sample in bus.fetch_recent(owner):
+        samples = bus.fetch_recent(owner)
+        heard_sim = heard_sim or (owner == topics.SIM and bool(samples))
+        for sample in samples:
             if sample.key != tick_key:
                 bus.take_in(sample)
                 continue
@@ -81,16 +98,17 @@ def _catch_up(client: TickClient, others: list[str], record: StartRecord,
             if tick.k > record.tick:
                 ticks.setdefault(tick.k, tick)
     run = sorted(ticks)
-    gap = bool(run) and run[0] != record.tick + 1
-    if gap:  # the others no longer keep what followed the store: go on from where it is
-        log.error("%s: the sim's ticks %d-%d are no longer kept; rejoining with the state of "
-                  "tick %d", bus.node, record.tick + 1, run[0] - 1, record.tick)
+    gap = ("the sim's last ticks could not be read" if not heard_sim else
+           f"the sim's ticks {record.tick + 1}-{run[0] - 1} are no longer kept"
+           if run and run[0] != record.tick + 1 else "")
+    if gap:  # go on from where it is, numbering afresh: its receivers saw higher numbers
+        log.error("%s: %s; rejoining with the state of tick %d", bus.node, gap, record.tick)
+        bus.number_afresh()
         run = []
     for k in run:
         client.catch_up(ticks[k])
     log.warning("%s: ran again ticks %s since the store", bus.node,
                 f"{run[0]}-{run[-1]}" if run else "(none)")
-    return StartRecord("restored", reason="the ticks since were no longer kept" if gap else "",
-                       tick=run[-1] if run else record.tick,
+    return StartRecord("restored", reason=gap, tick=run[-1] if run else record.tick,
                        t_sim=ticks[run[-1]].t_sim if run else record.t_sim,
                        wall_time=record.wall_time)
