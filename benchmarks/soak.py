@@ -66,10 +66,17 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--every", type=float, default=240.0, help="simulated s between kills")
     p.add_argument("--seed", type=int, default=42, help="the chaos schedule's seed")
     p.add_argument("--out", type=Path, help="where the two runs go (default: a temp folder)")
+    p.add_argument("--reuse-clean", action="store_true",
+                   help="take the clean run already in --out (same duration and code)")
     args = p.parse_args(argv)
     out = args.out or Path(tempfile.mkdtemp(prefix="soak-"))
-    clean, clean_wall = _fly(out / "clean", args.duration, 17551, [])
-    print(f"clean run: {clean['status']}, {args.duration:.0f} s in {clean_wall:.0f} s wall")
+    if args.reuse_clean and (out / "clean" / "summary.json").is_file():
+        clean = json.loads((out / "clean" / "summary.json").read_text())
+        print(f"clean run: {clean['status']}, {clean['duration_s']:.0f} s in "
+              f"{clean['wall_s']:.0f} s wall (reused)")
+    else:
+        clean, clean_wall = _fly(out / "clean", args.duration, 17551, [])
+        print(f"clean run: {clean['status']}, {args.duration:.0f} s in {clean_wall:.0f} s wall")
     schedule = _schedule(args.duration, args.every, np.random.default_rng(args.seed))
     soak, soak_wall = _fly(out / "soak", args.duration, 17552, schedule)
     print(f"soak run: {soak['status']}, {args.duration:.0f} s in {soak_wall:.0f} s wall, "

@@ -401,9 +401,13 @@ def _store_args(out: Path, restart: bool) -> list[str]:
     return ["--cds", str(out / "cds")]
 
 
+RESTART_WINDOW_S = 120.0
+"""Wall time over which restarts of one process are counted against ``MAX_RESTARTS``."""
 MAX_RESTARTS = 3
-"""Restarts of one process (--restart-on-crash) before it is left down (the recorder: before
-the run stops)."""
+"""Restarts of one process (--restart-on-crash) within ``RESTART_WINDOW_S`` after which its next
+death is a crash loop: a flight or ground process is left down, the router's or recorder's
+stops the run.  Deaths further apart are restarted every time (a long soak kills each process
+many times)."""
 RECORDER_READY_S = 30.0
 """How long the recorder, started, has to announce it records (its liveliness token), wall s."""
 SERVICE_READY_S = 30.0
@@ -420,14 +424,15 @@ class _Watch:
     router (no bus) and the recorder (no record) unless ``restart``.  A flight or ground
     process stopping early is an incident: the sim flies on with its last commands, the ground
     declares the silent spacecraft a link fault, and with ``restart`` the process is started
-    again (up to ``MAX_RESTARTS`` times), restored from its critical-data store, while the sim
+    again (unless it was restarted ``MAX_RESTARTS`` times within ``RESTART_WINDOW_S``: a
+    crash loop), restored from its critical-data store, while the sim
     holds the clock.
 
     With ``restart`` the router's and the recorder's deaths are incidents too: each is started
     again with the same command (the router on the same endpoint with the same accounts, and
     the clients reconnect, the sim holding the clock; the recorder continues the archive in the
     next segment, ``run-1.mcap``, ...).  The run stops, naming it, only when one cannot come
-    back: dead again after ``MAX_RESTARTS`` restarts, dead once the sim has finished, or not
+    back: in a crash loop (as above), dead once the sim has finished, or not
     back ``SERVICE_READY_S`` after a restart (the count of appearances of its token,
     ``recorder_up``, or of the sim's through it, ``sim_up``, not grown)."""
 
@@ -438,6 +443,9 @@ class _Watch:
         self.recorder_up, self.sim_up = recorder_up, sim_up
         self.incidents: list[Incident] = []
         self.restarts: dict[str, int] = {}
+        """Restarts so far, per process."""
+        self._restarted_at: dict[str, list[float]] = {}
+        """Per process, the wall times (monotonic s) of its restarts in the last window."""
         self.down: set[str] = set()
         self._back: dict[str, tuple[int, float]] = {}
         """Per service restarted and not yet back: the count of its appearances before the
@@ -521,15 +529,27 @@ class _Watch:
     def _service_restart(self, child: Child, up: Callable[[], int], consequence: str,
                          sim_done: bool) -> str | None:
         n = self.restarts.get(child.name, 0)
-        if sim_done or n >= MAX_RESTARTS:
+        if sim_done or self._looping(child.name):
             return self._stopped(child, consequence + (f" (restarted {n} times)" if n else ""))
         incident = Incident(child.name, child.describe_exit(), self.progress.t_sim, True)
         self.incidents.append(incident)
         log.error("%s; starting it again (%s)", incident, _AGAIN[child.name])
-        self.restarts[child.name] = n + 1
         self._back[child.name] = (up(), time.monotonic() + SERVICE_READY_S)
-        self.sup.restart(child, n + 1)
+        self._restart(child)
         return None
+
+    def _looping(self, name: str) -> bool:
+        """Whether ``name`` was restarted ``MAX_RESTARTS`` times in the last
+        ``RESTART_WINDOW_S``: a crash loop, not to be fed."""
+        now = time.monotonic()
+        recent = [t for t in self._restarted_at.get(name, []) if now - t < RESTART_WINDOW_S]
+        self._restarted_at[name] = recent
+        return len(recent) >= MAX_RESTARTS
+
+    def _restart(self, child: Child) -> None:
+        n = self.restarts[child.name] = self.restarts.get(child.name, 0) + 1
+        self._restarted_at.setdefault(child.name, []).append(time.monotonic())
+        self.sup.restart(child, n)
 
     def _service_silent(self, child: Child, up: Callable[[], int],
                         consequence: str) -> str | None:
@@ -554,15 +574,13 @@ class _Watch:
                 continue
             if sim_done and child.returncode == 0:
                 continue
-            n = self.restarts.get(name, 0)
-            again = self.restart and not sim_done and n < MAX_RESTARTS
+            again = self.restart and not sim_done and not self._looping(name)
             incident = Incident(name, child.describe_exit(), self.progress.t_sim, again)
             self.incidents.append(incident)
             log.error("%s; %s", incident, "starting it again" if again else
                       "the constellation flies on without it")
             if again:
-                self.restarts[name] = n + 1
-                self.sup.restart(child, n + 1)
+                self._restart(child)
             else:
                 self.down.add(name)
 
