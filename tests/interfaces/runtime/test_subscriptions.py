@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import contextlib
+
 import pytest
 
 from interfaces.contracts import catalogue, topics
@@ -43,3 +45,35 @@ def test_routes_and_awaited_keys_follow_the_subscriptions() -> None:
 def test_a_group_of_mixed_types_has_no_kind() -> None:
     subs = [Sub("a/**", Heartbeat, print, False), Sub("a/**", StateEstimate, print, False)]
     assert Group.of(subs).kind is None
+
+
+@pytest.mark.parametrize("scenario", ["default.toml", "paper_fig23.toml"])
+def test_no_node_subscribes_one_key_twice(scenario: str) -> None:
+    """Admission drops a key's number seen before as a duplicate, and the network delivers a
+    sample once per matching subscription: two key expressions of one node matching the same
+    key would lose the second delivery.  No node of the declared topology has such a pair."""
+    from interfaces.contracts.scenario import load_scenario
+    from interfaces.contracts.topology import topology
+    from interfaces.runtime.assembly import executive_of
+    from interfaces.runtime.bus import Bus
+    from interfaces.runtime.channel import ChannelModel
+    from interfaces.runtime.executive import TickClient
+    from interfaces.runtime.transport import InprocNetwork
+    from tests.conftest import REPO
+
+    sc = load_scenario(REPO / "deploy" / "scenarios" / scenario)
+    nodes = [topics.SIM, topics.GROUND,
+             *(topics.sc_node(i) for i in range(1, sc.observers.count + 1))]
+    keys = set()
+    for t in (t for t in vars(catalogue).values() if isinstance(t, catalogue.Topic)):
+        for n in nodes:
+            with contextlib.suppress(ValueError):  # a spacecraft topic of the sim, ...
+                keys.add(t.key(sc.name, n))
+    assert len(keys) > 50
+    for node in topology(sc).nodes:
+        bus = Bus(node.name, sc.name, InprocNetwork().endpoint(),
+                  channel=ChannelModel.of(node.name, sc))
+        TickClient(executive_of(node, bus, sc))
+        for key in keys:
+            matching = [e for e in bus.table.groups if topics.matches(e, key)]
+            assert len(matching) <= 1, f"{node.name} subscribes {key} as {matching}"
