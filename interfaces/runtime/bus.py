@@ -91,6 +91,8 @@ class Bus:
         self.table = SubscriptionTable(self.prefix)
         self.inbox = Inbox(self.node)
         self.recent = RecentSent(self.recent_ticks)
+        self._arriving: set[tuple[str, int]] = set()
+        """(key, number) of the messages being taken in on some thread right now."""
         if self.log is None:
             self.log = logging.getLogger(f"insp.bus.{self.node}")
         if self.channel is not None and self.channel.truth.claim_feed():
@@ -185,17 +187,40 @@ class Bus:
                 if msg is None:
                     return
                 decoded[sub.msg_type] = msg
-        # One envelope per message, whatever the number of local subscribers: the channel
-        # decides once, so every app of the node sees the same messages.  A duplicate is known,
-        # and the number recorded, in the same step (a resent copy and the late original may
-        # come on two threads).
         if not decoded:
             return
+        first = next(iter(decoded.values()))
+        if not self._claim(key, first):
+            return
+        try:  # the immediate handlers first: the barrier must not wake before they ran
+            for sub in group:
+                if sub.immediate:
+                    self._call(sub, decoded[sub.msg_type], key)
+        finally:
+            self._queue(key, group, decoded, (key, first.seq))
+
+    def _claim(self, key: str, msg: Message) -> bool:
+        """Whether ``msg`` is new to this node (not admitted yet, nor arriving on another
+        thread right now: a resent copy and the late original); it is then arriving until
+        ``_queue``."""
+        with self.inbox.lock:
+            if (key, msg.seq) in self._arriving:
+                self.admission.duplicates += 1
+                return False
+            if self.admission.duplicate(key, msg):
+                return False
+            self._arriving.add((key, msg.seq))
+            return True
+
+    def _queue(self, key: str, group: list[Sub], decoded: dict[type[Message], Message],
+               arriving: tuple[str, int]) -> None:
+        """Queue a claimed message for its deferred subscribers (one envelope per message,
+        whatever their number: the channel decides once, so every app of the node sees the
+        same messages), and record its number for the barrier, in one step."""
         src = self.admission.owner(key)
         inbox = self.inbox
         with inbox.lock:
-            if self.admission.duplicate(key, next(iter(decoded.values()))):
-                return
+            self._arriving.discard(arriving)
             deferred: dict[int, tuple[Message, list[Sub]]] = {}
             for sub in group:
                 if not sub.immediate:
@@ -206,9 +231,6 @@ class Bus:
             for msg in decoded.values():
                 self.admission.admit(key, msg)
             inbox.wake()
-        for sub in group:
-            if sub.immediate:
-                self._call(sub, decoded[sub.msg_type], key)
 
     def _on_made_here(self, key_expr: str, key: str, msg: Message) -> None:
         """In-process callback: a message another Bus of this process published.  It was
