@@ -31,7 +31,7 @@ from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.topology import topology
 from interfaces.runtime.cli import add_node_args, open_zenoh, start_node
-from interfaces.runtime.recent import parse_reply
+from interfaces.runtime.recent import fetch
 from interfaces.runtime.zenoh_transport import ZenohTransport
 
 
@@ -195,14 +195,10 @@ def _recent(transport: ZenohTransport, mission: str, nodes: list[str],
     """What ``nodes`` sent in their last ticks, ready to write (their own keys only)."""
     out: list[Pending] = []
     for node in nodes:
-        for _key, payload in transport.query(topics.recent_queryable(mission, node)):
-            try:
-                samples = parse_reply(payload)
-            except ValueError as e:
-                log.warning("%s answered what it sent lately with a malformed reply: %s", node, e)
-                continue
-            out += [prepare_raw(s.key, s.type_name, s.payload) for s in samples
-                    if topics.node_of_key(s.key) == node]
+        samples, malformed = fetch(transport, mission, node)
+        for why in malformed:
+            log.warning("%s answered what it sent lately with a malformed reply: %s", node, why)
+        out += [prepare_raw(s.key, s.type_name, s.payload) for s in samples]
     log.warning("took %d messages the nodes kept of their last ticks", len(out))
     return out
 

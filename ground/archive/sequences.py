@@ -8,9 +8,9 @@ recorder stores it as the MCAP sequence).  Read in archive order over every segm
 * a number one above the key's last is the next message;
 * a number further above skips messages: those between were **lost** (sent, never archived:
   in flight when the recorder died, or sent while it was down);
-* a number at or below the key's last starts a **new incarnation** of its publisher (a process
-  restarted cold counts from 1 again): the messages before it in that incarnation were lost
-  (none when it is 1);
+* a number at or below the key's last, at a later sim time, starts a **new incarnation** of
+  its publisher (a process restarted cold counts from 1 again): the messages before it in that
+  incarnation were lost (none when it is 1);
 * a key's first number n says that the n - 1 before it were lost;
 * 0 is no number (a payload without a usable ``seq``): not counted;
 * a number the Bus itself would refuse (a first one above ``MAX_FIRST_SEQ``, or a jump of more
@@ -19,27 +19,23 @@ recorder stores it as the MCAP sequence).  Read in archive order over every segm
   number stays.  (So a recorder down for more than ``MAX_SEQ_JUMP`` messages of a key would
   not see that key's loss; the sim holds the clock while it is down.)
 
-A message recorded again (the same key, sequence number and sim time as one of the key's last
-``RECENT`` messages, or as one of an earlier segment) is a **duplicate**, kept once.  A number
-counted lost that comes after all (recorded late, out of order: what a recorder took from the
-nodes' last ticks once the network was back) is no longer lost.  To know the repeats of
-earlier segments without holding every number, the ledger keeps, per key, the runs of
+A message recorded again (a number not above the key's last and a sim time not after it, or
+the same key, number and sim time as one of an earlier segment) is a **duplicate**, kept once.
+A number counted lost that comes after all (recorded late, out of order: what a recorder took
+from the nodes' last ticks once the network was back) is no longer lost.  To know the repeats
+of earlier segments without holding every number, the ledger keeps, per key, the runs of
 consecutive numbers each earlier segment held, with their sim times (a few per key: one, plus
 one per gap or incarnation).
 """
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 from interfaces.contracts.catalogue import topic_of
 from interfaces.runtime.admission import MAX_FIRST_SEQ, MAX_SEQ_JUMP
 
-RECENT = 512
-"""Messages of each key remembered to know one recorded twice in a segment (a recorder that
-takes what the nodes kept of their last ticks records some it had: at most a few ticks')."""
 
 
 @dataclass(slots=True)
@@ -57,34 +53,16 @@ class _Run:
                 and self.first_ns <= log_ns <= self.last_ns)
 
 
-class _Recent:
-    """The (number, sim time) of a key's last ``RECENT`` messages: in order, and as a set."""
-
-    __slots__ = ("_order", "_set")
-
-    def __init__(self) -> None:
-        self._order: deque[tuple[int, int]] = deque()
-        self._set: set[tuple[int, int]] = set()
-
-    def add(self, item: tuple[int, int]) -> None:
-        if len(self._order) == RECENT:
-            self._set.discard(self._order.popleft())
-        self._order.append(item)
-        self._set.add(item)
-
-    def __contains__(self, item: object) -> bool:
-        return item in self._set
-
-
 class SequenceLedger:
     """The sequence accounting of one archive read (see the module docstring): fed every
     message in archive order (:meth:`admit`), segment by segment (:meth:`begin_segment`)."""
 
     def __init__(self) -> None:
         self._last: dict[str, int] = {}
+        """Per key, the number of its last message."""
+        self._last_ns: dict[str, int] = {}
+        """Per key, the sim time (ns) of its last message."""
         self._lost: dict[str, int] = {}
-        self._seen: dict[str, _Recent] = {}
-        """Per key, the (number, sim time) of its last ``RECENT`` messages."""
         self._missing: dict[str, set[int]] = {}
         """Per key, the numbers counted lost in its current incarnation."""
         self._earlier: dict[str, list[_Run]] = {}
@@ -105,25 +83,21 @@ class SequenceLedger:
         """Account for the message numbered ``seq`` of ``key`` at sim time ``log_ns`` (ns);
         False if it is a duplicate (to drop)."""
         last = self._last.get(key, 0)
-        seen = self._seen.get(key)
-        if seen is None:
-            seen = self._seen[key] = _Recent()
         if seq == last + 1 and not self._earlier and not self._track:  # the common case
-            self._last[key] = seq
-            seen.add((seq, log_ns))
+            self._last[key], self._last_ns[key] = seq, log_ns
             return True
         if seq <= 0 or seq > (last + MAX_SEQ_JUMP if key in self._last else MAX_FIRST_SEQ):
             return True  # no number, or one the Bus would refuse: not accounted
-        if (seq, log_ns) in seen or (self._earlier and self._repeats(key, seq, log_ns)):
-            self.duplicates += 1
-            return False
-        seen.add((seq, log_ns))
         if self._late(key, seq):
             return True
+        if (seq <= last and log_ns <= self._last_ns[key]) or (
+                self._earlier and self._repeats(key, seq, log_ns)):
+            self.duplicates += 1
+            return False
         if seq != last + 1:
             self._count_lost(key, range(last + 1, seq) if seq > last else range(1, seq),
                              new_incarnation=seq <= last)
-        self._last[key] = seq
+        self._last[key], self._last_ns[key] = seq, log_ns
         if self._track:
             self._extend(key, seq, log_ns)
         return True

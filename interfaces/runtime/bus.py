@@ -48,7 +48,7 @@ from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
 from interfaces.runtime.channel import ChannelModel, Verdict
 from interfaces.runtime.inbox import Envelope, Inbox
-from interfaces.runtime.recent import RECENT_TICKS, RecentSent, parse_reply
+from interfaces.runtime.recent import RECENT_TICKS, RecentSent, fetch
 from interfaces.runtime.schemas import serve_schemas
 from interfaces.runtime.subscriptions import Route, Sub, SubscriptionTable
 from interfaces.runtime.transport import LivenessHandler, RawHandler, Sample, Transport
@@ -337,29 +337,27 @@ class Bus:
     def fetch_recent(self, owner: str, timeout_s: float = 2.0) -> list[Sample]:
         """What node ``owner`` sent in its last ticks (``interfaces.runtime.recent``), its own
         keys only, oldest first; a malformed reply is counted as invalid and skipped."""
-        where = topics.recent_queryable(self.mission, owner)
-        out: list[Sample] = []
-        for _key, payload in self.transport.query(where, timeout_s):
-            try:
-                samples = parse_reply(payload)
-            except ValueError as e:
-                self._invalid(where, str(e))
-                continue
-            out += [s for s in samples if self.admission.owner(s.key) == owner]
-        return out
+        samples, malformed = fetch(self.transport, self.mission, owner, timeout_s)
+        for why in malformed:
+            self._invalid(topics.recent_queryable(self.mission, owner), why)
+        return samples
 
     def take_in(self, sample: Sample) -> int:
         """Receive ``sample`` as if it had just arrived (validated, admitted: one already held
         is a duplicate), unless it is the lockstep's tick (its subscriber judges ticks as they
-        come; old ones are no news).  Returns 1 if it was new to this node."""
+        come; old ones are no news).  Returns 1 if it was taken (new, valid, admitted)."""
         if sample.key in self.admission.judged_by_subscriber:
             return 0
         expr = next((e for e in self.table.groups if topics.matches(e, sample.key)), None)
         if expr is None:
             return 0
-        before = self.admission.duplicates
+        before = self._dropped()
         self._on_sample(expr, sample)
-        return 1 if self.admission.duplicates == before else 0
+        return 1 if self._dropped() == before else 0
+
+    def _dropped(self) -> tuple[int, int, int]:
+        """What this node dropped so far: duplicates, invalid, refused."""
+        return self.admission.duplicates, self.stats.invalid_dropped, self.stats.refused
 
     # --- restarts --------------------------------------------------------------------------
 

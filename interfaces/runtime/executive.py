@@ -131,15 +131,17 @@ class Executive:
                          self.last_done.k)
         self.bus.send_again(self._keys["done"], self.last_done)
 
+    CRITICAL: ClassVar[tuple[str, ...]] = (
+        "stats", "app_errors", "barrier_timeouts", "ticks", "last_done")
+    """The executive's own critical data: its counters and its last answer."""
+
     def checkpoint(self) -> dict[str, object]:
-        """The counters and the last answer (for the node's critical-data store)."""
-        return {"stats": self.stats, "app_errors": self.app_errors,
-                "barrier_timeouts": self.barrier_timeouts, "ticks": self.ticks,
-                "last_done": self.last_done}
+        """The ``CRITICAL`` attributes (for the node's critical-data store)."""
+        return {name: getattr(self, name) for name in self.CRITICAL}
 
     def restore(self, saved: dict[str, object]) -> None:
         """Take back a ``checkpoint``."""
-        for name in ("stats", "app_errors", "barrier_timeouts", "ticks", "last_done"):
+        for name in self.CRITICAL:
             setattr(self, name, saved[name])
 
     def _barrier(self, tick: Tick) -> list[str]:

@@ -21,7 +21,8 @@ from __future__ import annotations
 import json
 from collections import deque
 
-from interfaces.runtime.transport import Sample
+from interfaces.contracts import topics
+from interfaces.runtime.transport import Sample, Transport
 
 RECENT_TICKS = 4
 """Ticks of sent messages kept for a resend request, by default."""
@@ -74,3 +75,17 @@ def parse_reply(payload: bytes) -> list[Sample]:
             for r in rows):
         raise ValueError("a reply is a list of [key, type name, payload] strings")
     return [Sample(k, t, payload=p.encode()) for k, t, p in rows]
+
+
+def fetch(transport: Transport, mission: str, owner: str,
+          timeout_s: float = 2.0) -> tuple[list[Sample], list[str]]:
+    """What node ``owner`` sent in its last ticks, its own keys only, oldest first; and why
+    each malformed reply was set aside (the Bus counts them, the recorder logs them)."""
+    samples: list[Sample] = []
+    malformed: list[str] = []
+    for _key, payload in transport.query(topics.recent_queryable(mission, owner), timeout_s):
+        try:
+            samples += [s for s in parse_reply(payload) if topics.node_of_key(s.key) == owner]
+        except ValueError as e:
+            malformed.append(str(e))
+    return samples, malformed
