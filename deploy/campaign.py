@@ -38,7 +38,7 @@ import logging
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -85,6 +85,8 @@ class FaultSpec(_Strict):
     start_s: Number
     end_s: Number | None = None
     magnitude: Number | None = None
+    velocity_mps: Number | None = None
+    disturbance: Literal["bias", "noise"] | list[Literal["bias", "noise"]] | None = None
 
 
 class Group(_Strict):

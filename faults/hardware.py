@@ -20,6 +20,15 @@ The sim's kinds act on the truth, as a failing unit would:
 * ``camera_calibration`` (common mode, ``spacecraft = 0``): every observer's precisions scaled
   by ``magnitude``, as if the true variance coefficient were k / ``magnitude`` while the ground
   models k: no single observer explains it.
+* ``state_disturbance`` (Sec. III.G's actuator fault): the true relative position moved by
+  ``magnitude`` m and velocity by ``velocity_mps`` m/s, in LVLH.  A ``bias`` (the default)
+  moves them along two directions drawn from the seed: all at once on the tick of ``start_s``
+  without ``end_s``, or spread evenly over the ticks of [start_s, end_s) (a drift).  A
+  ``noise`` draws a Gaussian offset per axis from the fault's own stream: once, with 1σ
+  ``magnitude`` and ``velocity_mps``, without ``end_s``; on every tick of [start_s, end_s),
+  scaled by √(dt / 1 s), so that the 1σ of the walk after 1 s is ``magnitude`` and
+  ``velocity_mps`` and grows as √(duration).  Nav and guidance see the new state through the
+  sensors, as they would after an unplanned impulse, and steer back to the plan.
 
 The link kinds (``link_loss``, ``packet_loss``) act in every node's channel stage
 (``faults/link.py``) and ``faulty_data`` in the faulty spacecraft's software
@@ -58,6 +67,14 @@ class Hardware(Protocol):
 
     @property
     def wheels(self) -> Wheels: ...
+
+
+class Disturbable(Protocol):
+    """The sim's truth as a state disturbance reaches it (``sim/dynamics.py``)."""
+
+    def disturb(self, delta_lvlh: np.ndarray) -> None:
+        """Add ``delta_lvlh`` (N, 6: m, m/s, LVLH) to the observers' relative states."""
+        ...
 
 
 class Cameras(Protocol):
@@ -117,11 +134,20 @@ class FaultInjector:
     hardware: Hardware
     cameras: Cameras
     relnav: list[RelNav]
+    truth: Disturbable | None = None
+    """the truth a ``state_disturbance`` moves (a scenario with one needs it)"""
     detail: list[dict[str, list[float] | float]] = field(init=False)
 
     def __post_init__(self) -> None:
         self._active = [False] * len(self.scenario.faults)
+        self._pending: set[int] = set()  # one-shot disturbances switched on, not yet applied
         self.detail = [self._realise(k, f) for k, f in enumerate(self.scenario.faults)]
+        self._noise = {k: stream(self.scenario.seed, "fault-noise", k)
+                       for k, f in enumerate(self.scenario.faults)
+                       if f.kind == "state_disturbance" and f.disturbance == "noise"}
+        if self.truth is None and any(f.kind == "state_disturbance"
+                                      for f in self.scenario.faults):
+            raise ValueError("a state_disturbance fault needs the truth to act on")
 
     def _realise(self, k: int, f: Fault) -> dict[str, list[float] | float]:
         """The concrete parameters of fault k (directions drawn from its own stream)."""
@@ -146,7 +172,50 @@ class FaultInjector:
         if f.kind == "nav_sensor_bias":
             d = _random_unit(rng)
             return {"direction_lvlh": d.tolist(), "bias_lvlh_m": (mag * d).tolist()}
+        if f.kind == "state_disturbance":
+            return self._realise_disturbance(f, rng)
         return {"magnitude": mag} if f.magnitude is not None else {}
+
+    def _realise_disturbance(self, f: Fault, rng: np.random.Generator
+                             ) -> dict[str, list[float] | float]:
+        """A bias's total offset (directions from the seed) or a noise's 1σ, and the ticks it
+        is spread over (1: at once)."""
+        dt = self.scenario.rates.dt_s
+        ticks = 1 if f.end_s is None else max(1, round((f.end_s - f.start_s) / dt))
+        dv = f.velocity_mps or 0.0
+        if f.disturbance == "noise":
+            return {"sigma_m": float(f.magnitude or 0.0), "sigma_mps": dv, "ticks": ticks}
+        dr_dir, dv_dir = _random_unit(rng), _random_unit(rng)
+        return {"delta_r_lvlh_m": (float(f.magnitude or 0.0) * dr_dir).tolist(),
+                "delta_v_lvlh_mps": (dv * dv_dir).tolist(), "ticks": ticks}
+
+    def _disturbance(self, k: int, f: Fault) -> np.ndarray:
+        """Fault k's offset (6,: m, m/s, LVLH) on one tick it acts."""
+        d = self.detail[k]
+        if f.disturbance != "noise":
+            total = np.concatenate([np.array(d["delta_r_lvlh_m"]), np.array(d["delta_v_lvlh_mps"])])
+            return total / float(d["ticks"])  # type: ignore[arg-type]
+        scale = 1.0 if f.end_s is None else math.sqrt(self.scenario.rates.dt_s)
+        sigma = np.repeat([float(d["sigma_m"]), float(d["sigma_mps"])], 3)  # type: ignore[arg-type]
+        return self._noise[k].standard_normal(6) * sigma * scale
+
+    def disturb(self, t_s: float) -> None:
+        """Move the truth by the state disturbances acting on the tick at ``t_s`` (call after
+        :meth:`update` for the same tick): a one-shot one on its switch-on tick, an interval's
+        on each of its ticks."""
+        delta = None
+        for k, f in enumerate(self.scenario.faults):
+            if f.kind != "state_disturbance" or not self._active[k]:
+                continue
+            if f.end_s is None and k not in self._pending:
+                continue
+            self._pending.discard(k)
+            if delta is None:
+                delta = np.zeros((self.scenario.observers.count, 6))
+            delta[f.spacecraft - 1] += self._disturbance(k, f)
+        if delta is not None:
+            assert self.truth is not None  # refused at construction otherwise
+            self.truth.disturb(delta)
 
     def update(self, t_s: float) -> list[FaultSwitch]:
         """Apply every fault whose state changes at ``t_s`` (on at start_s ≤ t, off at end_s ≤ t);
@@ -158,6 +227,8 @@ class FaultInjector:
                 self._active[k] = on
                 if f.kind in HARDWARE_KINDS:
                     self._apply(k, f, on)
+                if f.kind == "state_disturbance" and on:
+                    self._pending.add(k)
                 out.append(FaultSwitch(k, f, on, t_s, self.detail[k]))
         return out
 

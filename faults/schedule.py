@@ -18,8 +18,9 @@ from interfaces.contracts.scenario import Fault
 from interfaces.contracts.timing import TIME_TOL_S
 
 HARDWARE_KINDS = frozenset({"thruster_bias", "pointing_actuator", "camera_degradation",
-                            "camera_misalignment", "nav_sensor_bias", "camera_calibration"})
-"""Faults of the sim's units."""
+                            "camera_misalignment", "nav_sensor_bias", "camera_calibration",
+                            "state_disturbance"})
+"""Faults of the sim's units (and of the truth they move: ``state_disturbance``)."""
 LINK_KINDS = frozenset({"link_loss", "packet_loss"})
 """Faults of a spacecraft's links (every link it has, both ways)."""
 SOFTWARE_KINDS = frozenset({"faulty_data"})

@@ -440,6 +440,12 @@ class RelativeTruth:
         c, _ = _basis_and_rate(self._y[0])
         return self._y[1:, 0:3] @ c.T
 
+    def disturb(self, delta_lvlh: npt.ArrayLike) -> None:
+        """Add ``delta_lvlh`` (N, 6: m, m/s, in the chief's LVLH frame) to the deputies'
+        relative states at once (a state disturbance: ``faults/hardware.py``)."""
+        rel = self.rel_lvlh() + np.asarray(delta_lvlh, dtype=float)
+        self._y[1:] = lvlh_to_eci(self._y[0], rel)
+
     # ----- dynamics ---------------------------------------------------------
 
     def _deriv(self, y: FloatArray, a_lvlh: FloatArray | None) -> FloatArray:

@@ -123,7 +123,7 @@ class SimNode:
             RelNavSensor(sc.sensors.relnav_sigma_r_m, sc.sensors.relnav_sigma_v_mps,
                          stream(sc.seed, "relnav", i)) for i in self.ids
         ]
-        self.faults = FaultInjector(sc, self.hw, self.cameras, self.sensors)
+        self.faults = FaultInjector(sc, self.hw, self.cameras, self.sensors, self.truth)
         m = self.bus.mission
         nodes = [topics.sc_node(i) for i in self.ids]
         self._keys = {
@@ -276,6 +276,7 @@ class SimNode:
                 sender=topics.SIM, t_sim=t, spacecraft=f.spacecraft, kind=f.kind,
                 active=s.active, magnitude=f.magnitude, start_s=f.start_s, end_s=f.end_s,
                 detail=s.detail))
+        self.faults.disturb(t)
         rel = self.truth.rel_lvlh()
         hw = self.hw
         self._q_now = self._q_lvlh_eci()  # reused for the thrust of this tick

@@ -29,6 +29,7 @@ EXPECTED_CLASS: dict[str, FaultClass] = {
     "camera_degradation": "camera", "camera_misalignment": "camera",
     "nav_sensor_bias": "state_sensor", "link_loss": "link", "packet_loss": "link",
     "faulty_data": "data_integrity", "camera_calibration": "common_mode",
+    "state_disturbance": "actuator",
 }
 """The class each fault kind should be identified as (docs/contracts.md)."""
 

@@ -19,6 +19,7 @@ from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Scenario
 from sim.attitude import AttitudeTruth
 from sim.camera import TruthCameras
+from sim.dynamics import RelativeTruth, circular_chief_eci
 from faults.hardware import FaultInjector
 from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
@@ -29,13 +30,13 @@ def _scenario(*faults: dict) -> Scenario:
                                     "observers": {"count": 2}, "faults": list(faults)})
 
 
-def _injector(sc: Scenario) -> FaultInjector:
+def _injector(sc: Scenario, truth: object = None) -> FaultInjector:
     hw = ObserverHardware(sc, Rotation.identity())
     pos, nor = sphere_pois(300, 5.0)
     cams = TruthCameras(pos, nor, Camera(), np.array([0.0, 0.0, 1.0]), 0.05,
                         [stream(1, "camera", i) for i in (1, 2)])
     relnav = [RelNavSensor(0.1, 0.002, stream(1, "relnav", i)) for i in (1, 2)]
-    return FaultInjector(sc, hw, cams, relnav)
+    return FaultInjector(sc, hw, cams, relnav, truth)  # type: ignore[arg-type]
 
 
 def test_switches_on_at_start_and_off_at_end_once() -> None:
@@ -148,3 +149,88 @@ def test_common_mode_calibration_fault_scales_every_camera() -> None:
 def test_common_mode_kinds_and_spacecraft_zero_go_together(spacecraft: int, kind: str) -> None:
     with pytest.raises(ValueError, match="observer"):
         _scenario({"spacecraft": spacecraft, "kind": kind, "start_s": 0.0, "magnitude": 0.5})
+
+
+class _Recorder:
+    """A truth that records the disturbances it is given (isolates the injector's timing)."""
+
+    def __init__(self) -> None:
+        self.deltas: list[np.ndarray] = []
+
+    def disturb(self, delta_lvlh: np.ndarray) -> None:
+        self.deltas.append(np.array(delta_lvlh))
+
+
+def _disturbed(fault: dict, ticks: int) -> tuple[FaultInjector, list[np.ndarray]]:
+    """Run the injector over ``ticks`` ticks of 0.1 s; the per-tick deltas (zeros when none)."""
+    sc = _scenario({"spacecraft": 2, "kind": "state_disturbance", **fault})
+    truth = _Recorder()
+    inj = _injector(sc, truth)
+    out = []
+    for k in range(ticks):
+        t = k * sc.rates.dt_s
+        before = len(truth.deltas)
+        inj.update(t)
+        inj.disturb(t)
+        out.append(truth.deltas[-1] if len(truth.deltas) > before else np.zeros((2, 6)))
+    return inj, out
+
+
+def test_state_disturbance_bias_jumps_once_by_its_magnitudes() -> None:
+    inj, deltas = _disturbed({"start_s": 1.0, "magnitude": 3.0, "velocity_mps": 0.02}, 30)
+    moved = [k for k, d in enumerate(deltas) if np.any(d)]
+    assert moved == [10]  # the tick of start_s only
+    d = deltas[10]
+    assert np.all(d[0] == 0.0)  # only spacecraft 2
+    assert np.linalg.norm(d[1, :3]) == pytest.approx(3.0, rel=1e-12)
+    assert np.linalg.norm(d[1, 3:]) == pytest.approx(0.02, rel=1e-12)
+    assert d[1, :3].tolist() == inj.detail[0]["delta_r_lvlh_m"]
+
+
+def test_state_disturbance_bias_over_an_interval_is_spread_evenly() -> None:
+    _, deltas = _disturbed({"start_s": 1.0, "end_s": 3.0, "magnitude": 2.0}, 50)
+    moved = [k for k, d in enumerate(deltas) if np.any(d)]
+    assert moved == list(range(10, 30))  # the ticks of [1 s, 3 s)
+    total = np.sum(deltas, axis=0)[1]
+    assert np.linalg.norm(total[:3]) == pytest.approx(2.0, rel=1e-12)
+    assert np.all(total[3:] == 0.0)
+
+
+def test_state_disturbance_noise_walks_with_sqrt_time_and_repeats_from_the_seed() -> None:
+    fault = {"start_s": 0.0, "end_s": 400.0, "magnitude": 0.5, "velocity_mps": 0.001,
+             "disturbance": "noise"}
+    _, deltas = _disturbed(fault, 4000)
+    steps = np.array([d[1] for d in deltas])
+    # per tick, per axis: 1σ = magnitude·√dt; 12,000 draws give the σ to about 1%
+    assert steps[:, :3].std() == pytest.approx(0.5 * math.sqrt(0.1), rel=0.03)
+    assert steps[:, 3:].std() == pytest.approx(0.001 * math.sqrt(0.1), rel=0.03)
+    _, again = _disturbed(fault, 50)
+    assert all(np.array_equal(a, b) for a, b in zip(again, deltas[:50]))
+
+
+def test_the_truth_takes_a_disturbance_in_lvlh_exactly() -> None:
+    chief = circular_chief_eci(500e3, math.radians(51.6))
+    rel = np.array([[10.0, 0.0, 5.0, 0.0, -0.02, 0.0], [0.0, 20.0, 0.0, 0.01, 0.0, 0.0]])
+    truth = RelativeTruth(chief, rel, energy_match=False, compiled=False)
+    delta = np.zeros((2, 6))
+    delta[1] = [1.0, -2.0, 0.5, 0.003, 0.0, -0.001]
+    truth.disturb(delta)
+    assert np.allclose(truth.rel_lvlh(), rel + delta, atol=1e-9)
+
+
+@pytest.mark.parametrize("fault, says", [
+    ({"magnitude": -1.0}, ">= 0"),
+    ({"magnitude": 0.0, "velocity_mps": 0.0}, "not both 0"),
+    ({"magnitude": 1.0, "velocity_mps": -0.1}, ">= 0"),
+    ({}, "needs a magnitude"),
+    ({"magnitude": 1.0, "disturbance": "wobble"}, "disturbance"),
+])
+def test_a_bad_state_disturbance_is_refused(fault: dict, says: str) -> None:
+    with pytest.raises(ValueError, match=says):
+        _scenario({"spacecraft": 1, "kind": "state_disturbance", "start_s": 5.0, **fault})
+
+
+def test_velocity_is_refused_on_other_kinds() -> None:
+    with pytest.raises(ValueError, match="state_disturbance only"):
+        _scenario({"spacecraft": 1, "kind": "thruster_bias", "start_s": 5.0, "magnitude": 0.1,
+                   "velocity_mps": 0.1})
