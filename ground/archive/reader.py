@@ -63,7 +63,7 @@ from pydantic import ValidationError
 
 from ground.archive.segments import SEGMENT_RECORD, segment_paths
 from ground.archive.sequences import SequenceLedger
-from interfaces.contracts.catalogue import Topic
+from interfaces.contracts.catalogue import TICK, Topic, topic_of
 from interfaces.contracts.messages import Message, registry
 from interfaces.contracts.topics import matches
 
@@ -197,6 +197,14 @@ class RunArchive:
     def __repr__(self) -> str:
         state = f"truncated ({self.stop_reason})" if self.truncated else "complete"
         return f"RunArchive({str(self.path)!r}, {len(self._records)} records, {state})"
+
+    def mission(self) -> str:
+        """The run's mission (key-space name), from its lockstep ticks' key; ArchiveError when
+        no tick was archived (streamed ticks count: their keys are known)."""
+        tick = next((k for k in self.topics() if topic_of(k) is TICK), None)
+        if tick is None:
+            raise ArchiveError(f"{self.path}: no lockstep ticks archived: its mission is unknown")
+        return tick.split("/")[1]
 
     def topics(self) -> dict[str, tuple[str, int]]:
         """Key -> (type name, message count), keys sorted.

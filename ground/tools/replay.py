@@ -191,7 +191,7 @@ def replay_run(path: Path, settings: dict[str, str] | None = None,
     start = time.perf_counter()
     archive = load_run(path, stream={t.any_mission(): _drop for t in UNREAD})
     replay_scenario = with_settings(scenario or scenario_of(archive), settings or {})
-    mission = _mission_of(archive)
+    mission = archive.mission()
     replayed = _run_ground(archive, mission, replay_scenario)
     return Replay(replay_scenario, GroundOutput.of_archive(archive, mission), replayed,
                   time.perf_counter() - start)
@@ -214,13 +214,6 @@ def _run_ground(archive: RunArchive, mission: str, scenario: Scenario) -> Ground
 
 def _drop(_rec: Record) -> None:
     """Sink of the records a replay does not read."""
-
-
-def _mission_of(archive: RunArchive) -> str:
-    tick = next((k for k in archive.topics() if cat.topic_of(k) is cat.TICK), None)
-    if tick is None:
-        raise ArchiveError("no lockstep ticks archived, nothing to replay")
-    return tick.split("/")[1]
 
 
 def _play(records: Iterable[Record], player: Any, own_prefix: str) -> None:
