@@ -21,6 +21,9 @@ A campaign TOML names a base scenario and groups of runs::
     name = "nominal"
     nominal = true                        # no fault at all
 
+``study = "formations"`` (optional) also writes the formation study (Sec. III.G) beside the
+report (ground/analysis/formation_study.py).
+
 Each group expands to (its seeds) × (the Cartesian product of every list-valued fault field,
 in file order); every range is then drawn from a generator seeded by (campaign name, group,
 run index), so the list is the same on every machine and every restart.  A group may also
@@ -109,6 +112,9 @@ class Campaign(_Strict):
     base: str
     seeds: Annotated[list[int], Field(min_length=1)] | Seeds = Field(default_factory=lambda: [1])
     duration_s: float | None = Field(default=None, gt=0.0)
+    study: Literal["formations"] | None = None
+    """a study report written beside report.md (``formations``: study.md,
+    ground/analysis/formation_study.py)"""
     groups: list[Group] = Field(min_length=1)
 
     @model_validator(mode="after")

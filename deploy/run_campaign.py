@@ -60,6 +60,7 @@ from deploy.campaign import (  # noqa: E402
 )
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
 from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
+from ground.analysis.formation_study import write_formation_study  # noqa: E402
 from ground.analysis.run_summary import RunSummary  # noqa: E402
 from ground.tools.replay import parse_settings  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
@@ -204,8 +205,7 @@ def main(argv: list[str] | None = None) -> int:
                   "directory)", file=sys.stderr)
             return 2
         saved = json.loads(index.read_text())
-        write_campaign_report(args.out, saved["name"], saved["runs"])
-        print(f"report: {args.out / 'report.md'}", file=sys.stderr)
+        _reports(args.out, saved["name"], saved["runs"], saved.get("study"))
         return 0
     try:
         campaign, runs = load_campaign(args.campaign)
@@ -217,16 +217,23 @@ def main(argv: list[str] | None = None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     if args.campaign.resolve() != (args.out / "campaign.toml").resolve():
         shutil.copyfile(args.campaign, args.out / "campaign.toml")
-    index.write_text(json.dumps({"name": campaign.name, "runs": [r.id for r in runs]},
-                                indent=1) + "\n")
+    index.write_text(json.dumps({"name": campaign.name, "runs": [r.id for r in runs],
+                                 "study": campaign.study}, indent=1) + "\n")
     status = 0
     if not args.report_only:
         status = _run(runs, args)
-    write_campaign_report(args.out, campaign.name, [r.id for r in runs])
-    print(f"report: {args.out / 'report.md'}", file=sys.stderr)
+    _reports(args.out, campaign.name, [r.id for r in runs], campaign.study)
     if status == 0 and any(_failed(args.out, r.id) for r in runs):
         return 1
     return status
+
+
+def _reports(out: Path, name: str, ids: list[str], study: str | None) -> None:
+    """The campaign's report, and its study's (``study = "formations"``) when it names one."""
+    write_campaign_report(out, name, ids)
+    print(f"report: {out / 'report.md'}", file=sys.stderr)
+    if study == "formations":
+        print(f"study: {write_formation_study(out, ids)}", file=sys.stderr)
 
 
 def _replay(args: argparse.Namespace) -> int:

@@ -17,11 +17,14 @@ from interfaces.contracts.timing import TIME_TOL_S
 
 @dataclass
 class Coverage:
-    """H(t) of all images fused (sampled at each image time, s) and each observer's reported
-    H_i(t)."""
+    """H(t) of all images fused (sampled at each image time, s), each observer's H_j(t) on that
+    fused map (Eq. 8: the centralized decomposition, sampled with H) and each observer's
+    reported H_i(t)."""
 
     t_s: list[float] = field(default_factory=list)
     h: list[float] = field(default_factory=list)
+    h_j: list[list[float]] = field(default_factory=list)
+    """per sample, every observer's contribution H_j on the map of all images (Eq. 8)"""
     h_i: dict[int, tuple[list[float], list[float]]] = field(default_factory=dict)
     h_initial: float = 0.0
     fraction_observed: float = 0.0
@@ -54,10 +57,15 @@ class CoverageFuser:
         """Fuse one image (H is sampled before the first image at or after each sample time)."""
         if img.t_sim >= self._next_sample - TIME_TOL_S:
             self.out.t_s.append(img.t_sim)
-            self.out.h.append(self.fused.cost())
+            self._sample()
             self._next_sample = img.t_sim + self.sample_every_s
         self.fused.add(img.spacecraft, *img.arrays())
         self._last_t = img.t_sim
+
+    def _sample(self) -> None:
+        """H and every H_j of the images fused so far (the time is appended by the caller)."""
+        self.out.h.append(self.fused.cost())
+        self.out.h_j.append(self.fused.contributions().tolist())
 
     def add_record(self, rec: Record) -> None:
         """Decode an archived image and fuse it."""
@@ -68,7 +76,7 @@ class CoverageFuser:
         from ``archive``."""
         out = self.out
         out.t_s.append(self._last_t)
-        out.h.append(self.fused.cost())
+        self._sample()
         out.fraction_observed = self.fused.seen() / self.scenario.target.pois
         for tm in archive.of(cat.INFO_COST, mission):
             ts, hs = out.h_i.setdefault(tm.spacecraft, ([], []))
