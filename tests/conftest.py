@@ -34,6 +34,25 @@ def small_scenario(name: str = "t", **sections: object) -> Scenario:
     return Scenario.model_validate(base)
 
 
+def app_alone(cls: type[Any], scenario: Scenario, node: str = "sc1",
+              spacecraft: int | None = 1) -> tuple[Any, list[Message]]:
+    """An app of class ``cls`` on node ``node`` outside any executive, its publications kept in
+    the returned list instead of sent (to test an app's handlers and step directly)."""
+    import logging
+
+    from interfaces.runtime.app import AppContext
+    from interfaces.runtime.bus import Bus
+    from interfaces.runtime.transport import InprocNetwork
+
+    ctx = AppContext(bus=Bus(node, scenario.name, InprocNetwork().endpoint()), scenario=scenario,
+                     node=node, spacecraft=spacecraft, rng=np.random.default_rng(0),
+                     log=logging.getLogger("t"))
+    app = cls(ctx)
+    sent: list[Message] = []
+    app.publish = lambda name, msg: sent.append(msg)
+    return app, sent
+
+
 def write_scenario(path: Path, scenario: Scenario) -> Path:
     """Write a scenario as TOML (tables for the sections, inline tables/arrays inside)."""
     lines: list[str] = []

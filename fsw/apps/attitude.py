@@ -61,7 +61,7 @@ class AttitudeApp(App):
     OUTPUTS = (Output("wheels", cat.WHEELS), Output("estimate", cat.ATTITUDE_ESTIMATE))
     CRITICAL = ("q", "b", "P", "nis", "h_wheels", "tau", "w_est", "target", "target_rate",
                 "target_accel", "target_t", "slew", "slew_t0", "slew_end", "q_point", "mode",
-                "_meas", "t_att", "_est", "_x_est")
+                "_meas", "t_att", "_est", "_x_est", "t_star")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -101,6 +101,7 @@ class AttitudeApp(App):
         self.mode = "init"
         self._meas: list[AttitudeMeasurement] = []
         self.t_att: float | None = None  # time of the MEKF state, s
+        self.t_star: float | None = None  # time of the last star-tracker attitude, s
         self._est: StateEstimate | None = None
         self._x_est = np.zeros(6)  # the nav estimate as an array (LVLH, m, m/s)
 
@@ -154,6 +155,7 @@ class AttitudeApp(App):
             self.q, self.b, self.P = kern.mekf_propagate(self.q, self.b, self.P, w_meas, dt,
                                                          self.sigma_v, self.sigma_u)
         if meas.star_tracker is not None:
+            self.t_star = meas.t_sim
             R = np.diag(np.full(3, meas.st_sigma_cross_rad**2))
             R[self.st_axis, self.st_axis] = meas.st_sigma_roll_rad**2
             if self.q is None:
@@ -234,7 +236,9 @@ class AttitudeApp(App):
             q_lvlh_body=q_lvlh.tolist(), gyro_bias_radps=self.b.tolist(),
             sigma_att_rad=float(math.sqrt(max(0.0, np.trace(self.P[:3, :3])))),
             target_lvlh_m=self._target_at(t).tolist(), pointing_error_rad=error,
-            mode=self.mode, torque_body_nm=self.tau.tolist(), nis=self.nis))  # type: ignore[arg-type]
+            mode=self.mode, torque_body_nm=self.tau.tolist(), nis=self.nis,  # type: ignore[arg-type]
+            wheel_momentum_nms=self.h_wheels.tolist(),
+            star_tracker_age_s=None if self.t_star is None else max(0.0, t - self.t_star)))
 
 
 def _finite(tau: np.ndarray) -> np.ndarray:

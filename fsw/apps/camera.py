@@ -27,6 +27,7 @@ from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     AttitudeEstimate,
     CameraImage,
+    OnboardCommand,
     PointingTarget,
     PoiObservations,
     StateEstimate,
@@ -48,10 +49,11 @@ class CameraApp(App):
         Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
         Input(cat.NAV_ESTIMATE, "on_estimate"),
         Input(cat.ATTITUDE_ESTIMATE, "on_attitude"),
+        Input(cat.FDIR_COMMAND, "on_command"),
     )
     OUTPUTS = (Output("observations", cat.OBSERVATIONS), Output("pointing", cat.POINTING))
     CRITICAL = ("map", "aim_start", "aim_goal", "aim_t", "next_retarget", "_images", "_est",
-                "_tracking")
+                "_tracking", "off", "max_variance", "_to_centre")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -68,6 +70,8 @@ class CameraApp(App):
         self._images: list[CameraImage] = []
         self._est: StateEstimate | None = None
         self._tracking = False  # the attitude app tracks the aim (not slewing, initialised)
+        self.off = False  # the onboard FDIR turned the camera off: no observations shared
+        self._to_centre = False  # the onboard FDIR asked for the target's centre
 
     def on_image(self, msg: CameraImage) -> None:
         self._images.append(msg)
@@ -82,10 +86,22 @@ class CameraApp(App):
     def on_attitude(self, msg: AttitudeEstimate) -> None:
         self._tracking = msg.mode == "track"
 
+    def on_command(self, msg: OnboardCommand) -> None:
+        """The onboard FDIR: ``camera_off`` stops the observations for good; ``point_target``
+        glides the aim back to the target's centre and keeps it there."""
+        if msg.command == "camera_off" and not self.off:
+            self.off = True
+            self.log.warning("camera off (onboard FDIR): no more observations")
+        elif msg.command == "point_target":
+            self._to_centre = True
+
     def step(self, t: float) -> None:
         images, self._images = self._images, []
-        for img in images:
+        for img in images if not self.off else ():
             self.publish("observations", PoiObservations.of_image(img, self.ctx.node, t))
+        if self._to_centre:
+            self._to_centre, self.max_variance = False, False
+            self.aim_start, self.aim_t, self.aim_goal = self._aim_at(t)[0], t, np.zeros(3)
         if self.max_variance and t >= self.next_retarget - TIME_TOL_S and self._est is not None \
                 and self._tracking:
             self.next_retarget = t + RETARGET_S

@@ -34,6 +34,7 @@ from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     AttitudeEstimate,
     GuidanceStatus,
+    OnboardCommand,
     ProAssignment,
     ProAssignments,
     StateEstimate,
@@ -60,6 +61,7 @@ class GuidanceApp(App):
         Input(cat.ASSIGNMENTS, "on_assignments"),
         Input(cat.NAV_ESTIMATE, "on_estimate"),
         Input(cat.ATTITUDE_ESTIMATE, "on_attitude"),
+        Input(cat.FDIR_COMMAND, "on_command"),
     )
     OUTPUTS = (
         Output("thrust", cat.THRUST),
@@ -67,7 +69,7 @@ class GuidanceApp(App):
         Output("status", cat.GUIDANCE_STATUS),
     )
     CRITICAL = ("assignment", "pending", "previous", "refused_id", "pro", "plan", "plan_t0",
-                "planned_id", "dv_commanded", "_est", "_att", "mpc.warm")
+                "planned_id", "dv_commanded", "_est", "_att", "mpc.warm", "safe_from")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -93,6 +95,8 @@ class GuidanceApp(App):
         self.dv_commanded = 0.0
         self._est: StateEstimate | None = None
         self._att: AttitudeEstimate | None = None
+        self.safe_from: int | None = None
+        """in the onboard FDIR's safe hold since this assignment id was the newest (None: not)"""
 
     # --- inputs ------------------------------------------------------------------------------
 
@@ -113,9 +117,21 @@ class GuidanceApp(App):
     def on_attitude(self, msg: AttitudeEstimate) -> None:
         self._att = msg
 
+    def on_command(self, msg: OnboardCommand) -> None:
+        """The onboard FDIR's safe hold: no thrust and no transfer until an assignment newer
+        than every one received so far (fsw/apps/fdir.py)."""
+        if msg.command == "safe_hold" and self.safe_from is None:
+            self.safe_from = max([a.assignment_id for a in (self.assignment, self.pending) if a]
+                                 + [self.refused_id])
+            self.log.warning("safe hold (onboard FDIR): thrust off until an assignment newer "
+                             "than %d", self.safe_from)
+
     # --- cycle ---------------------------------------------------------------------------------
 
     def step(self, t: float) -> None:
+        if self._in_safe_hold():
+            self._status(t, "safe")
+            return
         if self.pending is not None and t >= self.pending.t_depart_s - TIME_TOL_S:
             self._activate(self.pending)
             self.pending = None
@@ -139,6 +155,16 @@ class GuidanceApp(App):
                 else "hold")
         err = x - refs[0]
         self._status(t, mode, err, u, res.status, 1e3 * res.solve_time_s)
+
+    def _in_safe_hold(self) -> bool:
+        """Whether safe hold goes on: it ends when a newer assignment has been received."""
+        if self.safe_from is None:
+            return False
+        if self.pending is not None and self.pending.assignment_id > self.safe_from:
+            self.log.warning("safe hold ended by assignment %d", self.pending.assignment_id)
+            self.safe_from = None
+            return False
+        return True
 
     def _activate(self, a: ProAssignment) -> None:
         """Fly assignment ``a`` from now (its transfer is planned in this cycle)."""

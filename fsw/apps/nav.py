@@ -24,6 +24,7 @@ from interfaces.contracts.messages import (
     MAX_RANGE_M,
     MAX_SPEED_MPS,
     GuidanceStatus,
+    OnboardCommand,
     RelNavMeasurement,
     StateEstimate,
 )
@@ -39,9 +40,10 @@ STATE_BOUNDS = np.array([MAX_RANGE_M] * 3 + [MAX_SPEED_MPS] * 3)
 class NavApp(App):
     NAME = "nav"
     RATE = "mid"
-    INPUTS = (Input(cat.RELNAV, "on_relnav"), Input(cat.GUIDANCE_STATUS, "on_guidance"))
+    INPUTS = (Input(cat.RELNAV, "on_relnav"), Input(cat.GUIDANCE_STATUS, "on_guidance"),
+              Input(cat.FDIR_COMMAND, "on_command"))
     OUTPUTS = (Output("estimate", cat.NAV_ESTIMATE),)
-    CRITICAL = ("x", "P", "t_est", "nis", "resets", "_cmd", "_meas")
+    CRITICAL = ("x", "P", "t_est", "nis", "resets", "_cmd", "_meas", "_reset_asked")
     REBUILT = ("_models",)  # the discrete models by step, a cache
 
     def __init__(self, ctx: AppContext) -> None:
@@ -57,6 +59,7 @@ class NavApp(App):
         self.cmd_period = 1.0 / sc.rates.low_hz
         self._cmd: tuple[float, np.ndarray] = (0.0, np.zeros(3))  # (start s, LVLH accel m/s²)
         self._meas: RelNavMeasurement | None = None
+        self._reset_asked = False  # by the onboard FDIR (fsw/apps/fdir.py)
         self._models: dict[float, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 
     def on_relnav(self, msg: RelNavMeasurement) -> None:
@@ -65,12 +68,19 @@ class NavApp(App):
     def on_guidance(self, msg: GuidanceStatus) -> None:
         self._cmd = (msg.t_sim, np.array(msg.accel_lvlh_mps2))
 
+    def on_command(self, msg: OnboardCommand) -> None:
+        if msg.command == "nav_reset":
+            self._reset_asked = True
+
     def _accel(self, t: float) -> np.ndarray:
         """The commanded acceleration acting from time t (zero outside its hold period)."""
         t0, u = self._cmd
         return u if t0 - TIME_TOL_S <= t < t0 + self.cmd_period - TIME_TOL_S else np.zeros(3)
 
     def step(self, t: float) -> None:
+        if self._reset_asked:
+            self._reset_asked = False
+            self._restart(t, "reset by the onboard FDIR")
         meas, self._meas = self._meas, None
         if self.x is None:
             if meas is None:
@@ -85,17 +95,18 @@ class NavApp(App):
                     self.x, self.P, np.array(meas.r_m + meas.v_mps), np.eye(6), _R(meas))
         self._propagate_to(t)
         if kalman.diverged(self.x, self.P, STATE_BOUNDS):
-            self._restart(t)
+            self._restart(t, "diverged")
             return
         self.publish("estimate", StateEstimate(
             sender=self.ctx.node, t_sim=t, spacecraft=self.ctx.spacecraft or 0,
             x=self.x.tolist(), P=self.P.tolist(), nis=self.nis, resets=self.resets))
 
-    def _restart(self, t: float) -> None:
-        """Drop a diverged estimate: the next measurement starts the filter again."""
+    def _restart(self, t: float, why: str) -> None:
+        """Drop the estimate (diverged, or reset by command): the next measurement starts the
+        filter again."""
         self.resets += 1
-        self.log.warning("%s nav diverged at t=%.1f s; restarting from the next measurement "
-                         "(reset #%d)", self.ctx.node, t, self.resets)
+        self.log.warning("%s nav %s at t=%.1f s; restarting from the next measurement "
+                         "(reset #%d)", self.ctx.node, why, t, self.resets)
         self.x, self.P, self.nis = None, np.eye(6), None
 
     def _propagate_to(self, t: float) -> None:

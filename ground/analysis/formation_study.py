@@ -38,6 +38,8 @@ from ground.archive.reader import Record, load_run  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts.scenario import Fault  # noqa: E402
 
+OTHERS = ("C0", "C1", "C2", "C4", "C5", "C6", "C7", "C8", "C9")
+"""Colours of the agents that are not faulty (red is the faulty one's)."""
 SAMPLE_S = 10.0
 """Sampling interval of H and H_i, s."""
 UNREAD = (cat.TRUTH, cat.ATTITUDE_SENSORS, cat.RELNAV, cat.NAV_ESTIMATE, cat.ATTITUDE_ESTIMATE,
@@ -206,7 +208,7 @@ def _case_figure(path: Path, run: StudyRun, twin: StudyRun) -> None:
     ax[0].plot(c.t_s, c.h, "r-", lw=1.2, label="H, faulty run")
     ax[0].set_ylabel("global cost H (Eq. 7)")
     for j in range(c.h_i.shape[1]):
-        style = {"color": "r" if j == k else f"C{j}", "lw": 1.4 if j == k else 0.8}
+        style = {"color": "r" if j == k else OTHERS[j % len(OTHERS)], "lw": 1.4 if j == k else 0.8}
         ax[1].plot(c.t_s, c.h_i[:, j], "-", label=f"H_{j + 1}", **style)
         ax[1].plot(w.t_s, w.h_i[:, j], ":", **style)
         ax[2].plot(c.t_s[1:], np.diff(c.h_i[:, j]), "-", label=f"ΔH_{j + 1}", **style)

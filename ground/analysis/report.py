@@ -51,6 +51,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     lines += _coverage_section(out, digest.coverage, summary)
     lines += _fdir_section(out, archive, mission, summary)
     lines += _links_section(summary) + _exec_section(summary) + _incidents_section(summary)
+    lines += _onboard_section(summary)
     lines += _archive_section(summary)
     return _write(out, lines)
 
@@ -365,6 +366,38 @@ def _incidents_section(summary: RunSummary) -> list[str]:
         gaps = ", ".join(f"{a:.1f}-{b:.1f}" for a, b in outages.get(sc, []))
         rows.append(f"| {node} | {events or '-'} | {gaps or '-'} |")
     return rows + [""]
+
+
+def _onboard_section(summary: RunSummary) -> list[str]:
+    """What the onboard FDIR did (fsw/apps/fdir.py): per injected fault, then every event."""
+    ob = summary.onboard_fdir
+    if ob is None:
+        return []
+
+    def at(v: float | None) -> str:
+        return "-" if v is None else f"{v:.1f}"
+
+    rows = ["## Onboard FDIR", "",
+            f"{ob.trips} watchpoint trips, {ob.reports} ground reports received, {ob.actions} "
+            f"stored sequences started, {ob.recoveries} safe holds ended by a new assignment.",
+            ""]
+    if ob.per_fault:
+        rows += ["| fault | onset | ground detected | class (at) | report received | action (at) "
+                 "| first trip (at): its action |", "|---|---|---|---|---|---|---|"]
+        rows += [f"| sc{f.spacecraft} {f.kind} | {f.start_s:.0f} | {at(f.detected_s)} | "
+                 f"{f.identified_class or '-'} ({at(f.identified_s)}) | "
+                 f"{at(f.report_received_s)} | {f.action or '-'} ({at(f.action_s)}) | "
+                 f"{f.trip or '-'} ({at(f.trip_s)}): {f.trip_action or '-'} |"
+                 for f in ob.per_fault]
+        rows.append("")
+    if ob.events:
+        rows += ["| t (s) | sc | event | name | value / limit | detail |",
+                 "|---|---|---|---|---|---|"]
+        rows += [f"| {e.t_sim:.1f} | {e.spacecraft} | {e.event} | {e.name} | "
+                 + (f"{e.value:.3g} / {e.limit:.3g}" if e.value is not None and e.limit else "-")
+                 + f" | {e.detail} |" for e in ob.events]
+        rows.append("")
+    return rows
 
 
 def _archive_section(summary: RunSummary) -> list[str]:

@@ -13,6 +13,7 @@ from pydantic import BaseModel
 from ground.analysis.coverage import coverage_summary
 from ground.analysis.digest import RunDigest, digest_run
 from ground.analysis.gnc import gnc_summary
+from ground.analysis.onboard import onboard_summary
 from ground.analysis.run_summary import (
     BUS_HEADER,
     AccessAudit,
@@ -109,6 +110,8 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str,
     summary.fault_events = [FaultEventRecord.model_validate(e.model_dump(exclude=BUS_HEADER))
                             for e in archive.of(cat.FAULT_EVENTS, mission)]
     summary.set_fdir(fdir_summary(archive, scenario, mission))
+    if scenario.onboard_fdir.enabled:
+        summary.onboard_fdir = onboard_summary(archive, mission, scenario.faults, summary.scores)
     summary.real_time_factor = round(t_final / outcome.wall_s, 2) if outcome.wall_s > 0 else None
     return summary
 

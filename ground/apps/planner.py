@@ -8,7 +8,8 @@ each information-driven ``AssignmentDecision`` on ``ground/planner/decisions``.
 What to fly comes from :class:`ground.planning.mission_plan.MissionPlan`: the scenario's phases,
 with ``assign = "information"`` phases chosen by expected information gain and reassigned when
 the set's gain saturates, and -- with ``fdir.recovery`` -- a recovery assignment when the FDIR
-reports an identified camera or actuator fault (input ``ground/fdir/report``).  An
+reports an identified camera or actuator fault (input ``ground/fdir/report``), or a spacecraft's
+onboard FDIR asks for a new plan naming one (input ``sc/N/fdir/event``, ``plan_request``).  An
 assignment is uplinked from ``UPLINK_LEAD_S`` before its departure and repeated every cycle
 until the next one supersedes it, so a command lost on the range-limited, lossy link is simply
 received later (a spacecraft acts on a new ``assignment_id`` once).
@@ -22,6 +23,7 @@ from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     AssignmentDecision,
     FaultReport,
+    OnboardFdirEvent,
     PoiObservations,
     ProAssignment,
     ProAssignments,
@@ -35,6 +37,7 @@ class MissionPlanner(App):
     INPUTS = (
         Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
         Input(cat.FAULT_REPORT, "on_fault"),
+        Input(cat.FDIR_EVENT, "on_onboard", every_spacecraft=True),
     )
     OUTPUTS = (Output("assignments", cat.ASSIGNMENTS), Output("decisions", cat.DECISIONS))
     CRITICAL = ("plan", "map", "_decisions_sent", "_faults")
@@ -45,7 +48,8 @@ class MissionPlanner(App):
         self.plan = MissionPlan(sc, ctx.constants)
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self._decisions_sent = 0
-        self._faults: list[FaultReport] = []
+        self._faults: list[tuple[int, str | None, dict[str, float]]] = []
+        """(observer, class, evidence) to recover from at the next step"""
 
     def on_observations(self, msg: PoiObservations) -> None:
         if msg.spacecraft <= self.map.n_agents:
@@ -53,17 +57,23 @@ class MissionPlanner(App):
 
     def on_fault(self, msg: FaultReport) -> None:
         if self.ctx.scenario.fdir.recovery and msg.spacecraft >= 1:  # 0: the constellation's
-            self._faults.append(msg)
+            self._faults.append((msg.spacecraft, msg.fault_class, dict(msg.evidence)))
+
+    def on_onboard(self, msg: OnboardFdirEvent) -> None:
+        """A spacecraft's plan request: recovered from as a declaration of its class (each
+        observer is replanned once per class, whoever asks: ``MissionPlan.recover``)."""
+        if (self.ctx.scenario.fdir.recovery and msg.event == "plan_request"
+                and msg.fault_class is not None and msg.spacecraft <= self.map.n_agents):
+            self._faults.append((msg.spacecraft, msg.fault_class, {}))
 
     def step(self, t: float) -> None:
         self.plan.update(t, self.map)
         faults, self._faults = self._faults, []
         if faults:
             try:
-                if self.plan.recover(t, [(f.spacecraft, f.fault_class, f.evidence)
-                                         for f in faults], self.map):
+                if self.plan.recover(t, faults, self.map):
                     self.log.warning("recovery: replanned around %s", ", ".join(
-                        f"sc{f.spacecraft} ({f.fault_class})" for f in faults))
+                        f"sc{sc} ({c})" for sc, c, _ in faults))
             except ValueError as e:
                 self.log.error("recovery impossible, plan unchanged: %s", e)
         for d in self.plan.decisions[self._decisions_sent:]:

@@ -120,6 +120,10 @@ GUIDANCE_STATUS = Topic(Space.SPACECRAFT, "guidance", "status", m.GuidanceStatus
                         "guidance mode, Δv spent, distance from plan")
 INFO_COST = Topic(Space.SPACECRAFT, "infocost", "telemetry", m.InfoCostTelemetry,
                   "local information cost H_i (Eq. 8)")
+FDIR_COMMAND = Topic(Space.SPACECRAFT, "fdir", "command", m.OnboardCommand,
+                     "onboard FDIR stored-sequence command to its own apps")
+FDIR_EVENT = Topic(Space.SPACECRAFT, "fdir", "event", m.OnboardFdirEvent,
+                   "onboard FDIR events: trips, reports, sequences, recovery")
 
 # --- every lockstep node's executive --------------------------------------------------------
 TICK_DONE = Topic(Space.EVERY_NODE, "exec", "tick_done", m.TickDone, "lockstep answer to a tick")
@@ -142,7 +146,7 @@ TLM_STATUS = Topic(Space.GROUND, "tlm", "status", m.TelemetryStatus, "telemetry 
 ALL: tuple[Topic[m.Message], ...] = (
     TICK, SIM_STATUS, TRUTH, FAULT_EVENTS, RELNAV, ATTITUDE_SENSORS, CAMERA_IMAGE,
     THRUST, WHEELS, NAV_ESTIMATE, ATTITUDE_ESTIMATE, OBSERVATIONS, POINTING, TRANSFER_PLAN,
-    GUIDANCE_STATUS, INFO_COST,
+    GUIDANCE_STATUS, INFO_COST, FDIR_COMMAND, FDIR_EVENT,
     TICK_DONE, HEARTBEAT, EXEC_STATS, LINK_STATS,
     ASSIGNMENTS, DECISIONS, FDIR_WINDOW, FAULT_REPORT, CONSTELLATION_WINDOW, BASELINE,
     TLM_STATUS,

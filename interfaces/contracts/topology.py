@@ -31,6 +31,9 @@ SPACECRAFT_APPS: tuple[str, ...] = (
 )
 """A spacecraft's onboard apps, in execution order within a rate group."""
 
+ONBOARD_FDIR_APPS: tuple[str, ...] = ("fsw.apps.fdir:OnboardFdirApp",)
+"""Added after them when the scenario turns the agent-level FDIR on (``[onboard_fdir]``)."""
+
 GROUND_APPS: tuple[str, ...] = (
     "ground.apps.planner:MissionPlanner",
     "ground.apps.telemetry:TelemetryMonitor",
@@ -81,9 +84,11 @@ SIM = Service(topics.SIM, "sim")
 """The time master and hardware stand-in."""
 
 
-def spacecraft_node(spacecraft: int) -> Node:
-    """Spacecraft ``spacecraft``'s flight software (1-based)."""
-    return Node(topics.sc_node(spacecraft), SPACECRAFT_APPS, "fsw.spacecraft:executive",
+def spacecraft_node(spacecraft: int, onboard_fdir: bool = False) -> Node:
+    """Spacecraft ``spacecraft``'s flight software (1-based), with the agent-level FDIR app
+    when ``onboard_fdir``."""
+    apps = SPACECRAFT_APPS + (ONBOARD_FDIR_APPS if onboard_fdir else ())
+    return Node(topics.sc_node(spacecraft), apps, "fsw.spacecraft:executive",
                 ("fsw", spacecraft), "fsw", ("--spacecraft", str(spacecraft)), spacecraft)
 
 
@@ -116,7 +121,8 @@ class Topology:
 def topology(scenario: Scenario, ground: bool = True) -> Topology:
     """The topology of a run of ``scenario``: one node per observer, and the ground unless
     ``ground`` is False (spacecraft only)."""
-    nodes = [spacecraft_node(i) for i in range(1, scenario.observers.count + 1)]
+    onboard = scenario.onboard_fdir.enabled
+    nodes = [spacecraft_node(i, onboard) for i in range(1, scenario.observers.count + 1)]
     return Topology(tuple(nodes + ([GROUND] if ground else [])))
 
 

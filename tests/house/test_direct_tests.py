@@ -40,7 +40,7 @@ INDIRECT: dict[str, str] = {
     "interfaces.contracts.messages.sim": _MESSAGES,
     **{f"interfaces.contracts.scenario.{m}": _SCENARIO
        for m in ("base", "comms", "faults", "fdir", "flight", "mission", "model", "observers",
-                 "planning", "rates", "sim")},
+                 "onboard", "planning", "rates", "sim")},
     "interfaces.contracts.timing": (
         "one constant, TIME_TOL_S: a fault switching on the tick at its time whatever the "
         "rounding tests it (tests/faults/test_schedule.py, tests/faults/test_software.py)"),
@@ -60,8 +60,9 @@ INDIRECT: dict[str, str] = {
     "ground.analysis.coverage": _EVALUATION.format(
         "tests/missions/test_digest_run.py and tests/missions/test_campaign_run.py"),
     "ground.analysis.gnc": _EVALUATION.format("tests/missions/test_gnc_run.py"),
+    "ground.analysis.onboard": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
     **{f"ground.analysis.run_summary.{m}": _SUMMARY
-       for m in ("document", "fdir", "figures", "records", "series")},
+       for m in ("document", "fdir", "figures", "onboard", "records", "series")},
     "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
     "ground.apps.planner": _APP.format("tests/ground/planning/test_mission_plan.py"),
     "ground.archive.__main__": (

@@ -44,6 +44,11 @@ from ground.analysis.run_summary.figures import (
     SegmentRecord,
     SimRecord,
 )
+from ground.analysis.run_summary.onboard import (
+    OnboardEventRecord,
+    OnboardFaultRecord,
+    OnboardFdirSummary,
+)
 from ground.analysis.run_summary.records import Figure, SummaryRecord
 from ground.analysis.run_summary.series import FdirSeries, MainWindow, SeriesWindow
 
@@ -51,7 +56,8 @@ __all__ = [
     "BUS_HEADER", "OTHER_TESTS_FLAG", "AccessAudit", "ArchiveInfo", "AssignmentRecord",
     "CoverageSummary", "Detection", "ExecRecord", "FailedTests", "FaultClass", "FaultEventRecord",
     "FaultScore", "FdirResults", "FdirSeries", "Figure", "GncStats", "LostMessages", "MainWindow",
-    "MessageCounts", "ModelZ", "NavStats", "RecoveryComparison", "ReplayResults",
+    "MessageCounts", "ModelZ", "NavStats", "OnboardEventRecord", "OnboardFaultRecord",
+    "OnboardFdirSummary", "RecoveryComparison", "ReplayResults",
     "ReplaySection", "PaceRecord", "RunFdirSettings", "RunSummary", "Scores", "SegmentRecord",
     "SeriesWindow", "SimRecord", "SummaryError", "SummaryRecord", "ThresholdCensus",
     "ThresholdSources",

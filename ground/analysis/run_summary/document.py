@@ -27,6 +27,7 @@ from ground.analysis.run_summary.figures import (
     RecoveryComparison,
     SimRecord,
 )
+from ground.analysis.run_summary.onboard import OnboardFdirSummary
 from ground.analysis.run_summary.records import SummaryRecord, filled_fields
 from ground.analysis.run_summary.series import FdirSeries
 from interfaces.contracts.messages import LinkCounter, TelemetryStatus
@@ -76,6 +77,8 @@ class RunSummary(SummaryRecord):
     fdir_series: FdirSeries | None = None
     fdir_thresholds: ThresholdCensus | None = None
     fdir_settings: RunFdirSettings | None = None
+    onboard_fdir: OnboardFdirSummary | None = Field(
+        default=None, description="what the onboard FDIR did (absent: it was off)")
     real_time_factor: float | None = Field(default=None,
                                            description="sim s per wall s (null: no wall time)")
     archive_error: str | None = Field(default=None, description="why the archive was unread")

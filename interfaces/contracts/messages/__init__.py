@@ -46,6 +46,8 @@ from interfaces.contracts.messages.fsw import (
     AttitudeEstimate,
     GuidanceStatus,
     InfoCostTelemetry,
+    OnboardCommand,
+    OnboardFdirEvent,
     PointingTarget,
     PoiObservations,
     StateEstimate,
@@ -132,6 +134,8 @@ __all__ = [
     "InfoCostTelemetry",
     "PointingTarget",
     "AttitudeEstimate",
+    "OnboardCommand",
+    "OnboardFdirEvent",
     "MAX_PRO_SIZE_M",
     "MAX_TRANSFER_S",
     "WindowTest",
@@ -178,6 +182,8 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     ExecStats,
     LinkStats,
     TelemetryStatus,
+    OnboardCommand,
+    OnboardFdirEvent,
 )
 
 

@@ -74,6 +74,10 @@ Rate = _vector(3, MAX_RATE_RADPS)
 """Body rate, rad/s."""
 
 
+Momentum = _vector(3, 1.0e3)
+"""Angular momentum, body axes, N·m·s."""
+
+
 Force = _vector(3, MAX_FORCE_N)
 """Body force, N."""
 

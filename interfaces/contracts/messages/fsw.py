@@ -14,6 +14,7 @@ from interfaces.contracts.messages.base import (
     Force,
     Mat6,
     Message,
+    Momentum,
     PoiPrecisions,
     Position,
     Quat,
@@ -84,14 +85,15 @@ class TransferPlanMsg(Message):
 
 
 class GuidanceStatus(Message):
-    """Guidance state of one observer at ω_low: mode, current assignment, tracking error of the
+    """Guidance state of one observer at ω_low: mode (``safe``: the onboard FDIR's safe hold,
+    no thrust until a newer assignment), current assignment, tracking error of the
     estimate against the reference (m, m/s), the acceleration commanded (LVLH, m/s²), Δv
     commanded so far (m/s, Σ|u|₁·dt) and the MPC solver status and time."""
 
     WALL_CLOCK_FIELDS: ClassVar[frozenset[str]] = frozenset({"t_wall", "mpc_ms"})
 
     spacecraft: int = Field(ge=1)
-    mode: Literal["idle", "transfer", "hold"]
+    mode: Literal["idle", "transfer", "hold", "safe"]
     assignment_id: int = Field(default=0, ge=0)
     phase: str = ""
     pos_error_m: float = Field(default=0.0, ge=0.0)
@@ -165,3 +167,45 @@ class AttitudeEstimate(Message):
     mode: Literal["init", "slew", "track"]
     torque_body_nm: Torque
     nis: float | None = None
+    wheel_momentum_nms: Momentum | None = Field(
+        default=None, description="the wheels' momentum as the app integrates its commands, "
+                                  "body axes, N·m·s (absent from archives before it existed)")
+    star_tracker_age_s: float | None = Field(
+        default=None, ge=0.0, description="time since the last star-tracker attitude, s "
+                                          "(None: none yet)")
+
+
+OnboardCommandName = Literal["safe_hold", "point_target", "camera_off", "nav_reset"]
+"""What the onboard FDIR's stored sequences command (fsw/lib/onboard_fdir.py)."""
+OnboardEventName = Literal["trip", "clear", "report", "sequence", "recovered", "plan_request"]
+FaultClassName = Literal["actuator", "camera", "state_sensor", "link", "data_integrity",
+                         "common_mode"]
+
+
+class OnboardCommand(Message):
+    """One command of a stored sequence of the onboard FDIR (fsw/apps/fdir.py) to an app of its
+    own spacecraft: ``safe_hold`` (guidance: thrust off, no transfer, until an assignment newer
+    than ``assignment_id``), ``point_target`` (camera: aim at the target's centre),
+    ``camera_off`` (camera: no more observations), ``nav_reset`` (nav: restart the filter from
+    the next measurement)."""
+
+    spacecraft: int = Field(ge=1)
+    command: OnboardCommandName
+    sequence: str = Field(max_length=32, description="the stored sequence it belongs to")
+    assignment_id: int = Field(default=0, ge=0, description="safe_hold: the assignment in force")
+
+
+class OnboardFdirEvent(Message):
+    """An event of the onboard FDIR (fsw/apps/fdir.py), as cFS's event messages: a watchpoint
+    tripped or cleared (``name``, its ``value`` and ``limit``), a ground FaultReport naming this
+    spacecraft received (``fault_class``), a stored sequence started (``name``, ``detail``: its
+    commands), safe hold ended by a new assignment (``recovered``), a new plan asked of the
+    ground (``plan_request``)."""
+
+    spacecraft: int = Field(ge=1)
+    event: OnboardEventName
+    name: str = Field(default="", max_length=32)
+    value: float | None = None
+    limit: float | None = None
+    fault_class: FaultClassName | None = None
+    detail: str = Field(default="", max_length=200)

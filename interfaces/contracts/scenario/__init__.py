@@ -16,13 +16,20 @@ from interfaces.contracts.scenario.model import (
     parse_scenario,
 )
 from interfaces.contracts.scenario.observers import ObserverOverride, Observers, Phase
+from interfaces.contracts.scenario.onboard import (
+    DEFAULT_WATCHPOINTS,
+    OnboardFdir,
+    SequenceName,
+    Watchpoint,
+)
 from interfaces.contracts.scenario.planning import AssignmentSettings
 from interfaces.contracts.scenario.rates import Rates
 from interfaces.contracts.scenario.sim import SimSettings
 
 __all__ = [
     "Actuators", "AssignmentSettings", "Attitude", "Burst", "COMMON_MODE_KINDS", "CameraSettings",
-    "Comms", "Fault", "FaultKind", "FdirSettings", "Guidance", "LinkCut", "Nav",
-    "ObserverOverride", "Observers", "Orbit", "Phase", "Rates", "Scenario", "ScenarioError",
-    "Section", "Sensors", "SimSettings", "Target", "load_scenario", "parse_scenario",
+    "Comms", "DEFAULT_WATCHPOINTS", "Fault", "FaultKind", "FdirSettings", "Guidance", "LinkCut",
+    "Nav", "ObserverOverride", "Observers", "OnboardFdir", "Orbit", "Phase", "Rates", "Scenario",
+    "ScenarioError", "Section", "Sensors", "SequenceName", "SimSettings", "Target", "Watchpoint",
+    "load_scenario", "parse_scenario",
 ]

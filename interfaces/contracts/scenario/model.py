@@ -21,6 +21,7 @@ from interfaces.contracts.scenario.fdir import FdirSettings
 from interfaces.contracts.scenario.flight import Actuators, Attitude, Guidance, Nav, Sensors
 from interfaces.contracts.scenario.mission import CameraSettings, Orbit, Target
 from interfaces.contracts.scenario.observers import Observers, Phase
+from interfaces.contracts.scenario.onboard import OnboardFdir
 from interfaces.contracts.scenario.planning import AssignmentSettings
 from interfaces.contracts.scenario.rates import Rates
 from interfaces.contracts.scenario.sim import SimSettings
@@ -44,6 +45,7 @@ class Scenario(Section):
     phases: list[Phase] = Field(default_factory=list)
     assignment: AssignmentSettings = AssignmentSettings()
     fdir: FdirSettings = FdirSettings()
+    onboard_fdir: OnboardFdir = OnboardFdir()
     sim: SimSettings = SimSettings()
     faults: list[Fault] = Field(default_factory=list)
 

@@ -5,27 +5,17 @@ constellation dropped and counted, not raised."""
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 import pytest
 
 from fsw.apps.infocost import InfoCostApp
 from interfaces.contracts.messages import InfoCostTelemetry, Message, PoiObservations
-from interfaces.runtime.app import AppContext
-from interfaces.runtime.bus import Bus
-from interfaces.runtime.transport import InprocNetwork
-from tests.conftest import small_scenario
+from tests.conftest import app_alone, small_scenario
 
 
 def _app() -> tuple[InfoCostApp, list[Message]]:
     sc = small_scenario("ic", observers={"count": 2}, rates={"fdi_period_s": 10.0})
-    ctx = AppContext(bus=Bus("sc1", "ic", InprocNetwork().endpoint()), scenario=sc, node="sc1",
-                     spacecraft=1, rng=np.random.default_rng(0), log=logging.getLogger("t"))
-    app = InfoCostApp(ctx)
-    sent: list[Message] = []
-    app.publish = lambda name, msg: sent.append(msg)  # type: ignore[method-assign]
-    return app, sent
+    return app_alone(InfoCostApp, sc)
 
 
 def _obs(sc: int, poi: list[int]) -> PoiObservations:

@@ -29,11 +29,29 @@ def test_defaults_and_pro_phasing() -> None:
     ('name = "x"\nduration_s = [', "not valid TOML"),
     ('name = "x"\nduration_s = 10\n[rates]\nfdi_period_s = 2.5\n', "whole number of ω_mid"),
     ('name = "x"\nduration_s = 10\n[rates]\nfdi_period_s = 0.5\n', "rates.fdi_period_s = 0.5"),
+    ('name = "x"\nduration_s = 10\n[onboard_fdir.watchpoints.pointing]\nlimit = 1\n',
+     "onboard_fdir.watchpoints.pointing: unknown watchpoint"),
+    ('name = "x"\nduration_s = 10\n[onboard_fdir.watchpoints.nav_nis]\nlimit = 0\n',
+     "onboard_fdir.watchpoints.nav_nis: limit"),
+    ('name = "x"\nduration_s = 10\n[onboard_fdir.watchpoints.nav_nis]\naction = "panic"\n',
+     "onboard_fdir.watchpoints.nav_nis: action"),
+    ('name = "x"\nduration_s = 10\n[onboard_fdir.watchpoints.nav_nis]\npersistance = 2\n',
+     "onboard_fdir.watchpoints.nav_nis: persistance"),
+    ('name = "x"\nduration_s = 10\n[onboard_fdir]\nenable = true\n', "onboard_fdir.enable"),
 ])
 def test_invalid_scenarios_name_the_field(text: str, needle: str) -> None:
     with pytest.raises(ScenarioError) as e:
         parse_scenario(text, source="s.toml")
     assert needle in str(e.value) and "s.toml" in str(e.value)
+
+
+def test_the_onboard_watchpoint_table_is_the_defaults_with_the_scenarios_overrides() -> None:
+    s = parse_scenario('name = "x"\nduration_s = 10\n[onboard_fdir]\nenabled = true\n'
+                       '[onboard_fdir.watchpoints.pointing_deg]\nlimit = 2.5\n')
+    table = s.onboard_fdir.table()
+    assert (table["pointing_deg"].limit, table["pointing_deg"].persistence) == (2.5, 2)
+    assert table["nav_nis"] == parse_scenario('name = "x"\nduration_s = 10\n'
+                                              ).onboard_fdir.table()["nav_nis"]
 
 
 def test_shipped_scenarios_load() -> None:

@@ -14,6 +14,7 @@ from fsw.apps.infocost import InfoCostApp
 from interfaces.contracts import topics
 from interfaces.contracts.topology import (
     GROUND_APPS,
+    ONBOARD_FDIR_APPS,
     SPACECRAFT_APPS,
     Node,
     describe,
@@ -34,7 +35,7 @@ def test_a_run_holds_one_node_per_observer_then_the_ground() -> None:
 
 
 def test_every_declared_name_resolves() -> None:
-    for name in (*SPACECRAFT_APPS, *GROUND_APPS):
+    for name in (*SPACECRAFT_APPS, *ONBOARD_FDIR_APPS, *GROUND_APPS):
         assert issubclass(app_class(name), App)
     for node in topology(small_scenario()).nodes:
         assert callable(resolve(node.executive))

@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 
 from interfaces.contracts import topics
 from interfaces.contracts.messages import Message, Tick
-from interfaces.contracts.topology import GROUND_APPS, SPACECRAFT_APPS
+from interfaces.contracts.topology import GROUND_APPS, ONBOARD_FDIR_APPS, SPACECRAFT_APPS
 from interfaces.runtime.app import App, AppContext, Input
 from interfaces.runtime.assembly import app_class
 from interfaces.runtime.bus import Bus
@@ -105,7 +105,7 @@ def message_payloads(msg_type: type[Message], owner: str) -> st.SearchStrategy[b
 
 
 def _apps() -> Iterator[tuple[type[App], str]]:
-    yield from ((app_class(a), "sc1") for a in SPACECRAFT_APPS)
+    yield from ((app_class(a), "sc1") for a in (*SPACECRAFT_APPS, *ONBOARD_FDIR_APPS))
     yield from ((app_class(a), topics.GROUND) for a in GROUND_APPS)
 
 
