@@ -3,7 +3,7 @@ from one campaign file, on a local process pool or a Dask cluster, resumable.
 
     python deploy/run_campaign.py --campaign deploy/campaigns/paper.toml --out runs/paper
         [--workers N] [--limit N] [--cluster tcp://HOST:PORT] [--transport inproc|zenoh]
-        [--report-only]
+        [--set SECTION.KEY=VALUE ...] [--report-only]
     python deploy/run_campaign.py --out runs/paper --replay [--set fdir.KEY=VALUE ...]
         [--out-report DIR] [--workers N] [--cluster ...]
     python deploy/run_campaign.py --out runs/paper --sweep fdir.KEY=V1,V2,... [--set ...]
@@ -14,7 +14,9 @@ run.log); a run directory appears only when its run has finished (each attempt w
 <id>.partial-<random>, then renames it), so a campaign started again with the same --out skips
 finished runs and redoes
 half-written ones.  A run that crashes is recorded as failed, with its error, and the campaign
-goes on.  SIGINT or SIGTERM stops the campaign: running runs are abandoned (redone next time)
+goes on.  ``--set`` changes a scenario setting of every run flown (e.g.
+``onboard_fdir.enabled=true``: the same campaign with the onboard FDIR on; use another --out).
+SIGINT or SIGTERM stops the campaign: running runs are abandoned (redone next time)
 and the report is written over what has finished.  --cluster sends the runs to an existing
 Dask distributed scheduler (its workers must import this repository and see --out).
 At the end <out>/report.md, PNG plots and results.csv are written
@@ -62,7 +64,7 @@ from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
 from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
 from ground.analysis.formation_study import write_formation_study  # noqa: E402
 from ground.analysis.run_summary import RunSummary  # noqa: E402
-from ground.tools.replay import parse_settings  # noqa: E402
+from ground.tools.replay import parse_settings, scenario_with  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
@@ -87,7 +89,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help="re-judge the finished runs of --out under --set detector settings "
                         "(ground.tools.replay), simulating nothing")
     p.add_argument("--set", dest="settings", action="append", default=[],
-                   metavar="fdir.KEY=VALUE", help="with --replay/--sweep: a detector setting")
+                   metavar="SECTION.KEY=VALUE",
+                   help="with --replay/--sweep: a detector setting; when flying: any scenario "
+                        "setting, on every run (e.g. onboard_fdir.enabled=true)")
     p.add_argument("--sweep", metavar="fdir.KEY=V1,V2,...",
                    help="replay the campaign once per value and write one table (sweep.md)")
     p.add_argument("--out-report", type=Path,
@@ -209,7 +213,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     try:
         campaign, runs = load_campaign(args.campaign)
-    except CampaignError as e:
+        settings = parse_settings(args.settings)
+        runs = [RunSpec(r.id, r.group, scenario_with(r.scenario, settings)) for r in runs]
+    except (CampaignError, ScenarioError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     if args.limit is not None:
@@ -218,7 +224,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.campaign.resolve() != (args.out / "campaign.toml").resolve():
         shutil.copyfile(args.campaign, args.out / "campaign.toml")
     index.write_text(json.dumps({"name": campaign.name, "runs": [r.id for r in runs],
-                                 "study": campaign.study}, indent=1) + "\n")
+                                 "study": campaign.study, "settings": settings},
+                                indent=1) + "\n")
     status = 0
     if not args.report_only:
         status = _run(runs, args)

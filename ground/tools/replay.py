@@ -161,14 +161,21 @@ def scenario_of(archive: RunArchive) -> Scenario:
 def with_settings(scenario: Scenario, settings: dict[str, str]) -> Scenario:
     """``scenario`` with ``section.key = value`` settings (values parsed as JSON where they
     are, else kept as text); only detector settings (``SETTABLE``).  Raises ScenarioError."""
-    data = scenario.model_dump()
-    for name, text in settings.items():
+    for name in settings:
         if not name.startswith(SETTABLE[0]) and name not in SETTABLE[1:]:
             raise ScenarioError(f"--set {name}: a replay re-runs the ground's detector only "
                                 f"(fdir.*, rates.fdi_period_s); {name} changes what was flown, "
                                 "simulate it instead")
+    return scenario_with(scenario, settings)
+
+
+def scenario_with(scenario: Scenario, settings: dict[str, str]) -> Scenario:
+    """``scenario`` with any ``section.key = value`` settings (values parsed as JSON where they
+    are, else kept as text).  Raises ScenarioError naming a setting that is not one."""
+    data = scenario.model_dump()
+    for name, text in settings.items():
         section, _, key = name.partition(".")
-        if key not in data[section]:
+        if not isinstance(data.get(section), dict) or key not in data[section]:
             raise ScenarioError(f"--set {name}: no such setting in [{section}]")
         try:
             data[section][key] = json.loads(text)

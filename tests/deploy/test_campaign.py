@@ -161,3 +161,15 @@ def test_campaign_workers_get_one_blas_thread(monkeypatch: pytest.MonkeyPatch) -
     one_blas_thread()
     assert {n: os.environ[n] for n in BLAS_THREADS} == {
         "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "3", "MKL_NUM_THREADS": "1"}
+
+
+def test_set_changes_every_run_flown_and_a_bad_one_is_refused(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    paper = Path(__file__).resolve().parents[2] / "deploy" / "campaigns" / "paper.toml"
+    out = tmp_path / "c"
+    args = ["--campaign", str(paper), "--out", str(out), "--report-only"]
+    assert run_campaign([*args, "--set", "onboard_fdir.enabld=true"]) == 2
+    assert "--set onboard_fdir.enabld: no such setting" in capsys.readouterr().err
+    assert run_campaign([*args, "--set", "onboard_fdir.enabled=true"]) == 0
+    index = json.loads((out / "campaign.json").read_text())
+    assert index["settings"] == {"onboard_fdir.enabled": "true"} and len(index["runs"]) == 200
