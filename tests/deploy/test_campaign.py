@@ -173,3 +173,13 @@ def test_set_changes_every_run_flown_and_a_bad_one_is_refused(
     assert run_campaign([*args, "--set", "onboard_fdir.enabled=true"]) == 0
     index = json.loads((out / "campaign.json").read_text())
     assert index["settings"] == {"onboard_fdir.enabled": "true"} and len(index["runs"]) == 200
+
+
+def test_every_shipped_campaign_expands() -> None:
+    """Each file of deploy/campaigns/ loads and expands into valid runs (counts as their
+    headers state)."""
+    counts = {"paper": 200, "hard": 58, "beyond": 64, "formations": 48, "identify": 184}
+    root = Path(__file__).resolve().parents[2] / "deploy" / "campaigns"
+    for path in sorted(root.glob("*.toml")):
+        campaign, runs = load_campaign(path)
+        assert len(runs) == counts[campaign.name], path.name
