@@ -1,6 +1,7 @@
 """A node's state taken whole and put back (``interfaces.runtime.checkpoint``), after a real
-run: every app declares what changes while it runs, and a fresh node given a running node's
-state is the same node: the same state, and the same messages on the next ticks."""
+run (with the onboard FDIR on, so that its app is checked too): every app declares what changes
+while it runs, and a fresh node given a running node's state is the same node: the same state,
+and the same messages on the next ticks."""
 
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.transport import InprocNetwork
 from tests.conftest import canonical, small_scenario
 
-SC = small_scenario("ckpt", duration_s=150.0)
+SC = small_scenario("ckpt", duration_s=150.0, onboard_fdir={"enabled": True})
 
 
 @cache
