@@ -51,7 +51,6 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     lines += _coverage_section(out, digest.coverage, summary)
     lines += _fdir_section(out, archive, mission, summary)
     lines += _links_section(summary) + _exec_section(summary) + _incidents_section(summary)
-    lines += _onboard_section(summary)
     lines += _archive_section(summary)
     return _write(out, lines)
 
@@ -351,11 +350,13 @@ def _links_section(summary: RunSummary) -> list[str]:
 
 
 def _incidents_section(summary: RunSummary) -> list[str]:
-    """Processes lost from the lockstep and telemetry outages (a degraded run)."""
+    """Processes lost from the lockstep and telemetry outages (a degraded run), and what the
+    onboard FDIR did."""
+    onboard = _onboard_lines(summary)
     lost = summary.sim.participants if summary.sim else {}
     outages = {e.spacecraft: e.outages for e in summary.telemetry or []}
     if not lost and not any(outages.values()):
-        return []
+        return ["## Incidents", "", *onboard] if onboard else []
     rows = ["## Incidents", "", f"Run status: **{summary.status}**"
             + (f" ({summary.error})" if summary.error else ""), "",
             "| node | lockstep (sim s) | telemetry outages (sim s) |", "|---|---|---|"]
@@ -365,10 +366,10 @@ def _incidents_section(summary: RunSummary) -> list[str]:
         sc = int(node[2:]) if node.startswith("sc") else None
         gaps = ", ".join(f"{a:.1f}-{b:.1f}" for a, b in outages.get(sc, []))
         rows.append(f"| {node} | {events or '-'} | {gaps or '-'} |")
-    return rows + [""]
+    return rows + [""] + onboard
 
 
-def _onboard_section(summary: RunSummary) -> list[str]:
+def _onboard_lines(summary: RunSummary) -> list[str]:
     """What the onboard FDIR did (fsw/apps/fdir.py): per injected fault, then every event."""
     ob = summary.onboard_fdir
     if ob is None:
@@ -377,7 +378,7 @@ def _onboard_section(summary: RunSummary) -> list[str]:
     def at(v: float | None) -> str:
         return "-" if v is None else f"{v:.1f}"
 
-    rows = ["## Onboard FDIR", "",
+    rows = ["### Onboard FDIR", "",
             f"{ob.trips} watchpoint trips, {ob.reports} ground reports received, {ob.actions} "
             f"stored sequences started, {ob.recoveries} safe holds ended by a new assignment.",
             ""]

@@ -78,4 +78,5 @@ def test_the_report_tells_the_onboard_story(flown: Path) -> None:
     from ground.analysis.report import write_report
     from ground.archive.metadata import archived_scenario
     text = write_report(flown, archived_scenario(flown / "run.mcap")).read_text()
-    assert "## Onboard FDIR" in text and "sc2 pointing_actuator" in text
+    assert "## Incidents" in text and "### Onboard FDIR" in text
+    assert "sc2 pointing_actuator" in text
