@@ -1,10 +1,17 @@
 """Message bytes (interfaces/runtime/encoding.py) in a real (in-process) run: every message type
-a run publishes, and the two it does not, encoded as pydantic does, and the Bus's own bytes."""
+a run publishes, and those it does not, encoded as pydantic does, and the Bus's own bytes."""
 
 from __future__ import annotations
 
 from deploy.inproc import run_inproc
-from interfaces.contracts.messages import AssignmentDecision, FaultReport, Message, registry
+from interfaces.contracts.messages import (
+    AssignmentDecision,
+    FaultReport,
+    Message,
+    OnboardCommand,
+    OnboardFdirEvent,
+    registry,
+)
 from interfaces.runtime.encoding import encode
 from interfaces.runtime.transport import Sample
 from tests.conftest import small_scenario
@@ -12,8 +19,8 @@ from tests.interfaces.runtime.test_encoding import _pydantic
 
 
 def test_every_message_type_of_a_run_is_encoded_as_pydantic_does() -> None:
-    """A short run with faults and FDIR windows: every message it publishes, then the two
-    types it does not (a fault report, an assignment decision)."""
+    """A short run with faults and FDIR windows: every message it publishes, then the types it
+    does not (a fault report, an assignment decision, the onboard FDIR's command and event)."""
     scenario = small_scenario(
         "enc", duration_s=100.0, rates={"fdi_period_s": 10.0},
         faults=[{"spacecraft": 1, "kind": "pointing_actuator", "start_s": 5.0, "magnitude": 20.0},
@@ -29,6 +36,11 @@ def test_every_message_type_of_a_run_is_encoded_as_pydantic_does() -> None:
                            library_indices=[3, -1, 17], expected_gain=0.25, upper_bound=0.5,
                            ratio_bound=0.5, current_gain=None, measured_gains=[0.1, 2e-9],
                            switched=True),
+        OnboardCommand(sender="sc2", t_sim=40.1, spacecraft=2, command="safe_hold",
+                       sequence="safe_hold", assignment_id=3),
+        OnboardFdirEvent(sender="sc2", t_sim=40.1, spacecraft=2, event="trip",
+                         name="pointing_deg", value=2.25, limit=1.0, fault_class="actuator",
+                         detail="action request_plan"),
     ]
     messages = [s.message for s in samples if s.message is not None] + extra
     assert {type(m).__name__ for m in messages} == set(registry())  # every type is here
