@@ -176,8 +176,8 @@ class OnboardFdirApp(App):
                 sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, command=command,  # type: ignore[arg-type]
                 sequence=seq, assignment_id=self.assignment_id))
         if seq == "request_plan":
-            self._event(t, "plan_request", seq, fault_class=fault_class,
-                        detail="a new plan asked of the ground")
+            self._event(t, "plan_request", "safe_hold" if self.safe != "off" else seq,
+                        fault_class=fault_class, detail="a new plan asked of the ground")
         self._event(t, "sequence", seq, fault_class=fault_class,
                     detail=", ".join(SEQUENCES[seq]) or "no command")
 

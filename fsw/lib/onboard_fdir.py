@@ -48,7 +48,8 @@ SEQUENCES: dict[str, tuple[str, ...]] = {
   until an assignment newer than the one in force; the camera aims at the target's centre;
 * ``camera_off``: the camera app shares no more observations (images stop);
 * ``nav_reset``: the nav filter restarts from its next measurement;
-* ``request_plan``: no command; the ground is asked for a new plan.
+* ``request_plan``: no command; the ground is asked for a new plan (from safe hold, the
+  ground answers with an assignment if its own recovery has not: ground/apps/planner.py).
 """
 
 CLASS_SEQUENCES: dict[str, tuple[str, ...]] = {
@@ -64,8 +65,8 @@ WATCHPOINT_CLASS: dict[str, str] = {
     "wheel_momentum_frac": "actuator", "nav_nis": "state_sensor",
     "star_tracker_gap_s": "state_sensor", "blank_image_frac": "camera",
 }
-"""The class a trip points at, named in the plan request it may start (the ground replans
-around it as around its own declaration of that class)."""
+"""The class a trip points at, named in the plan request it may start (the ground logs it;
+its FDIR decides: ground/apps/planner.py)."""
 
 BLANK_WINDOW = 10
 """Own images the blank-image watchpoint looks back over."""

@@ -8,8 +8,12 @@ each information-driven ``AssignmentDecision`` on ``ground/planner/decisions``.
 What to fly comes from :class:`ground.planning.mission_plan.MissionPlan`: the scenario's phases,
 with ``assign = "information"`` phases chosen by expected information gain and reassigned when
 the set's gain saturates, and -- with ``fdir.recovery`` -- a recovery assignment when the FDIR
-reports an identified camera or actuator fault (input ``ground/fdir/report``), or a spacecraft's
-onboard FDIR asks for a new plan naming one (input ``sc/N/fdir/event``, ``plan_request``).  An
+reports an identified camera or actuator fault (input ``ground/fdir/report``).  A spacecraft's
+onboard FDIR may ask for a new plan (input ``sc/N/fdir/event``, ``plan_request``): the ground's
+FDIR, not the request, decides a recovery; a request from a spacecraft in safe hold that no new
+assignment answers in the same cycle is answered by the current plan issued again
+(``MissionPlan.reissue``), so that safe hold, which only a newer assignment ends, always
+ends; a request from a watchpoint trip is logged.  An
 assignment is uplinked from ``UPLINK_LEAD_S`` before its departure and repeated every cycle
 until the next one supersedes it, so a command lost on the range-limited, lossy link is simply
 received later (a spacecraft acts on a new ``assignment_id`` once).
@@ -40,7 +44,7 @@ class MissionPlanner(App):
         Input(cat.FDIR_EVENT, "on_onboard", every_spacecraft=True),
     )
     OUTPUTS = (Output("assignments", cat.ASSIGNMENTS), Output("decisions", cat.DECISIONS))
-    CRITICAL = ("plan", "map", "_decisions_sent", "_faults")
+    CRITICAL = ("plan", "map", "_decisions_sent", "_faults", "_requests")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -50,32 +54,47 @@ class MissionPlanner(App):
         self._decisions_sent = 0
         self._faults: list[tuple[int, str | None, dict[str, float]]] = []
         """(observer, class, evidence) to recover from at the next step"""
+        self._requests: list[int] = []
+        """observers in safe hold that asked for a plan since the last step"""
 
     def on_observations(self, msg: PoiObservations) -> None:
         if msg.spacecraft <= self.map.n_agents:
             self.map.add(msg.spacecraft, *msg.arrays())
+
+    def _recover(self, t: float) -> None:
+        """Replan around the faults the FDIR identified since the last step."""
+        faults, self._faults = self._faults, []
+        if not faults:
+            return
+        try:
+            if self.plan.recover(t, faults, self.map):
+                self.log.warning("recovery: replanned around %s", ", ".join(
+                    f"sc{sc} ({c})" for sc, c, _ in faults))
+        except ValueError as e:
+            self.log.error("recovery impossible, plan unchanged: %s", e)
 
     def on_fault(self, msg: FaultReport) -> None:
         if self.ctx.scenario.fdir.recovery and msg.spacecraft >= 1:  # 0: the constellation's
             self._faults.append((msg.spacecraft, msg.fault_class, dict(msg.evidence)))
 
     def on_onboard(self, msg: OnboardFdirEvent) -> None:
-        """A spacecraft's plan request: recovered from as a declaration of its class (each
-        observer is replanned once per class, whoever asks: ``MissionPlan.recover``)."""
-        if (self.ctx.scenario.fdir.recovery and msg.event == "plan_request"
-                and msg.fault_class is not None and msg.spacecraft <= self.map.n_agents):
-            self._faults.append((msg.spacecraft, msg.fault_class, {}))
+        """A spacecraft's plan request (module docstring)."""
+        if msg.event != "plan_request" or not 1 <= msg.spacecraft <= self.map.n_agents:
+            return
+        if msg.name == "safe_hold" and self.ctx.scenario.fdir.recovery:
+            self._requests.append(msg.spacecraft)
+        else:
+            self.log.info("sc%d asks for a new plan (%s, %s): the ground's FDIR decides",
+                          msg.spacecraft, msg.name, msg.fault_class)
 
     def step(self, t: float) -> None:
         self.plan.update(t, self.map)
-        faults, self._faults = self._faults, []
-        if faults:
-            try:
-                if self.plan.recover(t, faults, self.map):
-                    self.log.warning("recovery: replanned around %s", ", ".join(
-                        f"sc{sc} ({c})" for sc, c, _ in faults))
-            except ValueError as e:
-                self.log.error("recovery impossible, plan unchanged: %s", e)
+        issued = len(self.plan.issued)
+        self._recover(t)
+        requests, self._requests = self._requests, []
+        if requests and len(self.plan.issued) == issued and self.plan.reissue(t):
+            self.log.warning("plan issued again for sc%s in safe hold",
+                             ", sc".join(map(str, sorted(set(requests)))))
         for d in self.plan.decisions[self._decisions_sent:]:
             self.log.info("%s at %.0f s (%s): PROs %s, expected gain %.4g (bound %.4g, "
                           "current %s), %s", d.phase, d.t_s, d.reason, d.library_indices,

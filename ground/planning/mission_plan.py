@@ -256,6 +256,18 @@ class MissionPlan:
         self._current_indices = per_observer if info_phase else None
         return True
 
+    def reissue(self, t: float) -> bool:
+        """Issue the current assignment's PROs again under a new id, leaving
+        ``UPLINK_LEAD_S`` from ``t`` and arriving ``assignment.transfer_s`` later (a transfer
+        planned afresh from where each observer is); False before the first assignment."""
+        cur = self.current
+        if cur is None:
+            return False
+        t_depart = t + UPLINK_LEAD_S
+        self._issue(cur.phase, dict(cur.pros), t_depart,
+                    t_depart + self.scenario.assignment.transfer_s)
+        return True
+
     def _holdable_keep_out(self, evidence: dict[str, float]) -> float:
         """The keep-out an actuator-impaired observer needs, m (``recover``): the nominal one
         plus twice the deviation the FDIR measured; for a pointing fault of θ at least

@@ -64,7 +64,6 @@ INDIRECT: dict[str, str] = {
     **{f"ground.analysis.run_summary.{m}": _SUMMARY
        for m in ("document", "fdir", "figures", "onboard", "records", "series")},
     "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
-    "ground.apps.planner": _APP.format("tests/ground/planning/test_mission_plan.py"),
     "ground.archive.__main__": (
         "``python -m ground.archive``, two lines handing over to ground/archive/cli.py's main "
         "(tests/ground/archive/test_cli.py, tests/missions/test_archive_cli_run.py)"),

@@ -200,7 +200,7 @@ class OnboardFdirEvent(Message):
     tripped or cleared (``name``, its ``value`` and ``limit``), a ground FaultReport naming this
     spacecraft received (``fault_class``), a stored sequence started (``name``, ``detail``: its
     commands), safe hold ended by a new assignment (``recovered``), a new plan asked of the
-    ground (``plan_request``)."""
+    ground (``plan_request``; ``name`` ``safe_hold`` when asked from safe hold)."""
 
     spacecraft: int = Field(ge=1)
     event: OnboardEventName

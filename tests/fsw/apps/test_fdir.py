@@ -63,7 +63,7 @@ def test_an_actuator_declaration_starts_safe_hold_in_the_same_step_and_asks_for_
     app.step(60.1)
     assert _commands(sent) == ["safe_hold", "point_target"]
     assert _events(sent) == [("report", "actuator"), ("sequence", "safe_hold"),
-                             ("plan_request", "request_plan"), ("sequence", "request_plan")]
+                             ("plan_request", "safe_hold"), ("sequence", "request_plan")]
     assert all(m.t_sim == 60.1 for m in sent)
     request = [m for m in sent if isinstance(m, OnboardFdirEvent) and m.event == "plan_request"]
     assert request[0].fault_class == "actuator"

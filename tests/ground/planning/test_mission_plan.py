@@ -266,3 +266,15 @@ def test_an_impossible_keep_out_falls_back_and_an_impossible_set_changes_nothing
     assert not plan.recover(200.0, [(1, "camera", {}), (2, "camera", {}), (3, "camera", {})],
                             fused)
     assert len(plan.issued) == issued and plan.dropped == set()
+
+
+def test_a_reissue_is_the_current_plan_under_a_new_id() -> None:
+    sc = _scenario([])
+    plan = MissionPlan(sc, MissionConstants.of(sc))
+    before = plan.current
+    assert before is not None
+    assert plan.reissue(300.0)
+    after = plan.current
+    assert after is not None and after.id == before.id + 1 and after.pros == before.pros
+    assert after.t_depart_s == 300.0 + UPLINK_LEAD_S
+    assert after.t_arrive_s == after.t_depart_s + sc.assignment.transfer_s
