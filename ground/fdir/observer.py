@@ -71,6 +71,8 @@ class ObserverState:
     """reported (time s, Δv commanded so far m/s, holding its PRO), in time order"""
     nis: list[tuple[float, float]] = field(default_factory=list)
     """the nav's reported (time s, NIS of that step's measurement update), in arrival order"""
+    camera_off_s: float | None = None
+    """when its onboard FDIR turned its camera off (s; None: on): no image is expected since"""
     silent: int = 0
     link_declared: bool = False
     last_seq: int = 0
@@ -92,6 +94,11 @@ class ObserverState:
         """Share of its observations that never reached the ground, since the start."""
         total = self.received + self.lost
         return self.lost / total if total else 0.0
+
+    def camera_off_before(self, b: float) -> bool:
+        """Whether its camera was turned off onboard before the window ending at b (s): such a
+        window is judged neither for silence nor for information."""
+        return self.camera_off_s is not None and self.camera_off_s < b
 
     def nis_between(self, a: float, b: float) -> list[float]:
         """The NIS of the nav updates in [a, b)."""

@@ -45,6 +45,7 @@ from interfaces.contracts.messages import (
     GuidanceStatus,
     InfoCostTelemetry,
     Message,
+    OnboardFdirEvent,
     PoiObservations,
     ProAssignments,
     StateEstimate,
@@ -144,6 +145,14 @@ class FdirPipeline:
             if msg.nis is not None:
                 obs.nis.append((msg.t_sim, msg.nis))
 
+    def onboard(self, msg: OnboardFdirEvent) -> None:
+        """An onboard FDIR event: a ``camera_off`` sequence means the observer stopped imaging
+        on purpose (its agent-level FDIR acting on a camera fault), so no image is expected of
+        it from then on (docs/fdir.md, "Link and data faults")."""
+        obs = self.observers.get(msg.spacecraft)
+        if obs is not None and msg.event == "sequence" and msg.name == "camera_off":
+            obs.camera_off_s = min(msg.t_sim, obs.camera_off_s or math.inf)
+
     def guidance(self, msg: GuidanceStatus) -> None:
         obs = self.observers.get(msg.spacecraft)
         if obs is not None and msg.t_sim >= self.window_start - self.schedule.period_s:
@@ -174,7 +183,7 @@ class FdirPipeline:
         judged: dict[int, Judgement] = {}
         for sc, obs in self.observers.items():
             mine = sorted((m for m in inside if m.spacecraft == sc), key=lambda m: m.image_t_s)
-            planned = obs.plan_at(a) is not None
+            planned = obs.plan_at(a) is not None and not obs.camera_off_before(b)
             lost, reports = self.links.judge(sc, obs, mine, planned, b)
             out += reports
             window = FdirWindow(sender=self.node, t_sim=b, spacecraft=sc, t_start_s=a,

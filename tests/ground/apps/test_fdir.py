@@ -1,7 +1,8 @@
 """The FDIR app's handling of late and missing telemetry, driven message by message: a late
 observation is fused into the ground's map (not judged, not dropped), a window without images
 is no decision (never zero information gain), and observations missing by sequence number
-make a link fault once the lost share stays above ``fdir.loss_tol``."""
+make a link fault once the lost share stays above ``fdir.loss_tol``; an observer whose camera its
+onboard FDIR turned off is not silent."""
 
 from __future__ import annotations
 
@@ -10,8 +11,16 @@ import logging
 import numpy as np
 import pytest
 
+from gnc.pro import Pro
 from ground.apps.fdir import FdirApp
-from interfaces.contracts.messages import FaultReport, FdirWindow, Message, PoiObservations
+from ground.fdir.twin import FlightPlan
+from interfaces.contracts.messages import (
+    FaultReport,
+    FdirWindow,
+    Message,
+    OnboardFdirEvent,
+    PoiObservations,
+)
 from interfaces.runtime.app import AppContext
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.transport import InprocNetwork
@@ -64,3 +73,23 @@ def test_observations_missing_by_sequence_make_a_link_fault() -> None:
     assert [(r.spacecraft, r.fault_class, r.t_sim) for r in reports] == [(2, "link", 30.0)]
     assert reports[0].metric == pytest.approx(0.6)
     assert app.pipeline.observers[2].lost_fraction() == pytest.approx(18 / 40)
+
+
+@pytest.mark.parametrize("camera_off", [False, True])
+def test_a_camera_turned_off_onboard_is_not_a_link_fault(camera_off: bool) -> None:
+    app, sent = _app()
+    app.pipeline.observers[2].plans[1] = FlightPlan(0.0, Pro(20.0, 0.0, 0.0, 25.0, 0.0), None,
+                                                    None)
+    if camera_off:  # its onboard FDIR acting on a camera declaration, as fsw/apps/fdir.py sends it
+        app.pipeline.onboard(OnboardFdirEvent(sender="sc2", t_sim=12.0, spacecraft=2,
+                                              event="sequence", name="camera_off",
+                                              fault_class="camera", detail="camera_off"))
+    for k in range(4):  # sc2 sends images in its first window only, then nothing
+        if k == 0:
+            for i in range(5):
+                app.pipeline.observations(_obs(2, 2.0 * i, i + 1, [1]))
+        app.step(10.0 * (k + 1))
+    reports = [(r.spacecraft, r.fault_class, r.t_sim) for r in sent if isinstance(r, FaultReport)]
+    assert reports == ([] if camera_off else [(2, "link", 30.0)])
+    windows = [m for m in sent if isinstance(m, FdirWindow) and m.spacecraft == 2]
+    assert len(windows) == 4 and all(w.metric is None for w in windows)
