@@ -32,19 +32,32 @@ evidence (in this order)                                    class
 β̂ off 1 (information short by a uniform factor), by more   ``camera``
 than beta_tol and ``BETA_SE_MARGIN`` standard errors
 nav off plan, the camera on it (within half the tolerance)  ``state_sensor``
+or off it the other way (``offset_alignment`` < −0.5)
 pointing error reported, and the pose explains the ΔH gap   ``actuator``
 the seen POIs show a boresight > 2 × pointing_tol_deg off    ``camera``
 (and ``SE_MARGIN`` standard errors of the located camera)
 Δv commanded while holding, above ``dv_rate_tol_mps2``      ``actuator``
 camera not where nav says, by more than nav is off plan,
-and nav and camera off the plan the same way                ``actuator``
+and dragged off the plan ahead of the nav the same way      ``actuator``
 camera not where nav says, by more than nav is off plan     ``state_sensor``
 (and ``SE_MARGIN`` standard errors of the located camera)
 nav off plan (the observer knows it is not on its orbit)    ``actuator``
-nav and camera off the plan the same way, camera off nav
-by more than half the position tolerance                    ``actuator``
-seen set not what the reported pose would see               ``camera``
+dragged off the plan ahead of the nav the same way, camera
+off nav by more than half the position tolerance            ``actuator``
+seen set not what the reported pose would see, with the     ``camera``
+camera located where the nav says (the nav right)
 ==========================================================  ================
+
+"The same way" (``offset_alignment`` > 0.5) counts only where the located camera's offset from
+the plan exceeds the standard error of its fixes (a camera on the plan, within its noise, has
+no direction), and "ahead of the nav" is the camera the farther off the plan: a leak drags the
+truth and the nav follows, lagging it, while a biased nav walks off the plan ahead of the truth
+it steers (identify campaign, seeds 201-205: four nav biases named ``actuator`` on cosines of
+0.65-0.73, two with the camera inside its noise, two with it nearer the plan than the nav).
+The seen set names the camera only where the nav is right: with the camera located off the nav
+by more than half the tolerance and ``SE_MARGIN`` standard errors of the fixes, the nav's
+error alone changes the set the reported pose would see (two nav biases walking off the plan
+were named ``camera`` on seen sets of 0.78-0.79).
 
 The comparison of the two distances separates a biased nav sensor (the observer flies its
 plan by its nav, so nav stays on plan and the camera is off by the bias) from an orbit
@@ -76,7 +89,12 @@ sensor's step, often before the truth has moved off the plan by more than the ca
 noise, and with the nav still near the plan the camera-off-nav fallback would name the sensor.
 Such a fault is declared unidentified and identified on a later window of the episode, when its
 other tests or its geometry speak (a leak: Δv spent, offsets the same way; a bias: the nav off
-the plan).
+the plan).  More generally, a window whose NIS test fails while the nav is still on its plan
+(``NAV_ON_PLAN_M``) and the camera is located off it by more than half the position tolerance
+names no class but ``actuator``: the truth has moved and the nav has not followed it yet (a
+leak's first seconds, a state disturbance's jump; a settled nav bias shows the same geometry,
+but its NIS passes).  The identify campaign named two leaks and a jump so ``state_sensor`` or
+``camera``; on their next window the nav had followed the truth the same way (cosine > 0.99).
 
 (``link`` and ``data_integrity`` are decided by the FDIR app from missing telemetry and from
 the reported H_i.)  Pure functions; the app gathers the inputs.
@@ -267,10 +285,14 @@ class Tolerances:
 
 def classify(ev: Evidence, tol: Tolerances, failed: Sequence[str] = ()) -> str | None:
     """The fault class the evidence points to (module docstring table), or None when nothing
-    stands out.  ``failed``: the detector's tests the window failed; a window failed by the
-    nav's NIS test alone is not called ``state_sensor`` (module docstring)."""
+    stands out.  ``failed``: the detector's tests the window failed.  A window failed by the
+    nav's NIS test alone is not called ``state_sensor``, and one whose NIS test fails while the
+    truth has left a nav still on its plan names no class but ``actuator`` (module
+    docstring)."""
     cls = _evidence_class(ev, tol)
     if cls == "state_sensor" and list(failed) == ["nis"]:
+        return None
+    if cls != "actuator" and "nis" in failed and _truth_not_followed(ev, tol):
         return None
     return cls
 
@@ -279,9 +301,12 @@ def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
     if ev.beta_hat is not None and abs(ev.beta_hat - 1.0) > max(
             tol.beta, BETA_SE_MARGIN * (ev.beta_se or 0.0)):
         return "camera"
-    nav_plan = ev.nav_vs_plan_m or 0.0
-    if nav_plan > tol.position_m and (ev.camera_vs_plan_m or math.inf) < tol.position_m / 2.0:
-        return "state_sensor"  # the nav left the plan, the spacecraft did not (yet)
+    nav_plan, camera_nav = ev.nav_vs_plan_m or 0.0, ev.camera_vs_nav_m or 0.0
+    half = tol.position_m / 2.0
+    align = _alignment(ev)
+    if nav_plan > tol.position_m and ((ev.camera_vs_plan_m or math.inf) < half
+                                      or (align or 0.0) < -SAME_WAY):
+        return "state_sensor"  # the nav left the plan; the spacecraft did not, or the other way
     explained = [e for e in (ev.explained_reported, ev.explained_located) if e is not None]
     pose_explains = not explained or max(explained) >= tol.explained
     if (ev.pointing_error_deg or 0.0) > tol.pointing_deg and pose_explains:
@@ -289,21 +314,53 @@ def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
     if (ev.camera_offset_deg or 0.0) > (2.0 * tol.pointing_deg  # beyond the fit's spread
                                         + SE_MARGIN * (ev.camera_se_deg or 0.0)):
         return "camera"  # it looks elsewhere than its attitude says: misaligned in its mount
-    camera_nav = ev.camera_vs_nav_m or 0.0
     if (ev.dv_rate_mps2 or 0.0) > tol.dv_rate_mps2:
         return "actuator"
+    dragged = (align or 0.0) > SAME_WAY and (ev.camera_vs_plan_m or 0.0) > nav_plan
     if camera_nav > tol.position_m and camera_nav > nav_plan:
-        if (ev.offset_alignment or 0.0) > SAME_WAY:
+        if dragged:
             return "actuator"
-        if camera_nav > SE_MARGIN * (ev.camera_se_m or 0.0):  # beyond the fixes' spread
+        if _beyond_fixes(ev, camera_nav):
             return "state_sensor"
     if nav_plan > tol.position_m:
         return "actuator"
-    if (ev.offset_alignment or 0.0) > SAME_WAY and camera_nav > tol.position_m / 2.0:
-        return "actuator"  # the truth and the nav dragged off the plan together: a leak
-    if ev.seen_overlap is not None and ev.seen_overlap < tol.overlap:
+    if dragged and camera_nav > half:
+        return "actuator"  # the truth dragged off the plan ahead of the nav: a leak
+    nav_wrong = camera_nav > half and _beyond_fixes(ev, camera_nav)
+    if ev.seen_overlap is not None and ev.seen_overlap < tol.overlap and not nav_wrong:
         return "camera"
     return None
+
+
+NAV_ON_PLAN_M = 0.1
+"""A nav estimate this close to its plan (median over the window), m, is on it: within the
+nominal spread of a nav steering its spacecraft along the plan, and far below the 0.25-0.5 m
+a biased nav walks off the plan in the first window of its step."""
+
+
+def _truth_not_followed(ev: Evidence, tol: Tolerances) -> bool:
+    """Whether the truth has left a nav still on its plan (``NAV_ON_PLAN_M``): the camera
+    located more than half the position tolerance off the nav.  With the NIS test failing this
+    is an unmodelled force's first seconds (a leak, a state disturbance), before the nav has
+    followed the truth; a settled nav bias shows the same geometry, but its NIS passes."""
+    return ((ev.nav_vs_plan_m or 0.0) < NAV_ON_PLAN_M
+            and (ev.camera_vs_nav_m or 0.0) > tol.position_m / 2.0)
+
+
+def _beyond_fixes(ev: Evidence, distance_m: float) -> bool:
+    """Whether a distance of the located camera (m) is beyond ``SE_MARGIN`` standard errors of
+    the fixes' median (``Evidence.camera_se_m``)."""
+    return distance_m > SE_MARGIN * (ev.camera_se_m or 0.0)
+
+
+def _alignment(ev: Evidence) -> float | None:
+    """``Evidence.offset_alignment``, where the located camera's offset from the plan exceeds
+    the standard error of its fixes (a camera on the plan, within its noise, has no
+    direction)."""
+    if (ev.camera_vs_plan_m is not None and ev.camera_se_m is not None
+            and ev.camera_vs_plan_m <= ev.camera_se_m):
+        return None
+    return ev.offset_alignment
 
 
 Observation = tuple[np.ndarray, np.ndarray]
