@@ -279,7 +279,7 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
         hub.close()
         if live is not None:
             live.close()
-        router.stop()
+        (sup.find(ROUTER.name) or router).stop()  # the one running: a restart replaced the first
 
 
 def _write_access(out: Path, mission: str, scenario: Scenario,

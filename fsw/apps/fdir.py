@@ -65,7 +65,7 @@ class OnboardFdirApp(App):
         Input(cat.OBSERVATIONS, "on_observations"),
     )
     OUTPUTS = (Output("command", cat.FDIR_COMMAND), Output("event", cat.FDIR_EVENT))
-    CRITICAL = ("states", "blank", "acted", "safe", "camera_off", "tracking", "track_since",
+    CRITICAL = ("states", "blank", "acted", "safe", "camera_off", "track_since",
                 "assignment_id", "_reports", "_samples", "_recovered")
 
     def __init__(self, ctx: AppContext) -> None:
@@ -82,7 +82,6 @@ class OnboardFdirApp(App):
         self.safe: Literal["off", "commanded", "on"] = "off"
         """safe hold: commanded, then on once guidance reports it, off when it ends"""
         self.camera_off = False
-        self.tracking = False
         self.track_since: float | None = None
         """when the attitude app last began tracking, s (None: not tracking)"""
         self.settle_s = sc.attitude.settling_time_s
@@ -98,8 +97,7 @@ class OnboardFdirApp(App):
             self._reports.append(msg)
 
     def on_attitude(self, msg: AttitudeEstimate) -> None:
-        self.tracking = msg.mode == "track"
-        if not self.tracking:
+        if msg.mode != "track":
             self.track_since = None
         elif self.track_since is None:
             self.track_since = msg.t_sim
@@ -120,7 +118,7 @@ class OnboardFdirApp(App):
         self._sample("thrust_duty_excess", thrust_duty(msg, self.u_max))
 
     def on_observations(self, msg: PoiObservations) -> None:
-        if self.tracking and not self.camera_off:
+        if self.track_since is not None and not self.camera_off:  # tracking
             self._sample("blank_image_frac", self.blank.add(len(msg.poi)))
 
     def _sample(self, name: str, value: float | None) -> None:

@@ -2,8 +2,8 @@
 and a 5° pointing fault on observer 2 once its tracking has settled.  Onboard, the pointing
 watchpoint trips within 10 s of the onset, before the ground declares the fault; the ground's
 declaration reaches the spacecraft and starts safe hold in the same tick; in safe hold it fires
-no thruster until the ground's re-plan reaches it; the healthy observers trip nothing; and
-summary.json and report.md tell the story with the times."""
+no thruster until the ground's re-plan reaches it, which ends it; the healthy observers trip
+nothing; and summary.json and report.md tell the story with the times."""
 
 from __future__ import annotations
 
@@ -67,11 +67,14 @@ def test_safe_hold_fires_no_thruster_until_the_ground_replans(flown: Path) -> No
     thrust = [c.t_sim for c in archive.of(cat.THRUST, m) if c.spacecraft == 2]
     assert not [t for t in thrust if safe[0] <= t <= safe[-1]]
     events = RunSummary.read(flown / "summary.json").onboard_fdir.events  # type: ignore[union-attr]
-    recovered = [e.t_sim for e in events if e.event == "recovered"]
-    assignments = [a for a in archive.of(cat.ASSIGNMENTS, m)
-                   if a.assignments[0].assignment_id > status[0].assignment_id]
-    if recovered:  # safe hold ended only by an assignment newer than the one in force
-        assert assignments and assignments[0].t_sim <= recovered[0]
+    recovered = [e.t_sim for e in events if e.event == "recovered" and e.spacecraft == 2]
+    assert recovered, "safe hold never ended"
+    # ended by an assignment newer than the one in force when it began, and guidance left it
+    in_force = next(s.assignment_id for s in status if s.mode == "safe")
+    newer = [a.t_sim for a in archive.of(cat.ASSIGNMENTS, m)
+             if any(e.spacecraft == 2 and e.assignment_id > in_force for e in a.assignments)]
+    assert newer and newer[0] <= recovered[0]
+    assert [s.mode for s in status if s.t_sim > recovered[0]][-1] != "safe"
 
 
 def test_the_report_tells_the_onboard_story(flown: Path) -> None:
