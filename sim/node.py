@@ -108,7 +108,9 @@ class SimNode:
     def __post_init__(self) -> None:
         sc = self.scenario
         self.constants = MissionConstants.of(sc)
-        chief = circular_chief_eci(sc.orbit.altitude_km * 1e3, np.radians(sc.orbit.inclination_deg))
+        chief = circular_chief_eci(
+            sc.orbit.altitude_km * 1e3, np.radians(sc.orbit.inclination_deg),
+            np.radians(sc.orbit.raan_deg), np.radians(sc.orbit.arg_latitude_deg))
         self.truth = RelativeTruth(
             chief, initial_states(sc, self.constants.n_rad_s), j2=sc.orbit.j2,
             energy_match=sc.observers.energy_match and sc.observers.start == "pro")

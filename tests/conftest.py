@@ -9,6 +9,7 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterator
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
@@ -74,6 +75,8 @@ def _toml(v: object) -> str:
         return "true" if v else "false"
     if isinstance(v, str):
         return f'"{v}"'
+    if isinstance(v, datetime):
+        return v.isoformat()
     if isinstance(v, float) and v == float("inf"):
         return "inf"
     if isinstance(v, dict):

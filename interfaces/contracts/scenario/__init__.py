@@ -7,6 +7,7 @@ from interfaces.contracts.scenario.base import Section
 from interfaces.contracts.scenario.comms import Burst, Comms, LinkCut
 from interfaces.contracts.scenario.faults import COMMON_MODE_KINDS, Fault, FaultKind
 from interfaces.contracts.scenario.fdir import FdirSettings
+from interfaces.contracts.scenario.ground import Ground, Station
 from interfaces.contracts.scenario.flight import Actuators, Attitude, Guidance, Nav, Sensors
 from interfaces.contracts.scenario.mission import CameraSettings, Orbit, Target
 from interfaces.contracts.scenario.model import (
@@ -28,8 +29,8 @@ from interfaces.contracts.scenario.sim import SimSettings
 
 __all__ = [
     "Actuators", "AssignmentSettings", "Attitude", "Burst", "COMMON_MODE_KINDS", "CameraSettings",
-    "Comms", "DEFAULT_WATCHPOINTS", "Fault", "FaultKind", "FdirSettings", "Guidance", "LinkCut",
-    "Nav", "ObserverOverride", "Observers", "OnboardFdir", "Orbit", "Phase", "Rates", "Scenario",
-    "ScenarioError", "Section", "Sensors", "SequenceName", "SimSettings", "Target", "Watchpoint",
-    "load_scenario", "parse_scenario",
+    "Comms", "DEFAULT_WATCHPOINTS", "Fault", "FaultKind", "FdirSettings", "Ground", "Guidance",
+    "LinkCut", "Nav", "ObserverOverride", "Observers", "OnboardFdir", "Orbit", "Phase", "Rates",
+    "Scenario", "ScenarioError", "Section", "Sensors", "SequenceName", "SimSettings", "Station",
+    "Target", "Watchpoint", "load_scenario", "parse_scenario",
 ]

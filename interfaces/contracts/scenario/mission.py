@@ -10,10 +10,15 @@ from interfaces.contracts.scenario.base import Section
 
 
 class Orbit(Section):
-    """Target (chief) orbit: circular at ``altitude_km``."""
+    """Target (chief) orbit: circular at ``altitude_km``, inclined ``inclination_deg``, its
+    ascending node at right ascension ``raan_deg`` and the target ``arg_latitude_deg`` past it
+    at t = 0.  The node and the argument of latitude matter to the relative motion only with
+    J2 (the latter) and to the ground passes (both)."""
 
     altitude_km: float = Field(default=500.0, gt=100.0, lt=40000.0)
     inclination_deg: float = Field(default=51.6, ge=0.0, le=180.0)
+    raan_deg: float = Field(default=0.0, ge=0.0, lt=360.0)
+    arg_latitude_deg: float = Field(default=0.0, ge=0.0, lt=360.0)
     j2: bool = Field(default=False, description="include J2 in the truth dynamics")
 
 

@@ -19,6 +19,7 @@ from interfaces.contracts.scenario.comms import Comms
 from interfaces.contracts.scenario.faults import Fault
 from interfaces.contracts.scenario.fdir import FdirSettings
 from interfaces.contracts.scenario.flight import Actuators, Attitude, Guidance, Nav, Sensors
+from interfaces.contracts.scenario.ground import Ground
 from interfaces.contracts.scenario.mission import CameraSettings, Orbit, Target
 from interfaces.contracts.scenario.observers import Observers, Phase
 from interfaces.contracts.scenario.onboard import OnboardFdir
@@ -46,6 +47,7 @@ class Scenario(Section):
     assignment: AssignmentSettings = AssignmentSettings()
     fdir: FdirSettings = FdirSettings()
     onboard_fdir: OnboardFdir = OnboardFdir()
+    ground: Ground = Ground()
     sim: SimSettings = SimSettings()
     faults: list[Fault] = Field(default_factory=list)
 

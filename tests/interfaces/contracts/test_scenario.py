@@ -38,6 +38,15 @@ def test_defaults_and_pro_phasing() -> None:
     ('name = "x"\nduration_s = 10\n[onboard_fdir.watchpoints.nav_nis]\npersistance = 2\n',
      "onboard_fdir.watchpoints.nav_nis: persistance"),
     ('name = "x"\nduration_s = 10\n[onboard_fdir]\nenable = true\n', "onboard_fdir.enable"),
+    ('name = "x"\nduration_s = 10\n[orbit]\ninclination_deg = 181\n', "orbit.inclination_deg"),
+    ('name = "x"\nduration_s = 10\n[orbit]\nraan_deg = -5\n', "orbit.raan_deg"),
+    ('name = "x"\nduration_s = 10\n[ground]\nstore_bytes = 0\n', "ground.store_bytes"),
+    ('name = "x"\nduration_s = 10\n[ground]\ncontact = "passes"\n', "[[ground.stations]]"),
+    ('name = "x"\nduration_s = 10\n[ground]\nepoch = 2026-03-20T12:00:00\n', "time zone"),
+    ('name = "x"\nduration_s = 10\n[[ground.stations]]\nname = "gs"\nlatitude_deg = 40\n'
+     'longitude_deg = 0\nelevation_mask_deg = -2\n', "ground.stations.0.elevation_mask_deg"),
+    ('name = "x"\nduration_s = 10\n[[ground.stations]]\nname = "gs"\nlatitude_deg = 95\n'
+     'longitude_deg = 0\n', "ground.stations.0.latitude_deg"),
 ])
 def test_invalid_scenarios_name_the_field(text: str, needle: str) -> None:
     with pytest.raises(ScenarioError) as e:
