@@ -39,8 +39,8 @@ INDIRECT: dict[str, str] = {
     "interfaces.contracts.messages.lockstep": _MESSAGES,
     "interfaces.contracts.messages.sim": _MESSAGES,
     **{f"interfaces.contracts.scenario.{m}": _SCENARIO
-       for m in ("base", "comms", "faults", "fdir", "flight", "mission", "model", "observers",
-                 "onboard", "planning", "rates", "sim")},
+       for m in ("base", "comms", "faults", "fdir", "flight", "ground", "mission", "model",
+                 "observers", "onboard", "planning", "rates", "sim")},
     "interfaces.contracts.timing": (
         "one constant, TIME_TOL_S: a fault switching on the tick at its time whatever the "
         "rounding tests it (tests/faults/test_schedule.py, tests/faults/test_software.py)"),
