@@ -2,7 +2,7 @@
 
 ``contact = "continuous"`` (the default) is a ground that hears every observer at every instant,
 through the target; ``"passes"`` hears only while a station sees the target
-(``sim/passes.py``), with telemetry stored onboard in between and dumped at the next pass.
+(``gnc/passes.py``), with telemetry stored onboard in between and dumped at the next pass.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Ground passes (sim/passes.py) against closed forms: an overhead pass seen from the pole, a
+"""Ground passes (gnc/passes.py) against closed forms: an overhead pass seen from the pole, a
 station beyond the orbit's reach, a geostationary target, the sidereal angle at J2000 and a
 sun-synchronous node rate."""
 
@@ -12,7 +12,7 @@ import pytest
 
 from gnc.constants import MU_EARTH_M3_S2, R_EARTH_M
 from interfaces.contracts.scenario import parse_scenario
-from sim.passes import (
+from gnc.passes import (
     OMEGA_EARTH_RAD_S,
     WGS84_FLATTENING,
     CircularOrbit,
