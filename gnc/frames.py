@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-__all__ = ["lvlh_rate_lvlh", "lvlh_to_eci_quat"]
+__all__ = ["lvlh_rate_lvlh", "lvlh_to_eci_quat", "orbit_plane_axes"]
 
 
 def lvlh_to_eci_quat(
@@ -63,3 +63,19 @@ def lvlh_to_eci_quat(
 def lvlh_rate_lvlh(n: float) -> np.ndarray:
     """Angular velocity of LVLH with respect to ECI, in LVLH axes: (0, 0, n) rad/s."""
     return np.array([0.0, 0.0, n])
+
+
+def orbit_plane_axes(cos_raan: np.ndarray | float, sin_raan: np.ndarray | float,
+                     cos_inc: float, sin_inc: float) -> tuple[np.ndarray, np.ndarray]:
+    """The orbital plane's unit vectors in ECI: the node line p and its in-plane normal q (the
+    first two columns of R3(Ω) R1(i)), from the cosines and sines of the node Ω and the
+    inclination i.  A point of a circular orbit of radius r at argument of latitude u is
+    r (cos u p + sin u q); its velocity is along -sin u p + cos u q.
+
+    The node may be an array (a node that drifts with time): p and q then have shape (..., 3);
+    for floats, shape (3,).  The caller takes the trigonometric functions, so each keeps its
+    own arithmetic (the sim's chief state uses ``math``'s)."""
+    co, so = np.asarray(cos_raan, dtype=float), np.asarray(sin_raan, dtype=float)
+    p = np.stack([co, so, np.zeros_like(co)], axis=-1)
+    q = np.stack([-so * cos_inc, co * cos_inc, np.full_like(co, sin_inc)], axis=-1)
+    return p, q

@@ -33,6 +33,7 @@ import numpy.typing as npt
 from scipy.optimize import brentq, minimize_scalar
 
 from gnc.constants import J2_EARTH, MU_EARTH_M3_S2, R_EARTH_M
+from gnc.frames import orbit_plane_axes
 from interfaces.contracts.scenario import Scenario
 
 FloatArray = npt.NDArray[np.float64]
@@ -75,10 +76,9 @@ class CircularOrbit:
         raan_rate, u_rate = self.rates_rad_s()
         node = self.raan_rad + raan_rate * t_s
         u = self.arg_lat_rad + u_rate * t_s
-        ci, si = math.cos(self.inclination_rad), math.sin(self.inclination_rad)
-        cu, su, co, so = np.cos(u), np.sin(u), np.cos(node), np.sin(node)
-        return self.radius_m * np.stack(
-            [cu * co - su * ci * so, cu * so + su * ci * co, su * si], axis=-1)
+        p, q = orbit_plane_axes(np.cos(node), np.sin(node), math.cos(self.inclination_rad),
+                                math.sin(self.inclination_rad))
+        return self.radius_m * (np.cos(u)[:, None] * p + np.sin(u)[:, None] * q)
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from gnc.constants import J2_EARTH, MU_EARTH_M3_S2, R_EARTH_M
+from gnc.frames import orbit_plane_axes
 from sim import kernels
 
 __all__ = [
@@ -83,9 +84,7 @@ def circular_chief_eci(
     co, so = math.cos(raan_rad), math.sin(raan_rad)
     ci, si = math.cos(inclination_rad), math.sin(inclination_rad)
     cu, su = math.cos(arg_lat_rad), math.sin(arg_lat_rad)
-    # Unit vectors of the orbital plane: node line p and its in-plane normal q.
-    p = np.array([co, so, 0.0])
-    q = np.array([-so * ci, co * ci, si])
+    p, q = orbit_plane_axes(co, so, ci, si)
     pos = r * (cu * p + su * q)
     vel = v * (-su * p + cu * q)
     return np.concatenate([pos, vel])
