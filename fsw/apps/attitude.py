@@ -68,7 +68,10 @@ class AttitudeApp(App):
         sc = ctx.scenario
         self.sc_id = ctx.spacecraft or 0
         self.n = ctx.constants.n_rad_s
-        self.incl = math.radians(sc.orbit.inclination_deg)
+        self.orbit = (math.radians(sc.orbit.inclination_deg), math.radians(sc.orbit.raan_deg),
+                      math.radians(sc.orbit.arg_latitude_deg))
+        """the target's orbit as the LVLH model flies it: inclination, node, argument of
+        latitude at t = 0 (rad; ``gnc.frames.lvlh_to_eci_quat``)"""
         self.dt = sc.rates.dt_s
         self.mid_every = sc.rates.ticks_per("mid")
         self.J = np.diag(sc.observers.inertia_kg_m2)
@@ -172,7 +175,7 @@ class AttitudeApp(App):
         """Line of sight to the pointing target at time t, ECI axes (m), from the nav estimate
         and the target, each extrapolated with its velocity."""
         assert self._est is not None
-        los = kern.los_eci(t, self.n, self.incl, self._x_est, self._est.t_sim, self.target,
+        los = kern.los_eci(t, self.n, *self.orbit, self._x_est, self._est.t_sim, self.target,
                            self.target_rate, self.target_accel, self.target_t)
         n2 = float(los @ los)
         if not (n2 > 0.0 and math.isfinite(n2)):
@@ -189,7 +192,7 @@ class AttitudeApp(App):
             r_des, w_des, wdot_des = self.slew.at_quat(t - self.slew_t0)
         else:
             status, t_bad, q_des, angle, tau = kern.track_cycle(
-                t, DESIRED_RATE_STEP_S, self.n, self.incl, self._x_est, self._est.t_sim,
+                t, DESIRED_RATE_STEP_S, self.n, *self.orbit, self._x_est, self._est.t_sim,
                 self.target, self.target_rate, self.target_accel, self.target_t,
                 self.q if self.q_point is None else self.q_point, self.q, self.w_est,
                 self.boresight, self.J, self.h_wheels, self.gains.kp, self.gains.kd,
@@ -224,7 +227,7 @@ class AttitudeApp(App):
 
     def _report(self, t: float) -> None:
         assert self.q is not None
-        q_lvlh = quat.mul(quat.conj(lvlh_to_eci_quat(t, self.n, self.incl)), self.q)
+        q_lvlh = quat.mul(quat.conj(lvlh_to_eci_quat(t, self.n, *self.orbit)), self.q)
         error = 0.0
         if self._est is not None:
             los = self._los_eci(t)

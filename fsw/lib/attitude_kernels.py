@@ -231,11 +231,12 @@ def angle_between(q_a: np.ndarray, q_b: np.ndarray) -> float:
 
 
 @njit(cache=True)
-def lvlh_to_eci_quat(t_s: float, n: float, inclination_rad: float) -> np.ndarray:
-    """:func:`gnc.frames.lvlh_to_eci_quat` with Ω = u0 = 0."""
-    u = n * t_s
+def lvlh_to_eci_quat(t_s: float, n: float, inclination_rad: float, raan_rad: float,
+                     arg_lat0_rad: float) -> np.ndarray:
+    """:func:`gnc.frames.lvlh_to_eci_quat`, compiled."""
+    u = arg_lat0_rad + n * t_s
     half_i = 0.5 * inclination_rad
-    diff, total = -0.5 * u, 0.5 * u
+    diff, total = 0.5 * (raan_rad - u), 0.5 * (raan_rad + u)
     si, ci = math.sin(half_i), math.cos(half_i)
     q = np.array([si * math.cos(diff), si * math.sin(diff), ci * math.sin(total),
                   ci * math.cos(total)])
@@ -247,15 +248,17 @@ def lvlh_to_eci_quat(t_s: float, n: float, inclination_rad: float) -> np.ndarray
 
 
 @njit(cache=True)
-def los_eci(t: float, n: float, inclination_rad: float, x_est: np.ndarray, t_est: float,
-            target: np.ndarray, target_rate: np.ndarray, target_accel: np.ndarray,
-            target_t: float) -> np.ndarray:
+def los_eci(t: float, n: float, inclination_rad: float, raan_rad: float, arg_lat0_rad: float,
+            x_est: np.ndarray, t_est: float, target: np.ndarray, target_rate: np.ndarray,
+            target_accel: np.ndarray, target_t: float) -> np.ndarray:
     """Line of sight (ECI, m) from the own position (nav estimate extrapolated with its
-    velocity) to the pointing target (extrapolated to second order) at time ``t``."""
+    velocity) to the pointing target (extrapolated to second order) at time ``t``; the
+    target's orbit is circular (mean motion ``n``, inclination, node, argument of latitude at
+    t = 0: :func:`lvlh_to_eci_quat`)."""
     dt_tgt = t - target_t
     aim = target + (target_rate + 0.5 * dt_tgt * target_accel) * dt_tgt
     r = x_est[:3] + x_est[3:] * (t - t_est)
-    return _qrot(lvlh_to_eci_quat(t, n, inclination_rad), aim - r, 1.0)
+    return _qrot(lvlh_to_eci_quat(t, n, inclination_rad, raan_rad, arg_lat0_rad), aim - r, 1.0)
 
 
 # --- control ------------------------------------------------------------------------------
@@ -297,8 +300,8 @@ NO_LINE_OF_SIGHT = 2
 
 
 @njit(cache=True)
-def track_cycle(t: float, h: float, n: float, inclination_rad: float, x_est: np.ndarray,
-                t_est: float, target: np.ndarray, target_rate: np.ndarray,
+def track_cycle(t: float, h: float, n: float, inclination_rad: float, raan_rad: float,
+                arg_lat0_rad: float, x_est: np.ndarray, t_est: float, target: np.ndarray, target_rate: np.ndarray,
                 target_accel: np.ndarray, target_t: float, q_seed: np.ndarray,
                 q_est: np.ndarray, w_est: np.ndarray, boresight: np.ndarray, J: np.ndarray,
                 h_wheels: np.ndarray, kp: float, kd: float, w_max: float, tau_max: float,
@@ -315,8 +318,8 @@ def track_cycle(t: float, h: float, n: float, inclination_rad: float, x_est: np.
     lines = np.empty((3, 3))
     for j in range(3):
         tj = t + (j - 1) * h
-        los = los_eci(tj, n, inclination_rad, x_est, t_est, target, target_rate, target_accel,
-                      target_t)
+        los = los_eci(tj, n, inclination_rad, raan_rad, arg_lat0_rad, x_est, t_est, target,
+                      target_rate, target_accel, target_t)
         n2 = los[0] * los[0] + los[1] * los[1] + los[2] * los[2]
         if not (n2 > 0.0 and math.isfinite(n2)):
             return NO_LINE_OF_SIGHT, tj, zero4, 0.0, zero3

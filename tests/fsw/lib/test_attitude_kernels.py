@@ -85,15 +85,17 @@ def test_pointing_reference_is_repoint_and_central_differences(seed: int) -> Non
 def test_los_matches_frames_model(seed: int) -> None:
     rng = np.random.default_rng(seed)
     n, incl = 1.1e-3, math.radians(rng.uniform(0, 98))
+    node, u0 = (0.0, 0.0) if seed == 0 else tuple(rng.uniform(-math.pi, math.pi, size=2))
+    orbit = (incl, node, u0)
     t, t_est, t_tgt = 500.0 + rng.uniform(0, 1e4), 499.5, 498.0
     x = rng.normal(size=6) * np.array([30, 30, 30, 0.05, 0.05, 0.05])
     tgt, rate, acc = rng.normal(size=3), rng.normal(size=3) * 0.1, rng.normal(size=3) * 0.01
     aim = tgt + (rate + 0.5 * (t - t_tgt) * acc) * (t - t_tgt)
     r = x[:3] + x[3:] * (t - t_est)
-    ref = quat.rotate(lvlh_to_eci_quat(t, n, incl), aim - r)
-    np.testing.assert_allclose(kern.lvlh_to_eci_quat(t, n, incl), lvlh_to_eci_quat(t, n, incl),
-                               atol=1e-15)
-    np.testing.assert_allclose(kern.los_eci(t, n, incl, x, t_est, tgt, rate, acc, t_tgt), ref,
+    ref = quat.rotate(lvlh_to_eci_quat(t, n, *orbit), aim - r)
+    np.testing.assert_allclose(kern.lvlh_to_eci_quat(t, n, *orbit),
+                               lvlh_to_eci_quat(t, n, *orbit), atol=1e-15)
+    np.testing.assert_allclose(kern.los_eci(t, n, *orbit, x, t_est, tgt, rate, acc, t_tgt), ref,
                                rtol=1e-12, atol=1e-12)
 
 
@@ -121,18 +123,19 @@ def test_track_cycle_is_the_kernels_called_one_by_one(seed: int) -> None:
     """The fused tracking cycle gives the same bits as the separate kernels, and names a slew
     beyond the threshold and a line of sight that vanishes."""
     rng = np.random.default_rng(seed)
-    n, incl, t, h = 1.1e-3, math.radians(51.6), float(rng.uniform(0.0, 5000.0)), 1.0
+    n, t, h = 1.1e-3, float(rng.uniform(0.0, 5000.0)), 1.0
+    orbit = (math.radians(51.6), *rng.uniform(-math.pi, math.pi, size=2))
     x_est = np.concatenate([rng.normal(size=3) * 40.0, rng.normal(size=3) * 0.05])
     target, rate, accel = rng.normal(size=3), rng.normal(size=3) * 0.01, rng.normal(size=3) * 1e-4
     q_est, w_est, h_w = _unit_quat(rng), rng.normal(size=3) * 1e-3, rng.normal(size=3) * 1e-3
     J, bore = np.diag(rng.uniform(0.5, 2.0, size=3)), np.array([0.0, 0.0, 1.0])
     threshold = math.radians(5.0) if seed % 3 == 0 else math.pi
-    los = [kern.los_eci(t + d, n, incl, x_est, t - 0.4, target, rate, accel, t - 0.7)
+    los = [kern.los_eci(t + d, n, *orbit, x_est, t - 0.4, target, rate, accel, t - 0.7)
            for d in (-h, 0.0, h)]
     q_des, w_des, wdot_des = kern.pointing_reference(q_est, *los, bore, h)
     angle = kern.angle_between(q_des, q_est)
     status, _, q_got, angle_got, tau_got = kern.track_cycle(
-        t, h, n, incl, x_est, t - 0.4, target, rate, accel, t - 0.7, q_est, q_est, w_est, bore,
+        t, h, n, *orbit, x_est, t - 0.4, target, rate, accel, t - 0.7, q_est, q_est, w_est, bore,
         J, h_w, 0.05, 0.4, 0.02, 0.01, threshold)
     assert np.array_equal(q_got, q_des) and angle_got == angle
     if angle > threshold:
@@ -144,6 +147,6 @@ def test_track_cycle_is_the_kernels_called_one_by_one(seed: int) -> None:
     on_target = x_est.copy()  # the spacecraft at the target, not moving: no line of sight
     on_target[:3], on_target[3:] = target, 0.0
     status, t_bad, *_ = kern.track_cycle(
-        t, h, n, incl, on_target, t, target, np.zeros(3), np.zeros(3), t, q_est, q_est, w_est,
+        t, h, n, *orbit, on_target, t, target, np.zeros(3), np.zeros(3), t, q_est, q_est, w_est,
         bore, J, h_w, 0.05, 0.4, 0.02, 0.01, threshold)
     assert status == kern.NO_LINE_OF_SIGHT and t_bad == t - h
