@@ -24,6 +24,8 @@ Units: SI (m, s, rad) in every function; degrees only in the names that say so.
 
 from __future__ import annotations
 
+import bisect
+import functools
 import math
 from dataclasses import dataclass
 from datetime import datetime, timezone
@@ -206,3 +208,58 @@ def scenario_pass_table(scenario: Scenario) -> list[ContactWindow]:
                               math.radians(s.longitude_deg), s.altitude_m,
                               math.radians(s.elevation_mask_deg)) for s in g.stations]
     return pass_table(orbit, stations, greenwich_sidereal_angle(g.epoch), scenario.duration_s)
+
+
+@dataclass(frozen=True)
+class ContactPlan:
+    """When the ground hears the constellation: the union of every station's passes, as
+    disjoint intervals [aos, los) in time order (s).  The channel stage, the ground FDIR and
+    the summary read the same plan, made by :meth:`of` from the scenario."""
+
+    windows: tuple[tuple[float, float], ...]
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> ContactPlan | None:
+        """The plan of a scenario with ``[ground] contact = "passes"``; None for a ground that
+        hears continuously."""
+        if scenario.ground.contact != "passes":
+            return None
+        return cls.merged(scenario_pass_table(scenario))
+
+    @classmethod
+    def merged(cls, table: list[ContactWindow]) -> ContactPlan:
+        """The union of the passes of ``table`` (overlapping passes of two stations merge)."""
+        out: list[tuple[float, float]] = []
+        for w in sorted(table, key=lambda w: w.aos_s):
+            if out and w.aos_s <= out[-1][1]:
+                out[-1] = (out[-1][0], max(out[-1][1], w.los_s))
+            elif w.los_s > w.aos_s:
+                out.append((w.aos_s, w.los_s))
+        return cls(tuple(out))
+
+    @functools.cached_property
+    def _aos(self) -> list[float]:
+        return [w[0] for w in self.windows]
+
+    def pass_index(self, t_s: float) -> int:
+        """Index of the latest contact acquired at or before ``t_s`` (s), or -1 before the
+        first (the contact in progress, or the last one ended)."""
+        return bisect.bisect_right(self._aos, t_s) - 1
+
+    def in_contact(self, t_s: float) -> bool:
+        i = self.pass_index(t_s)
+        return i >= 0 and t_s < self.windows[i][1]
+
+    def next_contact(self, t_s: float) -> float:
+        """``t_s`` if in contact then, else the next acquisition (s); inf if none follows."""
+        if self.in_contact(t_s):
+            return t_s
+        i = self.pass_index(t_s) + 1
+        return self.windows[i][0] if i < len(self.windows) else math.inf
+
+    def contact_end(self, t_s: float) -> float:
+        """The loss of signal that ends the contact at or after ``t_s`` (s); inf if none."""
+        t = self.next_contact(t_s)
+        if math.isinf(t):
+            return t
+        return self.windows[self.pass_index(t)][1]

@@ -301,7 +301,8 @@ NO_LINE_OF_SIGHT = 2
 
 @njit(cache=True)
 def track_cycle(t: float, h: float, n: float, inclination_rad: float, raan_rad: float,
-                arg_lat0_rad: float, x_est: np.ndarray, t_est: float, target: np.ndarray, target_rate: np.ndarray,
+                arg_lat0_rad: float, x_est: np.ndarray, t_est: float, target: np.ndarray,
+                target_rate: np.ndarray,
                 target_accel: np.ndarray, target_t: float, q_seed: np.ndarray,
                 q_est: np.ndarray, w_est: np.ndarray, boresight: np.ndarray, J: np.ndarray,
                 h_wheels: np.ndarray, kp: float, kd: float, w_max: float, tau_max: float,

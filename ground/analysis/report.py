@@ -50,6 +50,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     lines += _gnc_section(out, digest.gnc_series(scenario, mission), summary)
     lines += _coverage_section(out, digest.coverage, summary)
     lines += _fdir_section(out, archive, mission, summary)
+    lines += _contact_section(summary)
     lines += _links_section(summary) + _exec_section(summary) + _incidents_section(summary)
     lines += _archive_section(summary)
     return _write(out, lines)
@@ -337,6 +338,29 @@ def _gain_plot(out: Path, judged: list[FdirWindow], ids: list[int]) -> None:
     fig.tight_layout()
     fig.savefig(out / "fdir_gain.png", dpi=110)
     plt.close(fig)
+
+
+def _contact_section(summary: RunSummary) -> list[str]:
+    """The pass table and the onboard stores (runs with ground passes)."""
+    g = summary.ground_contact
+    if g is None:
+        return []
+    rows = ["## Ground passes", "",
+            f"The ground hears only in passes; longest gap {g.longest_gap_s:.0f} s. Downlink "
+            f"{g.downlink_bps / 1e6:g} Mbit/s per spacecraft, store {g.store_bytes / 2**20:g} "
+            "MiB.", "",
+            "| station | AOS (s) | LOS (s) | duration (s) | max elevation (°) |",
+            "|---|---|---|---|---|"]
+    rows += [f"| {p.station} | {p.aos_s:.0f} | {p.los_s:.0f} | {p.duration_s:.0f} | "
+             f"{p.max_elevation_deg:.1f} |" for p in g.passes]
+    rows += ["", "| spacecraft | stored | dumped | sent again | overflow | aboard at end | "
+             "uplinks held |", "|---|---|---|---|---|---|---|"]
+    for node, s in sorted(g.stores.items()):
+        lost = ", ".join(f"{r.topic} {r.first_s:.0f}-{r.last_s:.0f} s ({r.count})"
+                         for r in s.overflow_runs[:5]) or "none"
+        rows.append(f"| {node} | {s.stored} | {s.dumped} | {s.retransmitted} | {s.overflow}: "
+                    f"{lost} | {s.onboard} | {g.uplink_held.get(node, 0)} |")
+    return rows + [""]
 
 
 def _links_section(summary: RunSummary) -> list[str]:

@@ -10,6 +10,8 @@ Definitions (one run):
   constellation); ``latency_s`` is then measured to the first alarm on that spacecraft, and
   ``identified_class`` is the class of the first such alarm that names one (the detector may
   identify a window after it detects), at ``identification_latency_s`` from onset.
+  ``declared_latency_s`` is the time from onset to when that first alarm was declared (the
+  window judged: with ground passes, after its data came down).
 * A *false alarm* is an alarm on a spacecraft with no fault active at its time (within the
   same grace).  ``nominal_cycles`` counts the FDI windows judged (a decision was possible) that
   do not overlap a fault of their spacecraft; ``false_alarm_rate`` is false alarms per nominal
@@ -41,6 +43,8 @@ class Alarm:
     spacecraft: int
     t_s: float
     fault_class: FaultClass | None
+    declared_s: float | None = None
+    """when it was declared (s; None: not known)"""
 
 
 @dataclass(frozen=True)
@@ -81,6 +85,8 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
             identified_class=identified, expected_class=EXPECTED_CLASS[f.kind],
             identified_correctly=identified == EXPECTED_CLASS[f.kind],
             identification_latency_s=classed[0].t_s - f.start_s if classed else None,
+            declared_latency_s=(first.declared_s - f.start_s
+                                if first is not None and first.declared_s is not None else None),
         ))
 
     def faulty(sc: int, t: float) -> bool:  # a common-mode fault (0) acts on every observer

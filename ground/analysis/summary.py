@@ -13,6 +13,7 @@ from pydantic import BaseModel
 from ground.analysis.coverage import coverage_summary
 from ground.analysis.digest import RunDigest, digest_run
 from ground.analysis.gnc import gnc_summary
+from ground.analysis.ground_contact import ground_contact
 from ground.analysis.onboard import onboard_summary
 from ground.analysis.run_summary import (
     BUS_HEADER,
@@ -103,7 +104,11 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str,
                    for sc, e in digest.nav_errors(mission).items()}
     summary.gnc = gnc_summary(digest.gnc_series(scenario, mission))
     summary.coverage = coverage_summary(digest.coverage)
-    summary.links = _copies([c for node in sorted(links) for c in links[node].links])
+    summary.links = _copies([c for node in sorted(links) for c in links[node].links],
+                            exclude_none=True)
+    contact = ground_contact(scenario, summary.links)
+    if contact is not None:  # unset otherwise: not written
+        summary.ground_contact = contact
     summary.exec = {node: _exec_record(m) for node, m in sorted(execs.items())}
     summary.telemetry = _copies(tlm[-1].entries) if tlm else []
     summary.sim = _sim_record(archive.of(cat.SIM_STATUS, mission))
@@ -154,10 +159,11 @@ def _sim_record(statuses: list[SimStatus]) -> SimRecord:
     return record
 
 
-def _copies(records: Sequence[B]) -> list[B]:
+def _copies(records: Sequence[B], exclude_none: bool = False) -> list[B]:
     """Copies of ``records`` with every field given (as written: a message decoded from the
-    bus holds only the fields its sender gave, and a summary writes the fields given)."""
-    return [type(r).model_validate(r.model_dump()) for r in records]
+    bus holds only the fields its sender gave, and a summary writes the fields given); with
+    ``exclude_none``, those that are None are left unset (not written)."""
+    return [type(r).model_validate(r.model_dump(exclude_none=exclude_none)) for r in records]
 
 
 def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> FdirResults:
@@ -172,13 +178,15 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
                  verdicts: list[BaselineVerdict], scenario: Scenario) -> FdirResults:
     """The FDIR part of summary.json from the ground's own output messages (a live run's
     archive or a replay): detections, scores, baselines, series and settings."""
-    alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class) for r in reports]
+    alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class, r.declared_s) for r in reports
+              if r.cause is None]  # a known cause (store overflow) is no alarm of a fault
     judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
               if w.exceeded is not None]
     return FdirResults(
         detections=[Detection(spacecraft=r.spacecraft, time_s=r.t_sim, fault_class=r.fault_class,
                               direction=r.direction, metric=r.metric, threshold=r.threshold,
-                              evidence=dict(r.evidence))
+                              evidence=dict(r.evidence), declared_s=r.declared_s,
+                              **({"cause": r.cause} if r.cause else {}))
                     for r in reports],
         scores=score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
         baselines=baseline_scores(verdicts, scenario),

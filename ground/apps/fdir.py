@@ -5,7 +5,8 @@
 Rate group mid.  Inputs, each handed to the pipeline: every observer's POI observations (the
 images that reached the ground), its transfer plans, its nav, attitude, guidance and H_i
 telemetry, its onboard FDIR's events (a camera turned off onboard is expected to send no
-image), and the ground's own PRO assignments.  Outputs: one ``FdirWindow`` per observer and
+image), the ground's own PRO assignments, and its own link counters (with ground passes,
+what each observer's onboard store lost to overflow).  Outputs: one ``FdirWindow`` per observer and
 FDI window on ``ground/fdir/window``, one ``ConstellationWindow`` per FDI window on
 ``ground/fdir/constellation``, and a ``FaultReport`` on ``ground/fdir/report`` for each fault
 declared or identified.  Each window is judged ``fdir.latency_s`` after it closes.
@@ -31,6 +32,7 @@ class FdirApp(App):
         Input(cat.NAV_ESTIMATE, "pipeline.nav", every_spacecraft=True),
         Input(cat.GUIDANCE_STATUS, "pipeline.guidance", every_spacecraft=True),
         Input(cat.FDIR_EVENT, "pipeline.onboard", every_spacecraft=True),
+        Input(cat.LINK_STATS, "pipeline.link_stats"),
     )
     OUTPUTS = (Output("window", cat.FDIR_WINDOW), Output("report", cat.FAULT_REPORT),
                Output("constellation", cat.CONSTELLATION_WINDOW))

@@ -7,6 +7,8 @@ that does not reach the ground is a link fault, never zero information gain.
   for ``fdir.checks_persistence`` windows.
 * **Silence**: an observer with a plan that sends no image for ``fdir.silent_windows``
   windows in a row (once per episode).
+* **Store overflow** (ground passes): a window whose reports the observer's onboard store
+  lost is a link fault of known cause (once per episode), never judged for information.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ class LinkChecks:
             reports += self._silence(sc, obs, b)
         elif planned:
             obs.silent, obs.link_declared = 0, False
+        obs.overflow_declared = False
         return lost, reports
 
     def limit(self, sent: int) -> float:
@@ -51,6 +54,8 @@ class LinkChecks:
         if not images:
             return 0, []
         seqs = sorted(m.seq for m in images)
+        if obs.resync:  # the numbers the store lost were declared as its overflow
+            obs.last_seq, obs.resync = max(obs.last_seq, seqs[0] - 1), False
         lost = obs.count_observations(seqs)
         if obs.silent:  # the gap is the silence already judged (a link fault), not loss
             return 0, []
@@ -62,6 +67,19 @@ class LinkChecks:
                          100.0 * fraction)
         return lost, [FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
                                   metric=fraction, threshold=limit, window_end_s=b)]
+
+    def overflow(self, sc: int, obs: ObserverState, b: float) -> list[FaultReport]:
+        """A window whose reports the observer's onboard store lost to overflow (ground
+        passes): a link fault of known cause, declared once per episode; the window is judged
+        neither for silence nor for information."""
+        obs.silent, obs.resync = 0, True
+        if obs.overflow_declared:
+            return []
+        obs.overflow_declared = True
+        self.log.warning("FDIR: sc%d's onboard store lost its reports before %.0f s: link "
+                         "fault (store overflow)", sc, b)
+        return [FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
+                            window_end_s=b, cause="store_overflow")]
 
     def _silence(self, sc: int, obs: ObserverState, b: float) -> list[FaultReport]:
         obs.silent += 1

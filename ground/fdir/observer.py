@@ -75,11 +75,31 @@ class ObserverState:
     """when its onboard FDIR turned its camera off (s; None: on): no image is expected since"""
     silent: int = 0
     link_declared: bool = False
+    overflow: list[tuple[float, float]] = field(default_factory=list)
+    """send times (first, last; s) of its FDIR reports its onboard store lost (ground passes)"""
+    overflow_declared: bool = False
+    resync: bool = False
+    """the next judged window numbers its observations afresh (the store lost some before)"""
+    heard_s: float = -math.inf
+    """send time of the newest nav, attitude or image report received (s): with ground
+    passes, everything the FDIR judges sent before it is in (the dump keeps send order)"""
+    fresh: bool = False
+    """a report came in since the FDIR last looked (``FdirPipeline.due``)"""
+    heard_pass: int = -1
+    """index of the latest contact in which its reports came in (ground passes)"""
     last_seq: int = 0
     """last observation sequence number judged (the Bus numbers from 1)"""
     received: int = 0
     lost: int = 0
     """observations received and missing (sequence gaps) since the start"""
+
+    def overflowed(self, a: float, b: float) -> bool:
+        """Whether its store lost FDIR reports sent in the window [a, b) (s)."""
+        return any(first < b and a <= last for first, last in self.overflow)
+
+    def heard(self, t_s: float) -> None:
+        """A nav, attitude or image report sent at ``t_s`` (s) came in."""
+        self.heard_s, self.fresh = max(self.heard_s, t_s), True
 
     def count_observations(self, seqs: list[int]) -> int:
         """Count a window's received observations (their sequence numbers, sorted) and those

@@ -27,6 +27,7 @@ import numpy as np
 
 from gnc import quat
 from gnc.mission import MissionConstants
+from gnc.passes import ContactPlan
 from gnc.poi_map import PoiMap
 from ground.fdir.declaration import Declarer
 from ground.fdir.global_check import GlobalCheck
@@ -41,9 +42,11 @@ from ground.planning.pro_sets import pro_of
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
     AttitudeEstimate,
+    FaultReport,
     FdirWindow,
     GuidanceStatus,
     InfoCostTelemetry,
+    LinkStats,
     Message,
     OnboardFdirEvent,
     PoiObservations,
@@ -51,8 +54,10 @@ from interfaces.contracts.messages import (
     StateEstimate,
     TransferPlanMsg,
 )
+from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.timing import TIME_TOL_S
+from interfaces.contracts.topics import spacecraft_of
 
 
 class FdirPipeline:
@@ -64,6 +69,8 @@ class FdirPipeline:
         sc, cfg = scenario, scenario.fdir
         self.node, self.log, self.settle_s, self.latency_s = node, log, cfg.settle_s, cfg.latency_s
         self.schedule = FdiSchedule(sc.rates.fdi_period_s)
+        self.contact = ContactPlan.of(sc)
+        """when the ground hears (None: continuously)"""
         self.n = constants.n_rad_s
         self.twin = TwinModel(constants.poi_pos, constants.poi_normal, constants.camera,
                               sc.target.radius_m, sc.camera.noise_frac)
@@ -95,6 +102,7 @@ class FdirPipeline:
                            "%d of the target (%d dropped)", msg.spacecraft, len(self.twin.poi_pos),
                            self.rejected)
             return
+        self.observers[msg.spacecraft].heard(msg.t_sim)
         if msg.image_t_s >= self.window_start:
             self.pending.append(msg)
         else:  # too late for its window's verdict, not for the ground's map
@@ -112,12 +120,16 @@ class FdirPipeline:
                                                       plan.t_arrive_s)
 
     def assignments(self, msg: ProAssignments) -> None:
+        """The ground's own assignments.  With ground passes one sent out of contact waits for
+        the next pass, so the plan is in force from then at the earliest."""
+        reach = self.contact.next_contact(msg.t_sim) if self.contact is not None else 0.0
         for a in msg.assignments:
             obs = self.observers.get(a.spacecraft)
             if obs is None or a.assignment_id in obs.plans:
                 continue
             obs.plans[a.assignment_id] = FlightPlan(
-                a.t_depart_s, pro_of(a.pro), self._transfers.get((a.spacecraft, a.assignment_id)),
+                max(a.t_depart_s, reach), pro_of(a.pro),
+                self._transfers.get((a.spacecraft, a.assignment_id)),
                 a.t_arrive_s if a.t_arrive_s > a.t_depart_s else None)
 
     def telemetry(self, msg: InfoCostTelemetry) -> None:
@@ -129,6 +141,7 @@ class FdirPipeline:
         obs = self.observers.get(msg.spacecraft)
         if obs is None:
             return
+        obs.heard(msg.t_sim)
         if not obs.modes or obs.modes[-1][1] != msg.mode:
             bisect.insort(obs.modes, (msg.t_sim, msg.mode))
         if msg.t_sim >= self.window_start:
@@ -138,6 +151,8 @@ class FdirPipeline:
 
     def nav(self, msg: StateEstimate) -> None:
         obs = self.observers.get(msg.spacecraft)
+        if obs is not None:
+            obs.heard(msg.t_sim)
         if obs is not None and msg.t_sim >= self.window_start:
             obs.nav.add(msg.t_sim, np.array(msg.x[:3]))
             obs.nav_sigma.add(msg.t_sim, np.array([math.sqrt(max(
@@ -152,6 +167,15 @@ class FdirPipeline:
         obs = self.observers.get(msg.spacecraft)
         if obs is not None and msg.event == "sequence" and msg.name == "camera_off":
             obs.camera_off_s = min(msg.t_sim, obs.camera_off_s or math.inf)
+
+    def link_stats(self, msg: LinkStats) -> None:
+        """The ground's own channel counters: with ground passes, the FDIR topics' overflow
+        runs of each observer's onboard store (docs/fdir.md, "Ground passes")."""
+        for c in msg.links:
+            obs = self.observers.get(spacecraft_of(c.src) or 0)
+            if obs is not None and c.dst == self.node and c.store is not None:
+                obs.overflow = [(r.first_s, r.last_s) for r in c.store.overflow_runs
+                                if r.topic in FDIR_DOWNLINK_TOPICS]
 
     def guidance(self, msg: GuidanceStatus) -> None:
         obs = self.observers.get(msg.spacecraft)
@@ -168,11 +192,35 @@ class FdirPipeline:
     def due(self, t: float) -> list[Message]:
         """Judge every window due by time t (s): ``fdir.latency_s`` after it closed."""
         out: list[Message] = []
-        while t >= self.schedule.end(self.next_window) + self.latency_s - TIME_TOL_S:
+        if self.contact is not None:
+            now = self.contact.pass_index(t)
+            for o in self.observers.values():
+                o.heard_pass = now if o.fresh else o.heard_pass
+                o.fresh = False
+        while (t >= self.schedule.end(self.next_window) + self.latency_s - TIME_TOL_S
+               and self._data_in(self.next_window, t)):
             k = self.next_window
             self.next_window += 1  # first: a failing window is not retried forever
             out += self.evaluate(k)
-        return out
+        return [m.model_copy(update={"declared_s": t}) if isinstance(m, FaultReport) else m
+                for m in out]
+
+    def _data_in(self, k: int, t: float) -> bool:
+        """Whether window k's data is in by t (s).  Always, for a ground that hears
+        continuously.  With ground passes: once every observer has been heard from at or after
+        the window's end (its store dumps the FDIR's topics in send order), except one declared
+        silent of which nothing came down in this pass; or, for a window some observer's data
+        did not reach, at the end of the first pass after the window's end plus
+        ``fdir.latency_s`` (docs/fdir.md, "Ground passes").  An observer declared silent whose
+        dump comes down later is waited for again: judged on half its dump, the H_i it reports
+        first (priority 0) would not match the images still aboard."""
+        if self.contact is None:
+            return True
+        b, now = self.schedule.end(k), self.contact.pass_index(t)
+        if all(o.heard_s >= b - TIME_TOL_S or (o.link_declared and o.heard_pass < now)
+               for o in self.observers.values()):
+            return True
+        return t >= self.contact.contact_end(b + self.latency_s) - TIME_TOL_S
 
     def evaluate(self, k: int) -> list[Message]:
         """Window k through every stage; the window's images then join the ground's map."""
@@ -184,6 +232,11 @@ class FdirPipeline:
         for sc, obs in self.observers.items():
             mine = sorted((m for m in inside if m.spacecraft == sc), key=lambda m: m.image_t_s)
             planned = obs.plan_at(a) is not None and not obs.camera_off_before(b)
+            if obs.overflowed(a, b):  # data lost aboard, of known cause: not judged
+                out += self.links.overflow(sc, obs, b)
+                out.append(FdirWindow(sender=self.node, t_sim=b, spacecraft=sc, t_start_s=a,
+                                      t_end_s=b, images=len(mine), lost=0))
+                continue
             lost, reports = self.links.judge(sc, obs, mine, planned, b)
             out += reports
             window = FdirWindow(sender=self.node, t_sim=b, spacecraft=sc, t_start_s=a,

@@ -66,7 +66,10 @@ UNREAD = (cat.CAMERA_IMAGE, cat.RELNAV, cat.ATTITUDE_SENSORS, cat.THRUST, cat.WH
           cat.POINTING, cat.TICK_DONE, cat.EXEC_STATS, cat.LINK_STATS, cat.DECISIONS,
           cat.TLM_STATUS)
 """Topics no ground app subscribes to and the comparison does not read: counted and dropped as
-the archive is read (``tests/ground/tools/test_replay.py`` checks the ground reads none of them)."""
+the archive is read (``tests/ground/tools/test_replay.py`` checks the ground reads none of them).
+The one exception is the ground's own link counters (``LINK_STATS``; its FDIR reads the
+onboard stores' overflow from them with ground passes): the replay's ground makes them again,
+its channel stage running the stores on the archive's messages."""
 
 
 @dataclass

@@ -153,6 +153,26 @@ ALL: tuple[Topic[m.Message], ...] = (
 )
 
 
+DOWNLINK_FIRST = (FDIR_EVENT, INFO_COST, GUIDANCE_STATUS, TRANSFER_PLAN)
+"""Dumped first in a pass, and kept longest in a full store: the onboard FDIR's events and the
+small telemetry the ground FDIR decides on (H_i, guidance, plans)."""
+DOWNLINK_FDIR = (NAV_ESTIMATE, ATTITUDE_ESTIMATE, OBSERVATIONS)
+"""Dumped next: the rest of what the ground FDIR judges (the poses and the images)."""
+
+
+FDIR_DOWNLINK_TOPICS = frozenset(f"{t.app}/{t.name}" for t in (*DOWNLINK_FIRST, *DOWNLINK_FDIR))
+"""``app/name`` of every topic the ground FDIR judges from the dump."""
+
+
+def downlink_priority(key: str) -> int:
+    """A spacecraft topic's priority in its onboard store and dump (0 first): 0 for
+    ``DOWNLINK_FIRST``, 1 for ``DOWNLINK_FDIR``, 2 for the rest (housekeeping)."""
+    topic = topic_of(key)
+    if topic in DOWNLINK_FIRST:
+        return 0
+    return 1 if topic in DOWNLINK_FDIR else 2
+
+
 def topic_of(key: str) -> Topic | None:
     """The catalogued topic of a concrete key, or of the ``every`` expression of a topic; None
     for a key outside the catalogue."""

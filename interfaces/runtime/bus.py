@@ -21,7 +21,9 @@ What the Bus guarantees, identically on every transport:
   after the channel delay; sim messages (sensors, truth) as soon as the tick they belong to runs.
   Immediate subscriptions run on the transport thread (the executive's tick, the recorder).
 * **Channel.** Messages between two different spacecraft/ground nodes pass the receiver's
-  ``ChannelModel`` (range at send time, loss, cuts, delay) at dispatch.
+  ``ChannelModel`` (range at send time, loss, cuts, delay) at dispatch.  With ground passes
+  the space-ground ones wait there (stored onboard, or held on the ground) and come back
+  from it when they reach the receiver (``interfaces.runtime.space_ground``).
 * **Barrier.** ``wait_for(expect)`` blocks until the messages announced in a Tick have arrived.
 * **Recovery.** Each node keeps what it sent in its last ticks and sends it again to a node that
   asks (``interfaces.runtime.recent``): ``recover`` fetches what a tick announced and never came.
@@ -303,15 +305,25 @@ class Bus:
         delay = self.channel.delay_s if self.channel is not None else 0.0
         self.admission.advance(t_now)
         delivered = 0
+        channel = self.channel
         for env in self.inbox.take_due(t_now, include_now, delay):
-            if not env.local and self.channel is not None and self.inbox.crosses_link(env.src):
-                if self.channel.decide(env.src or "", env.msg.t_sim) is not Verdict.DELIVER:
+            if not env.local and channel is not None and self.inbox.crosses_link(env.src):
+                src = env.src or ""
+                if channel.passes is not None and channel.takes(src, env.key, env.msg, env):
+                    continue  # waits on a space-ground link: comes back from ``released``
+                if channel.decide(src, env.msg.t_sim) is not Verdict.DELIVER:
                     self.stats.channel_dropped += 1
                     continue
-            for sub in env.subs:
-                self._call(sub, env.msg, env.key)
-            delivered += 1
+            delivered += self._deliver(env)
+        if channel is not None and channel.passes is not None:
+            for env in channel.released(t_now):
+                delivered += self._deliver(env)
         return delivered
+
+    def _deliver(self, env: Envelope) -> int:
+        for sub in env.subs:
+            self._call(sub, env.msg, env.key)
+        return 1
 
     def wait_for(self, expect: dict[str, int], timeout_s: float) -> list[str]:
         """Block until every key of ``expect`` that this node subscribes to (and does not own)
@@ -372,13 +384,14 @@ class Bus:
         index = {id(s): (e, i) for e, group in self.table.groups.items()
                  for i, s in enumerate(group)}
         with self.inbox.lock:  # the receiving threads queue and admit under it: copies
-            pending = [(e.msg, e.key, e.src, e.local, [index[id(s)] for s in e.subs])
-                       for e in self.inbox.pending]
+            pending = [_pack(e, index) for e in self.inbox.pending]
             admission = self.admission.checkpoint()
             stats = dataclasses.replace(self.stats)
+            passes = (None if self.channel is None or self.channel.passes is None else
+                      self.channel.passes.with_envelopes(lambda e: _pack(e, index)))
         since = min([admission["clock_s"] or 0.0, *(m[0].t_sim for m in pending)])
         return {"seq": dict(self._seq), "stats": stats, "admission": admission,
-                "pending": pending,
+                "pending": pending, "passes": passes,
                 "channel": None if self.channel is None else self.channel.checkpoint(since)}
 
     def restore(self, saved: dict[str, Any]) -> None:
@@ -389,11 +402,12 @@ class Bus:
         self._seq, self.stats = saved["seq"], saved["stats"]
         with self.inbox.lock:
             self.admission.restore(saved["admission"])
-            self.inbox.pending = [
-                Envelope(msg, key, src, local, [groups[e][i] for e, i in which])
-                for msg, key, src, local, which in saved["pending"]]
+            self.inbox.pending = [_unpack(p, groups) for p in saved["pending"]]
         if self.channel is not None:
             self.channel.restore(saved["channel"])
+            if saved.get("passes") is not None:
+                self.channel.passes = saved["passes"].with_envelopes(
+                    lambda p: _unpack(p, groups))
 
     # --- services --------------------------------------------------------------------------
 
@@ -426,6 +440,19 @@ class Bus:
 
     def close(self) -> None:
         self.transport.close()
+
+
+Packed = tuple[Message, str, "str | None", bool, list[tuple[str, int]]]
+"""An envelope as a critical-data store keeps it: its subscribers by key expression and place."""
+
+
+def _pack(env: Envelope, index: dict[int, tuple[str, int]]) -> Packed:
+    return env.msg, env.key, env.src, env.local, [index[id(s)] for s in env.subs]
+
+
+def _unpack(packed: Packed, groups: dict[str, list[Sub]]) -> Envelope:
+    msg, key, src, local, which = packed
+    return Envelope(msg, key, src, local, [groups[e][i] for e, i in which])
 
 
 def _first_error(e: ValidationError) -> str:

@@ -30,17 +30,19 @@ import bisect
 import math
 import threading
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 from enum import Enum
 from typing import Any
 
 import numpy as np
 
 from faults.link import LinkFaults
-from interfaces.contracts.messages import LinkCounter, TruthState
+from gnc.passes import ContactPlan
+from interfaces.contracts.messages import LinkCounter, Message, TruthState
 from interfaces.contracts.rng import stream
-from interfaces.contracts.scenario import Comms, Fault, LinkCut, Scenario
+from interfaces.contracts.scenario import Comms, Fault, Ground, LinkCut, Scenario
 from interfaces.contracts.topics import GROUND, spacecraft_of
+from interfaces.runtime.space_ground import SpaceGroundLink
 
 
 class Verdict(Enum):
@@ -173,8 +175,13 @@ class ChannelModel:
     adds a loss probability (``magnitude``) on them, each over [start_s, end_s)."""
     truth: TruthHistory = field(default_factory=TruthHistory)
     """Where the true positions come from (shared by the channel models of one process)."""
+    ground: Ground = field(default_factory=Ground)
+    """How the ground hears: with ``contact = "passes"``, the space-ground links wait for the
+    contact windows (``interfaces.runtime.space_ground``)."""
     _links: dict[str, _Link] = field(default_factory=dict)
     _cuts: list[_Cut] = field(default_factory=list)
+    contact: InitVar[ContactPlan | None] = None
+    """The ground's contact windows (None: it hears continuously)."""
 
     @classmethod
     def of(cls, receiver: str, scenario: Scenario,
@@ -183,9 +190,13 @@ class ChannelModel:
         and replay builds it this way, so its draws are the same), reading ``truth`` (shared
         by the nodes of one process; a history of its own by default)."""
         return cls(receiver, scenario.comms, scenario.seed, scenario.faults,
-                   truth if truth is not None else history_for(scenario))
+                   truth if truth is not None else history_for(scenario), scenario.ground,
+                   contact=ContactPlan.of(scenario))
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, contact: ContactPlan | None) -> None:
+        self.passes = (SpaceGroundLink(self.receiver, contact, self.ground, self.comms.delay_s)
+                       if contact is not None else None)
+        """What waits on the space-ground links (None: the ground hears continuously)."""
         self._cuts = [_Cut(c.a, c.b, c.start_s, c.end_s) for c in self.comms.cuts]
         self._faults = LinkFaults(self.receiver, self.seed, self.faults)
         self._cuts += [_Cut(c.node, "*", c.start_s, c.end_s) for c in self._faults.cuts()]
@@ -230,13 +241,38 @@ class ChannelModel:
             link.counter.dropped_cut += 1
         return verdict
 
+    def delivers(self, src: str, t_send: float) -> bool:
+        """Whether ``decide`` delivers the message."""
+        return self.decide(src, t_send) is Verdict.DELIVER
+
+    def takes(self, src: str, key: str, msg: Message, env: object) -> bool:
+        """With ground passes, take a message that must wait on a space-ground link (stored
+        onboard, or held on the ground until a pass); the Bus then gets it from
+        ``released``.  False: ``decide`` judges it now."""
+        return self.passes is not None and self.passes.takes(src, key, msg, env)
+
+    def released(self, t_now: float) -> list[Any]:
+        """The envelopes taken (``takes``) that reach the receiver by ``t_now`` (s), in order."""
+        return [] if self.passes is None else self.passes.released(t_now, self)
+
     def _verdict(self, link: _Link, src: str, t_send: float) -> Verdict:
-        if any(c.covers(src, self.receiver, t_send) for c in self._cuts):
+        blocked = self._blocked(src, t_send)
+        if blocked is not None:
+            return blocked
+        return Verdict.LOSS if self._lost(link, src, t_send) else Verdict.DELIVER
+
+    def _blocked(self, src: str, t: float) -> Verdict | None:
+        """CUT or RANGE when the link from ``src`` is down at ``t`` (s), else None."""
+        if any(c.covers(src, self.receiver, t) for c in self._cuts):
             return Verdict.CUT
-        if not self._in_range(src, t_send):
+        if not self._in_range(src, t):
             return Verdict.RANGE
-        # A message in range and not cut draws exactly once from its link's stream; cut and
-        # out-of-range messages draw nothing (the Gilbert-Elliott state advances per packet sent).
+        return None
+
+    def _lost(self, link: _Link, src: str, t: float) -> bool:
+        """Whether one packet on the link, in range and not cut, is lost.  It draws exactly
+        once from its link's stream; cut and out-of-range messages draw nothing (the
+        Gilbert-Elliott state advances per packet sent)."""
         lost = False
         if self._ge is not None:
             p, r = self._ge
@@ -245,7 +281,7 @@ class ChannelModel:
             lost = link.bad
         elif self.comms.packet_loss > 0.0:
             lost = link.rng.random() < self.comms.packet_loss
-        return Verdict.LOSS if lost or self._faults.lost(src, t_send) else Verdict.DELIVER
+        return lost or self._faults.lost(src, t)
 
     def _in_range(self, src: str, t_send: float) -> bool:
         pos = self.truth.positions_at(t_send)
@@ -279,7 +315,13 @@ class ChannelModel:
 
     def counters(self) -> list[LinkCounter]:
         """Copies of the per-link counters, sorted by source."""
-        return [self._links[s].counter.model_copy() for s in sorted(self._links)]
+        if self.passes is not None:
+            for src in self.passes.stores:  # a store not yet dumped from has its link too
+                self._link(src)
+        copies = [self._links[s].counter.model_copy() for s in sorted(self._links)]
+        if self.passes is None:
+            return copies
+        return [self.passes.annotate(c) for c in copies]
 
 
 def history_for(scenario: Scenario) -> TruthHistory:

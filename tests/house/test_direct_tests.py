@@ -62,7 +62,7 @@ INDIRECT: dict[str, str] = {
     "ground.analysis.gnc": _EVALUATION.format("tests/missions/test_gnc_run.py"),
     "ground.analysis.onboard": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
     **{f"ground.analysis.run_summary.{m}": _SUMMARY
-       for m in ("document", "fdir", "figures", "onboard", "records", "series")},
+       for m in ("document", "fdir", "figures", "onboard", "passes", "records", "series")},
     "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
     "ground.archive.__main__": (
         "``python -m ground.archive``, two lines handing over to ground/archive/cli.py's main "

@@ -1,9 +1,9 @@
 """The import rules of the house: the contracts import nothing else of the project; the runtime
-imports only the contracts (and the link faults its channel stage applies, and the mission's
-constants it hands the apps); the shared GNC library (``gnc``) only the contracts; fault
-injection (``faults``) the contracts and the library; none of them imports flight, sim or
-ground code, and flight, sim and ground never import each other (imports inside functions
-included: they are read from the source, not from what a run happens to load)."""
+imports only the contracts (and the link faults and contact windows its channel stage applies,
+and the mission's constants it hands the apps); the shared GNC library (``gnc``) only the
+contracts; fault injection (``faults``) the contracts and the library; none of them imports
+flight, sim or ground code, and flight, sim and ground never import each other (imports inside
+functions included: they are read from the source, not from what a run happens to load)."""
 
 from __future__ import annotations
 
@@ -46,9 +46,10 @@ def _violations(room: str, allowed: tuple[str, ...], root: Path = REPO) -> list[
 
 
 RUNTIME_MAY = ("interfaces.contracts", "interfaces.runtime", "faults.link", "faults.schedule",
-               "gnc.mission")
-"""The runtime's channel stage applies the link faults (``faults/link.py``), and an app's
-context carries the mission's constants (``gnc/mission.py``)."""
+               "gnc.mission", "gnc.passes")
+"""The runtime's channel stage applies the link faults (``faults/link.py``) and the ground's
+contact windows (``gnc/passes.py``), and an app's context carries the mission's constants
+(``gnc/mission.py``)."""
 
 
 def test_the_contracts_import_only_the_contracts() -> None:

@@ -28,6 +28,7 @@ from ground.analysis.run_summary.figures import (
     SimRecord,
 )
 from ground.analysis.run_summary.onboard import OnboardFdirSummary
+from ground.analysis.run_summary.passes import GroundContact
 from ground.analysis.run_summary.records import SummaryRecord, filled_fields
 from ground.analysis.run_summary.series import FdirSeries
 from interfaces.contracts.messages import LinkCounter, TelemetryStatus
@@ -65,6 +66,9 @@ class RunSummary(SummaryRecord):
     gnc: dict[str, GncStats] | None = Field(default=None, description="by observer")
     coverage: CoverageSummary | None = None
     links: list[LinkCounter] | None = Field(default=None, description="every directed link")
+    ground_contact: GroundContact | None = Field(
+        default=None, description="the passes and what waited for them (absent: the ground "
+                                  "heard continuously)")
     exec: dict[str, ExecRecord] | None = Field(default=None, description="by node")
     telemetry: list[TelemetryStatus.Entry] | None = Field(
         default=None, description="the ground's telemetry monitor's last status, by observer")

@@ -25,7 +25,12 @@ class Detection(SummaryRecord):
     FILLABLE: ClassVar[tuple[str, ...]] = ("evidence",)
 
     spacecraft: int = Field(ge=0, description="the faulty observer; 0: the constellation")
-    time_s: float = Field(description="when declared, sim s")
+    time_s: float = Field(description="end of the declaring window, sim s")
+    declared_s: float | None = Field(
+        default=None, description="when the ground declared it, sim s (with ground passes: "
+                                  "once the window's data came down)")
+    cause: Literal["store_overflow"] | None = Field(
+        default=None, description="a link fault's known cause (not scored as an alarm)")
     fault_class: FaultClass | None = Field(alias="class",
                                            description="identified class (null: not yet)")
     direction: Literal["improved", "degraded"] | None = Field(
@@ -56,6 +61,10 @@ class FaultScore(SummaryRecord):
     identified_correctly: bool
     identification_latency_s: float | None = Field(
         default=None, description="onset to the first alarm naming its class, s")
+    declared_latency_s: float | None = Field(
+        default=None, description="onset to the first (isolating) alarm's declaration, s: "
+                                  "what the ground knew when (with ground passes, the gap "
+                                  "to the pass is in it)")
 
 
 class Scores(SummaryRecord):

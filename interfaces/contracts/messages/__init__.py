@@ -76,7 +76,9 @@ from interfaces.contracts.messages.lockstep import (
     Heartbeat,
     LinkCounter,
     LinkStats,
+    OverflowRun,
     SimStatus,
+    StoreCounter,
     Tick,
     TickDone,
 )
@@ -120,6 +122,8 @@ __all__ = [
     "ExecStats",
     "LinkCounter",
     "LinkStats",
+    "OverflowRun",
+    "StoreCounter",
     "TruthState",
     "RelNavMeasurement",
     "AttitudeMeasurement",

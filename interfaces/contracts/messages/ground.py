@@ -140,6 +140,13 @@ class FaultReport(Message):
     threshold: float | None = None
     window_end_s: Time
     evidence: dict[str, float] = Field(default_factory=dict, max_length=32)
+    cause: Literal["store_overflow"] | None = Field(
+        default=None, description="a link fault's known cause: the observer's onboard store "
+                                  "overflowed (ground passes), not a fault of the observer")
+    declared_s: Time | None = Field(
+        default=None, description="when the ground judged the window and declared, s: "
+                                  "fdir.latency_s after its end, or, with ground passes, "
+                                  "once its data came down")
 
 
 class BaselineVerdict(Message):

@@ -3,7 +3,7 @@ nodes' answers, heartbeats, executive statistics and link counters."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import ClassVar, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -94,8 +94,42 @@ class ExecStats(Message):
     ticks: int = 0
 
 
+class OverflowRun(BaseModel):
+    """Messages of one topic that an onboard store could not keep, sent no more than
+    ``MERGE_GAP_S`` apart (``interfaces/runtime/onboard_store.py``)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    MERGE_GAP_S: ClassVar[float] = 10.0
+    topic: str = Field(description="app/name of the key")
+    first_s: float = Field(description="send time of the first, s")
+    last_s: float = Field(description="send time of the last, s")
+    count: int = Field(ge=1)
+
+
+class StoreCounter(BaseModel):
+    """A spacecraft's onboard store of its telemetry to the ground, with ground passes
+    (``[ground] contact = "passes"``): what entered it, what was dumped (each message's last
+    bit received), sent again after a loss, lost to overflow (by topic and time) and what is
+    still on board.  Bytes are JSON bytes without the wall-clock stamp."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    stored: int = 0
+    stored_bytes: int = 0
+    dumped: int = 0
+    dumped_bytes: int = 0
+    retransmitted: int = 0
+    overflow: int = 0
+    overflow_bytes: int = 0
+    onboard: int = 0
+    onboard_bytes: int = 0
+    overflow_runs: list[OverflowRun] = Field(default_factory=list, max_length=100_000)
+
+
 class LinkCounter(BaseModel):
-    """Counters of one directed link src -> dst (messages offered to the channel)."""
+    """Counters of one directed link src -> dst (messages offered to the channel).  With
+    ground passes a downlink has its store's counters (``store``; ``sent`` counts the
+    transmissions of the dump, ``dropped_loss`` those sent again) and an uplink counts the
+    messages that waited on the ground for a pass (``held``)."""
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
     src: str
@@ -105,6 +139,8 @@ class LinkCounter(BaseModel):
     dropped_range: int = 0
     dropped_loss: int = 0
     dropped_cut: int = 0
+    held: int | None = None
+    store: StoreCounter | None = None
 
 
 class LinkStats(Message):

@@ -30,8 +30,11 @@ def _scenario(**fdir: object) -> Scenario:
 
 
 def test_what_a_replay_drops_unread_no_ground_app_reads() -> None:
+    """The ground's own channel counters (which the FDIR reads with ground passes) are made
+    again by the replay's own channel stage, from the archive's messages: the archived ones
+    are not needed."""
     ground_inputs = {i.topic for app in map(app_class, GROUND_APPS) for i in app.INPUTS}
-    assert ground_inputs and not ground_inputs & set(UNREAD)
+    assert ground_inputs and not (ground_inputs - {cat.LINK_STATS}) & set(UNREAD)
     assert cat.TRUTH not in UNREAD and cat.TICK not in UNREAD
 
 

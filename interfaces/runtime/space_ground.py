@@ -1,0 +1,132 @@
+"""The links between the spacecraft and the ground when the ground hears only in passes
+(``[ground] contact = "passes"``; docs/architecture.md, "Ground passes"): the part of a
+node's channel stage (``interfaces.runtime.channel``) that holds what crosses them.
+
+* **Downlink** (into the ground): every message a spacecraft sends the ground goes into that
+  spacecraft's onboard store (``interfaces.runtime.onboard_store``) and reaches the ground
+  when the dump brings it down, the link's delay later.  The dump's link is up in a contact
+  window while the spacecraft's link is neither cut nor out of range of the target (the
+  ground is reached through it); each transmission draws the link's loss.
+* **Uplink** (from the ground): a message sent in contact is judged by the channel as any
+  other; one sent out of contact waits on the ground until the next acquisition and is judged
+  then (cut, range, loss at that time), the link's delay later.  Nothing leaves a ground that
+  hears no station: it stays, counted as held.
+
+Both are simulated in send time, so what is delivered when does not depend on when the Bus
+asks (``released``), only on the messages.
+"""
+
+from __future__ import annotations
+
+import bisect
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from gnc.passes import ContactPlan
+from interfaces.contracts import catalogue
+from interfaces.contracts.messages import LinkCounter, Message
+from interfaces.contracts.scenario import Ground
+from interfaces.contracts.timing import TIME_TOL_S
+from interfaces.contracts.topics import GROUND, spacecraft_of
+from interfaces.runtime.onboard_store import OnboardStore
+
+if TYPE_CHECKING:
+    from interfaces.runtime.channel import ChannelModel
+
+
+@dataclass
+class _DumpLink:
+    """The downlink of spacecraft ``src`` as its store sees it (``onboard_store.Downlink``)."""
+
+    channel: ChannelModel
+    src: str
+    plan: ContactPlan
+
+    def up(self, t_s: float) -> bool:
+        return self.plan.in_contact(t_s) and self.channel._blocked(self.src, t_s) is None
+
+    def lost(self, t_s: float) -> bool:
+        link = self.channel._link(self.src)
+        link.counter.sent += 1
+        lost = self.channel._lost(link, self.src, t_s)
+        if lost:
+            link.counter.dropped_loss += 1
+        else:
+            link.counter.delivered += 1
+        return lost
+
+    def next_contact(self, t_s: float) -> float:
+        return self.plan.next_contact(t_s)
+
+
+def _topic(key: str) -> str:
+    """``app/name`` of a spacecraft key."""
+    return "/".join(key.rsplit("/", 2)[-2:])
+
+
+@dataclass(eq=False)
+class SpaceGroundLink:
+    """What waits on the space-ground links into node ``receiver`` (module docstring)."""
+
+    receiver: str
+    plan: ContactPlan
+    ground: Ground
+    delay_s: float
+    stores: dict[str, OnboardStore] = field(default_factory=dict)
+    """the onboard store of each spacecraft heard (receiver: the ground)"""
+    uplink: list[tuple[float, tuple[float, str, int], Any]] = field(default_factory=list)
+    """messages waiting on the ground: (time they go, delivery order, envelope)"""
+    held: int = 0
+
+    def takes(self, src: str, key: str, msg: Message, env: Any) -> bool:
+        """Take a message from ``src`` on ``key`` that crosses a space-ground link into the
+        receiver, when it must wait (a downlink always; an uplink sent out of contact).
+        False: the channel judges it now, as any other."""
+        if self.receiver == GROUND and spacecraft_of(src) is not None:
+            self._store(src).offer(env, msg, _topic(key), catalogue.downlink_priority(key))
+            return True
+        if src == GROUND and not self.plan.in_contact(msg.t_sim):
+            bisect.insort(self.uplink, (self.plan.next_contact(msg.t_sim),
+                                        (msg.t_sim, key, msg.seq), env), key=lambda u: u[:2])
+            self.held += 1
+            return True
+        return False
+
+    def released(self, t_now: float, channel: ChannelModel) -> list[Any]:
+        """The envelopes that reach the receiver by ``t_now`` (s): dumped ones in the order
+        their last bits came, then uplinked ones the channel delivers at their acquisition."""
+        horizon = t_now - self.delay_s + TIME_TOL_S
+        dumped = sorted((t, env.order, env) for src in sorted(self.stores)
+                        for t, env in self.stores[src].advance(
+                            horizon, _DumpLink(channel, src, self.plan)))
+        out = [env for _, _, env in dumped]
+        while self.uplink and self.uplink[0][0] < horizon:
+            t_go, _, env = self.uplink.pop(0)
+            if channel.delivers(env.src or "", t_go):
+                out.append(env)
+        return out
+
+    def _store(self, src: str) -> OnboardStore:
+        store = self.stores.get(src)
+        if store is None:
+            store = self.stores[src] = OnboardStore(src, self.ground.store_bytes,
+                                                    self.ground.downlink_bps)
+        return store
+
+    def with_envelopes(self, fn: Callable[[Any], Any]) -> SpaceGroundLink:
+        """A copy whose waiting messages carry ``fn(envelope)`` instead (a node's critical-data
+        store packs them, and unpacks them on restore)."""
+        return dataclasses.replace(
+            self, stores={s: st.with_envelopes(fn) for s, st in self.stores.items()},
+            uplink=[(t, order, fn(env)) for t, order, env in self.uplink])
+
+    def annotate(self, counter: LinkCounter) -> LinkCounter:
+        """``counter`` (a copy) with the store's or the uplink's counts of its link."""
+        store = self.stores.get(counter.src)
+        if store is not None:
+            counter.store = store.counter.model_copy(deep=True)
+        elif counter.src == GROUND:
+            counter.held = self.held
+        return counter
