@@ -5,7 +5,7 @@ explains.
 Over one FDI window, with ψ held at its start, the constellation's cost changes by
 ΔH = Σ_i ΔH_i (the prior term does not move), so the windowed form of Eq. 6's integrand is the
 constellation ratio X = Σ_i ΔH_i / Σ_i ΔH_i^pred.  Each observer's nominal ratio x_i has the
-hardware model's N(μ_i, σ_i²) (``ground/fdir/hardware_threshold.py``) and the observers' errors
+hardware model's N(μ_i, σ_i²) (``gnc/hardware_threshold.py``) and the observers' errors
 are independent, so X ~ N(Σ μ_i P_i / Σ P_i, Σ σ_i² P_i² / (Σ P_i)²), P_i = ΔH_i^pred.
 
 A constellation-level fault is one no single observer explains: X departs from its model by
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
-from ground.fdir.hardware_threshold import RatioModel
+from gnc.hardware_threshold import RatioModel
 
 MIN_OBSERVERS = 3
 """Fewer judged observers than this give no constellation verdict (one left out must leave at

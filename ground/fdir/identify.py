@@ -111,8 +111,8 @@ import numpy.typing as npt
 
 from gnc.infocost import visibility
 from ground.fdir.boresight import boresight_offset
-from ground.fdir.hardware_threshold import clipped_noise_moments
-from ground.fdir.twin import TwinModel, sample_stride
+from gnc.hardware_threshold import clipped_noise_moments
+from gnc.twin import TwinModel, sample_stride
 from interfaces.contracts.scenario import FdirSettings
 
 FloatArray = npt.NDArray[np.float64]

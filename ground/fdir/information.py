@@ -6,7 +6,7 @@ force, the identification evidence, and the consistency tests fused with it.
 * ΔH_i^pred: the same sum for the same image times from the nominal twin -- each image at the
   plan's position, the camera on the aim point the observer reports, β = 1;
 * H_m,i (Eq. 9) against the threshold in force (``WindowThreshold``): by default the hardware
-  model's quantile (``ground/fdir/hardware_threshold.py``), else Eq. 11-12's (``fdir.samples``
+  model's quantile (``gnc/hardware_threshold.py``), else Eq. 11-12's (``fdir.samples``
   pointings within ``fdir.eps_deg``), both archived, with the floor guard ``fdir.floor``;
   direction by Table 3;
 * with ``fdir.fuse_guidance`` the window also fails on the nav-vs-plan, pointing and Δv-rate
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ground.fdir.consistency import failed_tests, nis_test
-from ground.fdir.hardware_threshold import position_sigma, ratio_model
+from gnc.hardware_threshold import position_sigma, ratio_model
 from ground.fdir.identify import (
     Evidence,
     Tolerances,
@@ -34,10 +34,10 @@ from ground.fdir.identify import (
     located_cameras,
     pose_evidence,
 )
-from ground.fdir.metric import direction, metric
+from gnc.fdi_metric import direction, metric
 from ground.fdir.observer import ObserverState
 from ground.fdir.threshold import WindowThreshold, sampled_threshold
-from ground.fdir.twin import TwinModel, delta_h, planned_boresights
+from gnc.twin import TwinModel, delta_h, planned_boresights
 from ground.fdir.window import WindowContext
 from interfaces.contracts.messages import FdirWindow
 from interfaces.contracts.scenario import Scenario

@@ -14,7 +14,7 @@ import numpy as np
 
 from gnc.infocost import agent_contributions
 from gnc.poi_map import PoiMap
-from ground.fdir.twin import FlightPlan
+from gnc.twin import FlightPlan
 
 
 class TimeSeries:

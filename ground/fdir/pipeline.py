@@ -31,12 +31,12 @@ from gnc.passes import ContactPlan
 from gnc.poi_map import PoiMap
 from ground.fdir.declaration import Declarer
 from ground.fdir.global_check import GlobalCheck
-from ground.fdir.hardware_threshold import window_false_alarm
+from gnc.hardware_threshold import window_false_alarm
 from ground.fdir.information import InformationTest, Judgement
 from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
 from ground.fdir.observer import ObserverState
-from ground.fdir.twin import FlightPlan, Transfer, TwinModel
+from gnc.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.window import SettledMap, window_context
 from ground.planning.pro_sets import pro_of
 from interfaces.contracts.fdi_schedule import FdiSchedule

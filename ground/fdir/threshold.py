@@ -12,9 +12,9 @@ from typing import Literal
 
 import numpy as np
 
-from ground.fdir.hardware_threshold import RatioModel
-from ground.fdir.metric import metric
-from ground.fdir.twin import TwinModel, perturbed_boresights, sample_stride
+from gnc.hardware_threshold import RatioModel
+from gnc.fdi_metric import metric
+from gnc.twin import TwinModel, perturbed_boresights, sample_stride
 
 
 def adaptive_threshold(dh_samples: Sequence[float], dh_pred: float, h_prev: float = 0.0,

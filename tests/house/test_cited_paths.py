@@ -24,13 +24,13 @@ def _citing_files() -> list[Path]:
 
 
 def cited_paths(text: str) -> set[str]:
-    """The repository paths ``text`` cites (``ground/fdir/twin.py``, ``docs/fdir.md``)."""
+    """The repository paths ``text`` cites (``gnc/twin.py``, ``docs/fdir.md``)."""
     return {m.rstrip(".") for m in CITED.findall(text)}
 
 
 def test_the_pattern_finds_citations() -> None:
-    assert cited_paths("see ``ground/fdir/twin.py`` and docs/fdir.md, not x/ground/y.py") == {
-        "ground/fdir/twin.py", "docs/fdir.md"}
+    assert cited_paths("see ``gnc/twin.py`` and docs/fdir.md, not x/ground/y.py") == {
+        "gnc/twin.py", "docs/fdir.md"}
 
 
 def test_every_cited_path_exists() -> None:

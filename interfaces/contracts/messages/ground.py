@@ -87,7 +87,7 @@ class FdirWindow(Message):
     evidence: dict[str, float] = Field(default_factory=dict, max_length=32)
     threshold_model: float | None = Field(
         default=None, description="τ from the hardware's nominal ratio distribution "
-                                  "(ground/fdir/hardware_threshold.py)")
+                                  "(gnc/hardware_threshold.py)")
     threshold_sampled: float | None = Field(
         default=None, description="τ of Eq. 11-12 (ε-sampled pointings), before the floor")
     threshold_by: Literal["model", "sampled", "floor"] | None = Field(

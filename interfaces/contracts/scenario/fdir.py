@@ -13,7 +13,7 @@ class FdirSettings(Section):
     """The ground FDIR (ground/apps/fdir.py, docs/fdir.md): every
     FDI window (``rates.fdi_period_s``) each observer's information gain is compared with the
     nominal twin's prediction (Eq. 9).  The threshold in force (``threshold``) is by default
-    the hardware model's (ground/fdir/hardware_threshold.py): the quantile, for
+    the hardware model's (gnc/hardware_threshold.py): the quantile, for
     ``false_alarms_per_observer_hour``, of the ratio's distribution under no fault given the
     camera's noise (``[camera] noise_frac``), the station-keeping accuracy (``track_sigma_m``,
     ``transfer_sigma_m``) plus the nav's reported 1σ, and the pointing jitter

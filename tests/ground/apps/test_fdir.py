@@ -13,7 +13,7 @@ import pytest
 
 from gnc.pro import Pro
 from ground.apps.fdir import FdirApp
-from ground.fdir.twin import FlightPlan
+from gnc.twin import FlightPlan
 from interfaces.contracts.messages import (
     FaultReport,
     FdirWindow,

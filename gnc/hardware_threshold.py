@@ -1,7 +1,7 @@
 """The threshold that comes from the hardware (the chapter's future work, Sec. III.E; docs/fdir.md
-"Detection and isolation"): the distribution of the ratio x = ΔH_i / ΔH_i^pred of one
-observer over one FDI window when nothing is faulty, from what the ground knows of the
-observer's hardware, and τ_i as its quantile for a stated false-alarm probability.
+"Detection and isolation"): the distribution of the ratio x = ΔH_i / ΔH_i^pred of one observer
+over one FDI window when nothing is faulty, from what its judge (the ground, or a neighbour)
+knows of the observer's hardware, and τ_i as its quantile for a stated false-alarm probability.
 
 Where the nominal ratio departs from 1:
 
@@ -35,7 +35,7 @@ import numpy.typing as npt
 from scipy.optimize import brentq
 from scipy.special import ndtr
 
-from ground.fdir.twin import TwinModel, sample_stride
+from gnc.twin import TwinModel, sample_stride
 
 FloatArray = npt.NDArray[np.float64]
 

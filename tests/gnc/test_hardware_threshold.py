@@ -1,4 +1,4 @@
-"""The hardware threshold (ground/fdir/hardware_threshold.py) against independent truth: the
+"""The hardware threshold (gnc/hardware_threshold.py) against independent truth: the
 sim's own cameras imaging the same poses (sim/camera.py), brute-force Monte Carlo of the clipped
 noise, and the normal distribution's quantiles."""
 
@@ -13,7 +13,7 @@ from scipy.stats import norm
 
 from gnc.infocost import Camera
 from gnc.poi import sphere_pois
-from ground.fdir.hardware_threshold import (
+from gnc.hardware_threshold import (
     RatioModel,
     clipped_noise_moments,
     position_sigma,
@@ -21,7 +21,7 @@ from ground.fdir.hardware_threshold import (
     small_rotations,
     window_false_alarm,
 )
-from ground.fdir.twin import TwinModel, centre_boresights, delta_h
+from gnc.twin import TwinModel, centre_boresights, delta_h
 from interfaces.contracts.rng import stream
 from sim.camera import TruthCameras
 

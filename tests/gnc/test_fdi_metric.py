@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from gnc import infocost as ic
-from ground.fdir.metric import direction, global_check, metric, ratio
+from gnc.fdi_metric import direction, global_check, metric, ratio
 from ground.fdir.threshold import Persistence, adaptive_threshold, calibrate_floor
 from interfaces.contracts.scenario import FdirSettings
 

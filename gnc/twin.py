@@ -1,6 +1,6 @@
-"""The ground's nominal twin of one observer: where the plan puts it, where its camera points,
-and the information its images should bring (docs/fdir.md: H_i^pred over [t − Δt, t] from the
-plan and the fused state at t − Δt).
+"""The nominal twin of one observer (the ground's FDIR and the neighbours' judge fly it): where the
+plan puts it, where its camera points, and the information its images should bring
+(docs/fdir.md: H_i^pred over [t − Δt, t] from the plan and the fused state at t − Δt).
 
 Information change with ψ held at the window start.  With F the fused precision and
 ψ = H_POI(t − Δt)² (Eq. 8) frozen over the window, agent i's contribution changes by::

@@ -1,4 +1,4 @@
-"""The ground's nominal twin (ground/fdir/twin.py) against independent truth: the SCP plan's own
+"""The ground's nominal twin (gnc/twin.py) against independent truth: the SCP plan's own
 propagation, the PRO closed form, the Eq. 8 decomposition with ψ held, uniform cone sampling."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from gnc import infocost as ic
 from gnc.hcw import mean_motion
 from gnc.poi import sphere_pois
 from gnc.pro import Pro
-from ground.fdir.twin import (
+from gnc.twin import (
     FlightPlan,
     Transfer,
     centre_boresights,
