@@ -189,7 +189,13 @@ def planned_boresights(attitude: FloatArray | None, positions: FloatArray) -> Fl
     against this prediction."""
     if attitude is None:
         return centre_boresights(positions)
-    los = attitude[:, 4:7] - positions
+    return aimed_boresights(attitude[:, 4:7], positions)
+
+
+def aimed_boresights(aims: FloatArray, positions: FloatArray) -> FloatArray:
+    """Unit boresights from each position (K, 3) to its aim point (K, 3), LVLH m; to the
+    target centre where an aim point coincides with its position."""
+    los = aims - positions
     norm = np.linalg.norm(los, axis=1, keepdims=True)
     if np.any(norm <= 0.0):
         return centre_boresights(positions)

@@ -22,14 +22,18 @@ import math
 
 import numpy as np
 
+from fsw.lib.neighbour_judge import Exclusions
 from gnc.poi_map import PoiMap
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     AttitudeEstimate,
     CameraImage,
+    NeighbourDeclaration,
+    NeighbourRuling,
     OnboardCommand,
     PointingTarget,
     PoiObservations,
+    ReportedPose,
     StateEstimate,
 )
 from interfaces.contracts.timing import TIME_TOL_S
@@ -50,10 +54,13 @@ class CameraApp(App):
         Input(cat.NAV_ESTIMATE, "on_estimate"),
         Input(cat.ATTITUDE_ESTIMATE, "on_attitude"),
         Input(cat.FDIR_COMMAND, "on_command"),
+        Input(cat.NEIGHBOUR_DECLARATION, "on_declaration"),
+        Input(cat.NEIGHBOUR_RULING, "on_ruling"),
     )
     OUTPUTS = (Output("observations", cat.OBSERVATIONS), Output("pointing", cat.POINTING))
     CRITICAL = ("map", "aim_start", "aim_goal", "aim_t", "next_retarget", "_images", "_est",
-                "_tracking", "off", "max_variance", "_to_centre")
+                "_tracking", "off", "max_variance", "_to_centre", "_att", "_track_since",
+                "exclusions")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -72,19 +79,35 @@ class CameraApp(App):
         self._tracking = False  # the attitude app tracks the aim (not slewing, initialised)
         self.off = False  # the onboard FDIR turned the camera off: no observations shared
         self._to_centre = False  # the onboard FDIR asked for the target's centre
+        self.with_pose = sc.neighbours.enabled  # each image's observations carry the pose
+        self._att: AttitudeEstimate | None = None
+        self._track_since: float | None = None  # when the attitude app began tracking, s
+        self.exclusions = Exclusions()  # observers the neighbours declared: not fused
 
     def on_image(self, msg: CameraImage) -> None:
         self._images.append(msg)
 
     def on_observations(self, msg: PoiObservations) -> None:
-        if self.max_variance:  # the map only serves the max-variance choice
-            self.map.add(msg.spacecraft, *msg.arrays())
+        if self.max_variance and (msg.spacecraft == self.sc_id or self.exclusions.admits(msg)):
+            self.map.add(msg.spacecraft, *msg.arrays())  # the map serves max-variance only
+
+    def on_declaration(self, msg: NeighbourDeclaration) -> None:
+        self.exclusions.declared(msg, self.sc_id)
+
+    def on_ruling(self, msg: NeighbourRuling) -> None:
+        for m in self.exclusions.ruled(msg):
+            self.on_observations(m)
 
     def on_estimate(self, msg: StateEstimate) -> None:
         self._est = msg
 
     def on_attitude(self, msg: AttitudeEstimate) -> None:
         self._tracking = msg.mode == "track"
+        self._att = msg
+        if not self._tracking:
+            self._track_since = None
+        elif self._track_since is None:
+            self._track_since = msg.t_sim
 
     def on_command(self, msg: OnboardCommand) -> None:
         """The onboard FDIR: ``camera_off`` stops the observations for good; ``point_target``
@@ -97,8 +120,9 @@ class CameraApp(App):
 
     def step(self, t: float) -> None:
         images, self._images = self._images, []
+        pose = self._pose(t) if self.with_pose else None
         for img in images if not self.off else ():
-            self.publish("observations", PoiObservations.of_image(img, self.ctx.node, t))
+            self.publish("observations", PoiObservations.of_image(img, self.ctx.node, t, pose))
         if self._to_centre:
             self._to_centre, self.max_variance = False, False
             self.aim_start, self.aim_t, self.aim_goal = self._aim_at(t)[0], t, np.zeros(3)
@@ -111,6 +135,20 @@ class CameraApp(App):
         self.publish("pointing", PointingTarget(
             sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, target_lvlh_m=aim.tolist(),
             target_rate_lvlh_mps=rate.tolist(), target_accel_lvlh_mps2=accel.tolist()))
+
+    def _pose(self, t: float) -> ReportedPose | None:
+        """The pose this observer reports with its observations (its latest nav and attitude
+        estimates): what its neighbours judge it by (``fsw/apps/neighbours.py``)."""
+        est, att = self._est, self._att
+        if est is None or att is None:
+            return None
+        p = est.P
+        return ReportedPose(
+            nav_m=list(est.x[:3]), nav_sigma_m=math.sqrt(max((p[0][0] + p[1][1] + p[2][2]) / 3.0,
+                                                             0.0)),
+            aim_m=list(att.target_lvlh_m), knowledge_rad=att.sigma_att_rad,
+            tracking_rad=att.pointing_error_rad,
+            tracking_s=0.0 if self._track_since is None else max(t - self._track_since, 0.0))
 
     def _aim_at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Aim point (m), rate (m/s) and acceleration (m/s²) at time t on the glide from

@@ -3,9 +3,10 @@ style (watchpoints, sequences and their tables: ``fsw/lib/onboard_fdir.py``).
 
 Rate group high (ω_high), so that a ground declaration is acted on in the tick it arrives.
 Inputs, all of this spacecraft: the attitude estimate (pointing error, wheel momentum, star
-tracker), the nav estimate (NIS), the guidance status (thrust, safe hold), its own
-observations (blank images), and the ground's fault reports.  Outputs: stored-sequence commands
-to this spacecraft's apps (``sc/N/fdir/command``) and events (``sc/N/fdir/event``).
+tracker), the nav estimate (NIS), the guidance status (thrust, safe hold), its own observations
+(blank images), the ground's fault reports, and its neighbours' declarations naming it
+(``fsw/apps/neighbours.py``: an event, and ``[neighbours] action``). Outputs: stored-sequence
+commands to this spacecraft's apps (``sc/N/fdir/command``) and events (``sc/N/fdir/event``).
 
 Each step it first acts on the ground's reports that name this spacecraft, then samples the
 watchpoints with what arrived.  A report starts its class's sequences (actuator: safe hold and
@@ -35,6 +36,7 @@ from interfaces.contracts.messages import (
     AttitudeEstimate,
     FaultReport,
     GuidanceStatus,
+    NeighbourDeclaration,
     OnboardCommand,
     OnboardFdirEvent,
     PoiObservations,
@@ -63,10 +65,11 @@ class OnboardFdirApp(App):
         Input(cat.NAV_ESTIMATE, "on_estimate"),
         Input(cat.GUIDANCE_STATUS, "on_guidance"),
         Input(cat.OBSERVATIONS, "on_observations"),
+        Input(cat.NEIGHBOUR_DECLARATION, "on_neighbours"),
     )
     OUTPUTS = (Output("command", cat.FDIR_COMMAND), Output("event", cat.FDIR_EVENT))
     CRITICAL = ("states", "blank", "acted", "safe", "camera_off", "track_since",
-                "assignment_id", "_reports", "_samples", "_recovered")
+                "assignment_id", "_reports", "_samples", "_recovered", "_told")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -89,6 +92,8 @@ class OnboardFdirApp(App):
         self._reports: list[FaultReport] = []
         self._samples: list[tuple[str, float]] = []
         self._recovered = False
+        self._told: list[NeighbourDeclaration] = []
+        self.neighbours_action = sc.neighbours.action
 
     # --- inputs: each sample queued for the step ------------------------------------------
 
@@ -117,6 +122,10 @@ class OnboardFdirApp(App):
             self._recovered = True
         self._sample("thrust_duty_excess", thrust_duty(msg, self.u_max))
 
+    def on_neighbours(self, msg: NeighbourDeclaration) -> None:
+        if msg.subject == self.sc_id:
+            self._told.append(msg)
+
     def on_observations(self, msg: PoiObservations) -> None:
         if self.track_since is not None and not self.camera_off:  # tracking
             self._sample("blank_image_frac", self.blank.add(len(msg.poi)))
@@ -131,6 +140,11 @@ class OnboardFdirApp(App):
         reports, self._reports = self._reports, []
         for r in reports:
             self._on_declared(t, r)
+        told, self._told = self._told, []
+        for d in told:
+            self._event(t, "report", "neighbours", detail=f"declared by neighbours {d.judges} "
+                        f"(window to {d.t_end_s:.0f} s)")
+            self._run(t, self.neighbours_action, None)
         samples, self._samples = self._samples, []
         for name, value in samples:
             self._check(t, name, value)

@@ -1,11 +1,12 @@
 """Information-cost app: the spacecraft's share of the inspection (paper Eq. 8, Sec. III.A).
 
-Rate group mid (ω_mid).  Input: the observations of every observer (its own, and a neighbour's
-only while in communication range: the channel decides).  Output: at every FDI window
-boundary (``interfaces.contracts.fdi_schedule``, every ``rates.fdi_period_s``) the information-cost
+Rate group mid (ω_mid). Input: the observations of every observer (its own, and a neighbour's
+only while in communication range: the channel decides), leaving out an observer this
+spacecraft's neighbours' FDIR declared until the ground overrules it
+(``fsw/apps/neighbours.py``). Output: at every FDI window boundary
+(``interfaces.contracts.fdi_schedule``, every ``rates.fdi_period_s``) the information-cost
 telemetry to the ground — its contribution H_i, the cost H and prior term of its fused view,
-every contribution H_j as fused here, and counts.
-"""
+every contribution H_j as fused here, and counts."""
 
 from __future__ import annotations
 
@@ -14,16 +15,24 @@ from collections.abc import Callable
 from gnc.poi_map import PoiMap
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.fdi_schedule import FdiSchedule
-from interfaces.contracts.messages import InfoCostTelemetry, PoiObservations
+from fsw.lib.neighbour_judge import Exclusions
+from interfaces.contracts.messages import (
+    InfoCostTelemetry,
+    NeighbourDeclaration,
+    NeighbourRuling,
+    PoiObservations,
+)
 from interfaces.runtime.app import App, AppContext, Input, Output
 
 
 class InfoCostApp(App):
     NAME = "infocost"
     RATE = "mid"
-    INPUTS = (Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),)
+    INPUTS = (Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
+              Input(cat.NEIGHBOUR_DECLARATION, "on_declaration"),
+              Input(cat.NEIGHBOUR_RULING, "on_ruling"))
     OUTPUTS = (Output("telemetry", cat.INFO_COST),)
-    CRITICAL = ("map", "last_boundary", "images", "shared", "rejected")
+    CRITICAL = ("map", "last_boundary", "images", "shared", "rejected", "exclusions")
     REBUILT = ("report_factor",)  # the software-fault hook, set at start (fsw/spacecraft.py)
 
     def __init__(self, ctx: AppContext) -> None:
@@ -38,6 +47,8 @@ class InfoCostApp(App):
         self.shared = 0
         self.rejected = 0
         """observations dropped for naming a spacecraft outside the constellation"""
+        self.exclusions = Exclusions()
+        """observers left out of the fusion since the neighbours declared them"""
         self.report_factor: Callable[[float], float] = lambda t: 1.0
         """Factor on the reported H_i at time t: 1 unless the harness injects ``faulty_data``
         (faults/software.py)."""
@@ -48,10 +59,20 @@ class InfoCostApp(App):
             self.log.warning("dropped observations of spacecraft %d: the constellation has %d "
                              "(%d dropped)", msg.spacecraft, self.map.n_agents, self.rejected)
             return
+        if msg.spacecraft != self.sc_id and not self.exclusions.admits(msg):
+            return
         self.map.add(msg.spacecraft, *msg.arrays())
         if msg.spacecraft == self.sc_id:
             self.images += 1
         else:
+            self.shared += 1
+
+    def on_declaration(self, msg: NeighbourDeclaration) -> None:
+        self.exclusions.declared(msg, self.sc_id)
+
+    def on_ruling(self, msg: NeighbourRuling) -> None:
+        for m in self.exclusions.ruled(msg):
+            self.map.add(m.spacecraft, *m.arrays())
             self.shared += 1
 
     def step(self, t: float) -> None:

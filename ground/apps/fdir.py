@@ -2,21 +2,28 @@
 (paper Sec. III.B-E; docs/fdir.md).  The app is the bus adapter of the FDIR pipeline
 (``ground/fdir/pipeline.py``, which holds the stages and says what each judges).
 
-Rate group mid.  Inputs, each handed to the pipeline: every observer's POI observations (the
+Rate group mid. Inputs, each handed to the pipeline: every observer's POI observations (the
 images that reached the ground), its transfer plans, its nav, attitude, guidance and H_i
-telemetry, its onboard FDIR's events (a camera turned off onboard is expected to send no
-image), the ground's own PRO assignments, and its own link counters (with ground passes,
-what each observer's onboard store lost to overflow).  Outputs: one ``FdirWindow`` per observer and
-FDI window on ``ground/fdir/window``, one ``ConstellationWindow`` per FDI window on
-``ground/fdir/constellation``, and a ``FaultReport`` on ``ground/fdir/report`` for each fault
-declared or identified.  Each window is judged ``fdir.latency_s`` after it closes.
-"""
+telemetry, its onboard FDIR's events (a camera turned off onboard is expected to send no image),
+the ground's own PRO assignments, its own link counters (with ground passes, what each
+observer's onboard store lost to overflow), and the faults the observers' neighbours declared
+aboard, which it rules on (``NeighbourRuling`` on ``ground/fdir/ruling``). Outputs: one
+``FdirWindow`` per observer and FDI window on ``ground/fdir/window``, one
+``ConstellationWindow`` per FDI window on ``ground/fdir/constellation``, and a ``FaultReport``
+on ``ground/fdir/report`` for each fault declared or identified. Each window is judged
+``fdir.latency_s`` after it closes."""
 
 from __future__ import annotations
 
 from ground.fdir.pipeline import FdirPipeline
 from interfaces.contracts import catalogue as cat
-from interfaces.contracts.messages import ConstellationWindow, FaultReport, FdirWindow, Message
+from interfaces.contracts.messages import (
+    ConstellationWindow,
+    FaultReport,
+    FdirWindow,
+    Message,
+    NeighbourRuling,
+)
 from interfaces.runtime.app import App, AppContext, Input, Output
 
 
@@ -33,12 +40,15 @@ class FdirApp(App):
         Input(cat.GUIDANCE_STATUS, "pipeline.guidance", every_spacecraft=True),
         Input(cat.FDIR_EVENT, "pipeline.onboard", every_spacecraft=True),
         Input(cat.LINK_STATS, "pipeline.link_stats"),
+        Input(cat.NEIGHBOUR_DECLARATION, "pipeline.neighbours", every_spacecraft=True),
     )
     OUTPUTS = (Output("window", cat.FDIR_WINDOW), Output("report", cat.FAULT_REPORT),
-               Output("constellation", cat.CONSTELLATION_WINDOW))
+               Output("constellation", cat.CONSTELLATION_WINDOW),
+               Output("ruling", cat.NEIGHBOUR_RULING))
     CRITICAL = ("pipeline",)
     PORTS: dict[type[Message], str] = {FdirWindow: "window", FaultReport: "report",
-                                        ConstellationWindow: "constellation"}
+                                        ConstellationWindow: "constellation",
+                                        NeighbourRuling: "ruling"}
     """the output each of the pipeline's messages goes out on"""
 
     def __init__(self, ctx: AppContext) -> None:

@@ -19,6 +19,7 @@ observations are missing, no report is judged (counted in ``unjudged``, logged).
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 
 import numpy as np
 
@@ -44,10 +45,12 @@ class IntegrityCheck:
         """Keep the H_i ``msg`` reports at window boundary ``boundary``."""
         self._reported[(msg.spacecraft, boundary)] = msg.h_i
 
-    def check(self, j: int, b: float, settled: PoiMap, observers: dict[int, ObserverState]
-              ) -> list[FaultReport]:
+    def check(self, j: int, b: float, settled: PoiMap, observers: dict[int, ObserverState],
+              excludes: Callable[[int], bool] = lambda sc: False) -> list[FaultReport]:
         """Judge the reports at boundary ``j`` (time b, s) against ``settled``, the ground's
-        map holding every image before b; returns the data-integrity faults declared."""
+        map holding every image before b; returns the data-integrity faults declared.  An
+        observer that ``excludes`` a neighbour its neighbours declared fuses less than the
+        ground: its report is not judged (counted in ``unjudged``)."""
         lost = np.array([o.lost_fraction() for o in observers.values()])
         ground = ground_contributions(settled, lost)
         judgeable = float(lost.max(initial=0.0)) <= self.cfg.integrity_max_loss
@@ -57,7 +60,7 @@ class IntegrityCheck:
             mine = float(ground[sc - 1])
             if reported is None or mine <= 0.0:
                 continue
-            if not judgeable:
+            if not judgeable or excludes(sc):
                 self._unjudged(sc, lost)
                 continue
             deviation = abs(reported / mine - 1.0)

@@ -35,6 +35,7 @@ from gnc.hardware_threshold import window_false_alarm
 from ground.fdir.information import InformationTest, Judgement
 from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
+from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
 from gnc.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.window import SettledMap, window_context
@@ -48,6 +49,7 @@ from interfaces.contracts.messages import (
     InfoCostTelemetry,
     LinkStats,
     Message,
+    NeighbourDeclaration,
     OnboardFdirEvent,
     PoiObservations,
     ProAssignments,
@@ -86,6 +88,7 @@ class FdirPipeline:
         self.global_check = GlobalCheck(cfg, q_window, node, log)
         self.declarer = Declarer(cfg, node, log)
         self.integrity = IntegrityCheck(cfg, node, log)
+        self.rulings = NeighbourRulings(node, log)
         self.next_window = 0
         """the next FDI window to judge (``interfaces.contracts.fdi_schedule``)"""
         self.rejected = 0
@@ -167,6 +170,12 @@ class FdirPipeline:
         obs = self.observers.get(msg.spacecraft)
         if obs is not None and msg.event == "sequence" and msg.name == "camera_off":
             obs.camera_off_s = min(msg.t_sim, obs.camera_off_s or math.inf)
+
+    def neighbours(self, msg: NeighbourDeclaration) -> None:
+        """A fault the observers' neighbours declared aboard: ruled on when the ground has
+        judged its subject (``ground/fdir/neighbour_rulings.py``)."""
+        if msg.subject in self.observers and msg.spacecraft in self.observers:
+            self.rulings.declaration(msg)
 
     def link_stats(self, msg: LinkStats) -> None:
         """The ground's own channel counters: with ground passes, the FDIR topics' overflow
@@ -253,8 +262,11 @@ class FdirPipeline:
         out += messages
         for sc, j in judged.items():
             out += self.declarer.declare(sc, j, common)
+        out += self.rulings.rule(b, {w.spacecraft: w.exceeded for w in out
+                                     if isinstance(w, FdirWindow)})
         self._settle(inside, b)
-        out += self.integrity.check(k + 1, b, self.settled, self.observers)
+        out += self.integrity.check(k + 1, b, self.settled, self.observers,
+                                    self.rulings.excludes)
         return out
 
     def _settle(self, inside: list[PoiObservations], b: float) -> None:

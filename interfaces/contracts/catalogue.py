@@ -124,6 +124,10 @@ FDIR_COMMAND = Topic(Space.SPACECRAFT, "fdir", "command", m.OnboardCommand,
                      "onboard FDIR stored-sequence command to its own apps")
 FDIR_EVENT = Topic(Space.SPACECRAFT, "fdir", "event", m.OnboardFdirEvent,
                    "onboard FDIR events: trips, reports, sequences, recovery")
+NEIGHBOUR_JUDGEMENT = Topic(Space.SPACECRAFT, "neighbours", "judgement", m.NeighbourJudgement,
+                            "verdicts on the neighbours heard over an FDI window (Eq. 9)")
+NEIGHBOUR_DECLARATION = Topic(Space.SPACECRAFT, "neighbours", "declaration",
+                              m.NeighbourDeclaration, "a fault declared by neighbours' agreement")
 
 # --- every lockstep node's executive --------------------------------------------------------
 TICK_DONE = Topic(Space.EVERY_NODE, "exec", "tick_done", m.TickDone, "lockstep answer to a tick")
@@ -141,21 +145,25 @@ FAULT_REPORT = Topic(Space.GROUND, "fdir", "report", m.FaultReport, "declared fa
 CONSTELLATION_WINDOW = Topic(Space.GROUND, "fdir", "constellation", m.ConstellationWindow,
                              "the global check (Eq. 6) of one FDI window")
 BASELINE = Topic(Space.GROUND, "fdir", "baseline", m.BaselineVerdict, "baseline detectors")
+NEIGHBOUR_RULING = Topic(Space.GROUND, "fdir", "ruling", m.NeighbourRuling,
+                         "the ground's ruling on a fault the neighbours declared")
 TLM_STATUS = Topic(Space.GROUND, "tlm", "status", m.TelemetryStatus, "telemetry freshness")
 
 ALL: tuple[Topic[m.Message], ...] = (
     TICK, SIM_STATUS, TRUTH, FAULT_EVENTS, RELNAV, ATTITUDE_SENSORS, CAMERA_IMAGE,
     THRUST, WHEELS, NAV_ESTIMATE, ATTITUDE_ESTIMATE, OBSERVATIONS, POINTING, TRANSFER_PLAN,
-    GUIDANCE_STATUS, INFO_COST, FDIR_COMMAND, FDIR_EVENT,
+    GUIDANCE_STATUS, INFO_COST, FDIR_COMMAND, FDIR_EVENT, NEIGHBOUR_JUDGEMENT,
+    NEIGHBOUR_DECLARATION,
     TICK_DONE, HEARTBEAT, EXEC_STATS, LINK_STATS,
     ASSIGNMENTS, DECISIONS, FDIR_WINDOW, FAULT_REPORT, CONSTELLATION_WINDOW, BASELINE,
-    TLM_STATUS,
+    NEIGHBOUR_RULING, TLM_STATUS,
 )
 
 
-DOWNLINK_FIRST = (FDIR_EVENT, INFO_COST, GUIDANCE_STATUS, TRANSFER_PLAN)
-"""Dumped first in a pass, and kept longest in a full store: the onboard FDIR's events and the
-small telemetry the ground FDIR decides on (H_i, guidance, plans)."""
+DOWNLINK_FIRST = (FDIR_EVENT, NEIGHBOUR_DECLARATION, INFO_COST, GUIDANCE_STATUS, TRANSFER_PLAN)
+"""Dumped first in a pass, and kept longest in a full store: the onboard FDIR's events, the
+neighbours' declarations, and the small telemetry the ground FDIR decides on (H_i, guidance,
+plans)."""
 DOWNLINK_FDIR = (NAV_ESTIMATE, ATTITUDE_ESTIMATE, OBSERVATIONS)
 """Dumped next: the rest of what the ground FDIR judges (the poses and the images)."""
 

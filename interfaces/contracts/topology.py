@@ -34,6 +34,9 @@ SPACECRAFT_APPS: tuple[str, ...] = (
 ONBOARD_FDIR_APPS: tuple[str, ...] = ("fsw.apps.fdir:OnboardFdirApp",)
 """Added after them when the scenario turns the agent-level FDIR on (``[onboard_fdir]``)."""
 
+NEIGHBOUR_APPS: tuple[str, ...] = ("fsw.apps.neighbours:NeighboursApp",)
+"""Added after those when the scenario turns the neighbours' FDIR on (``[neighbours]``)."""
+
 GROUND_APPS: tuple[str, ...] = (
     "ground.apps.planner:MissionPlanner",
     "ground.apps.telemetry:TelemetryMonitor",
@@ -84,10 +87,12 @@ SIM = Service(topics.SIM, "sim")
 """The time master and hardware stand-in."""
 
 
-def spacecraft_node(spacecraft: int, onboard_fdir: bool = False) -> Node:
+def spacecraft_node(spacecraft: int, onboard_fdir: bool = False,
+                    neighbours: bool = False) -> Node:
     """Spacecraft ``spacecraft``'s flight software (1-based), with the agent-level FDIR app
-    when ``onboard_fdir``."""
-    apps = SPACECRAFT_APPS + (ONBOARD_FDIR_APPS if onboard_fdir else ())
+    when ``onboard_fdir`` and the neighbours' FDIR app when ``neighbours``."""
+    apps = (SPACECRAFT_APPS + (ONBOARD_FDIR_APPS if onboard_fdir else ())
+            + (NEIGHBOUR_APPS if neighbours else ()))
     return Node(topics.sc_node(spacecraft), apps, "fsw.spacecraft:executive",
                 ("fsw", spacecraft), "fsw", ("--spacecraft", str(spacecraft)), spacecraft)
 
@@ -121,8 +126,9 @@ class Topology:
 def topology(scenario: Scenario, ground: bool = True) -> Topology:
     """The topology of a run of ``scenario``: one node per observer, and the ground unless
     ``ground`` is False (spacecraft only)."""
-    onboard = scenario.onboard_fdir.enabled
-    nodes = [spacecraft_node(i, onboard) for i in range(1, scenario.observers.count + 1)]
+    onboard, neighbours = scenario.onboard_fdir.enabled, scenario.neighbours.enabled
+    nodes = [spacecraft_node(i, onboard, neighbours)
+             for i in range(1, scenario.observers.count + 1)]
     return Topology(tuple(nodes + ([GROUND] if ground else [])))
 
 

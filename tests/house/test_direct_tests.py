@@ -40,7 +40,7 @@ INDIRECT: dict[str, str] = {
     "interfaces.contracts.messages.sim": _MESSAGES,
     **{f"interfaces.contracts.scenario.{m}": _SCENARIO
        for m in ("base", "comms", "faults", "fdir", "flight", "ground", "mission", "model",
-                 "observers", "onboard", "planning", "rates", "sim")},
+                 "neighbours", "observers", "onboard", "planning", "rates", "sim")},
     "interfaces.contracts.timing": (
         "one constant, TIME_TOL_S: a fault switching on the tick at its time whatever the "
         "rounding tests it (tests/faults/test_schedule.py, tests/faults/test_software.py)"),
@@ -64,6 +64,10 @@ INDIRECT: dict[str, str] = {
     **{f"ground.analysis.run_summary.{m}": _SUMMARY
        for m in ("document", "fdir", "figures", "onboard", "passes", "records", "series")},
     "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
+    "fsw.apps.neighbours": (
+        "the neighbours' FDIR app, built by name from the topology with [neighbours] on: "
+        "flown in tests/missions/test_neighbours_run.py; its judge and agreement rule are "
+        "tested where they live (tests/fsw/lib/test_neighbour_judge.py)"),
     "ground.archive.__main__": (
         "``python -m ground.archive``, two lines handing over to ground/archive/cli.py's main "
         "(tests/ground/archive/test_cli.py, tests/missions/test_archive_cli_run.py)"),

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import ClassVar, Literal
 
-from pydantic import Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from interfaces.contracts.messages.base import (
     MAX_SPEED_MPS,
@@ -104,20 +104,39 @@ class GuidanceStatus(Message):
     mpc_ms: float = Field(default=0.0, ge=0.0)
 
 
+class ReportedPose(BaseModel):
+    """Where an observer says it was and where its camera aimed when it took an image (its
+    nav and attitude estimates then): what a neighbour judging it needs of it besides the
+    observations (docs/fdir.md, "Neighbours judge each other")."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+    nav_m: Position = Field(description="estimated LVLH position, m")
+    nav_sigma_m: float = Field(ge=0.0, le=1e6, description="its 1σ per axis, m")
+    aim_m: Position = Field(description="the pointing target, LVLH, m")
+    knowledge_rad: Angle = Field(description="attitude knowledge, 1σ, rad")
+    tracking_rad: Angle = Field(description="the estimated pointing error, rad")
+    tracking_s: float = Field(ge=0.0, description="time in track mode (0: not tracking), s")
+
+
 class PoiObservations(PoiPrecisions):
     """The observations of one image of ``spacecraft`` (taken at ``image_t_s``) as shared with
-    the other observers and the ground.  Received only within range."""
+    the other observers and the ground.  Received only within range.  With the neighbours'
+    FDIR on, each carries the observer's reported pose (``pose``)."""
 
     image_t_s: Time
+    pose: ReportedPose | None = None
 
     @classmethod
-    def of_image(cls, image: CameraImage, sender: str, t_sim: float) -> PoiObservations:
+    def of_image(cls, image: CameraImage, sender: str, t_sim: float,
+                 pose: ReportedPose | None = None) -> PoiObservations:
         """The observations of ``image``, sent by ``sender`` at ``t_sim`` (s): the image's own
         validated, immutable lists, not validated again (``model_construct`` of valid parts;
         a 2,500-POI image's lists cost ~0.1 ms to validate).  A header outside the rules goes
         to pydantic, which raises."""
         fields = {"sender": sender, "t_sim": t_sim, "spacecraft": image.spacecraft,
                   "image_t_s": image.t_sim, "poi": image.poi, "precision": image.precision}
+        if pose is not None:
+            fields["pose"] = pose
         msg = cls.model_construct(**fields) if header_ok(sender, t_sim) else cls(**fields)
         msg.__pydantic_private__["_arrays"] = image._arrays  # type: ignore[index]
         return msg
@@ -209,3 +228,42 @@ class OnboardFdirEvent(Message):
     limit: float | None = None
     fault_class: FaultClassName | None = None
     detail: str = Field(default="", max_length=200)
+
+
+class NeighbourVerdict(BaseModel):
+    """One neighbour's window as judged aboard another observer (Eq. 9 on the judge's fused
+    map): ΔH_j of its shared observations, the twin's ΔH_j^pred on its assigned PRO, H_m
+    against τ from the hardware model; ``exceeded`` None when the window could not decide."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+    subject: int = Field(ge=1)
+    images: int = Field(ge=0)
+    dh: float | None = None
+    dh_pred: float | None = None
+    metric: float | None = None
+    threshold: float | None = None
+    exceeded: bool | None = None
+    direction: Literal["improved", "degraded"] | None = None
+
+
+class NeighbourJudgement(Message):
+    """An observer's verdicts on the neighbours it heard over one FDI window [t_start_s,
+    t_end_s), shared on the crosslinks (``fsw/apps/neighbours.py``)."""
+
+    spacecraft: int = Field(ge=1, description="the judge")
+    t_start_s: Time
+    t_end_s: Time
+    verdicts: list[NeighbourVerdict] = Field(default_factory=list, max_length=64)
+
+
+class NeighbourDeclaration(Message):
+    """A fault declared aboard ``spacecraft`` on ``subject`` by its neighbours' agreement over
+    the window [t_start_s, t_end_s): ``judges`` found it failed, of ``decided`` that judged it
+    (docs/fdir.md, "Neighbours judge each other").  Sent to the ground, which rules on it."""
+
+    spacecraft: int = Field(ge=1, description="where the rule was applied")
+    subject: int = Field(ge=1)
+    t_start_s: Time
+    t_end_s: Time
+    judges: list[int] = Field(min_length=1, max_length=64)
+    decided: list[int] = Field(min_length=1, max_length=64)

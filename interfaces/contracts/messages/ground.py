@@ -199,3 +199,14 @@ class TelemetryStatus(Message):
             description="[last heard, heard again] (sim s) of each silence that ended")
 
     entries: list[Entry]
+
+
+class NeighbourRuling(Message):
+    """The ground's ruling on a fault its observers' neighbours declared (``NeighbourDeclaration``)
+    once it has judged the subject's window itself: ``upheld`` (it declared too) or
+    ``overruled`` (it found the window nominal; the observers fuse the subject's observations
+    again).  The ground's decision stands over the neighbours'."""
+
+    subject: int = Field(ge=1)
+    window_end_s: Time
+    verdict: Literal["upheld", "overruled"]

@@ -17,6 +17,7 @@ from interfaces.contracts.scenario.model import (
     parse_scenario,
 )
 from interfaces.contracts.scenario.observers import ObserverOverride, Observers, Phase
+from interfaces.contracts.scenario.neighbours import Neighbours
 from interfaces.contracts.scenario.onboard import (
     DEFAULT_WATCHPOINTS,
     OnboardFdir,
@@ -30,7 +31,8 @@ from interfaces.contracts.scenario.sim import SimSettings
 __all__ = [
     "Actuators", "AssignmentSettings", "Attitude", "Burst", "COMMON_MODE_KINDS", "CameraSettings",
     "Comms", "DEFAULT_WATCHPOINTS", "Fault", "FaultKind", "FdirSettings", "Ground", "Guidance",
-    "LinkCut", "Nav", "ObserverOverride", "Observers", "OnboardFdir", "Orbit", "Phase", "Rates",
+    "LinkCut", "Nav", "Neighbours", "ObserverOverride", "Observers", "OnboardFdir", "Orbit",
+    "Phase", "Rates",
     "Scenario", "ScenarioError", "Section", "Sensors", "SequenceName", "SimSettings", "Station",
     "Target", "Watchpoint", "load_scenario", "parse_scenario",
 ]

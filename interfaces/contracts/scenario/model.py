@@ -22,6 +22,7 @@ from interfaces.contracts.scenario.flight import Actuators, Attitude, Guidance, 
 from interfaces.contracts.scenario.ground import Ground
 from interfaces.contracts.scenario.mission import CameraSettings, Orbit, Target
 from interfaces.contracts.scenario.observers import Observers, Phase
+from interfaces.contracts.scenario.neighbours import Neighbours
 from interfaces.contracts.scenario.onboard import OnboardFdir
 from interfaces.contracts.scenario.planning import AssignmentSettings
 from interfaces.contracts.scenario.rates import Rates
@@ -47,6 +48,7 @@ class Scenario(Section):
     assignment: AssignmentSettings = AssignmentSettings()
     fdir: FdirSettings = FdirSettings()
     onboard_fdir: OnboardFdir = OnboardFdir()
+    neighbours: Neighbours = Neighbours()
     ground: Ground = Ground()
     sim: SimSettings = SimSettings()
     faults: list[Fault] = Field(default_factory=list)

@@ -10,7 +10,12 @@ from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.catalogue import Space, Topic
 from interfaces.contracts.messages import Heartbeat, Message, StateEstimate
-from interfaces.contracts.topology import GROUND_APPS, ONBOARD_FDIR_APPS, SPACECRAFT_APPS
+from interfaces.contracts.topology import (
+    GROUND_APPS,
+    NEIGHBOUR_APPS,
+    ONBOARD_FDIR_APPS,
+    SPACECRAFT_APPS,
+)
 from interfaces.runtime.app import App
 from interfaces.runtime.assembly import app_class
 from interfaces.runtime.bus import Bus
@@ -80,7 +85,7 @@ def declared_wiring() -> tuple[Producers, Producers]:
     producers: Producers = {}
     consumers: Producers = {}
     apps: list[type[App]] = [app_class(a) for a in (*SPACECRAFT_APPS, *ONBOARD_FDIR_APPS,
-                                                    *GROUND_APPS)]
+                                                    *NEIGHBOUR_APPS, *GROUND_APPS)]
     for app in apps:
         for o in app.OUTPUTS:
             producers.setdefault(o.topic, []).append(f"{app.NAME}.{o.name}")

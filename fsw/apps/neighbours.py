@@ -1,0 +1,169 @@
+"""Neighbours' FDIR app: this observer judges every neighbour it hears, and declares a fault by
+their agreement (docs/fdir.md, "Neighbours judge each other"; ``[neighbours]``).
+
+Rate group mid.  Inputs: every observer's shared observations (a neighbour's only within
+range, each with its reported pose), the ground's PRO assignments, every observer's
+judgements (its own come back through the bus), and the ground's rulings.  Outputs: this
+observer's ``NeighbourJudgement`` of each FDI window, on the crosslinks, and a
+``NeighbourDeclaration`` when the judgements of a neighbour's window agree
+(``fsw/lib/neighbour_judge.py``), sent to every app of this spacecraft and to the ground.
+
+Timing, per window [a, b): judged ``fdir.latency_s`` after b (the neighbours' observations up to
+b are in); the judgements of the others arrive one tick later, and the agreement is applied
+one ω_mid cycle after the judging.  ψ is held at a on this observer's own fused map, which
+takes each window's observations once the window is judged, leaving out the observers its
+neighbours declared (until the ground overrules them).
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+
+import numpy as np
+
+from gnc.pro import Pro
+from gnc.poi_map import PoiMap
+from gnc.twin import TwinModel
+from fsw.lib.neighbour_judge import Exclusions, JudgeSettings, agreed, judge
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.fdi_schedule import FdiSchedule
+from interfaces.contracts.messages import (
+    NeighbourDeclaration,
+    NeighbourJudgement,
+    NeighbourRuling,
+    PoiObservations,
+    ProAssignments,
+)
+from interfaces.contracts.timing import TIME_TOL_S
+from interfaces.runtime.app import App, AppContext, Input, Output
+
+
+class NeighboursApp(App):
+    NAME = "neighbours"
+    RATE = "mid"
+    INPUTS = (
+        Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
+        Input(cat.ASSIGNMENTS, "on_assignments"),
+        Input(cat.NEIGHBOUR_JUDGEMENT, "on_judgement", every_spacecraft=True),
+        Input(cat.NEIGHBOUR_RULING, "on_ruling"),
+    )
+    OUTPUTS = (Output("judgement", cat.NEIGHBOUR_JUDGEMENT),
+               Output("declaration", cat.NEIGHBOUR_DECLARATION))
+    CRITICAL = ("map", "pending", "plans", "verdicts", "exclusions", "declared", "next_judge",
+                "next_decide")
+
+    def __init__(self, ctx: AppContext) -> None:
+        super().__init__(ctx)
+        sc, k = ctx.scenario, ctx.constants
+        self.sc_id = ctx.spacecraft or 0
+        self.n = k.n_rad_s
+        self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
+        self.twin = TwinModel(k.poi_pos, k.poi_normal, k.camera, sc.target.radius_m,
+                              sc.camera.noise_frac)
+        self.cfg = JudgeSettings.of(sc)
+        self.agree = sc.neighbours.agree
+        self.schedule = FdiSchedule(sc.rates.fdi_period_s)
+        self.latency_s = sc.fdir.latency_s
+        self.decide_after_s = 1.0 / sc.rates.mid_hz
+        self.seed = sc.seed
+        self.pending: list[PoiObservations] = []
+        self.plans: dict[int, list[tuple[float, float, Pro]]] = defaultdict(list)
+        """by observer: (in force from, arrival of its transfer, PRO), by the first"""
+        self.verdicts: dict[tuple[int, int], dict[int, bool | None]] = {}
+        """(window index, subject) -> judge -> exceeded"""
+        self.exclusions = Exclusions()
+        self.declared: set[int] = set()
+        """subjects declared aboard (an episode: until the ground overrules)"""
+        self.next_judge = 0
+        self.next_decide = 0
+
+    # --- inputs -------------------------------------------------------------------------------
+
+    def on_observations(self, msg: PoiObservations) -> None:
+        if 1 <= msg.spacecraft <= self.map.n_agents:
+            self.pending.append(msg)
+
+    def on_assignments(self, msg: ProAssignments) -> None:
+        for a in msg.assignments:
+            plans = self.plans[a.spacecraft]
+            if any(p[0] == a.t_depart_s for p in plans):
+                continue
+            e = a.pro
+            plans.append((a.t_depart_s, a.t_arrive_s,
+                          Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)))
+            plans.sort(key=lambda p: p[0])
+
+    def on_judgement(self, msg: NeighbourJudgement) -> None:
+        k = self.schedule.boundary_at(msg.t_start_s)  # window k starts at boundary k
+        if k is None:  # not a window of this schedule: dropped
+            return
+        for v in msg.verdicts:
+            if v.subject != msg.spacecraft:
+                self.verdicts.setdefault((k, v.subject), {})[msg.spacecraft] = v.exceeded
+
+    def on_ruling(self, msg: NeighbourRuling) -> None:
+        if msg.verdict == "overruled" and msg.subject in self.declared:
+            self.declared.discard(msg.subject)
+            self.pending += self.exclusions.readmit(msg.subject)
+            self.log.warning("the ground overruled the neighbours on sc%d: fused again",
+                             msg.subject)
+
+    # --- the cycle ----------------------------------------------------------------------------
+
+    def step(self, t: float) -> None:
+        while t >= self.schedule.end(self.next_decide) + self.latency_s \
+                + self.decide_after_s - TIME_TOL_S and self.next_decide < self.next_judge:
+            self._decide(self.next_decide, t)
+            self.next_decide += 1
+        while t >= self.schedule.end(self.next_judge) + self.latency_s - TIME_TOL_S:
+            self._judge(self.next_judge, t)
+            self.next_judge += 1
+
+    def _judge(self, k: int, t: float) -> None:
+        """Judge window k's neighbours, then fuse its observations into this observer's map."""
+        a, b = self.schedule.start(k), self.schedule.end(k)
+        inside = [m for m in self.pending if a <= m.image_t_s < b]
+        psi, phi = self.map.variance() ** 2, self.map.phi
+        verdicts = []
+        for subject in sorted({m.spacecraft for m in inside} - {self.sc_id} - self.declared):
+            images = sorted((m for m in inside if m.spacecraft == subject),
+                            key=lambda m: m.image_t_s)
+            rng = np.random.default_rng([self.seed, self.sc_id, subject, k])
+            verdicts.append(judge(subject, images, self._pro(subject, a, b), psi, phi,
+                                  self.twin, self.n, self.cfg, rng))
+        if verdicts:
+            self.publish("judgement", NeighbourJudgement(
+                sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, t_start_s=a, t_end_s=b,
+                verdicts=verdicts))
+        for m in inside:
+            if m.spacecraft == self.sc_id or self.exclusions.admits(m):
+                self.map.add(m.spacecraft, *m.arrays())
+        self.pending = [m for m in self.pending if m.image_t_s >= b]
+
+    def _pro(self, subject: int, a: float, b: float) -> Pro | None:
+        """The PRO ``subject`` holds over all of [a, b) (s): None without a plan, or when a
+        transfer (its path is the subject's own choice) or a change of plan falls in it."""
+        plans = [p for p in self.plans.get(subject, []) if p[0] <= b]
+        if not plans or plans[-1][0] > a or plans[-1][1] > a:
+            return None
+        return plans[-1][2]
+
+    def _decide(self, k: int, t: float) -> None:
+        """Apply the agreement rule to window k's judgements."""
+        a, b = self.schedule.start(k), self.schedule.end(k)
+        for (kk, subject), by_judge in sorted(self.verdicts.items()):
+            if kk != k or subject in self.declared:
+                continue
+            judges = agreed(by_judge, self.agree)
+            if judges is None:
+                continue
+            self.declared.add(subject)
+            if subject != self.sc_id:
+                self.exclusions.exclude(subject, b)
+            decided = sorted(j for j, v in by_judge.items() if v is not None)
+            self.log.warning("neighbours declare sc%d at %.0f s (%s of %s found its window "
+                             "failed)", subject, b, judges, decided)
+            self.publish("declaration", NeighbourDeclaration(
+                sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, subject=subject,
+                t_start_s=a, t_end_s=b, judges=judges, decided=decided))
+        self.verdicts = {key: v for key, v in self.verdicts.items() if key[0] > k}
