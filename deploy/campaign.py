@@ -24,6 +24,16 @@ A campaign TOML names a base scenario and groups of runs::
 ``study = "formations"`` (optional) also writes the formation study (Sec. III.G) beside the
 report (ground/analysis/formation_study.py).
 
+``[[variants]]`` (optional) flies every group once per variant, each with its own scenario
+overrides, the same seeds and the same drawn faults: group ``g`` becomes ``g-<variant>``::
+
+    [[variants]]
+    name = "central"
+    overrides = { neighbours = { enabled = false } }
+    [[variants]]
+    name = "neighbours"
+    overrides = { neighbours = { enabled = true } }
+
 Each group expands to (its seeds) × (the Cartesian product of every list-valued fault field,
 in file order); every range is then drawn from a generator seeded by (campaign name, group,
 run index), so the list is the same on every machine and every restart.  A group may also
@@ -107,21 +117,33 @@ class Group(_Strict):
         return self
 
 
+class Variant(_Strict):
+    """One way every group is flown (``[[variants]]``): its name and scenario overrides."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=32)
+    overrides: dict[str, dict[str, Any]] = Field(default_factory=dict)
+
+
 class Campaign(_Strict):
     name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=64)
     base: str
     seeds: Annotated[list[int], Field(min_length=1)] | Seeds = Field(default_factory=lambda: [1])
     duration_s: float | None = Field(default=None, gt=0.0)
-    study: Literal["formations"] | None = None
+    study: Literal["formations", "neighbours"] | None = None
     """a study report written beside report.md (``formations``: study.md,
-    ground/analysis/formation_study.py)"""
+    ground/analysis/formation_study.py; ``neighbours``: study.md,
+    ground/analysis/neighbours_study.py)"""
     groups: list[Group] = Field(min_length=1)
+    variants: list[Variant] = Field(default_factory=list)
 
     @model_validator(mode="after")
     def _unique(self) -> Campaign:
         names = [g.name for g in self.groups]
         if len(set(names)) != len(names):
             raise ValueError(f"group names must be unique: {names}")
+        variants = [v.name for v in self.variants]
+        if len(set(variants)) != len(variants):
+            raise ValueError(f"variant names must be unique: {variants}")
         return self
 
 
@@ -198,44 +220,57 @@ def expand(campaign: Campaign, root: Path) -> list[RunSpec]:
     directory scenario paths are relative to."""
     runs: list[RunSpec] = []
     for group in campaign.groups:
-        base = _read_toml(root / (group.scenario or campaign.base))
-        seeds = _seeds(group.seeds if group.seeds is not None else campaign.seeds)
-        axes = _axes(group.faults)
-        combos = list(itertools.product(*(values for _, _, values in axes))) or [()]
-        index = 0
-        for seed in seeds:
-            for combo in combos:
-                chosen: dict[int, dict[str, Any]] = {}
-                for (i, name, _), value in zip(axes, combo):
-                    chosen.setdefault(i, {})[name] = value
-                rng = _rng(campaign.name, group.name, index)
-                data = _merge(base, group.overrides)
-                data["seed"] = seed
-                if campaign.duration_s is not None:
-                    data["duration_s"] = campaign.duration_s
-                if group.nominal:
-                    data["faults"] = []
-                elif group.faults:
-                    data["faults"] = [_fault(f, chosen.get(i, {}), rng)
-                                      for i, f in enumerate(group.faults)]
-                run_id = f"{group.name}-{index:04d}"
-                data["name"] = f"{campaign.name}-{run_id}"
-                try:
-                    scenario = Scenario.model_validate(data)
-                    late = [f for f in scenario.faults if f.start_s >= scenario.duration_s]
-                    if late:
-                        raise ValueError(f"a fault starts at {late[0].start_s:g} s, not before "
-                                         f"the end of the run ({scenario.duration_s:g} s)")
-                except ValueError as e:
-                    if not isinstance(e, ValidationError):
-                        raise CampaignError(f"run {run_id}: {e}") from None
-                    raise CampaignError(f"run {run_id}: invalid scenario: "
-                                        + "; ".join(f"{'.'.join(map(str, err['loc']))}: "
-                                                    f"{err['msg']}" for err in e.errors())
-                                        ) from None
-                runs.append(RunSpec(run_id, group.name, scenario))
-                index += 1
+        for variant in campaign.variants or [None]:
+            runs += _expand_group(campaign, group, variant, root)
     return runs
+
+
+def _expand_group(campaign: Campaign, group: Group, variant: Variant | None,
+                  root: Path) -> list[RunSpec]:
+    """One group's runs, flown as ``variant`` (None: the campaign has no variants); the fault
+    draws depend on the group and the run's index, never on the variant."""
+    label = group.name if variant is None else f"{group.name}-{variant.name}"
+    base = _merge(_read_toml(root / (group.scenario or campaign.base)),
+                  variant.overrides if variant is not None else {})
+    axes = _axes(group.faults)
+    combos = list(itertools.product(*(values for _, _, values in axes))) or [()]
+    runs: list[RunSpec] = []
+    for seed in _seeds(group.seeds if group.seeds is not None else campaign.seeds):
+        for combo in combos:
+            chosen: dict[int, dict[str, Any]] = {}
+            for (i, field_name, _), value in zip(axes, combo):
+                chosen.setdefault(i, {})[field_name] = value
+            data = _merge(base, group.overrides)
+            data["seed"] = seed
+            if campaign.duration_s is not None:
+                data["duration_s"] = campaign.duration_s
+            if group.nominal:
+                data["faults"] = []
+            elif group.faults:
+                rng = _rng(campaign.name, group.name, len(runs))
+                data["faults"] = [_fault(f, chosen.get(i, {}), rng)
+                                  for i, f in enumerate(group.faults)]
+            run_id = f"{label}-{len(runs):04d}"
+            data["name"] = f"{campaign.name}-{run_id}"
+            runs.append(RunSpec(run_id, label, _validated(run_id, data)))
+    return runs
+
+
+def _validated(run_id: str, data: dict[str, Any]) -> Scenario:
+    """Run ``run_id``'s scenario; CampaignError says what is wrong with it."""
+    try:
+        scenario = Scenario.model_validate(data)
+        late = [f for f in scenario.faults if f.start_s >= scenario.duration_s]
+        if late:
+            raise ValueError(f"a fault starts at {late[0].start_s:g} s, not before "
+                             f"the end of the run ({scenario.duration_s:g} s)")
+    except ValueError as e:
+        if not isinstance(e, ValidationError):
+            raise CampaignError(f"run {run_id}: {e}") from None
+        raise CampaignError(f"run {run_id}: invalid scenario: "
+                            + "; ".join(f"{'.'.join(map(str, err['loc']))}: {err['msg']}"
+                                        for err in e.errors())) from None
+    return scenario
 
 
 def load_campaign(path: str | Path) -> tuple[Campaign, list[RunSpec]]:

@@ -368,7 +368,7 @@ def _rescore(runs: list[CampaignRun], detector: str, scale: float,
         series = s.fdir_series.of(detector)
         grace = s.fdir_settings.fdi_period_s if s.fdir_settings else 0.0
         fixed = [Alarm(d.spacecraft, d.time_s, d.fault_class) for d in s.detections or []
-                 if detector == "main" and _kept(d, scale)]
+                 if detector == "main" and d.declared_by == "ground" and _kept(d, scale)]
         judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in series]
         m, n = rule or _persistence(s, detector)
         sc = score(s.injected_faults, fixed + _alarms_at(series, scale, m, n), judged, grace)

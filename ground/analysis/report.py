@@ -50,7 +50,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     lines += _gnc_section(out, digest.gnc_series(scenario, mission), summary)
     lines += _coverage_section(out, digest.coverage, summary)
     lines += _fdir_section(out, archive, mission, summary)
-    lines += _contact_section(summary)
+    lines += _contact_section(summary) + _neighbours_section(summary)
     lines += _links_section(summary) + _exec_section(summary) + _incidents_section(summary)
     lines += _archive_section(summary)
     return _write(out, lines)
@@ -256,8 +256,9 @@ def _identification_rows(summary: RunSummary) -> list[str]:
         ev = ", ".join(f"{k} {v:.3g}" for k, v in d.evidence.items()) or "-"
         m = "-" if d.metric is None else f"{d.metric:.3g}"
         tau = "-" if d.threshold is None else f"{d.threshold:.3g}"
-        rows.append(f"| {d.time_s:.0f} | {d.spacecraft} | {d.fault_class or 'unidentified'} | "
-                    f"{m} | {tau} | {ev} |")
+        who = (f"neighbours {', '.join(map(str, d.judges or []))}"
+               if d.declared_by == "neighbours" else d.fault_class or "unidentified")
+        rows.append(f"| {d.time_s:.0f} | {d.spacecraft} | {who} | {m} | {tau} | {ev} |")
     return rows + [""] if len(rows) > 2 else []
 
 
@@ -360,6 +361,31 @@ def _contact_section(summary: RunSummary) -> list[str]:
                          for r in s.overflow_runs[:5]) or "none"
         rows.append(f"| {node} | {s.stored} | {s.dumped} | {s.retransmitted} | {s.overflow}: "
                     f"{lost} | {s.onboard} | {g.uplink_held.get(node, 0)} |")
+    return rows + [""]
+
+
+def _neighbours_section(summary: RunSummary) -> list[str]:
+    """The neighbours' FDIR aboard: its declarations with the ground's rulings, its figures
+    and where it and the ground disagreed (docs/fdir.md, "Neighbours judge each other")."""
+    nb = summary.neighbours
+    if nb is None:
+        return []
+    w, d, s = nb.windows, nb.disagreements, nb.scores
+    rows = ["## Neighbours' FDIR", "",
+            f"{w.neighbour_windows} neighbour-windows decided ({w.judge_windows} judges' "
+            f"verdicts; {w.nominal_exceeded} of {w.nominal_judge_windows} on a healthy "
+            f"neighbour failed). False alarms: {s.false_alarms} in {s.nominal_cycles} nominal "
+            f"neighbour-windows. Agreement: at least {nb.agree} and more than half of those "
+            "that decided (one when only one did).", "",
+            f"The ground upheld {d.upheld}, overruled {d.overruled}, had not ruled on "
+            f"{d.unruled}; it declared {d.ground_only} spacecraft the neighbours had not.", "",
+            "| window end (s) | declared (s) | spacecraft | judges | ground's ruling |",
+            "|---|---|---|---|---|"]
+    for det in summary.detections or []:
+        if det.declared_by == "neighbours":
+            ruling = nb.rulings.get(f"{det.spacecraft}@{det.time_s:g}", "-")
+            rows.append(f"| {det.time_s:.0f} | {det.declared_s or 0:.0f} | {det.spacecraft} | "
+                        f"{', '.join(map(str, det.judges or []))} | {ruling} |")
     return rows + [""]
 
 

@@ -14,6 +14,7 @@ from ground.analysis.coverage import coverage_summary
 from ground.analysis.digest import RunDigest, digest_run
 from ground.analysis.gnc import gnc_summary
 from ground.analysis.ground_contact import ground_contact
+from ground.analysis.neighbours import neighbours_summary
 from ground.analysis.onboard import onboard_summary
 from ground.analysis.run_summary import (
     BUS_HEADER,
@@ -117,6 +118,10 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str,
     summary.set_fdir(fdir_summary(archive, scenario, mission))
     if scenario.onboard_fdir.enabled:
         summary.onboard_fdir = onboard_summary(archive, mission, scenario.faults, summary.scores)
+    if scenario.neighbours.enabled:
+        summary.neighbours, found = neighbours_summary(archive, scenario, mission,
+                                                       summary.detections or [])
+        summary.detections = [*(summary.detections or []), *found]
     summary.real_time_factor = round(t_final / outcome.wall_s, 2) if outcome.wall_s > 0 else None
     return summary
 

@@ -178,8 +178,28 @@ def test_set_changes_every_run_flown_and_a_bad_one_is_refused(
 def test_every_shipped_campaign_expands() -> None:
     """Each file of deploy/campaigns/ loads and expands into valid runs (counts as their
     headers state)."""
-    counts = {"paper": 200, "hard": 58, "beyond": 64, "formations": 48, "identify": 184}
+    counts = {"paper": 200, "hard": 58, "beyond": 64, "formations": 48, "identify": 184,
+              "passes": 52}
     root = Path(__file__).resolve().parents[2] / "deploy" / "campaigns"
     for path in sorted(root.glob("*.toml")):
         campaign, runs = load_campaign(path)
         assert len(runs) == counts[campaign.name], path.name
+
+
+def test_variants_fly_every_group_with_the_same_faults(tmp_path: Path) -> None:
+    """``[[variants]]``: each group once per variant, named ``group-variant``, with the same
+    seeds and the same drawn faults, and the variant's overrides."""
+    path = Path(__file__).resolve().parents[2] / "deploy" / "campaigns" / "passes.toml"
+    campaign, runs = load_campaign(path)
+    by_group: dict[str, list] = {}
+    for r in runs:
+        by_group.setdefault(r.group, []).append(r.scenario)
+    assert sorted(by_group) == sorted(f"{g.name}-{v.name}" for g in campaign.groups
+                                      for v in campaign.variants)
+    for g in campaign.groups:
+        off, on = by_group[f"{g.name}-central"], by_group[f"{g.name}-neighbours"]
+        assert [s.faults for s in off] == [s.faults for s in on]
+        assert [s.seed for s in off] == [s.seed for s in on]
+        assert not any(s.neighbours.enabled for s in off) and all(s.neighbours.enabled for s in on)
+    starts = [f.start_s for r in runs for f in r.scenario.faults]
+    assert starts and all(500.0 <= t <= 560.0 for t in starts)  # just after the pass (498 s)

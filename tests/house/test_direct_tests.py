@@ -61,8 +61,10 @@ INDIRECT: dict[str, str] = {
         "tests/missions/test_digest_run.py and tests/missions/test_campaign_run.py"),
     "ground.analysis.gnc": _EVALUATION.format("tests/missions/test_gnc_run.py"),
     "ground.analysis.onboard": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
+    "ground.analysis.neighbours": _EVALUATION.format("tests/missions/test_neighbours_run.py"),
     **{f"ground.analysis.run_summary.{m}": _SUMMARY
-       for m in ("document", "fdir", "figures", "onboard", "passes", "records", "series")},
+       for m in ("document", "fdir", "figures", "neighbours", "onboard", "passes", "records",
+                 "series")},
     "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
     "fsw.apps.neighbours": (
         "the neighbours' FDIR app, built by name from the topology with [neighbours] on: "

@@ -44,6 +44,11 @@ from ground.analysis.run_summary.figures import (
     SegmentRecord,
     SimRecord,
 )
+from ground.analysis.run_summary.neighbours import (
+    Disagreements,
+    NeighboursSummary,
+    NeighbourWindows,
+)
 from ground.analysis.run_summary.onboard import (
     OnboardEventRecord,
     OnboardFaultRecord,
@@ -56,7 +61,8 @@ __all__ = [
     "BUS_HEADER", "OTHER_TESTS_FLAG", "AccessAudit", "ArchiveInfo", "AssignmentRecord",
     "CoverageSummary", "Detection", "ExecRecord", "FailedTests", "FaultClass", "FaultEventRecord",
     "FaultScore", "FdirResults", "FdirSeries", "Figure", "GncStats", "LostMessages", "MainWindow",
-    "MessageCounts", "ModelZ", "NavStats", "OnboardEventRecord", "OnboardFaultRecord",
+    "MessageCounts", "ModelZ", "NavStats", "Disagreements", "NeighboursSummary",
+    "NeighbourWindows", "OnboardEventRecord", "OnboardFaultRecord",
     "OnboardFdirSummary", "RecoveryComparison", "ReplayResults",
     "ReplaySection", "PaceRecord", "RunFdirSettings", "RunSummary", "Scores", "SegmentRecord",
     "SeriesWindow", "SimRecord", "SummaryError", "SummaryRecord", "ThresholdCensus",

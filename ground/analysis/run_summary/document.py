@@ -27,6 +27,7 @@ from ground.analysis.run_summary.figures import (
     RecoveryComparison,
     SimRecord,
 )
+from ground.analysis.run_summary.neighbours import NeighboursSummary
 from ground.analysis.run_summary.onboard import OnboardFdirSummary
 from ground.analysis.run_summary.passes import GroundContact
 from ground.analysis.run_summary.records import SummaryRecord, filled_fields
@@ -83,6 +84,8 @@ class RunSummary(SummaryRecord):
     fdir_settings: RunFdirSettings | None = None
     onboard_fdir: OnboardFdirSummary | None = Field(
         default=None, description="what the onboard FDIR did (absent: it was off)")
+    neighbours: NeighboursSummary | None = Field(
+        default=None, description="what the neighbours' FDIR did (absent: it was off)")
     real_time_factor: float | None = Field(default=None,
                                            description="sim s per wall s (null: no wall time)")
     archive_error: str | None = Field(default=None, description="why the archive was unread")

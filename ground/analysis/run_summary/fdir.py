@@ -31,6 +31,11 @@ class Detection(SummaryRecord):
                                   "once the window's data came down)")
     cause: Literal["store_overflow"] | None = Field(
         default=None, description="a link fault's known cause (not scored as an alarm)")
+    declared_by: Literal["ground", "neighbours"] = Field(
+        default="ground", description="who declared it: the ground's FDIR, or the observers' "
+                                      "neighbours by agreement aboard")
+    judges: list[int] | None = Field(
+        default=None, description="the neighbours that found the window failed")
     fault_class: FaultClass | None = Field(alias="class",
                                            description="identified class (null: not yet)")
     direction: Literal["improved", "degraded"] | None = Field(
