@@ -63,7 +63,7 @@ class CampaignRun:
     summary: RunSummary
 
 
-def _load(out: Path, ids: Sequence[str]) -> list[CampaignRun]:
+def load_runs(out: Path, ids: Sequence[str]) -> list[CampaignRun]:
     """The finished runs.  The group is the run's campaign group (one per paper figure in
     paper.toml); without a campaign.json, the id less its ``-<index>``.  Raises SummaryError
     for a summary that is not one."""
@@ -202,7 +202,7 @@ def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> d
     isolated faults (s), false alarms and nominal cycles (over whole runs, and over each
     replay's faithful span: ``ground.tools.replay``), runs, and runs whose replay (if any)
     stayed faithful to the end."""
-    runs = _load(out, ids)
+    runs = load_runs(out, ids)
     rows = [r for r in _rows(runs) if r["detector"] == detector]
     st = _stats(rows, 0.0)
     lat = [r["latency_s"] for r in rows if r["kind"] != "none" and r["isolated"]
@@ -431,7 +431,7 @@ RESULT_FIELDS = ["run", "group", "seed", "status", "detector", "kind", "spacecra
 
 def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     """Write results.csv, report.md and plots for the runs ``ids`` of campaign ``name``."""
-    loaded = _load(out, ids)
+    loaded = load_runs(out, ids)
     runs = [r for r in loaded if r.summary.status == "completed"]  # failed runs: listed only
     rows = _rows(runs)
     with open(out / "results.csv", "w", newline="") as f:

@@ -15,7 +15,7 @@ from ground.analysis.campaign_report import (
     SCALES,
     CampaignRun,
     _alarms_at,
-    _load,
+    load_runs,
     _magnitude_bins,
     _rescore,
     _roc,
@@ -131,7 +131,7 @@ def test_report_figures(campaign: Path) -> None:
 
 
 def test_roc_rescoring(campaign: Path) -> None:
-    fa, det = _roc(_load(campaign, ["a", "b", "c"]), "main")
+    fa, det = _roc(load_runs(campaign, ["a", "b", "c"]), "main")
     one = int(np.argmin(np.abs(SCALES - 1.0)))
     # at the configured threshold: the camera fault detected, the thruster fault missed; one
     # false alarm (run c) in 4 nominal windows (run a sc1, run c sc1)
