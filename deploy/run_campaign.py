@@ -63,6 +63,7 @@ from deploy.campaign import (  # noqa: E402
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
 from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
 from ground.analysis.formation_study import write_formation_study  # noqa: E402
+from ground.analysis.neighbours_study import write_neighbours_study  # noqa: E402
 from ground.analysis.run_summary import RunSummary  # noqa: E402
 from ground.tools.replay import parse_settings, scenario_with  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
@@ -241,6 +242,8 @@ def _reports(out: Path, name: str, ids: list[str], study: str | None) -> None:
     print(f"report: {out / 'report.md'}", file=sys.stderr)
     if study == "formations":
         print(f"study: {write_formation_study(out, ids)}", file=sys.stderr)
+    elif study == "neighbours":
+        print(f"study: {write_neighbours_study(out, ids)}", file=sys.stderr)
 
 
 def _replay(args: argparse.Namespace) -> int:

@@ -7,6 +7,7 @@ degraded to β = 0.3 at 300 s, ``[neighbours]`` on.
   within 60 s of the onset; nothing is declared on 1 or 3 (their windows pass).
 * From the declaration on, 1 and 3 leave observer 2's observations out of their fusion.
 * The ground, in contact, rules on the declaration from its own judgement: upheld.
+* summary.json says who declared what, and scores the neighbours as a detector of their own.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from __future__ import annotations
 import pytest
 
 from deploy.campaign import RunSpec, execute_run
+from ground.analysis.run_summary import RunSummary
 from ground.archive.reader import RunArchive, load_run
 from interfaces.contracts import catalogue as cat
 from tests.conftest import small_scenario
@@ -81,3 +83,18 @@ def test_the_declared_observer_is_left_out_and_the_ground_upholds(flown: RunArch
     rulings = flown.of(cat.NEIGHBOUR_RULING, m)
     assert [(r.subject, r.window_end_s, r.verdict) for r in rulings] == [
         (2, first.t_end_s, "upheld")]
+
+
+def test_the_summary_says_who_declared(flown: RunArchive) -> None:
+    summary = RunSummary.read(flown.path.parent / "summary.json")
+    nb = summary.neighbours
+    assert nb is not None and summary.detections is not None
+    (mine,) = [d for d in summary.detections if d.declared_by == "neighbours"]
+    assert (mine.spacecraft, mine.judges) == (2, [1, 3])
+    assert all(d.declared_by == "ground" for d in summary.detections if d is not mine)
+    (fault,) = nb.scores.per_fault
+    assert fault.isolated and fault.declared_latency_s is not None
+    assert fault.declared_latency_s <= 60.0
+    assert nb.scores.false_alarms == 0 and nb.scores.nominal_cycles >= 20
+    assert nb.rulings == {f"2@{mine.time_s:g}": "upheld"}
+    assert (nb.disagreements.upheld, nb.disagreements.overruled) == (1, 0)
