@@ -67,8 +67,8 @@ class NeighboursApp(App):
         self.decide_after_s = 1.0 / sc.rates.mid_hz
         self.seed = sc.seed
         self.pending: list[PoiObservations] = []
-        self.plans: dict[int, list[tuple[float, float, Pro]]] = defaultdict(list)
-        """by observer: (in force from, arrival of its transfer, PRO), by the first"""
+        self.plans: dict[int, dict[int, tuple[float, float, Pro]]] = defaultdict(dict)
+        """by observer and assignment id: (in force from, arrival of its transfer, PRO)"""
         self.verdicts: dict[tuple[int, int], dict[int, bool | None]] = {}
         """(window index, subject) -> judge -> exceeded"""
         self.exclusions = Exclusions()
@@ -85,13 +85,10 @@ class NeighboursApp(App):
 
     def on_assignments(self, msg: ProAssignments) -> None:
         for a in msg.assignments:
-            plans = self.plans[a.spacecraft]
-            if any(p[0] == a.t_depart_s for p in plans):
-                continue
             e = a.pro
-            plans.append((a.t_depart_s, a.t_arrive_s,
-                          Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)))
-            plans.sort(key=lambda p: p[0])
+            self.plans[a.spacecraft].setdefault(a.assignment_id, (
+                a.t_depart_s, a.t_arrive_s,
+                Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)))
 
     def on_judgement(self, msg: NeighbourJudgement) -> None:
         k = self.schedule.boundary_at(msg.t_start_s)  # window k starts at boundary k
@@ -143,10 +140,12 @@ class NeighboursApp(App):
     def _pro(self, subject: int, a: float, b: float) -> Pro | None:
         """The PRO ``subject`` holds over all of [a, b) (s): None without a plan, or when a
         transfer (its path is the subject's own choice) or a change of plan falls in it."""
-        plans = [p for p in self.plans.get(subject, []) if p[0] <= b]
-        if not plans or plans[-1][0] > a or plans[-1][1] > a:
+        plans = sorted((p[0], aid) for aid, p in self.plans.get(subject, {}).items()
+                       if p[0] < b)
+        if not plans:
             return None
-        return plans[-1][2]
+        t_from, t_arrive, pro = self.plans[subject][plans[-1][1]]
+        return None if t_from > a or t_arrive > a else pro
 
     def _decide(self, k: int, t: float) -> None:
         """Apply the agreement rule to window k's judgements."""

@@ -359,8 +359,10 @@ def _contact_section(summary: RunSummary) -> list[str]:
     for node, s in sorted(g.stores.items()):
         lost = ", ".join(f"{r.topic} {r.first_s:.0f}-{r.last_s:.0f} s ({r.count})"
                          for r in s.overflow_runs[:5]) or "none"
+        aboard = (f"{s.onboard} (sent from {s.onboard_since_s:.0f} s)"
+                  if s.onboard_since_s is not None else str(s.onboard))
         rows.append(f"| {node} | {s.stored} | {s.dumped} | {s.retransmitted} | {s.overflow}: "
-                    f"{lost} | {s.onboard} | {g.uplink_held.get(node, 0)} |")
+                    f"{lost} | {aboard} | {g.uplink_held.get(node, 0)} |")
     return rows + [""]
 
 

@@ -192,8 +192,10 @@ class OnboardStore:
     def _count_onboard(self) -> None:
         c = self.counter
         flying = [self._inflight[0]] if self._inflight is not None else []
-        c.onboard = sum(len(q) for q in self._queues) + len(flying)
-        c.onboard_bytes = sum(self._bytes) + sum(i.size for i in flying)
+        aboard = [*flying, *(i for q in self._queues for i in q)]
+        c.onboard = len(aboard)
+        c.onboard_bytes = sum(i.size for i in aboard)
+        c.onboard_since_s = min((i.t for i in aboard), default=None)
 
     def with_envelopes(self, fn: Callable[[Any], Any]) -> OnboardStore:
         """A copy whose messages carry ``fn(envelope)`` instead (a node's critical-data store

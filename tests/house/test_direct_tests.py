@@ -66,10 +66,6 @@ INDIRECT: dict[str, str] = {
        for m in ("document", "fdir", "figures", "neighbours", "onboard", "passes", "records",
                  "series")},
     "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
-    "fsw.apps.neighbours": (
-        "the neighbours' FDIR app, built by name from the topology with [neighbours] on: "
-        "flown in tests/missions/test_neighbours_run.py; its judge and agreement rule are "
-        "tested where they live (tests/fsw/lib/test_neighbour_judge.py)"),
     "ground.archive.__main__": (
         "``python -m ground.archive``, two lines handing over to ground/archive/cli.py's main "
         "(tests/ground/archive/test_cli.py, tests/missions/test_archive_cli_run.py)"),

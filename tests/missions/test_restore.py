@@ -1,5 +1,6 @@
 """A node's state taken whole and put back (``interfaces.runtime.checkpoint``), after a real
-run (with the onboard FDIR on, so that its app is checked too): every app declares what changes
+run (with the onboard FDIR and the neighbours' FDIR on, so that their apps are checked too, and
+ground passes, so that what waits in the onboard stores is): every app declares what changes
 while it runs, and a fresh node given a running node's state is the same node: the same state,
 and the same messages on the next ticks."""
 
@@ -23,7 +24,11 @@ from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.transport import InprocNetwork
 from tests.conftest import canonical, small_scenario
 
-SC = small_scenario("ckpt", duration_s=150.0, onboard_fdir={"enabled": True})
+SC = small_scenario(
+    "ckpt", duration_s=150.0, onboard_fdir={"enabled": True}, neighbours={"enabled": True},
+    orbit={"inclination_deg": 51.6, "raan_deg": 255.0, "arg_latitude_deg": 90.0},
+    ground={"contact": "passes",  # a pass from 29 s: the stores wait, then dump
+            "stations": [{"name": "mid", "latitude_deg": 48.08, "longitude_deg": 11.28}]})
 
 
 @cache

@@ -122,6 +122,9 @@ class StoreCounter(BaseModel):
     overflow_bytes: int = 0
     onboard: int = 0
     onboard_bytes: int = 0
+    onboard_since_s: float | None = Field(
+        default=None, description="send time of the oldest message still aboard, s (None: "
+                                  "none aboard)")
     overflow_runs: list[OverflowRun] = Field(default_factory=list, max_length=100_000)
 
 

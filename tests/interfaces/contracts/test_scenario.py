@@ -47,6 +47,9 @@ def test_defaults_and_pro_phasing() -> None:
      'longitude_deg = 0\nelevation_mask_deg = -2\n', "ground.stations.0.elevation_mask_deg"),
     ('name = "x"\nduration_s = 10\n[[ground.stations]]\nname = "gs"\nlatitude_deg = 95\n'
      'longitude_deg = 0\n', "ground.stations.0.latitude_deg"),
+    ('name = "x"\nduration_s = 10\n[neighbours]\nagree = 0\n', "neighbours.agree"),
+    ('name = "x"\nduration_s = 10\n[neighbours]\naction = "panic"\n', "neighbours.action"),
+    ('name = "x"\nduration_s = 10\n[neighbours]\nenable = true\n', "neighbours.enable"),
 ])
 def test_invalid_scenarios_name_the_field(text: str, needle: str) -> None:
     with pytest.raises(ScenarioError) as e:

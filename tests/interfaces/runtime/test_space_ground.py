@@ -72,12 +72,14 @@ def test_a_link_cut_for_a_whole_pass_keeps_the_data_for_the_next() -> None:
     assert ch.released(299.0) == []
     (c,) = ch.counters()
     assert c.store is not None and (c.store.onboard, c.store.dumped) == (len(envs), 0)
+    assert c.store.onboard_since_s == 0.0  # the oldest aboard
     got = ch.released(400.0)
     assert got == envs
     (c,) = ch.counters()
     assert c.store is not None
     assert (c.store.stored, c.store.dumped, c.store.onboard, c.store.overflow) == (
         len(envs), len(envs), 0, 0)
+    assert c.store.onboard_since_s is None
     assert c.dropped_cut == 0 and c.sent == len(envs)
 
 

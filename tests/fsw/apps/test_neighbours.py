@@ -1,0 +1,110 @@
+"""The neighbours' FDIR app (fsw/apps/neighbours.py) fed by hand, as observer 1 of three: it
+judges each neighbour's window ``fdir.latency_s`` after it closes (observer 2's camera at
+β = 0.3 fails, observer 3 passes), shares its verdicts, and one ω_mid cycle later declares
+observer 2 with observer 3's agreeing verdict; the plan in force over a window is none while a
+transfer or a change of plan falls in it; the ground's overruling fuses the held observations
+again."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fsw.apps.neighbours import NeighboursApp
+from gnc.pro import Pro
+from gnc.twin import centre_boresights
+from interfaces.contracts.messages import (
+    Message,
+    NeighbourDeclaration,
+    NeighbourJudgement,
+    NeighbourRuling,
+    NeighbourVerdict,
+    PoiObservations,
+    ProAssignment,
+    ProAssignments,
+    ProElements,
+    ReportedPose,
+)
+from tests.conftest import app_alone, small_scenario
+
+SC = small_scenario("nb", target={"radius_m": 5.0, "pois": 1000},
+                    camera={"half_angle_deg": 12.0}, rates={"fdi_period_s": 30.0},
+                    neighbours={"enabled": True})
+PROS = {2: Pro(10.0, 0.3, 0.0, 15.0, 1.1), 3: Pro(10.0, 2.4, 0.0, 15.0, 3.2)}
+
+
+def _app() -> tuple[NeighboursApp, list[Message]]:
+    app, sent = app_alone(NeighboursApp, SC)
+    app.on_assignments(_assignments({sc: (0.0, 0.0) for sc in PROS}))
+    return app, sent
+
+
+def _assignments(times: dict[int, tuple[float, float]], aid: int = 1) -> ProAssignments:
+    return ProAssignments(sender="ground", seq=aid, t_sim=0.0, assignments=[
+        ProAssignment(spacecraft=sc, assignment_id=aid, phase="p",
+                      pro=ProElements(rho_x_m=p.rho_x_m, alpha_x_rad=p.alpha_x_rad,
+                                      rho_y_m=p.rho_y_m, rho_z_m=p.rho_z_m,
+                                      alpha_z_rad=p.alpha_z_rad),
+                      t_depart_s=times[sc][0], t_arrive_s=times[sc][1])
+        for sc, p in PROS.items() if sc in times])
+
+
+def _images(app: NeighboursApp, sc: int, beta: float) -> list[PoiObservations]:
+    """A window [30, 60) of images from the PRO, aimed at the target centre, at β."""
+    times = np.arange(30.0, 60.0)
+    pos = PROS[sc].states(app.n, times)[:, :3]
+    prec = app.twin.precision(pos, centre_boresights(pos))
+    out = []
+    for t, p, row in zip(times, pos, prec):
+        seen = np.flatnonzero(row > 0.0)
+        pose = ReportedPose(nav_m=list(p), nav_sigma_m=0.05, aim_m=[0.0, 0.0, 0.0],
+                            knowledge_rad=1e-4, tracking_rad=2e-4, tracking_s=500.0)
+        out.append(PoiObservations(sender=f"sc{sc}", seq=int(t), t_sim=float(t), spacecraft=sc,
+                                   image_t_s=float(t), poi=seen.tolist(),
+                                   precision=(beta * row[seen]).tolist(), pose=pose))
+    return out
+
+
+def test_it_judges_its_neighbours_and_declares_by_agreement() -> None:
+    app, sent = _app()
+    for m in [*_images(app, 2, 0.3), *_images(app, 3, 1.0)]:
+        app.on_observations(m)
+    app.step(60.0 + SC.fdir.latency_s - 0.5)
+    assert sent == []  # not yet due
+    app.step(60.0 + SC.fdir.latency_s)
+    (judgement,) = sent
+    assert isinstance(judgement, NeighbourJudgement)
+    assert (judgement.spacecraft, judgement.t_start_s, judgement.t_end_s) == (1, 30.0, 60.0)
+    assert {v.subject: v.exceeded for v in judgement.verdicts} == {2: True, 3: False}
+    app.on_judgement(judgement)  # its own comes back through the bus
+    app.on_judgement(NeighbourJudgement(
+        sender="sc3", seq=1, t_sim=judgement.t_sim, spacecraft=3, t_start_s=30.0, t_end_s=60.0,
+        verdicts=[NeighbourVerdict(subject=2, images=30, exceeded=True),
+                  NeighbourVerdict(subject=1, images=30, exceeded=False)]))
+    app.step(60.0 + SC.fdir.latency_s + 1.0 / SC.rates.mid_hz)
+    (declaration,) = [m for m in sent if isinstance(m, NeighbourDeclaration)]
+    assert (declaration.subject, declaration.judges, declaration.decided) == (2, [1, 3], [1, 3])
+    assert app.declared == {2} and app.exclusions.since_s == {2: 60.0}
+
+
+def test_no_plan_is_in_force_over_a_transfer_or_a_change_of_plan() -> None:
+    app, _ = _app()
+    assert app._pro(2, 30.0, 60.0) == PROS[2]
+    app.on_assignments(_assignments({2: (40.0, 40.0)}, aid=2))  # a new plan from 40 s
+    assert app._pro(2, 30.0, 60.0) is None and app._pro(2, 60.0, 90.0) == PROS[2]
+    app.on_assignments(_assignments({3: (70.0, 200.0)}, aid=2))  # a transfer to 200 s
+    assert app._pro(3, 90.0, 120.0) is None and app._pro(3, 210.0, 240.0) == PROS[3]
+    assert app._pro(4, 30.0, 60.0) is None  # no plan known
+
+
+def test_an_overruled_neighbour_is_fused_again() -> None:
+    app, _ = _app()
+    app.declared.add(2)
+    app.exclusions.exclude(2, 30.0)
+    held = _images(app, 2, 1.0)
+    for m in held:
+        app.on_observations(m)
+        app.exclusions.admits(m)
+    app.on_ruling(NeighbourRuling(sender="ground", seq=1, t_sim=90.0, subject=2,
+                                  window_end_s=30.0, verdict="overruled"))
+    assert app.declared == set() and app.exclusions.since_s == {}
+    assert [m for m in app.pending if m.spacecraft == 2] == held + held
