@@ -13,6 +13,11 @@ The test is the ground's information test (Eq. 9) with what a neighbour has of t
   error; the ground's floor guard below it.  Judged only on images taken while the subject's
   attitude had been tracking for ``fdir.settle_s`` and while it holds its PRO (its transfer's
   path is its own choice: not judged).
+* with ``fdir.fuse_guidance`` (the ground's default), the two pose tests the ground fuses with
+  it, on the same reported pose: the median distance of the reported nav from the plan against
+  ``fdir.position_tol_m`` (``plan``), and the median pointing error the attitude reports
+  against ``fdir.pointing_tol_deg`` (``pointing``).  A pointing actuator fault shows in the
+  attitude estimate before it costs information; a small one may never (Fig. 26).
 
 Agreement (``agreed``): a subject's window is declared failed when at least ``agree`` of the
 neighbours that decided on it found it failed and they are more than half of them; when only
@@ -35,6 +40,7 @@ from interfaces.contracts.messages import (
     NeighbourRuling,
     NeighbourVerdict,
     PoiObservations,
+    ReportedPose,
 )
 from interfaces.contracts.scenario import Scenario
 
@@ -54,6 +60,7 @@ class JudgeSettings:
     samples: int
     q_window: float
     floor: float
+    pose_tests: bool
 
     @classmethod
     def of(cls, scenario: Scenario) -> JudgeSettings:
@@ -63,7 +70,7 @@ class JudgeSettings:
                    scenario.camera.noise_frac, cfg.model_samples,
                    window_false_alarm(cfg.false_alarms_per_observer_hour,
                                       scenario.rates.fdi_period_s, cfg.persistence),
-                   cfg.floor)
+                   cfg.floor, cfg.fuse_guidance)
 
 
 def judge(subject: int, images: list[PoiObservations], pro: Pro | None, psi: np.ndarray,
@@ -84,13 +91,28 @@ def judge(subject: int, images: list[PoiObservations], pro: Pro | None, psi: np.
     dh_pred = delta_h(psi, phi, prec)
     m_val = metric(dh, dh_pred)
     tau = _threshold(planned, aims, poses, psi, phi, prec, twin, cfg, rng)
-    exceeded = None if m_val is None or tau is None else m_val > tau
+    failed = [] if m_val is None or tau is None or m_val <= tau else ["information"]
+    failed += pose_tests(planned, poses, cfg) if cfg.pose_tests else []
+    decided = bool(failed) or (m_val is not None and tau is not None)
     return NeighbourVerdict(subject=subject, images=len(usable), dh=dh, dh_pred=dh_pred,
-                            metric=m_val, threshold=tau, exceeded=exceeded,
-                            direction=direction(dh, dh_pred))
+                            metric=m_val, threshold=tau, exceeded=bool(failed) if decided else None,
+                            direction=direction(dh, dh_pred), failed=failed)
 
 
-def _threshold(planned: np.ndarray, aims: np.ndarray, poses: list, psi: np.ndarray,
+def pose_tests(planned: np.ndarray, poses: list[ReportedPose], cfg: JudgeSettings) -> list[str]:
+    """The ground's pose tests on the subject's reported pose over the window: ``plan`` when
+    the median distance of its nav from the plan (m) exceeds ``position_tol_m``, ``pointing``
+    when its median reported pointing error exceeds ``pointing_tol_rad``."""
+    nav = np.array([p.nav_m for p in poses])
+    out = []
+    if float(np.median(np.linalg.norm(nav - planned, axis=1))) > cfg.position_tol_m:
+        out.append("plan")
+    if float(np.median([p.tracking_rad for p in poses])) > cfg.pointing_tol_rad:
+        out.append("pointing")
+    return out
+
+
+def _threshold(planned: np.ndarray, aims: np.ndarray, poses: list[ReportedPose], psi: np.ndarray,
                phi: np.ndarray, prec: np.ndarray, twin: TwinModel, cfg: JudgeSettings,
                rng: np.random.Generator) -> float | None:
     """τ of the hardware model for the window (the ground's, with the subject's reported

@@ -8,6 +8,8 @@ from interfaces.contracts.messages import (
     AssignmentDecision,
     FaultReport,
     Message,
+    NeighbourDeclaration,
+    NeighbourRuling,
     OnboardCommand,
     OnboardFdirEvent,
     registry,
@@ -19,10 +21,12 @@ from tests.interfaces.runtime.test_encoding import _pydantic
 
 
 def test_every_message_type_of_a_run_is_encoded_as_pydantic_does() -> None:
-    """A short run with faults and FDIR windows: every message it publishes, then the types it
-    does not (a fault report, an assignment decision, the onboard FDIR's command and event)."""
+    """A short run with faults, FDIR windows and the neighbours' FDIR (its judgements, and the
+    pose with every observation): every message it publishes, then the types it does not (a
+    fault report, an assignment decision, the onboard FDIR's command and event, a neighbours'
+    declaration and the ground's ruling)."""
     scenario = small_scenario(
-        "enc", duration_s=100.0, rates={"fdi_period_s": 10.0},
+        "enc", duration_s=100.0, rates={"fdi_period_s": 10.0}, neighbours={"enabled": True},
         faults=[{"spacecraft": 1, "kind": "pointing_actuator", "start_s": 5.0, "magnitude": 20.0},
                 {"spacecraft": 2, "kind": "thruster_bias", "start_s": 5.0, "magnitude": 0.5}],
         phases=[{"name": "p", "start_s": 1.0, "transfer_s": 30.0}])
@@ -41,6 +45,10 @@ def test_every_message_type_of_a_run_is_encoded_as_pydantic_does() -> None:
         OnboardFdirEvent(sender="sc2", t_sim=40.1, spacecraft=2, event="trip",
                          name="pointing_deg", value=2.25, limit=1.0, fault_class="actuator",
                          detail="action request_plan"),
+        NeighbourDeclaration(sender="sc1", t_sim=64.0, spacecraft=1, subject=2, t_start_s=30.0,
+                             t_end_s=60.0, judges=[1, 3], decided=[1, 3, 4]),
+        NeighbourRuling(sender="ground", t_sim=90.0, subject=2, window_end_s=60.0,
+                        verdict="upheld"),
     ]
     messages = [s.message for s in samples if s.message is not None] + extra
     assert {type(m).__name__ for m in messages} == set(registry())  # every type is here

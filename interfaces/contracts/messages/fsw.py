@@ -244,6 +244,8 @@ class NeighbourVerdict(BaseModel):
     threshold: float | None = None
     exceeded: bool | None = None
     direction: Literal["improved", "degraded"] | None = None
+    failed: list[Literal["information", "plan", "pointing"]] = Field(
+        default_factory=list, max_length=3, description="the tests the window failed")
 
 
 class NeighbourJudgement(Message):

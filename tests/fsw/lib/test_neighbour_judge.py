@@ -32,9 +32,11 @@ TWIN = TwinModel(*sphere_pois(2000, 5.0), Camera(math.radians(12.0), 200.0, 1.0)
 
 
 def _images(beta: float, rng: np.random.Generator, tracking_s: float = 100.0,
-            posed: bool = True) -> list[PoiObservations]:
+            posed: bool = True, nav_off_m: float = 0.0, pointing_rad: float = 2e-4
+            ) -> list[PoiObservations]:
     """30 images at 1 Hz from the PRO, aimed at the target centre, each precision the nominal
-    camera's times β and the hardware model's noise max(0, 1 + ν ε)."""
+    camera's times β and the hardware model's noise max(0, 1 + ν ε); the reported nav
+    ``nav_off_m`` off the plan (radially) and the reported pointing error ``pointing_rad``."""
     times = np.arange(300.0, 330.0)
     pos = PRO.states(N, times)[:, :3]
     prec = TWIN.precision(pos, centre_boresights(pos))
@@ -43,8 +45,9 @@ def _images(beta: float, rng: np.random.Generator, tracking_s: float = 100.0,
         seen = np.flatnonzero(row > 0.0)
         noisy = beta * row[seen] * np.maximum(0.0, 1.0 + TWIN.noise_frac
                                               * rng.standard_normal(seen.size))
-        pose = ReportedPose(nav_m=list(p), nav_sigma_m=0.05, aim_m=[0.0, 0.0, 0.0],
-                            knowledge_rad=1e-4, tracking_rad=2e-4, tracking_s=tracking_s)
+        pose = ReportedPose(nav_m=list(p + [nav_off_m, 0.0, 0.0]), nav_sigma_m=0.05,
+                            aim_m=[0.0, 0.0, 0.0], knowledge_rad=1e-4,
+                            tracking_rad=pointing_rad, tracking_s=tracking_s)
         out.append(PoiObservations(sender="sc2", seq=1, t_sim=float(t), spacecraft=2,
                                    image_t_s=float(t), poi=seen.tolist(),
                                    precision=noisy.tolist(), pose=pose if posed else None))
@@ -65,8 +68,25 @@ def test_a_nominal_neighbour_passes_and_a_degraded_camera_fails() -> None:
     v = judge(2, _images(0.3, np.random.default_rng(9)), PRO, psi, phi, TWIN, N, CFG,
               np.random.default_rng(1))
     assert v.exceeded is True and v.direction == "degraded" and v.images == 30
+    assert v.failed == ["information"]
     assert v.metric == pytest.approx(0.7, abs=0.03)
     assert v.threshold is not None and CFG.floor <= v.threshold < 0.2
+
+
+def test_the_pose_tests_read_the_reported_nav_and_pointing() -> None:
+    """A nav 1 m off the plan fails ``plan`` (tolerance 0.5 m), a reported pointing error of
+    2° fails ``pointing`` (1°), each while the information still matches the plan; with the
+    ground's guidance tests off (``fdir.fuse_guidance = false``) neither is judged."""
+    psi, phi = _map()
+    rng = np.random.default_rng(4)
+    for kwargs, failed in (({"nav_off_m": 1.0}, ["plan"]),
+                           ({"pointing_rad": math.radians(2.0)}, ["pointing"]),
+                           ({"nav_off_m": 0.3, "pointing_rad": math.radians(0.8)}, [])):
+        v = judge(2, _images(1.0, rng, **kwargs), PRO, psi, phi, TWIN, N, CFG, rng)
+        assert v.failed == failed and v.exceeded is bool(failed), kwargs
+    off = JudgeSettings.of(small_scenario(fdir={"fuse_guidance": False}))
+    v = judge(2, _images(1.0, rng, nav_off_m=1.0), PRO, psi, phi, TWIN, N, off, rng)
+    assert v.failed == [] and v.exceeded is False
 
 
 def test_a_window_without_plan_pose_or_settled_attitude_does_not_decide() -> None:
