@@ -193,11 +193,6 @@ def pass_table(orbit: CircularOrbit, stations: list[GroundStation], theta0_rad: 
     return sorted(windows, key=lambda w: (w.aos_s, w.station))
 
 
-def in_contact(table: list[ContactWindow], t_s: float) -> bool:
-    """Whether some station sees the target at ``t_s``."""
-    return any(w.aos_s <= t_s < w.los_s for w in table)
-
-
 def scenario_pass_table(scenario: Scenario) -> list[ContactWindow]:
     """The passes of a scenario's stations over its run (``[orbit]``, ``[ground]``), by
     acquisition time; none without stations."""

@@ -142,10 +142,8 @@ class CameraApp(App):
         est, att = self._est, self._att
         if est is None or att is None:
             return None
-        p = est.P
         return ReportedPose(
-            nav_m=list(est.x[:3]), nav_sigma_m=math.sqrt(max((p[0][0] + p[1][1] + p[2][2]) / 3.0,
-                                                             0.0)),
+            nav_m=list(est.x[:3]), nav_sigma_m=est.position_sigma_m(),
             aim_m=list(att.target_lvlh_m), knowledge_rad=att.sigma_att_rad,
             tracking_rad=att.pointing_error_rad,
             tracking_s=0.0 if self._track_since is None else max(t - self._track_since, 0.0))

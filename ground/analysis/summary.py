@@ -191,6 +191,7 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
         detections=[Detection(spacecraft=r.spacecraft, time_s=r.t_sim, fault_class=r.fault_class,
                               direction=r.direction, metric=r.metric, threshold=r.threshold,
                               evidence=dict(r.evidence), declared_s=r.declared_s,
+                              declared_by="ground",
                               **({"cause": r.cause} if r.cause else {}))
                     for r in reports],
         scores=score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),

@@ -158,8 +158,7 @@ class FdirPipeline:
             obs.heard(msg.t_sim)
         if obs is not None and msg.t_sim >= self.window_start:
             obs.nav.add(msg.t_sim, np.array(msg.x[:3]))
-            obs.nav_sigma.add(msg.t_sim, np.array([math.sqrt(max(
-                (msg.P[0][0] + msg.P[1][1] + msg.P[2][2]) / 3.0, 0.0))]))
+            obs.nav_sigma.add(msg.t_sim, np.array([msg.position_sigma_m()]))
             if msg.nis is not None:
                 obs.nis.append((msg.t_sim, msg.nis))
 

@@ -215,8 +215,8 @@ class OnboardStore:
         return copy
 
     def held(self) -> list[Any]:
-        """Every message offered and not yet dumped (the envelopes), in delivery order: for a
-        node's critical-data store."""
+        """Every message offered and not yet dumped (the envelopes), in delivery order: what
+        is aboard, to inspect (a node's critical-data store copies it by ``with_envelopes``)."""
         items = [*self._arrivals, *(i for q in self._queues for i in q)]
         if self._inflight is not None:
             items.append(self._inflight[0])

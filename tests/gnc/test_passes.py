@@ -20,7 +20,7 @@ from gnc.passes import (
     contact_windows,
     elevation_rad,
     greenwich_sidereal_angle,
-    in_contact,
+    ContactPlan,
     pass_table,
     scenario_pass_table,
 )
@@ -76,7 +76,8 @@ def test_the_pass_edges_are_at_the_mask_and_the_pass_is_above_it() -> None:
         inside = elevation_rad(orbit, station, theta0, np.linspace(w.aos_s, w.los_s, 50)[1:-1])
         assert np.allclose(edges, station.mask_rad, atol=1e-6)
         assert np.all(inside > station.mask_rad)
-        assert in_contact(windows, w.tca_s) and not in_contact(windows, w.los_s + 1.0)
+        plan = ContactPlan.merged(windows)
+        assert plan.in_contact(w.tca_s) and not plan.in_contact(w.los_s + 1.0)
 
 
 def test_a_pass_open_at_the_start_is_clipped_there() -> None:

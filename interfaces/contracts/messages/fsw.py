@@ -3,6 +3,8 @@ guidance status and transfer plans, observations and the information cost it rep
 
 from __future__ import annotations
 
+import math
+
 from typing import ClassVar, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -64,6 +66,12 @@ class StateEstimate(Message):
         if max(abs(v) for v in self.x[3:]) > MAX_SPEED_MPS:
             raise ValueError(f"velocity beyond {MAX_SPEED_MPS} m/s")
         return self
+
+    def position_sigma_m(self) -> float:
+        """The position's 1σ per axis, m: √(trace P_rr / 3) (the ground's FDIR and the pose an
+        observer shares with its observations both read it)."""
+        p = self.P
+        return math.sqrt(max((p[0][0] + p[1][1] + p[2][2]) / 3.0, 0.0))
 
 
 class TransferPlanMsg(Message):
