@@ -21,7 +21,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from ground.analysis.run_summary import RunSummary  # noqa: E402
+from harness.summary import RunSummary  # noqa: E402
 
 
 def _free_port() -> int:

@@ -47,7 +47,7 @@ from benchmarks.lockstep_limit import free_port  # noqa: E402
 from benchmarks.lockstep_limit import measure as lockstep_rate  # noqa: E402
 from benchmarks.tick_budget import CALLS  # noqa: E402
 from benchmarks.tick_budget import TARGETS_MS as TICK_TARGETS_MS  # noqa: E402
-from ground.analysis.run_summary import RunSummary  # noqa: E402
+from harness.summary import RunSummary  # noqa: E402
 from interfaces.contracts.scenario import load_scenario  # noqa: E402
 
 TWO_ORBITS_S = 11354.0
@@ -192,9 +192,9 @@ def bench_reference(quick: bool, tmp: Path, rows: list, res: dict) -> None:
 _REPORT_AGAIN = """
 import sys
 from pathlib import Path
-from ground.analysis.digest import digest_run
-from ground.analysis.report import write_report
-from ground.analysis.summary import write_summary
+from harness.summary.digest import digest_run
+from harness.report import write_report
+from harness.summary.build import write_summary
 from interfaces.contracts.scenario import load_scenario
 out, scen, dur = Path(sys.argv[1]), load_scenario(sys.argv[2]), float(sys.argv[3])
 scen = scen.with_overrides(None, dur)

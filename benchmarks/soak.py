@@ -41,7 +41,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from ground.archive.reader import Record, load_run  # noqa: E402
+from harness.archive.reader import Record, load_run  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, registry  # noqa: E402

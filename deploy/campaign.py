@@ -22,7 +22,7 @@ A campaign TOML names a base scenario and groups of runs::
     nominal = true                        # no fault at all
 
 ``study = "formations"`` (optional) also writes the formation study (Sec. III.G) beside the
-report (ground/analysis/formation_study.py).
+report (harness/campaign/formation_study.py).
 
 ``[[variants]]`` (optional) flies every group once per variant, each with its own scenario
 overrides, the same seeds and the same drawn faults: group ``g`` becomes ``g-<variant>``::
@@ -56,7 +56,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ground.analysis.run_summary import RunSummary
+from harness.summary import RunSummary
 from interfaces.contracts.scenario import FaultKind, Scenario
 
 
@@ -131,8 +131,8 @@ class Campaign(_Strict):
     duration_s: float | None = Field(default=None, gt=0.0)
     study: Literal["formations", "neighbours"] | None = None
     """a study report written beside report.md (``formations``: study.md,
-    ground/analysis/formation_study.py; ``neighbours``: study.md,
-    ground/analysis/neighbours_study.py)"""
+    harness/campaign/formation_study.py; ``neighbours``: study.md,
+    harness/campaign/neighbours_study.py)"""
     groups: list[Group] = Field(min_length=1)
     variants: list[Variant] = Field(default_factory=list)
 
@@ -371,8 +371,8 @@ def _inproc_run(spec: RunSpec, out: Path) -> RunSummary:
     import traceback
 
     from deploy.inproc import run_inproc
-    from ground.analysis.digest import LiveDigest, RunDigest
-    from ground.analysis.summary import write_summary
+    from harness.summary.digest import LiveDigest, RunDigest
+    from harness.summary.build import write_summary
     from ground.archive.metadata import run_metadata
     from ground.archive.recorder import McapRecorder
 
@@ -409,7 +409,7 @@ def _zenoh_run(spec: RunSpec, out: Path) -> RunSummary:
     import sys
 
     from deploy.processes import die_with_parent
-    from ground.analysis.summary import write_summary
+    from harness.summary.build import write_summary
 
     scenario = out / "scenario.json"
     scenario.write_text(spec.scenario.model_dump_json(indent=1))

@@ -1,6 +1,6 @@
 """A finished campaign re-judged under other detector settings, without re-simulating.
 
-Every run of ``<out>/runs/`` is replayed (``ground.tools.replay``: the ground station itself
+Every run of ``<out>/runs/`` is replayed (``harness.replay``: the ground station itself
 on the run's archive) with the settings given; its ``summary.json`` is rewritten with the
 replay's FDIR fields (detections, scores, baselines, series, settings) and a ``replay`` section
 (settings, ``faithful_until_s``, ``matches_live``, replay wall time) into
@@ -25,11 +25,11 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-from ground.analysis.campaign_report import detector_figures, write_campaign_report
-from ground.analysis.run_summary import ReplaySection, RunSummary
-from ground.archive.metadata import archived_scenario
-from ground.archive.reader import ArchiveError
-from ground.tools.replay import replay_run, with_settings
+from harness.campaign.report import detector_figures, write_campaign_report
+from harness.summary import ReplaySection, RunSummary
+from harness.archive.run_scenario import archived_scenario
+from harness.archive.reader import ArchiveError
+from harness.replay import replay_run, with_settings
 from interfaces.contracts.scenario import ScenarioError
 
 log = logging.getLogger("insp.campaign")

@@ -5,7 +5,7 @@ command line to the tool's own ``main(argv)`` (``insp-fdir run --help`` is the r
     insp-fdir archive list runs/x/run.mcap
 
 The tools keep their own commands too (``python deploy/run_constellation.py``,
-``python -m ground.archive``...).  The console script is declared in pyproject.toml
+``python -m harness.archive``...).  The console script is declared in pyproject.toml
 (``[project.scripts]``); ``python -m deploy.cli`` is the same without installing.
 """
 
@@ -28,9 +28,9 @@ class Command(NamedTuple):
 COMMANDS: Final = {
     "run": Command("deploy.run_constellation", "run one scenario (sim, flight software, ground)"),
     "campaign": Command("deploy.run_campaign", "run, replay or sweep a fault campaign"),
-    "replay": Command("ground.tools.replay", "re-run the ground FDIR on a run's archive"),
+    "replay": Command("harness.replay", "re-run the ground FDIR on a run's archive"),
     "tlm": Command("ground.tools.tlm", "watch a running constellation's telemetry live"),
-    "archive": Command("ground.archive.cli", "list, summarize or export a run archive"),
+    "archive": Command("harness.archive.cli", "list, summarize or export a run archive"),
 }
 """Subcommand -> the module that runs it (imported only when that subcommand is run)."""
 

@@ -20,7 +20,7 @@ SIGINT or SIGTERM stops the campaign: running runs are abandoned (redone next ti
 and the report is written over what has finished.  --cluster sends the runs to an existing
 Dask distributed scheduler (its workers must import this repository and see --out).
 At the end <out>/report.md, PNG plots and results.csv are written
-(ground/analysis/campaign_report.py);
+(harness/campaign/report.py);
 --report-only rewrites them from the run directories without running anything (given only
 --out, from the run list saved there).  --replay re-judges the finished runs under other
 detector settings without simulating (deploy/campaign_replay.py) and writes the full report in
@@ -61,11 +61,11 @@ from deploy.campaign import (  # noqa: E402
     record_failure,
 )
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
-from ground.analysis.campaign_report import write_campaign_report  # noqa: E402
-from ground.analysis.formation_study import write_formation_study  # noqa: E402
-from ground.analysis.neighbours_study import write_neighbours_study  # noqa: E402
-from ground.analysis.run_summary import RunSummary  # noqa: E402
-from ground.tools.replay import parse_settings, scenario_with  # noqa: E402
+from harness.campaign.report import write_campaign_report  # noqa: E402
+from harness.campaign.formation_study import write_formation_study  # noqa: E402
+from harness.campaign.neighbours_study import write_neighbours_study  # noqa: E402
+from harness.summary import RunSummary  # noqa: E402
+from harness.replay import parse_settings, scenario_with  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
@@ -88,7 +88,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help="rewrite the report from the run directories, run nothing")
     p.add_argument("--replay", action="store_true",
                    help="re-judge the finished runs of --out under --set detector settings "
-                        "(ground.tools.replay), simulating nothing")
+                        "(harness.replay), simulating nothing")
     p.add_argument("--set", dest="settings", action="append", default=[],
                    metavar="SECTION.KEY=VALUE",
                    help="with --replay/--sweep: a detector setting; when flying: any scenario "

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ground.analysis.run_summary import RunSummary
+from harness.summary import RunSummary
 from interfaces.contracts.messages import Message
 from interfaces.contracts.scenario import Scenario, parse_scenario
 
@@ -126,7 +126,7 @@ def recorded_run(scenario: Scenario, out: Path, *types: type[Message]
     those of ``types`` (as :func:`collector`); returns (collected by type name, the run's
     summary as written to summary.json)."""
     from deploy.inproc import run_inproc
-    from ground.analysis.summary import write_summary
+    from harness.summary.build import write_summary
     from ground.archive.recorder import McapRecorder
 
     tap, got = collector(*types)

@@ -17,7 +17,7 @@
 Crash safety: messages are grouped in zstd chunks of about ``chunk_size`` bytes (uncompressed).
 The file is written without a user-space buffer, so each chunk reaches the operating system the
 moment it is complete: after a SIGKILL every complete chunk is in the file and
-:func:`ground.archive.reader.load_run` recovers it (``truncated=True``).  The chunk in progress is
+:func:`harness.archive.reader.load_run` recovers it (``truncated=True``).  The chunk in progress is
 lost unless :meth:`McapFile.flush` closes it early.  No fsync (a process kill does not need it; a
 power loss does).
 """

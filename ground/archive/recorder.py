@@ -13,7 +13,7 @@ not in the registry is recorded all the same and counted in :attr:`McapRecorder.
 
 Payloads that are not a JSON object (not JSON, NaN/Infinity, an array, ...) are stored as received
 and counted in :attr:`McapRecorder.invalid`; payloads are not validated against their model here
-(that is the reader's :meth:`~ground.archive.reader.Record.message`).
+(that is the reader's :meth:`~harness.archive.reader.Record.message`).
 
 A killed recorder loses at most the chunk in progress (``chunk_size`` bytes of messages); call
 :meth:`McapRecorder.flush` to close it early.
@@ -128,7 +128,7 @@ class McapRecorder:
     """Thread-safe MCAP writer of raw bus samples (the file: :mod:`ground.archive.mcap_file`).
 
     Use as a context manager or call :meth:`close`; an unclosed file (process killed) is still
-    readable up to its last complete chunk with :func:`ground.archive.reader.load_run`.
+    readable up to its last complete chunk with :func:`harness.archive.reader.load_run`.
 
     Counters (read-only properties): :attr:`recorded`, :attr:`invalid`, :attr:`unknown_type`,
     :attr:`dropped`, :attr:`after_close`, :attr:`counts` (messages per key).

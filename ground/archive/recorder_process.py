@@ -9,7 +9,7 @@ the back-pressure: a writer that falls behind blocks the run, nothing is dropped
 Failure: if the run's process dies, the child reads the end of the pipe, writes what it
 received and closes the file (a complete archive up to the last batch sent).  If the child
 dies, the next send raises :class:`RecorderDied` with its exit code; the file stays readable
-up to its last complete chunk (``ground.archive.reader.load_run``).
+up to its last complete chunk (``harness.archive.reader.load_run``).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 recorder was restarted during the run (docs/campaigns-and-replay.md, "Segments").
 
 The one place that names a run's segments.  Every reader of a run lists them here
-(:func:`segment_paths`, through :func:`ground.archive.reader.load_run`: the digest, summary and
+(:func:`segment_paths`, through :func:`harness.archive.reader.load_run`: the digest, summary and
 report, the replay, the archive command line and the topic frames); the recorder process
 (``ground/archive/record.py``) claims the next free one (:func:`claim_segment`), so a restarted
 recorder never overwrites what its predecessor wrote; the launcher clears a run's segments

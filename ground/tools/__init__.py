@@ -1,1 +1,2 @@
-"""Tools for people: live telemetry table, Foxglove live view, the FDIR replayed on an archive."""
+"""Live telemetry for the ground station's operators: the telemetry table and the Foxglove live
+view."""

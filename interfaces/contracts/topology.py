@@ -4,7 +4,7 @@ which process holds what.
 
 Read by the in-process runner (``deploy/inproc.py``: every node in one process), the
 multi-process launcher (``deploy/run_constellation.py``: one process per node, plus the
-router, the recorder and the sim), replay (``ground/tools/replay.py``: the ground node alone),
+router, the recorder and the sim), replay (``harness/replay.py``: the ground node alone),
 the spacecraft and station processes (``python -m fsw``, ``python -m ground``) and the sim
 (the participants it waits for).
 

@@ -90,7 +90,7 @@ def test_a_crashing_run_is_recorded_as_failed(tmp_path: Path,
     report counts it); it is not redone on restart."""
     import deploy.inproc
     from deploy.campaign import execute_run
-    from ground.analysis.campaign_report import write_campaign_report
+    from harness.campaign.report import write_campaign_report
 
     def boom(*_a: object, **_k: object) -> None:
         raise RuntimeError("sim exploded")

@@ -15,7 +15,7 @@ from pathlib import Path
 from tests.conftest import REPO
 from tests.house.test_import_rules import _imports
 
-PACKAGES = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "deploy")
+PACKAGES = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "harness", "deploy")
 
 _PART = "a part of a package that re-exports every name it holds; tests import them from {}"
 _MESSAGES = _PART.format(
@@ -23,14 +23,14 @@ _MESSAGES = _PART.format(
     "tests/interfaces/runtime/test_encoding.py)")
 _SCENARIO = _PART.format(
     "interfaces.contracts.scenario (tests/interfaces/contracts/test_scenario.py)")
-_SUMMARY = _PART.format("ground.analysis.run_summary, the type of summary.json")
+_SUMMARY = _PART.format("harness.summary, the type of summary.json")
 _NODE_MAIN = ("a node process's entry point (``python -m``): the launcher starts it in "
               "tests/missions/test_constellation.py")
 _APP = ("a ground app, built by name from the topology: fuzzed with every other app in "
         "tests/interfaces/runtime/test_fuzz_apps.py and flown in tests/missions/; its logic is "
         "tested where it lives ({})")
 _EVALUATION = ("a run's evaluation from its archive, part of summary.json "
-               "(ground/analysis/summary.py): checked on real runs in {}")
+               "(harness/summary/build.py): checked on real runs in {}")
 
 INDIRECT: dict[str, str] = {
     "interfaces.contracts.messages.base": _MESSAGES,
@@ -57,18 +57,18 @@ INDIRECT: dict[str, str] = {
         "sim/hardware.py: tests/sim/test_kernels.py compares them with those classes' numpy "
         "references"),
     "ground.__main__": _NODE_MAIN,
-    "ground.analysis.coverage": _EVALUATION.format(
+    "harness.summary.coverage_eval": _EVALUATION.format(
         "tests/missions/test_digest_run.py and tests/missions/test_campaign_run.py"),
-    "ground.analysis.gnc": _EVALUATION.format("tests/missions/test_gnc_run.py"),
-    "ground.analysis.onboard": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
-    "ground.analysis.neighbours": _EVALUATION.format("tests/missions/test_neighbours_run.py"),
-    **{f"ground.analysis.run_summary.{m}": _SUMMARY
-       for m in ("document", "fdir", "figures", "neighbours", "onboard", "passes", "records",
-                 "series")},
+    "harness.summary.control_eval": _EVALUATION.format("tests/missions/test_gnc_run.py"),
+    "harness.summary.onboard_eval": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
+    "harness.summary.neighbours_eval": _EVALUATION.format("tests/missions/test_neighbours_run.py"),
+    **{f"harness.summary.{m}": _SUMMARY
+       for m in ("document", "fdir", "figures", "neighbours", "onboard", "ground_contact",
+                 "records", "series")},
     "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
-    "ground.archive.__main__": (
-        "``python -m ground.archive``, two lines handing over to ground/archive/cli.py's main "
-        "(tests/ground/archive/test_cli.py, tests/missions/test_archive_cli_run.py)"),
+    "harness.archive.__main__": (
+        "``python -m harness.archive``, two lines handing over to harness/archive/cli.py's main "
+        "(tests/harness/archive/test_cli.py, tests/missions/test_archive_cli_run.py)"),
     "ground.archive.record": (
         "the recorder process (``python -m ground.archive.record``): the launcher starts it, "
         "tests/missions/test_constellation.py kills it mid-run"),

@@ -14,7 +14,8 @@ import pytest
 
 from tests.conftest import REPO
 
-PROJECT = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "deploy", "benchmarks", "tests")
+PROJECT = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "harness", "deploy", "benchmarks",
+           "tests")
 
 
 def _imports(path: Path) -> set[str]:

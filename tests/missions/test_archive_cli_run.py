@@ -1,4 +1,4 @@
-"""``python -m ground.archive``: list, summary and CSV export of a real run archive, with its
+"""``python -m harness.archive``: list, summary and CSV export of a real run archive, with its
 scenario, seed and software version in the metadata."""
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from deploy.inproc import run_inproc
-from ground.archive.cli import export_csv, main
+from harness.archive.cli import export_csv, main
 from ground.archive.metadata import run_metadata, software_version
-from ground.archive.reader import load_run
+from harness.archive.reader import load_run
 from ground.archive.recorder import McapRecorder
 from tests.conftest import small_scenario
 

@@ -1,4 +1,4 @@
-"""An archived topic as a DataFrame (ground/archive/frame.py) and as Parquet (the archive CLI),
+"""An archived topic as a DataFrame (harness/archive/frame.py) and as Parquet (the archive CLI),
 checked against the reader's decoded messages of a real recorded run."""
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from ground.archive.cli import main as archive_main
-from ground.archive.frame import INDEX_NAME, topic_frame
-from ground.archive.reader import ArchiveError, RunArchive, load_run
+from harness.archive.cli import main as archive_main
+from harness.archive.frame import INDEX_NAME, topic_frame
+from harness.archive.reader import ArchiveError, RunArchive, load_run
 from interfaces.contracts.messages import (
     ExecStats,
     Message,

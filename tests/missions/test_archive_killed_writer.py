@@ -1,5 +1,5 @@
 """A SIGKILLed writer of the MCAP run archive (ground.archive.recorder.McapRecorder), a real
-process, leaves a file ground.archive.reader.load_run reads back: truncated, its metadata
+process, leaves a file harness.archive.reader.load_run reads back: truncated, its metadata
 whole, and at least every record flushed before the kill, in order."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from ground.archive.reader import Record, load_run
+from harness.archive.reader import Record, load_run
 from tests.conftest import REPO
 
 _KILLED_WRITER = """

@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 
 from deploy.run_campaign import main as run_campaign
-from ground.analysis.campaign_report import detector_figures
-from ground.analysis.run_summary import FdirResults
+from harness.campaign.report import detector_figures
+from harness.summary import FdirResults
 from tests.conftest import dask_cluster
 from tests.deploy.test_campaign import BASE, CAMPAIGN
 

@@ -15,8 +15,8 @@ from pathlib import Path
 import pytest
 
 from deploy import cli
-from ground.archive.cli import list_topics
-from ground.archive.reader import load_run
+from harness.archive.cli import list_topics
+from harness.archive.reader import load_run
 from tests.conftest import REPO, recorded_run, small_scenario
 from tests.deploy.test_cli import SUBCOMMANDS
 

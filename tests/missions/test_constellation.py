@@ -19,8 +19,8 @@ import numpy as np
 from mcap.reader import make_reader
 
 from deploy.inproc import run_inproc
-from ground.archive.reader import RunArchive, load_run
-from ground.archive.sequences import by_topic
+from harness.archive.reader import RunArchive, load_run
+from harness.archive.sequences import by_topic
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.messages import ExecStats, LinkStats, StateEstimate, TruthState, registry

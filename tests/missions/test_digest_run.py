@@ -10,15 +10,15 @@ import pytest
 from mcap.reader import make_reader
 
 from deploy.inproc import run_inproc
-from ground.analysis.digest import (
+from harness.summary.digest import (
     LiveDigest,
     RunDigest,
     digest_archive,
     digest_run,
     unread_keys,
 )
-from ground.analysis.summary import RunOutcome, build_summary
-from ground.archive.reader import ArchiveError, Record, load_run
+from harness.summary.build import RunOutcome, build_summary
+from harness.archive.reader import ArchiveError, Record, load_run
 from ground.archive.recorder import McapRecorder
 from interfaces.contracts.scenario import Scenario, load_scenario
 from tests.conftest import REPO

@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from ground.analysis.run_summary import RunSummary
+from harness.summary import RunSummary
 from interfaces.contracts.messages import ConstellationWindow, FaultReport, FdirWindow
 from tests.conftest import recorded_run, small_scenario
 

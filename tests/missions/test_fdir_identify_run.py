@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 
-from ground.analysis.run_summary import RunSummary
+from harness.summary import RunSummary
 from interfaces.contracts.messages import BaselineVerdict, FaultReport
 from tests.conftest import recorded_run, small_scenario
 

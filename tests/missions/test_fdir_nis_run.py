@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 
 from deploy.inproc import run_inproc
-from ground.analysis.summary import _series
+from harness.summary.build import _series
 from interfaces.contracts.messages import FaultReport, FdirWindow
 from tests.conftest import collector, small_scenario
 

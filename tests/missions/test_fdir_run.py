@@ -9,9 +9,9 @@ import re
 
 import pytest
 
-from ground.analysis.calibrate import main as calibrate_main
-from ground.analysis.report import write_report
-from ground.analysis.run_summary import RunSummary
+from harness.campaign.calibrate import main as calibrate_main
+from harness.report import write_report
+from harness.summary import RunSummary
 from interfaces.contracts.messages import FaultReport, FdirWindow
 from tests.conftest import recorded_run, small_scenario
 

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from deploy.campaign import execute_run, load_campaign
-from ground.analysis.formation_study import load_study, twins, write_formation_study
-from ground.archive.reader import load_run
+from harness.campaign.formation_study import load_study, twins, write_formation_study
+from harness.archive.reader import load_run
 from interfaces.contracts import catalogue as cat
 from tests.conftest import REPO
 

@@ -7,8 +7,8 @@ import numpy as np
 from scipy.stats import chi2
 
 from deploy.inproc import run_inproc
-from ground.analysis.nav import nav_errors
-from ground.archive.reader import load_run
+from harness.summary.nav_eval import nav_errors
+from harness.archive.reader import load_run
 from ground.archive.recorder import McapRecorder
 from tests.conftest import small_scenario
 

@@ -16,8 +16,8 @@ from __future__ import annotations
 import pytest
 
 from deploy.campaign import RunSpec, execute_run
-from ground.analysis.run_summary import RunSummary
-from ground.archive.reader import RunArchive, load_run
+from harness.summary import RunSummary
+from harness.archive.reader import RunArchive, load_run
 from interfaces.contracts import catalogue as cat
 from tests.conftest import small_scenario
 

@@ -23,8 +23,8 @@ import pytest
 
 from deploy.campaign import RunSpec, execute_run
 from gnc.passes import ContactPlan
-from ground.analysis.run_summary import RunSummary
-from ground.archive.reader import load_run
+from harness.summary import RunSummary
+from harness.archive.reader import load_run
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import topology

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from ground.archive.reader import load_run
+from harness.archive.reader import load_run
 from ground.archive.recorder import McapRecorder
 from ground.archive.recorder_process import BATCH, RecorderDied, RecorderProcess
 from interfaces.contracts.messages import Heartbeat

@@ -1,4 +1,4 @@
-"""Replay (ground/tools/replay.py): the live ground re-run on a recorded run reproduces the live
+"""Replay (harness/replay.py): the live ground re-run on a recorded run reproduces the live
 detections, windows and verdicts exactly -- with lossy, range-limited and cut links and three
 faults -- and, under another setting, what the live run with that setting declared, up to the
 first uplink the two runs differ in."""
@@ -10,14 +10,15 @@ from pathlib import Path
 import pytest
 
 from deploy.inproc import run_inproc
-from ground.analysis.run_summary import Detection, RunSummary
-from ground.analysis.summary import write_summary
-from ground.archive.metadata import archived_scenario, run_metadata
-from ground.archive.reader import ArchiveError, load_run
+from harness.summary import Detection, RunSummary
+from harness.summary.build import write_summary
+from ground.archive.metadata import run_metadata
+from harness.archive.run_scenario import archived_scenario
+from harness.archive.reader import ArchiveError, load_run
 from ground.archive.recorder import McapRecorder
-from ground.tools.replay import GroundOutput, main, replay_run
+from harness.replay import GroundOutput, main, replay_run
 from interfaces.contracts.scenario import Scenario
-from tests.ground.tools.test_replay import _scenario
+from tests.harness.test_replay import _scenario
 
 
 def _record(scenario: Scenario, out: Path) -> RunSummary:

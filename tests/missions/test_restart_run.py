@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ground.archive.reader import load_run
+from harness.archive.reader import load_run
 from interfaces.contracts import topics
 from interfaces.contracts.messages import StateEstimate, registry
 from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport

@@ -1,4 +1,4 @@
-"""summary.json's type (ground/analysis/run_summary): a real run's summary reads back as
+"""summary.json's type (harness/summary): a real run's summary reads back as
 written, byte for byte; its window series stay positional arrays on disk; a summary written
 before a field existed loads with the field filled in and named, and writes back unchanged;
 a malformed one is refused naming the field."""
@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 from pydantic import ValidationError
 
-from ground.analysis.run_summary import (
+from harness.summary import (
     OTHER_TESTS_FLAG,
     RunSummary,
     SeriesWindow,
@@ -27,7 +27,7 @@ from tests.conftest import recorded_run, small_scenario
 OLDER = {OTHER_TESTS_FLAG, "fdir_thresholds.failed.nis",
          "scores.per_fault[].identification_latency_s", "detections[].evidence",
          "exec.ground.refused", "sim.participants"}
-"""What the summaries of older versions lack (git history of ground/analysis/summary.py)."""
+"""What the summaries of older versions lack (git history of harness/summary/build.py)."""
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,7 @@
 """A run's archive in segments (ground/archive/segments.py) read back as one run
-(ground.archive.reader.load_run): the segments listed and claimed, their records merged, a
+(harness.archive.reader.load_run): the segments listed and claimed, their records merged, a
 message two segments hold kept once, and the messages lost between counted from the sequence
-numbers (ground/archive/sequences.py).
+numbers (harness/archive/sequences.py).
 
 Files are real MCAP files written by the project's McapRecorder; a recorder killed mid-run is
 the snapshot of a live recorder's file (its flushed chunks, not the messages after them).  The
@@ -15,9 +15,10 @@ from pathlib import Path
 
 import pytest
 
-from ground.archive.live import LiveArchive
-from ground.archive.metadata import archived_scenario, run_metadata
-from ground.archive.reader import ArchiveError, Record, load_run
+from harness.archive.live import LiveArchive
+from ground.archive.metadata import run_metadata
+from harness.archive.run_scenario import archived_scenario
+from harness.archive.reader import ArchiveError, Record, load_run
 from ground.archive.recorder import McapRecorder, prepare_raw
 from ground.archive.segments import (
     SEGMENT_RECORD,

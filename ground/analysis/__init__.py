@@ -1,2 +1,0 @@
-"""Offline analysis of run archives: summary, report, coverage, nav and GNC evaluation, scoring,
-calibration, campaign report."""

@@ -1,0 +1,162 @@
+"""Archive tools: list, summarize and export any run archive (run.mcap).
+
+    python -m harness.archive list RUN.mcap [RUN2.mcap ...]
+    python -m harness.archive summary RUN.mcap
+    python -m harness.archive export RUN.mcap --topic KEY_EXPR [--out FILE.csv|FILE.parquet]
+
+``list`` prints each key with its message type, count and sim-time span; ``summary`` the
+metadata the recorder wrote (scenario, seed, transport, software version), the message counts
+per type, the injected faults and the FDIR's declarations; ``export`` writes the messages of
+a key expression (``*`` one chunk, ``**`` any number) as CSV, one row per message, nested
+fields flattened (``r_m.0``, ``P.2.3``), to ``--out`` or stdout; an ``--out`` ending in
+``.parquet`` (or ``.pq``) gets instead the topic's DataFrame (harness/archive/frame.py: indexed
+by sim time ``t_sim_s``, lists of varying length kept whole) as Parquet, which
+``pandas.read_parquet`` reads back as it was.  A damaged archive is read up to its last
+complete chunk (harness/archive/reader.py) and said so.  ``RUN.mcap`` is a run's first segment:
+the segments after it (``run-1.mcap``, ...: a restarted recorder's) are read with it as one
+run, and ``list`` and ``summary`` name them and the messages lost, by topic.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any, TextIO
+
+from harness.archive.frame import topic_frame
+from harness.archive.reader import ArchiveError, RunArchive, load_run
+from harness.archive.sequences import by_topic
+
+PARQUET_SUFFIXES = (".parquet", ".pq")
+"""``export --out`` file suffixes that choose Parquet over CSV."""
+
+
+def flatten(value: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
+    """(dotted name, scalar) pairs of a JSON value: dicts by key, lists by index."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            yield from flatten(v, f"{prefix}.{k}" if prefix else str(k))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from flatten(v, f"{prefix}.{i}" if prefix else str(i))
+    else:
+        yield prefix, value
+
+
+def _span(archive: RunArchive, key: str) -> tuple[float, float]:
+    times = [r.log_time_ns for r in archive.records(key)]
+    return (min(times) / 1e9, max(times) / 1e9) if times else (0.0, 0.0)
+
+
+def _continuity(archive: RunArchive, out: TextIO) -> None:
+    """The archive's segments and the messages lost, when it has several or lost some."""
+    if len(archive.segments) == 1 and not archive.lost:
+        return
+    out.write("  segments: " + ", ".join(s.path.name + (" (truncated)" if s.truncated else "")
+                                         for s in archive.segments) + "\n")
+    lost = by_topic(archive.lost)
+    out.write(f"  lost: {sum(lost.values())} messages"
+              + "".join(f", {t} {n}" for t, n in lost.items()) + "\n")
+
+
+def list_topics(archive: RunArchive, out: TextIO) -> None:
+    out.write(f"{archive.path}: {len(archive)} messages"
+              + (f", TRUNCATED ({archive.stop_reason})" if archive.truncated else "") + "\n")
+    _continuity(archive, out)
+    for key, (type_name, count) in archive.topics().items():
+        t0, t1 = _span(archive, key)
+        out.write(f"  {key}  {type_name}  {count}  [{t0:.1f}, {t1:.1f}] s\n")
+
+
+def summarize(archive: RunArchive, out: TextIO) -> None:
+    out.write(f"{archive.path}: {len(archive)} messages, "
+              + ("truncated: " + str(archive.stop_reason) if archive.truncated else "complete")
+              + "\n")
+    _continuity(archive, out)
+    run = archive.metadata.get("run", {})
+    for k in ("scenario", "seed", "transport", "duration_s", "software_version", "started_utc"):
+        out.write(f"  {k}: {run.get(k, '-')}\n")
+    counts: dict[str, int] = {}
+    for type_name, count in archive.topics().values():
+        counts[type_name] = counts.get(type_name, 0) + count
+    out.write("  messages by type: " + ", ".join(f"{t} {n}" for t, n in sorted(counts.items()))
+              + "\n")
+    for r in archive.records("**"):
+        if r.type_name == "FaultEvent":
+            m = json.loads(r.payload)
+            out.write(f"  fault {m['kind']} on sc{m['spacecraft']} "
+                      f"{'on' if m['active'] else 'off'} at {m['t_sim']:.0f} s\n")
+        elif r.type_name == "FaultReport":
+            m = json.loads(r.payload)
+            out.write(f"  declared: sc{m['spacecraft']} {m['fault_class'] or 'unidentified'} "
+                      f"at {m['t_sim']:.0f} s\n")
+
+
+def export_csv(archive: RunArchive, key_expr: str, out: TextIO) -> int:
+    """Write the messages of ``key_expr`` as CSV; returns the number of rows."""
+    rows = []
+    for r in archive.records(key_expr):
+        row = {"key": r.key, "type": r.type_name, "log_time_s": r.log_time_ns / 1e9}
+        row.update(flatten(json.loads(r.payload)))
+        rows.append(row)
+    fields: dict[str, None] = {}
+    for row in rows:
+        fields.update(dict.fromkeys(row))
+    w = csv.DictWriter(out, fieldnames=list(fields))
+    w.writeheader()
+    w.writerows(rows)
+    return len(rows)
+
+
+def export(run: Path, key_expr: str, out: Path | None) -> int:
+    """Export the messages of ``key_expr``: Parquet if ``out`` has a Parquet suffix, else CSV
+    to ``out`` or stdout; returns the number of rows (a Parquet export of nothing raises)."""
+    if out is not None and out.suffix.lower() in PARQUET_SUFFIXES:
+        frame = topic_frame(run, key_expr)
+        frame.to_parquet(out)
+        return len(frame)
+    archive = load_run(run)
+    if out is None:
+        return export_csv(archive, key_expr, sys.stdout)
+    with open(out, "w", newline="") as f:
+        return export_csv(archive, key_expr, f)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m harness.archive", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="keys, types, counts").add_argument("runs", nargs="+", type=Path)
+    sub.add_parser("summary", help="metadata, counts, faults").add_argument("run", type=Path)
+    e = sub.add_parser("export", help="CSV or Parquet of a key expression")
+    e.add_argument("run", type=Path)
+    e.add_argument("--topic", required=True, help="key expression, e.g. 'insp/*/sc/1/nav/**'")
+    e.add_argument("--out", type=Path,
+                   help="CSV file (default: stdout), or Parquet if it ends in .parquet or .pq")
+    args = p.parse_args(argv)
+    try:
+        if args.command == "list":
+            for run in args.runs:
+                list_topics(load_run(run), sys.stdout)
+        elif args.command == "summary":
+            summarize(load_run(args.run), sys.stdout)
+        else:
+            n = export(args.run, args.topic, args.out)
+            print(f"{n} messages exported", file=sys.stderr)
+            if n == 0:
+                print(f"warning: no message matches {args.topic!r}; `list` shows the keys",
+                      file=sys.stderr)
+    except BrokenPipeError:  # e.g. piped into `head`
+        return 0
+    except (ArchiveError, OSError, ValueError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,310 @@
+"""Replay: the live ground re-run on the telemetry in a run's archive, under the run's own or
+other detector settings.
+
+    python -m harness.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR]
+
+RUN is a run directory (holding ``run.mcap``) or an archive (its first segment: the segments
+after it, a restarted recorder's, are read with it as one run).  The ground node itself, built
+from the declared topology as a run builds it (``interfaces.contracts.topology``: planner,
+telemetry monitor, FDIR, baselines -- the code the live ground runs, not a copy) is fed, on
+the in-process bus, every archived message of the other nodes that the ground subscribes to,
+in the lockstep's order: all messages of sim time t, then the sim's Tick at t.  Its own
+channel model (the scenario's comms, seed, cuts and link faults) decides again, in the same
+deterministic order, which of them reached it, so losses and range cuts replay as they
+happened.  What it publishes -- FDI windows, fault reports, baseline verdicts --
+is scored as ``summary.json`` scores the live run (``harness.summary.build.fdir_results``);
+``scores_faithful`` scores only what it declared and judged up to ``faithful_until_s``.
+
+Faithfulness.  With the run's own settings the replay reproduces the live detections, their
+times and classes, and every window and verdict exactly (``matches_live``).  The spacecraft's
+data, however, is what they flew: once an uplink differs from the live one -- a recovery
+replan after a declaration made at another time, or not made -- the replay judges a
+trajectory that its own uplinks did not command.  ``faithful_until_s`` is the sim time of the
+first such difference (the run's end when there is none); what the replay reports after it is
+kept, and marked, and left out of ``scores_faithful``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from harness.summary import ReplayResults
+from harness.summary.build import fdir_results
+from harness.archive.run_scenario import scenario_from_metadata
+from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
+from ground.archive.segments import run_archive
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.topology import topology
+from interfaces.contracts.messages import (
+    BaselineVerdict,
+    ConstellationWindow,
+    FaultReport,
+    FdirWindow,
+    ProAssignments,
+)
+from interfaces.contracts.scenario import Scenario, ScenarioError
+from interfaces.runtime.assembly import executive_of
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.channel import ChannelModel
+from interfaces.runtime.executive import TickClient
+from interfaces.runtime.transport import InprocNetwork, Sample
+
+SETTABLE = ("fdir.", "rates.fdi_period_s")
+"""Settings a replay may change: the ground's detector only.  Anything else changes what the
+spacecraft flew, which only a new simulation can tell."""
+
+UNREAD = (cat.CAMERA_IMAGE, cat.RELNAV, cat.ATTITUDE_SENSORS, cat.THRUST, cat.WHEELS,
+          cat.POINTING, cat.TICK_DONE, cat.EXEC_STATS, cat.LINK_STATS, cat.DECISIONS,
+          cat.TLM_STATUS)
+"""Topics no ground app subscribes to and the comparison does not read: counted and dropped as
+the archive is read (``tests/harness/test_replay.py`` checks the ground reads none of them).
+The one exception is the ground's own link counters (``LINK_STATS``; its FDIR reads the
+onboard stores' overflow from them with ground passes): the replay's ground makes them again,
+its channel stage running the stores on the archive's messages."""
+
+
+@dataclass
+class GroundOutput:
+    """What a ground published (live, from the archive; or replayed)."""
+
+    windows: list[FdirWindow] = field(default_factory=list)
+    reports: list[FaultReport] = field(default_factory=list)
+    verdicts: list[BaselineVerdict] = field(default_factory=list)
+    assignments: list[ProAssignments] = field(default_factory=list)
+    constellation: list[ConstellationWindow] = field(default_factory=list)
+
+    def add(self, msg: object) -> None:
+        for kind, holder in ((FdirWindow, self.windows), (FaultReport, self.reports),
+                             (BaselineVerdict, self.verdicts), (ProAssignments, self.assignments),
+                             (ConstellationWindow, self.constellation)):
+            if type(msg) is kind:
+                holder.append(msg)  # type: ignore[attr-defined]
+
+    @classmethod
+    def of_archive(cls, archive: RunArchive, mission: str) -> GroundOutput:
+        return cls(archive.of(cat.FDIR_WINDOW, mission), archive.of(cat.FAULT_REPORT, mission),
+                   archive.of(cat.BASELINE, mission), archive.of(cat.ASSIGNMENTS, mission),
+                   archive.of(cat.CONSTELLATION_WINDOW, mission))
+
+
+@dataclass
+class Replay:
+    """One replayed run: the scenario it ran with, the replay's and the live ground's output."""
+
+    scenario: Scenario
+    live: GroundOutput
+    replayed: GroundOutput
+    wall_s: float
+
+    def faithful_until_s(self) -> float:
+        """Sim time of the first uplink that differs from the live run's (s); the run's end
+        when none does."""
+        live = [_plan(m) for m in self.live.assignments]
+        mine = [_plan(m) for m in self.replayed.assignments]
+        for a, b in zip(live, mine):
+            if a != b:
+                return min(a[0], b[0])
+        if len(live) != len(mine):
+            return (live if len(live) > len(mine) else mine)[min(len(live), len(mine))][0]
+        return self.scenario.duration_s
+
+    def matches_live(self) -> bool:
+        """Every window, report and verdict equal to the live ground's (sender-stamped wall
+        times aside)."""
+        return all(_same(a, b) for a, b in (
+            (self.live.windows, self.replayed.windows), (self.live.reports, self.replayed.reports),
+            (self.live.verdicts, self.replayed.verdicts),
+            (self.live.constellation, self.replayed.constellation)))
+
+    def results(self) -> ReplayResults:
+        """``summary.json``'s FDIR fields for the replay, with its faithfulness."""
+        mine = self.replayed
+        out = fdir_results(mine.reports, mine.windows, mine.verdicts, self.scenario)
+        horizon = self.faithful_until_s()
+        for d in out.detections:
+            d.faithful = d.time_s <= horizon
+        faithful = fdir_results([r for r in mine.reports if r.t_sim <= horizon],
+                                [w for w in mine.windows if w.t_end_s <= horizon],
+                                [v for v in mine.verdicts if v.t_end_s <= horizon],
+                                self.scenario)
+        census = {"fdir_thresholds": faithful.fdir_thresholds}  # the census: faithful span
+        return ReplayResults(scenario=self.scenario.name, seed=self.scenario.seed,
+                             replay_wall_s=round(self.wall_s, 3), faithful_until_s=horizon,
+                             matches_live=self.matches_live(), **(dict(out) | census),
+                             scores_faithful=faithful.scores)
+
+
+def _plan(msg: ProAssignments) -> tuple[float, list[dict[str, Any]]]:
+    return msg.t_sim, [a.model_dump() for a in msg.assignments]
+
+
+def _same(a: list[Any], b: list[Any]) -> bool:
+    skip = {"t_wall"}
+    return len(a) == len(b) and all(x.model_dump(exclude=skip) == y.model_dump(exclude=skip)
+                                    for x, y in zip(a, b))
+
+
+# --- settings ---------------------------------------------------------------------------------
+
+
+def scenario_of(archive: RunArchive) -> Scenario:
+    """The scenario a run ran with, from its metadata (written by every run and campaign)."""
+    return scenario_from_metadata(archive.metadata)
+
+
+def with_settings(scenario: Scenario, settings: dict[str, str]) -> Scenario:
+    """``scenario`` with ``section.key = value`` settings (values parsed as JSON where they
+    are, else kept as text); only detector settings (``SETTABLE``).  Raises ScenarioError."""
+    for name in settings:
+        if not name.startswith(SETTABLE[0]) and name not in SETTABLE[1:]:
+            raise ScenarioError(f"--set {name}: a replay re-runs the ground's detector only "
+                                f"(fdir.*, rates.fdi_period_s); {name} changes what was flown, "
+                                "simulate it instead")
+    return scenario_with(scenario, settings)
+
+
+def scenario_with(scenario: Scenario, settings: dict[str, str]) -> Scenario:
+    """``scenario`` with any ``section.key = value`` settings (values parsed as JSON where they
+    are, else kept as text).  Raises ScenarioError naming a setting that is not one."""
+    data = scenario.model_dump()
+    for name, text in settings.items():
+        section, _, key = name.partition(".")
+        if not isinstance(data.get(section), dict) or key not in data[section]:
+            raise ScenarioError(f"--set {name}: no such setting in [{section}]")
+        try:
+            data[section][key] = json.loads(text)
+        except json.JSONDecodeError:
+            data[section][key] = text
+    try:
+        return Scenario.model_validate(data)
+    except ValueError as e:
+        raise ScenarioError(f"--set: {e}") from e
+
+
+# --- the replay ---------------------------------------------------------------------------------
+
+
+def replay_run(path: Path, settings: dict[str, str] | None = None,
+               scenario: Scenario | None = None) -> Replay:
+    """Replay the ground of the run archived at ``path`` (module docstring).  ``scenario``:
+    the run's scenario when its archive carries none; ``settings``: detector settings changed
+    from the run's."""
+    start = time.perf_counter()
+    archive = load_run(path, stream={t.any_mission(): _drop for t in UNREAD})
+    replay_scenario = with_settings(scenario or scenario_of(archive), settings or {})
+    mission = archive.mission()
+    replayed = _run_ground(archive, mission, replay_scenario)
+    return Replay(replay_scenario, GroundOutput.of_archive(archive, mission), replayed,
+                  time.perf_counter() - start)
+
+
+def _run_ground(archive: RunArchive, mission: str, scenario: Scenario) -> GroundOutput:
+    """The ground station, built as a run builds it, fed the archive; what it published."""
+    net = InprocNetwork()
+    bus = Bus(topics.GROUND, mission, net.endpoint(),
+              channel=ChannelModel.of(topics.GROUND, scenario))
+    executive = executive_of(topology(scenario).node(topics.GROUND), bus, scenario)
+    executive.barrier_timeout_s = 0.0  # everything the archive holds is delivered before a tick
+    TickClient(executive, synchronous=True)
+    own = topics.node_prefix(mission, topics.GROUND)
+    out = GroundOutput()
+    net.endpoint().subscribe_samples(own + "/**", lambda s: out.add(s.message))
+    _play(archive.held(), net.endpoint(), own + "/")
+    return out
+
+
+def _drop(_rec: Record) -> None:
+    """Sink of the records a replay does not read."""
+
+
+def _play(records: Iterable[Record], player: Any, own_prefix: str) -> None:
+    """Send the other nodes' records in lockstep order: per sim time, every message, then the
+    Tick (archives are in sim-time order; a Tick may have been recorded before a message of
+    its own time arrived)."""
+    group: list[Record] = []
+    for rec in records:
+        if rec.key.startswith(own_prefix):
+            continue
+        if group and rec.log_time_ns != group[0].log_time_ns:
+            _send_group(group, player)
+            group = []
+        group.append(rec)
+    _send_group(group, player)
+
+
+def _send_group(group: list[Record], player: Any) -> None:
+    tick = cat.TICK.type.__name__
+    for rec in sorted(group, key=lambda r: r.type_name == tick):
+        player.send(Sample(rec.key, rec.type_name, payload=rec.payload))
+
+
+# --- command line -------------------------------------------------------------------------------
+
+
+def _archive_path(run: Path) -> Path:
+    return run_archive(run) if run.is_dir() else run
+
+
+def parse_settings(pairs: list[str]) -> dict[str, str]:
+    """``SECTION.KEY=VALUE`` strings as a settings dict (ScenarioError if malformed)."""
+    out = {}
+    for p in pairs:
+        name, sep, value = p.partition("=")
+        if not sep or not name:
+            raise ScenarioError(f"--set {p!r}: expected SECTION.KEY=VALUE")
+        out[name.strip()] = value.strip()
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m harness.replay", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("runs", nargs="+", type=Path, help="run directories or run.mcap files")
+    p.add_argument("--set", dest="settings", action="append", default=[],
+                   metavar="fdir.KEY=VALUE", help="a detector setting (repeatable)")
+    p.add_argument("--out", type=Path, default=None,
+                   help="directory for <run>.replay.json (default: beside each archive)")
+    args = p.parse_args(argv)
+    logging.basicConfig(level=logging.ERROR)
+    try:
+        settings = parse_settings(args.settings)
+    except ScenarioError as e:
+        p.error(str(e))
+    failed = 0
+    for run in args.runs:
+        try:
+            replay = replay_run(_archive_path(run), settings)
+        except (ArchiveError, ScenarioError, OSError) as e:
+            print(f"{run}: {e}", file=sys.stderr)
+            failed += 1
+            continue
+        _write(replay, run, args.out)
+    return 1 if failed else 0
+
+
+def _write(replay: Replay, run: Path, out: Path | None) -> None:
+    res = replay.results()
+    name = (run if run.is_dir() else run.parent).name or "run"
+    dest = (out / f"{name}.replay.json") if out else _archive_path(run).parent / "replay.json"
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    dest.write_text(res.to_json(indent=1))
+    dets = ", ".join(f"sc{d.spacecraft} {d.fault_class or 'unidentified'} at {d.time_s:.0f} s"
+                     + ("" if d.faithful else " (after divergence)")
+                     for d in res.detections) or "no detection"
+    print(f"{run}: {dets}; "
+          f"{'matches the live run' if res.matches_live else 'differs from the live run'}"
+          f"; faithful until {res.faithful_until_s:.0f} s; "
+          f"{res.replay_wall_s:.1f} s -> {dest}")
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

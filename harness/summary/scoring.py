@@ -1,0 +1,107 @@
+"""Scoring a detector against the injected faults (docs/contracts.md, summary.json
+``detections`` and ``scores``).
+
+Definitions (one run):
+
+* A fault is *detected* when any alarm is raised at or after its onset and before it ends
+  (plus ``grace_s``, one FDI window by default: a window closing after the end still holds
+  faulty data); its *latency* is the time from onset to the first such alarm.
+* It is *isolated* when such an alarm names its spacecraft (0 for a common-mode fault: the
+  constellation); ``latency_s`` is then measured to the first alarm on that spacecraft, and
+  ``identified_class`` is the class of the first such alarm that names one (the detector may
+  identify a window after it detects), at ``identification_latency_s`` from onset.
+  ``declared_latency_s`` is the time from onset to when that first alarm was declared (the
+  window judged: with ground passes, after its data came down).
+* A *false alarm* is an alarm on a spacecraft with no fault active at its time (within the
+  same grace).  ``nominal_cycles`` counts the FDI windows judged (a decision was possible) that
+  do not overlap a fault of their spacecraft; ``false_alarm_rate`` is false alarms per nominal
+  cycle, and ``false_alarms_per_hour`` per hour of nominal spacecraft time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from harness.summary import FaultClass, FaultScore, Scores
+from interfaces.contracts.scenario import Fault
+
+EXPECTED_CLASS: dict[str, FaultClass] = {
+    "thruster_bias": "actuator", "pointing_actuator": "actuator",
+    "camera_degradation": "camera", "camera_misalignment": "camera",
+    "nav_sensor_bias": "state_sensor", "link_loss": "link", "packet_loss": "link",
+    "faulty_data": "data_integrity", "camera_calibration": "common_mode",
+    "state_disturbance": "actuator",
+}
+"""The class each fault kind should be identified as (docs/contracts.md)."""
+
+
+@dataclass(frozen=True)
+class Alarm:
+    """A declared fault: spacecraft, time (s), identified class (None: not identified)."""
+
+    spacecraft: int
+    t_s: float
+    fault_class: FaultClass | None
+    declared_s: float | None = None
+    """when it was declared (s; None: not known)"""
+
+
+@dataclass(frozen=True)
+class Judged:
+    """One FDI window on one spacecraft where the detector could decide: [t_start, t_end)."""
+
+    spacecraft: int
+    t_start_s: float
+    t_end_s: float
+
+
+def _active(f: Fault, t: float, grace_s: float) -> bool:
+    return f.start_s <= t and (f.end_s is None or t <= f.end_s + grace_s)
+
+
+def overlaps_fault(faults: Sequence[Fault], spacecraft: int, t_start_s: float,
+                   t_end_s: float) -> bool:
+    """Whether a fault of ``spacecraft`` (or a common-mode one, spacecraft 0) overlaps the
+    window [t_start_s, t_end_s)."""
+    return any(f.spacecraft in (0, spacecraft) and f.start_s < t_end_s
+               and (f.end_s is None or t_start_s < f.end_s) for f in faults)
+
+
+def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Judged],
+          grace_s: float) -> Scores:
+    """The ``scores`` section: ``per_fault`` (in scenario order) and the false-alarm figures."""
+    per_fault = []
+    for f in faults:
+        during = sorted((a for a in alarms if _active(f, a.t_s, grace_s)), key=lambda a: a.t_s)
+        on_it = [a for a in during if a.spacecraft == f.spacecraft]
+        first = on_it[0] if on_it else (during[0] if during else None)
+        classed = [a for a in on_it if a.fault_class is not None]
+        identified = classed[0].fault_class if classed else None
+        per_fault.append(FaultScore(
+            spacecraft=f.spacecraft, kind=f.kind, start_s=f.start_s,
+            detected=bool(during), isolated=bool(on_it),
+            latency_s=None if first is None else first.t_s - f.start_s,
+            identified_class=identified, expected_class=EXPECTED_CLASS[f.kind],
+            identified_correctly=identified == EXPECTED_CLASS[f.kind],
+            identification_latency_s=classed[0].t_s - f.start_s if classed else None,
+            declared_latency_s=(first.declared_s - f.start_s
+                                if first is not None and first.declared_s is not None else None),
+        ))
+
+    def faulty(sc: int, t: float) -> bool:  # a common-mode fault (0) acts on every observer
+        return any(f.spacecraft in (0, sc) and _active(f, t, grace_s) for f in faults)
+
+    def overlaps(j: Judged) -> bool:
+        return overlaps_fault(faults, j.spacecraft, j.t_start_s, j.t_end_s)
+
+    false_alarms = [a for a in alarms if not faulty(a.spacecraft, a.t_s)]
+    nominal = [j for j in judged if not overlaps(j)]
+    hours = sum(j.t_end_s - j.t_start_s for j in nominal) / 3600.0
+    return Scores(
+        per_fault=per_fault,
+        false_alarms=len(false_alarms),
+        nominal_cycles=len(nominal),
+        false_alarm_rate=len(false_alarms) / len(nominal) if nominal else None,
+        false_alarms_per_hour=len(false_alarms) / hours if hours > 0 else None,
+    )

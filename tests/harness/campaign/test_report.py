@@ -1,0 +1,279 @@
+"""The campaign report on constructed run summaries: rates, latencies, false alarms, the
+confusion matrix, magnitude bins and the ROC re-scored from the archived window series."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from harness.campaign.report import (
+    SCALES,
+    CampaignRun,
+    _alarms_at,
+    load_runs,
+    _magnitude_bins,
+    _rescore,
+    _roc,
+    detector_figures,
+    write_campaign_report,
+)
+from harness.summary import MainWindow, RunSummary, SummaryError
+
+
+def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | None,
+           cls: str | None, expected: str) -> dict[str, object]:
+    return {"spacecraft": sc, "kind": kind, "start_s": start, "detected": detected,
+            "isolated": detected, "latency_s": latency, "identified_class": cls,
+            "expected_class": expected, "identified_correctly": cls == expected}
+
+
+def _scores(per_fault: list[dict[str, object]], false_alarms: int, nominal_cycles: int
+            ) -> dict[str, object]:
+    return {"per_fault": per_fault, "false_alarms": false_alarms,
+            "nominal_cycles": nominal_cycles,
+            "false_alarm_rate": false_alarms / nominal_cycles if nominal_cycles else None,
+            "false_alarms_per_hour": None}
+
+
+def _detection(sc: int, t: float, cls: str | None, metric: float | None = None,
+               threshold: float | None = None) -> dict[str, object]:
+    return {"spacecraft": sc, "time_s": t, "class": cls, "direction": None, "metric": metric,
+            "threshold": threshold}
+
+
+def _summary(rid: str, sections: dict[str, Any]) -> RunSummary:
+    """A completed run's summary with ``sections`` (the rest as a run would have them)."""
+    return RunSummary.model_validate({
+        "scenario": rid, "seed": 1, "wall_s": 60.0, "status": "completed", "error": None,
+        "detections": [], "fdir_settings": {"fdi_period_s": 100.0, "persistence": 2},
+        **sections})
+
+
+def _run(sections: dict[str, Any]) -> CampaignRun:
+    return CampaignRun("r", "r", "unknown", _summary("r", sections))
+
+
+def _write(out: Path, rid: str, summary: dict[str, Any], group: str | None = None) -> None:
+    d = out / "runs" / rid
+    d.mkdir(parents=True)
+    if group is not None:  # as the campaign runner writes it beside the run
+        (d / "campaign.json").write_text(json.dumps({"run": rid, "group": group}))
+    _summary(rid, summary).write(d / "summary.json")
+
+
+@pytest.fixture()
+def campaign(tmp_path: Path) -> Path:
+    # run a: camera fault on sc2 from 0 s, declared at 200 s (two windows over 0.05)
+    _write(tmp_path, "a", {
+        "injected_faults": [{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0,
+                             "end_s": None, "magnitude": 0.5}],
+        "scores": _scores([_fault(2, "camera_degradation", 0.0, True, 200.0, "camera",
+                                  "camera")], 0, 2),
+        "baselines": {"cusum": _scores([_fault(2, "camera_degradation", 0.0, True, 100.0,
+                                               None, "camera")], 0, 2)},
+        "fdir_series": {"main": [[2, 0, 100, 0.5, 0.05], [2, 100, 200, 0.5, 0.05],
+                                 [1, 0, 100, 0.01, 0.05], [1, 100, 200, 0.01, 0.05]]}},
+           group="faulty")
+    # run b: a thruster fault missed by the main detector, identified by nobody
+    _write(tmp_path, "b", {
+        "injected_faults": [{"spacecraft": 1, "kind": "thruster_bias", "start_s": 100.0,
+                             "end_s": None, "magnitude": 0.3}],
+        "scores": _scores([_fault(1, "thruster_bias", 100.0, False, None, None,
+                                  "actuator")], 0, 0),
+        "fdir_series": {"main": [[1, 100, 200, 0.03, 0.05], [1, 200, 300, 0.03, 0.05]]}},
+           group="faulty")
+    # run c: nominal, one false alarm (two windows just over the threshold)
+    _write(tmp_path, "c", {
+        "injected_faults": [],
+        "scores": _scores([], 1, 2),
+        "fdir_series": {"main": [[1, 0, 100, 0.06, 0.05], [1, 100, 200, 0.07, 0.05]]}})
+    write_campaign_report(tmp_path, "t", ["a", "b", "c", "missing"])
+    return tmp_path
+
+
+def test_report_figures(campaign: Path) -> None:
+    report = (campaign / "report.md").read_text()
+    assert "3 of 4 runs finished (0 failed;" in report
+    assert "Software: unknown (3 runs)." in report  # no version in these campaign.json
+    assert "median 60 s, max 60 s, 0.05 worker-hours in all." in report
+    assert "| main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | 0.2500 (1/4; 95% ≤ " \
+        "0.75) |" in report
+    assert "| cusum | 100% (1/1) | 100% (1/1) | - | 100 / 100 / 100 |" in report
+    assert "| camera_degradation (→ camera) | 0 | 1 | 0 | 0 | 0 | 0 | 0 |" in report
+    assert "| thruster_bias (→ actuator) | 0 | 0 | 0 | 0 | 0 | 0 | 1 |" in report
+    # per campaign group: a and b form "faulty" (its nominal cycles are a's sc1); c, with no
+    # campaign.json, is its own group by its id
+    assert "| faulty | main | 50% (1/2) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | " \
+        "0.0000 (0/2; 95% ≤ 0.78) |" in report
+    assert "| c | main | - | - | - | - / - / - | 0.5000 (1/2; 95% ≤ 0.97) |" in report
+    # persistence re-scored: one window in a row declares run a's fault at 100 s, three never
+    # do (it has two windows), and c's false alarm needs only two
+    fa = "0.2500 (1/4; 95% ≤ 0.75) |"
+    assert "| 1 of 1 | 50% (1/2) | 50% (1/2) | 100 / 100 / 100 | " + fa in report
+    assert "| 2 of 2 (as run) | 50% (1/2) | 50% (1/2) | 200 / 200 / 200 | " + fa in report
+    assert "| 3 of 3 | 0% (0/2) | 0% (0/2) | - / - / - | 0.0000 (0/4; 95% ≤ 0.53) |" in report
+    # margins H_m/τ by the fault active in the window: a's sc1 and c's windows are nominal
+    assert "| nominal | 4 | 0.7 | 1.39 | 1.4 | 50% (2/4) |" in report
+    assert "| camera_degradation | 2 | 10 | 10 | 10 | 100% (2/2) |" in report
+    assert "| thruster_bias | 2 | 0.6 | 0.6 | 0.6 | 0% (0/2) |" in report
+    rows = list(csv.DictReader(open(campaign / "results.csv")))
+    assert [r["group"] for r in rows] == ["faulty", "faulty", "faulty", "c"]
+    assert [(r["run"], r["detector"], r["kind"]) for r in rows] == [
+        ("a", "main", "camera_degradation"), ("a", "cusum", "camera_degradation"),
+        ("b", "main", "thruster_bias"), ("c", "main", "none")]
+    for png in ("roc.png", "confusion.png", "latency.png", "margins.png"):
+        assert (campaign / png).stat().st_size > 5000
+
+
+def test_roc_rescoring(campaign: Path) -> None:
+    fa, det = _roc(load_runs(campaign, ["a", "b", "c"]), "main")
+    one = int(np.argmin(np.abs(SCALES - 1.0)))
+    # at the configured threshold: the camera fault detected, the thruster fault missed; one
+    # false alarm (run c) in 4 nominal windows (run a sc1, run c sc1)
+    assert det[one] == pytest.approx(0.5) and fa[one] == pytest.approx(0.25)
+    low = int(np.argmin(np.abs(SCALES - 0.5)))  # threshold 0.025: the 0.03 fault is caught,
+    assert det[low] == pytest.approx(1.0)  # and the nominal sc1 of run a (0.01) still quiet
+    assert fa[low] == pytest.approx(0.25)
+    assert det[-1] == 0.0 and fa[-1] == 0.0  # threshold 0.5: nothing
+    assert np.all(np.diff(det) <= 0)  # fewer detections as the threshold rises
+
+
+def test_roc_scores_like_the_run(tmp_path: Path) -> None:
+    """At scale 1 the ROC gives the run's own scores: a fault is detected by an alarm on any
+    spacecraft while it is active (not only its own), and link or data-integrity
+    declarations, which no threshold scales, count at every scale."""
+    faults = [{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0, "end_s": None,
+               "magnitude": 0.5},
+              {"spacecraft": 3, "kind": "link_loss", "start_s": 0.0, "end_s": 150.0,
+               "magnitude": None}]
+    run = _run({"injected_faults": faults, "detections": [_detection(3, 200.0, "link")],
+                "fdir_series": {"main": [[1, 0, 100, 0.2, 0.05], [1, 100, 200, 0.2, 0.05],
+                                         [2, 0, 100, 0.01, 0.05], [2, 100, 200, 0.01, 0.05]]}})
+    fa, det = _roc([run], "main")
+    one = int(np.argmin(np.abs(SCALES - 1.0)))
+    assert det[one] == 1.0  # sc1's alarm at 200 s falls in sc2's fault: detected
+    assert fa[one] == 0.5  # ... and a false alarm on sc1, whose 2 windows are nominal
+    # at 10x only the link declaration on sc3 remains: it detects the link fault, and, being
+    # an alarm while sc2's fault is active, "detects" that one too (detection counts any
+    # alarm; isolation, in the tables, needs the right spacecraft)
+    assert det[-1] == 1.0 and fa[-1] == 0.0
+
+
+def test_magnitude_bins() -> None:
+    rows = [{"kind": "k", "magnitude": m, "run": str(i), "fault_index": 0}
+            for i, m in enumerate([4.0, 5.5, 7.0, 8.5, 10.0, 13.0])]
+    bins = _magnitude_bins(rows)
+    assert list(bins) == [("k", "4–7"), ("k", "7–10"), ("k", "10–13")]  # numeric order
+    assert [len(v) for v in bins.values()] == [2, 2, 2]
+    few = _magnitude_bins(rows[:3])
+    assert list(few) == [("k", "4"), ("k", "5.5"), ("k", "7")]
+
+
+def test_m_of_n_persistence() -> None:
+    """m exceedances among the last n windows declare once per episode; m == n is n in a row
+    (threshold.Persistence)."""
+    def series(levels: list[float]) -> list[MainWindow]:
+        return [MainWindow(spacecraft=1, t_start_s=100.0 * i, t_end_s=100.0 * (i + 1),
+                           statistic=h, threshold=0.05) for i, h in enumerate(levels)]
+
+    gappy = series([0.1, 0.0, 0.1, 0.1, 0.1, 0.0, 0.0, 0.0, 0.1, 0.0, 0.1])
+    assert [a.t_s for a in _alarms_at(gappy, 1.0, 2, 2)] == [400.0]
+    assert [a.t_s for a in _alarms_at(gappy, 1.0, 2, 3)] == [300.0, 1100.0]
+    assert [a.t_s for a in _alarms_at(gappy, 1.0, 1, 1)] == [100.0, 300.0, 900.0, 1100.0]
+    assert _alarms_at(gappy, 3.0, 1, 1) == []  # threshold scaled above every level
+
+
+def test_windows_failed_on_other_tests_count_at_every_threshold_scale() -> None:
+    """A main-detector window failed by the plan, pointing, Δv or NIS test (sixth value 1) is
+    exceeded whatever the information threshold's scale; a five-value row (a summary written
+    before the flag) is judged on H_m alone."""
+    rows = [[1, 0.0, 30.0, 0.001, 0.05, 1.0], [1, 30.0, 60.0, 0.001, 0.05, 0.0]]
+    nis_only = [MainWindow.model_validate(r) for r in rows]
+    assert [a.t_s for a in _alarms_at(nis_only, 1.0, 1, 1)] == [30.0]
+    assert [a.t_s for a in _alarms_at(nis_only, 100.0, 1, 1)] == [30.0]
+    assert _alarms_at([MainWindow.model_validate(r[:5]) for r in rows], 1.0, 1, 1) == []
+
+
+def test_the_report_says_when_summaries_lack_the_other_tests(tmp_path: Path) -> None:
+    """Re-scoring from five-value rows undercounts the main detector: the report says so."""
+    base = {"injected_faults": [], "duration_s": 60.0, "scores": _scores([], 0, 2)}
+    _write(tmp_path, "old", base | {"fdir_series": {"main": [[1, 0, 30, 0.01, 0.05]]}})
+    _write(tmp_path, "new", base | {"fdir_series": {"main": [[1, 0, 30, 0.01, 0.05, 0.0]]}})
+    write_campaign_report(tmp_path, "x", ["old", "new"])
+    assert "1 of 2 runs' summaries predate" in (tmp_path / "report.md").read_text()
+    write_campaign_report(tmp_path, "x", ["new"])
+    assert "predate" not in (tmp_path / "report.md").read_text()
+
+
+def test_the_global_checks_declaration_counts_in_the_rescoring() -> None:
+    """A common-mode fault (spacecraft 0) is isolated by the global check, which has no rows in
+    ``fdir_series`` (hard campaign, late-common-mode-0000: H 0.33 against 0.031 at 3,300 s):
+    the re-scoring keeps it while its statistic passes the scaled threshold."""
+    run = _run({"injected_faults": [{"spacecraft": 0, "kind": "camera_calibration",
+                                     "start_s": 3274.1, "magnitude": 0.6}],
+                "fdir_settings": {"fdi_period_s": 30.0, "persistence": 1},
+                "detections": [_detection(0, 3300.0, "common_mode", 0.33, 0.031)],
+                "fdir_series": {"main": [[1, 3270.0, 3300.0, 0.01, 0.05, 0.0]]}})
+    for scale, isolated in ((1.0, True), (10.0, True), (11.0, False)):
+        (fault,) = _rescore([run], "main", scale).per_fault
+        assert fault.isolated is isolated, scale
+
+
+def test_a_replays_main_detector_is_scored_over_its_faithful_span(tmp_path: Path) -> None:
+    """A replay's declarations after its uplinks left the flown run's judge a trajectory nobody
+    commanded: the report's main detector counts the faithful span's false alarms (0 here), the
+    replay table's whole-run column the whole run's (2)."""
+    whole, faithful = _scores([], 2, 10), _scores([], 0, 8)
+    _write(tmp_path, "r", {"injected_faults": [], "duration_s": 100.0, "scores": whole,
+                           "replay": {"settings": {"fdir.persistence": "1"}, "wall_s": 1.0,
+                                      "faithful_until_s": 80.0, "matches_live": False,
+                                      "scores_faithful": faithful},
+                           "fdir_series": {"main": []}})
+    write_campaign_report(tmp_path, "x", ["r"])
+    main = [r for r in csv.DictReader(open(tmp_path / "results.csv"))
+            if r["detector"] == "main"]
+    assert [(r["false_alarms"], r["nominal_cycles"]) for r in main] == [("0", "8")]
+    figures = detector_figures(tmp_path, ["r"])
+    assert (figures["false_alarms"], figures["false_alarms_faithful"]) == (2, 0)
+
+
+def test_faults_before_the_first_judged_window_are_reported_apart(tmp_path: Path) -> None:
+    """A fault injected at 10 s on an observer whose first judged window opens at 150 s and
+    declared at 180 s: 170 s from onset, 30 s from the first window that could judge it; a
+    fault at 400 s on a judged observer counts among the later ones."""
+    _write(tmp_path, "e", {
+        "injected_faults": [{"spacecraft": 2, "kind": "pointing_actuator", "start_s": 10.0,
+                             "end_s": None, "magnitude": 4.0},
+                            {"spacecraft": 1, "kind": "thruster_bias", "start_s": 400.0,
+                             "end_s": None, "magnitude": 0.3}],
+        "scores": _scores([_fault(2, "pointing_actuator", 10.0, True, 170.0, "actuator",
+                                  "actuator"),
+                           _fault(1, "thruster_bias", 400.0, True, 40.0, "actuator",
+                                  "actuator")], 0, 4),
+        "fdir_series": {"main": [[1, 60, 90, 0.01, 0.05], [2, 150, 180, 0.5, 0.05],
+                                 [2, 180, 210, 0.5, 0.05]]}})
+    report = write_campaign_report(tmp_path, "x", ["e"]).read_text()
+    assert ("| began before their observer's first judged window | 1 | 170 / 170 / 170 | "
+            "30 / 30 / 30 |") in report
+    assert "| began later | 1 | 40 / 40 / 40 | - |" in report
+    main = [r for r in csv.DictReader(open(tmp_path / "results.csv"))
+            if r["detector"] == "main"]
+    assert [float(r["judgeable_s"]) for r in main] == [150.0, 400.0]
+
+
+def test_a_malformed_summary_is_refused_naming_its_file_and_field(tmp_path: Path) -> None:
+    """A summary that is not one stops the report with pydantic's account of the field at
+    fault, and the file it is in, rather than a KeyError deep in a figure."""
+    _write(tmp_path, "ok", {"injected_faults": [], "scores": _scores([], 0, 1)})
+    bad = tmp_path / "runs" / "bad"
+    bad.mkdir()
+    text = (tmp_path / "runs" / "ok" / "summary.json").read_text()
+    (bad / "summary.json").write_text(text.replace('"nominal_cycles": 1', '"nominal_cycles": -1'))
+    with pytest.raises(SummaryError, match=r"runs/bad/summary\.json: .*\nscores\.nominal_cycles\n"
+                                           r".*greater than or equal to 0"):
+        write_campaign_report(tmp_path, "x", ["ok", "bad"])
