@@ -31,7 +31,7 @@ The sim's kinds act on the truth, as a failing unit would:
   sensors, as they would after an unplanned impulse, and steer back to the plan.
 
 The link kinds (``link_loss``, ``packet_loss``) act in every node's channel stage
-(``faults/link.py``) and ``faulty_data`` in the faulty spacecraft's software
+(``links/faults.py``) and ``faulty_data`` in the faulty spacecraft's software
 (``faults/software.py``); the injector switches them too, so that the truth of every fault is
 archived.
 

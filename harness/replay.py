@@ -54,7 +54,7 @@ from interfaces.contracts.messages import (
 from interfaces.contracts.scenario import Scenario, ScenarioError
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
-from interfaces.runtime.channel import ChannelModel
+from links.channel import ChannelModel
 from interfaces.runtime.executive import TickClient
 from interfaces.runtime.transport import InprocNetwork, Sample
 

@@ -23,14 +23,14 @@ What the Bus guarantees, identically on every transport:
 * **Channel.** Messages between two different spacecraft/ground nodes pass the receiver's
   ``ChannelModel`` (range at send time, loss, cuts, delay) at dispatch.  With ground passes
   the space-ground ones wait there (stored onboard, or held on the ground) and come back
-  from it when they reach the receiver (``interfaces.runtime.space_ground``).
+  from it when they reach the receiver (``links.space_ground``).
 * **Barrier.** ``wait_for(expect)`` blocks until the messages announced in a Tick have arrived.
 * **Recovery.** Each node keeps what it sent in its last ticks and sends it again to a node that
   asks (``interfaces.runtime.recent``): ``recover`` fetches what a tick announced and never came.
 
 The Bus's parts of their own: the subscription table (``interfaces.runtime.subscriptions``), the
 inbox of deferred messages with the delivery order and the barrier (``interfaces.runtime.inbox``),
-admission (``interfaces.runtime.admission``), the channel stage (``interfaces.runtime.channel``)
+admission (``interfaces.runtime.admission``), the channel stage (``links.channel``)
 and the schema service (``interfaces.runtime.schemas``).
 """
 
@@ -48,7 +48,7 @@ from pydantic import ValidationError
 from interfaces.contracts import catalogue, topics
 from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
-from interfaces.runtime.channel import ChannelModel, Verdict
+from links.channel import ChannelModel, Verdict
 from interfaces.runtime.inbox import Envelope, Inbox
 from interfaces.runtime.recent import RECENT_TICKS, RecentSent, fetch
 from interfaces.runtime.schemas import serve_schemas

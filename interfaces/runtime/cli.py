@@ -15,7 +15,7 @@ from interfaces.contracts import topics
 from interfaces.contracts.topology import topology
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore
-from interfaces.runtime.channel import ChannelModel
+from links.channel import ChannelModel
 from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.recent import depth_for
 from interfaces.runtime.restart import resume

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from interfaces.contracts import topics
 from interfaces.contracts.messages import Message
 from interfaces.contracts.timing import TIME_TOL_S
-from interfaces.runtime.channel import applies
+from links.channel import applies
 from interfaces.runtime.subscriptions import Sub
 
 

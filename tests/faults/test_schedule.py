@@ -1,4 +1,4 @@
-"""When and where injected faults act (faults/schedule.py, faults/link.py): a hardware or
+"""When and where injected faults act (faults/schedule.py, links/faults.py): a hardware or
 software fault switches on the tick at its start and off the tick at its end, whatever the
 tick time's rounding; a link fault acts on the messages sent in [start, end), a cut on every
 link of its spacecraft, a packet loss with its own draws on the faulty spacecraft's links
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from faults.link import LinkCutWindow, LinkFaults
+from links.faults import LinkCutWindow, LinkFaults
 from faults.schedule import HARDWARE_KINDS, LINK_KINDS, SOFTWARE_KINDS, end_s, switched_on
 from interfaces.contracts.scenario import Fault
 

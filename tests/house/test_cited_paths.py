@@ -9,10 +9,10 @@ from pathlib import Path
 from tests.conftest import REPO
 
 CITED = re.compile(
-    r"(?<![\w./-])((?:interfaces|gnc|faults|fsw|sim|ground|harness|deploy|docs|benchmarks|tests)"
+    r"(?<![\w./-])((?:interfaces|gnc|faults|links|fsw|sim|ground|harness|deploy|docs|benchmarks|tests)"
     r"/[\w./-]*\w\.(?:py|md|toml))")
-SOURCES = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "harness", "deploy", "benchmarks",
-           "tests", "docs")
+SOURCES = ("interfaces", "gnc", "faults", "links", "fsw", "sim", "ground", "harness", "deploy",
+           "benchmarks", "tests", "docs")
 
 
 def _citing_files() -> list[Path]:

@@ -15,7 +15,7 @@ from pathlib import Path
 from tests.conftest import REPO
 from tests.house.test_import_rules import _imports
 
-PACKAGES = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "harness", "deploy")
+PACKAGES = ("interfaces", "gnc", "faults", "links", "fsw", "sim", "ground", "harness", "deploy")
 
 _PART = "a part of a package that re-exports every name it holds; tests import them from {}"
 _MESSAGES = _PART.format(

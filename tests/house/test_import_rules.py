@@ -14,8 +14,8 @@ import pytest
 
 from tests.conftest import REPO
 
-PROJECT = ("interfaces", "gnc", "faults", "fsw", "sim", "ground", "harness", "deploy", "benchmarks",
-           "tests")
+PROJECT = ("interfaces", "gnc", "faults", "links", "fsw", "sim", "ground", "harness", "deploy",
+           "benchmarks", "tests")
 
 
 def _imports(path: Path) -> set[str]:
@@ -46,9 +46,9 @@ def _violations(room: str, allowed: tuple[str, ...], root: Path = REPO) -> list[
     return bad
 
 
-RUNTIME_MAY = ("interfaces.contracts", "interfaces.runtime", "faults.link", "faults.schedule",
+RUNTIME_MAY = ("interfaces.contracts", "interfaces.runtime", "links", "faults.schedule",
                "gnc.mission", "gnc.passes")
-"""The runtime's channel stage applies the link faults (``faults/link.py``) and the ground's
+"""The runtime's channel stage applies the link faults (``links/faults.py``) and the ground's
 contact windows (``gnc/passes.py``), and an app's context carries the mission's constants
 (``gnc/mission.py``)."""
 
@@ -71,8 +71,8 @@ def test_fault_injection_imports_only_the_contracts_the_library_and_itself() -> 
 
 def test_the_link_faults_import_no_library() -> None:
     """The channel stage of every process loads them: the contracts are all they need."""
-    for room in ("faults.link", "faults.schedule"):
-        assert _violations(room, ("interfaces.contracts", "faults")) == []
+    for room in ("links.faults", "faults.schedule"):
+        assert _violations(room, ("interfaces.contracts", "faults", "links")) == []
 
 
 @pytest.mark.parametrize("room", ["fsw", "sim", "ground"])

@@ -18,7 +18,7 @@ from interfaces.contracts.topology import topology
 from interfaces.runtime.app import App
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
-from interfaces.runtime.channel import ChannelModel
+from links.channel import ChannelModel
 from interfaces.runtime.checkpoint import capture, restore
 from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.transport import InprocNetwork

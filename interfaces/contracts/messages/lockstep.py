@@ -96,7 +96,7 @@ class ExecStats(Message):
 
 class OverflowRun(BaseModel):
     """Messages of one topic that an onboard store could not keep, sent no more than
-    ``MERGE_GAP_S`` apart (``interfaces/runtime/onboard_store.py``)."""
+    ``MERGE_GAP_S`` apart (``links/onboard_store.py``)."""
 
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
     MERGE_GAP_S: ClassVar[float] = 10.0

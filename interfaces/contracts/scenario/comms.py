@@ -1,4 +1,4 @@
-"""The links between nodes, as the channel stage models them (``interfaces/runtime/channel.py``):
+"""The links between nodes, as the channel stage models them (``links/channel.py``):
 range, loss, bursts, delay, scheduled cuts."""
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ from interfaces.contracts.messages import Tick
 from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
-from interfaces.runtime.channel import ChannelModel
+from links.channel import ChannelModel
 from interfaces.runtime.checkpoint import capture, restore
 from interfaces.runtime.executive import TickClient
 from interfaces.runtime.transport import InprocNetwork

@@ -12,7 +12,7 @@ from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore, read_starts, write_run_key
-from interfaces.runtime.channel import ChannelModel
+from links.channel import ChannelModel
 from interfaces.runtime.executive import TickClient
 from interfaces.runtime.restart import resume
 from interfaces.runtime.transport import InprocNetwork

@@ -1,9 +1,9 @@
 """The links between the spacecraft and the ground when the ground hears only in passes
 (``[ground] contact = "passes"``; docs/architecture.md, "Ground passes"): the part of a
-node's channel stage (``interfaces.runtime.channel``) that holds what crosses them.
+node's channel stage (``links.channel``) that holds what crosses them.
 
 * **Downlink** (into the ground): every message a spacecraft sends the ground goes into that
-  spacecraft's onboard store (``interfaces.runtime.onboard_store``) and reaches the ground
+  spacecraft's onboard store (``links.onboard_store``) and reaches the ground
   when the dump brings it down, the link's delay later.  The dump's link is up in a contact
   window while the spacecraft's link is neither cut nor out of range of the target (the
   ground is reached through it); each transmission draws the link's loss.
@@ -30,10 +30,10 @@ from interfaces.contracts.messages import LinkCounter, Message
 from interfaces.contracts.scenario import Ground
 from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.contracts.topics import GROUND, spacecraft_of
-from interfaces.runtime.onboard_store import OnboardStore
+from links.onboard_store import OnboardStore
 
 if TYPE_CHECKING:
-    from interfaces.runtime.channel import ChannelModel
+    from links.channel import ChannelModel
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""The onboard store and its dump (interfaces/runtime/onboard_store.py) against hand-computed
+"""The onboard store and its dump (links/onboard_store.py) against hand-computed
 times: a dump at the stated rate in priority order, overflow by the stated rule with every
 message accounted for, a lost transmission sent again, and results that do not depend on how
 often the store is asked."""
@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import pytest
 
 from interfaces.contracts.messages import Heartbeat, Message
-from interfaces.runtime.onboard_store import RETRY_S, OnboardStore, message_bytes
+from links.onboard_store import RETRY_S, OnboardStore, message_bytes
 
 RATE_BPS = 8000.0
 """1000 bytes per second: a message of s bytes takes s ms on the air."""

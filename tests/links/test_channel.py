@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from interfaces.contracts.scenario import Burst, Comms, Fault, LinkCut
-from interfaces.runtime.channel import (
+from links.channel import (
     ChannelModel,
     TruthHistory,
     Verdict,

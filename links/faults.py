@@ -1,7 +1,7 @@
 """Link fault injection: a spacecraft's ``link_loss`` cuts every link it has, and its
 ``packet_loss`` adds an independent loss probability (``magnitude``) on each, both for the
 messages sent in [start_s, end_s) (``faults/schedule.py``).  The receiving node's channel stage
-(``interfaces/runtime/channel.py``) asks for both on every cross-link message.
+(``links/channel.py``) asks for both on every cross-link message.
 
 A ``packet_loss`` fault draws from a stream of its own per directed link
 (``link-fault:<src>-><receiver>``), so the link's nominal loss draws are the same with and

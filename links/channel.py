@@ -7,13 +7,13 @@ transport or on arrival order:
 * range: delivered only when the two ends are within ``comms.range_m`` at the *send* time, using
   the sim's truth positions (LVLH, m).  The ground is reached through the target, at the origin.
 * cuts: scheduled link cuts (``comms.cuts``), ``link_loss`` faults (every link of the faulty
-  spacecraft: ``faults/link.py``) and injected ones (``cut``) drop everything.
+  spacecraft: ``links/faults.py``) and injected ones (``cut``) drop everything.
 * loss: Bernoulli with ``comms.packet_loss``, or Gilbert-Elliott bursts with the same mean loss
   rate and a mean burst length ``comms.burst.mean_length_packets`` (Gilbert 1960, Elliott 1963:
   two-state Markov chain, loss in the bad state).  Every directed link has its own generator
   seeded from the scenario seed and the link name.  A ``packet_loss`` fault adds an independent
   Bernoulli loss (its ``magnitude``) on every link of its spacecraft, from a separate stream
-  (``faults/link.py``).
+  (``links/faults.py``).
 * delay: a fixed ``comms.delay_s``; the Bus holds a message until the receiver's time reaches
   send time + delay (and at least one tick).
 
@@ -36,13 +36,13 @@ from typing import Any
 
 import numpy as np
 
-from faults.link import LinkFaults
+from links.faults import LinkFaults
 from gnc.passes import ContactPlan
 from interfaces.contracts.messages import LinkCounter, Message, TruthState
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Comms, Fault, Ground, LinkCut, Scenario
 from interfaces.contracts.topics import GROUND, spacecraft_of
-from interfaces.runtime.space_ground import SpaceGroundLink
+from links.space_ground import SpaceGroundLink
 
 
 class Verdict(Enum):
@@ -177,7 +177,7 @@ class ChannelModel:
     """Where the true positions come from (shared by the channel models of one process)."""
     ground: Ground = field(default_factory=Ground)
     """How the ground hears: with ``contact = "passes"``, the space-ground links wait for the
-    contact windows (``interfaces.runtime.space_ground``)."""
+    contact windows (``links.space_ground``)."""
     _links: dict[str, _Link] = field(default_factory=dict)
     _cuts: list[_Cut] = field(default_factory=list)
     contact: InitVar[ContactPlan | None] = None

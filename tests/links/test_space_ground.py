@@ -1,4 +1,4 @@
-"""The space-ground links with ground passes (interfaces/runtime/space_ground.py, through the
+"""The space-ground links with ground passes (links/space_ground.py, through the
 channel stage that owns them): a downlink waits in the store for the pass and comes down at
 the stated rate, an uplink sent out of contact waits on the ground for the acquisition, and a
 link cut for a whole pass keeps everything aboard for the next one, accounted for."""
@@ -10,10 +10,10 @@ import pytest
 from gnc.passes import ContactPlan
 from interfaces.contracts.messages import Heartbeat, ProAssignments
 from interfaces.contracts.scenario import Comms, Ground, LinkCut, Station
-from interfaces.runtime.channel import ChannelModel, TruthHistory
+from links.channel import ChannelModel, TruthHistory
 from interfaces.runtime.inbox import Envelope
-from interfaces.runtime.onboard_store import message_bytes
-from interfaces.runtime.space_ground import SpaceGroundLink
+from links.onboard_store import message_bytes
+from links.space_ground import SpaceGroundLink
 
 GROUND = Ground(contact="passes", downlink_bps=8000.0,
                 stations=[Station(name="st", latitude_deg=48.0, longitude_deg=11.0)])
