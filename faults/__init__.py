@@ -4,8 +4,8 @@
 
 * ``hardware.py``: the sim's units (thrusters, wheels, cameras, the relative-navigation
   sensor), the faults a failing unit would cause; the sim hands its units to the injector;
-* ``link.py``: a spacecraft's links (``link_loss``, ``packet_loss``), applied by every
-  receiving node's channel stage (``links/channel.py``);
+* a spacecraft's links (``link_loss``, ``packet_loss``): the simulated radio's own
+  (``links/faults.py``), applied by every receiving node's channel stage;
 * ``software.py``: a spacecraft's own software (``faulty_data``: a corrupted H_i report),
   hooked in by its builder (``fsw/spacecraft.py``).
 

@@ -11,6 +11,7 @@ from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import add_node_args, run_participant
 from interfaces.runtime.executive import Executive
+from links.channel import ChannelModel
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -26,7 +27,7 @@ def main(argv: list[str] | None = None) -> int:
         except ValueError as e:
             raise SystemExit(f"spacecraft {args.spacecraft} is not in this scenario: {e}") from e
 
-    return run_participant(args, node, build)
+    return run_participant(args, node, build, ChannelModel.of)
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import add_node_args, run_participant
 from interfaces.runtime.executive import Executive
+from links.channel import ChannelModel
 
 
 def _build(bus: Bus, scenario: Scenario) -> Executive:
@@ -20,7 +21,7 @@ def _build(bus: Bus, scenario: Scenario) -> Executive:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m ground", description=__doc__)
     add_node_args(parser)
-    return run_participant(parser.parse_args(argv), topics.GROUND, _build)
+    return run_participant(parser.parse_args(argv), topics.GROUND, _build, ChannelModel.of)
 
 
 if __name__ == "__main__":

@@ -17,32 +17,30 @@ transport or on arrival order:
 * delay: a fixed ``comms.delay_s``; the Bus holds a message until the receiver's time reaches
   send time + delay (and at least one tick).
 
-The channel is a stage of its own between sender and receivers: the receiving Bus asks its
-``decide`` for every cross-link message, in delivery order.  The truth it reads is a
-:class:`TruthHistory`, one per process, fed by the sim's TruthState through a single
-subscription however many nodes the process hosts; positions are made from a truth message only
-for the times a delivery is decided.
+The channel is a stage of its own between sender and receivers: it is the link stage the
+runtime declares (``interfaces.runtime.link_stage``), and the receiving Bus asks its
+``transmit`` for every cross-link message, in delivery order.  The truth it reads is a
+:class:`links.truth.TruthHistory`, one per process.  With ground passes, what waits on the
+space-ground links is the ``SpaceGroundLink``'s (``links.space_ground``).
 """
 
 from __future__ import annotations
 
-import bisect
 import math
-import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import InitVar, dataclass, field
 from enum import Enum
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
-from links.faults import LinkFaults
 from gnc.passes import ContactPlan
 from interfaces.contracts.messages import LinkCounter, Message, TruthState
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Comms, Fault, Ground, LinkCut, Scenario
-from interfaces.contracts.topics import GROUND, spacecraft_of
+from links.faults import LinkFaults
 from links.space_ground import SpaceGroundLink
+from links.truth import TruthHistory, history_for
 
 
 class Verdict(Enum):
@@ -95,74 +93,6 @@ def _end_matches(pattern: str, node: str) -> bool:
     return pattern == "*" or pattern == node
 
 
-@dataclass(eq=False)
-class TruthHistory:
-    """The sim's truth positions (LVLH, m) of the last ``horizon_s`` seconds, by sim time, as the
-    channel models of one process read them (thread-safe).  The first Bus whose channel reads it
-    feeds it (``claim_feed``), with the TruthState messages as they come; a time's positions are
-    converted when a delivery first asks for them."""
-
-    horizon_s: float = 60.0
-    """History kept behind the newest truth (s): at least the link delay and a margin."""
-    _t: list[float] = field(default_factory=list)
-    _pos: list[dict[str, np.ndarray] | tuple[list[int], list[list[float]]]] = field(
-        default_factory=list)
-    _fed: bool = False
-    _lock: threading.Lock = field(default_factory=threading.Lock)
-
-    def claim_feed(self) -> bool:
-        """True for the first caller only: it subscribes ``observe`` to the sim's truth."""
-        with self._lock:
-            first, self._fed = not self._fed, True
-        return first
-
-    def observe(self, msg: TruthState) -> None:
-        """Bus handler of the sim's TruthState."""
-        self.record(msg.t_sim, msg.spacecraft, msg.r_lvlh_m)
-
-    def record(self, t_sim: float, spacecraft: list[int], r_lvlh_m: list[list[float]]) -> None:
-        """Record the true positions (m) of ``spacecraft`` at ``t_sim`` (s)."""
-        with self._lock:
-            i = bisect.bisect_right(self._t, t_sim)
-            if i > 0 and self._t[i - 1] == t_sim:
-                self._pos[i - 1] = (spacecraft, r_lvlh_m)
-                return
-            self._t.insert(i, t_sim)
-            self._pos.insert(i, (spacecraft, r_lvlh_m))
-            old = bisect.bisect_left(self._t, self._t[-1] - self.horizon_s)
-            if old > 0:
-                del self._t[:old]
-                del self._pos[:old]
-
-    def checkpoint(self, since_s: float) -> tuple[list[float], list[object]]:
-        """The history (times, positions) that ``positions_at`` reads for times from
-        ``since_s`` (s) on, for a node's critical-data store."""
-        with self._lock:
-            i = max(0, bisect.bisect_right(self._t, since_s + 1e-6) - 1)
-            return self._t[i:], self._pos[i:]
-
-    def restore(self, saved: tuple[list[float], list[object]]) -> None:
-        """Take back a ``checkpoint``."""
-        with self._lock:
-            self._t, self._pos = list(saved[0]), list(saved[1])  # type: ignore[arg-type]
-
-    def positions_at(self, t: float) -> dict[str, np.ndarray] | None:
-        """Positions by node (the ground at the origin) at the latest truth time <= t
-        (+1 µs tolerance), or None if there is none."""
-        with self._lock:
-            i = bisect.bisect_right(self._t, t + 1e-6)
-            if i == 0:
-                return None
-            pos = self._pos[i - 1]
-            if isinstance(pos, tuple):
-                spacecraft, r_lvlh_m = pos
-                pos = {f"sc{sc}": np.asarray(r, dtype=float)
-                       for sc, r in zip(spacecraft, r_lvlh_m)}
-                pos[GROUND] = np.zeros(3)
-                self._pos[i - 1] = pos
-            return pos
-
-
 @dataclass
 class ChannelModel:
     """The channel as seen by one receiving node (``receiver``: "sc<N>" or "ground")."""
@@ -208,14 +138,20 @@ class ChannelModel:
 
     @property
     def delay_s(self) -> float:
+        """The links' fixed delay, s (``comms.delay_s``)."""
         return self.comms.delay_s
+
+    @property
+    def plan(self) -> ContactPlan | None:
+        """The ground's contact windows (None: it hears continuously)."""
+        return None if self.passes is None else self.passes.plan
 
     # --- inputs --------------------------------------------------------------------------
 
-    def observe_truth(self, t_sim: float, spacecraft: list[int],
-                      r_lvlh_m: list[list[float]]) -> None:
-        """Record true positions (m) at ``t_sim`` (s) in this model's truth history."""
-        self.truth.record(t_sim, spacecraft, r_lvlh_m)
+    def truth_feed(self) -> Callable[[TruthState], None] | None:
+        """The handler of the sim's truth for the first Bus of the process to ask (its truth
+        history is shared by the process's channel models); None for the others."""
+        return self.truth.observe if self.truth.claim_feed() else None
 
     def cut(self, a: str, b: str = "*", start_s: float = 0.0, end_s: float = math.inf) -> None:
         """Inject a link cut (e.g. a ``link_loss`` fault)."""
@@ -224,42 +160,56 @@ class ChannelModel:
 
     # --- decision ------------------------------------------------------------------------
 
+    def transmit(self, src: str, key: str, msg: Message,
+                 envelope: object) -> Literal["deliver", "drop", "wait"]:
+        """One message from ``src`` on ``key`` (the runtime's link stage): with ground passes
+        one that must wait on a space-ground link (stored onboard, or held on the ground until
+        a pass) is taken, to come back from ``released``; any other is judged now
+        (``decide``, counted)."""
+        if self.passes is not None and self.passes.takes(src, key, msg, envelope):
+            return "wait"
+        return "deliver" if self.delivers(src, msg.t_sim) else "drop"
+
     def decide(self, src: str, t_send: float) -> Verdict:
         """Fate of one message from ``src`` sent at ``t_send``; updates the link counters.
 
         Call in a deterministic order (the Bus sorts by send time, key, sequence)."""
         link = self._link(src)
+        blocked = self._blocked(src, t_send)
+        if blocked is None:
+            return Verdict.LOSS if self.lose(src, t_send) else Verdict.DELIVER
         link.counter.sent += 1
-        verdict = self._verdict(link, src, t_send)
-        if verdict is Verdict.DELIVER:
-            link.counter.delivered += 1
-        elif verdict is Verdict.RANGE:
+        if blocked is Verdict.RANGE:
             link.counter.dropped_range += 1
-        elif verdict is Verdict.LOSS:
-            link.counter.dropped_loss += 1
         else:
             link.counter.dropped_cut += 1
-        return verdict
+        return blocked
 
     def delivers(self, src: str, t_send: float) -> bool:
         """Whether ``decide`` delivers the message."""
         return self.decide(src, t_send) is Verdict.DELIVER
 
-    def takes(self, src: str, key: str, msg: Message, env: object) -> bool:
-        """With ground passes, take a message that must wait on a space-ground link (stored
-        onboard, or held on the ground until a pass); the Bus then gets it from
-        ``released``.  False: ``decide`` judges it now."""
-        return self.passes is not None and self.passes.takes(src, key, msg, env)
+    def link_up(self, src: str, t_s: float) -> bool:
+        """Whether the link from ``src`` is up at ``t_s`` (s): not cut, and in range."""
+        return self._blocked(src, t_s) is None
+
+    def lose(self, src: str, t_s: float) -> bool:
+        """One transmission from ``src`` at ``t_s`` (s) on a link that is up: whether it is
+        lost (drawn once from the link's stream), counted on the link as sent and as lost or
+        delivered."""
+        link = self._link(src)
+        link.counter.sent += 1
+        lost = self._lost(link, src, t_s)
+        if lost:
+            link.counter.dropped_loss += 1
+        else:
+            link.counter.delivered += 1
+        return lost
 
     def released(self, t_now: float) -> list[Any]:
-        """The envelopes taken (``takes``) that reach the receiver by ``t_now`` (s), in order."""
+        """The envelopes taken (``transmit`` gave ``"wait"``) that reach the receiver by
+        ``t_now`` (s), in order."""
         return [] if self.passes is None else self.passes.released(t_now, self)
-
-    def _verdict(self, link: _Link, src: str, t_send: float) -> Verdict:
-        blocked = self._blocked(src, t_send)
-        if blocked is not None:
-            return blocked
-        return Verdict.LOSS if self._lost(link, src, t_send) else Verdict.DELIVER
 
     def _blocked(self, src: str, t: float) -> Verdict | None:
         """CUT or RANGE when the link from ``src`` is down at ``t`` (s), else None."""
@@ -300,18 +250,24 @@ class ChannelModel:
             self._links[src] = link
         return link
 
-    def checkpoint(self, since_s: float) -> dict[str, object]:
-        """What this model learnt while running (each link's random stream, burst state and
-        counters, the cuts, the link-fault streams, the truth history from ``since_s`` on), for
-        a node's critical-data store; the values are the model's own (pickle them at once)."""
-        return {"links": self._links, "cuts": self._cuts,
-                "fault_streams": self._faults.streams, "truth": self.truth.checkpoint(since_s)}
+    # --- restarts ------------------------------------------------------------------------
 
-    def restore(self, saved: dict[str, Any]) -> None:
-        """Take back a ``checkpoint``."""
+    def checkpoint(self, since_s: float, pack: Callable[[Any], Any]) -> dict[str, Any]:
+        """What this model learnt while running (each link's random stream, burst state and
+        counters, the cuts, the link-fault streams, the truth history from ``since_s`` on, and
+        what waits on the space-ground links, each envelope as ``pack(envelope)``), for a
+        node's critical-data store; the values are the model's own (pickle them at once)."""
+        return {"links": self._links, "cuts": self._cuts,
+                "fault_streams": self._faults.streams, "truth": self.truth.checkpoint(since_s),
+                "passes": None if self.passes is None else self.passes.with_envelopes(pack)}
+
+    def restore(self, saved: dict[str, Any], unpack: Callable[[Any], Any]) -> None:
+        """Take back a ``checkpoint``, each waiting envelope as ``unpack(packed)``."""
         self._links, self._cuts = saved["links"], saved["cuts"]
         self._faults.streams = saved["fault_streams"]
         self.truth.restore(saved["truth"])
+        if saved["passes"] is not None:
+            self.passes = saved["passes"].with_envelopes(unpack)
 
     def counters(self) -> list[LinkCounter]:
         """Copies of the per-link counters, sorted by source."""
@@ -322,16 +278,3 @@ class ChannelModel:
         if self.passes is None:
             return copies
         return [self.passes.annotate(c) for c in copies]
-
-
-def history_for(scenario: Scenario) -> TruthHistory:
-    """A truth history long enough for ``scenario``'s link delay."""
-    return TruthHistory(horizon_s=scenario.comms.delay_s + 60.0)
-
-
-def applies(src: str | None, dst: str) -> bool:
-    """Whether a message from node ``src`` to node ``dst`` crosses a modelled link: between two
-    different nodes that are each a spacecraft or the ground (sim traffic is hardware-internal)."""
-    if src is None or src == dst:
-        return False
-    return all(n == GROUND or spacecraft_of(n) is not None for n in (src, dst))

@@ -1,6 +1,7 @@
 """Link fault injection: a spacecraft's ``link_loss`` cuts every link it has, and its
 ``packet_loss`` adds an independent loss probability (``magnitude``) on each, both for the
-messages sent in [start_s, end_s) (``faults/schedule.py``).  The receiving node's channel stage
+messages sent in [start_s, end_s) (link faults act on send times; the sim's and the software's
+switch on ticks, ``faults/schedule.py``).  The receiving node's channel stage
 (``links/channel.py``) asks for both on every cross-link message.
 
 A ``packet_loss`` fault draws from a stream of its own per directed link
@@ -10,12 +11,12 @@ without it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from faults.schedule import end_s
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Fault
 from interfaces.contracts.topics import sc_node
@@ -63,3 +64,8 @@ class LinkFaults:
                                                    f"link-fault:{src}->{self.receiver}")
                 lost = (rng.random() < p) or lost
         return lost
+
+
+def end_s(fault: Fault) -> float:
+    """When ``fault`` ends (s): never, when the scenario gives no end."""
+    return math.inf if fault.end_s is None else fault.end_s

@@ -22,7 +22,7 @@ import bisect
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from gnc.passes import ContactPlan
 from interfaces.contracts import catalogue
@@ -32,30 +32,33 @@ from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.contracts.topics import GROUND, spacecraft_of
 from links.onboard_store import OnboardStore
 
-if TYPE_CHECKING:
-    from links.channel import ChannelModel
+
+class Radio(Protocol):
+    """What the space-ground links ask of the receiver's channel model (``links.channel``)."""
+
+    def link_up(self, src: str, t_s: float) -> bool:
+        """Whether the link from ``src`` is up at ``t_s`` (s): not cut, in range."""
+
+    def lose(self, src: str, t_s: float) -> bool:
+        """One counted transmission from ``src`` at ``t_s`` on an up link: whether it is lost."""
+
+    def delivers(self, src: str, t_send: float) -> bool:
+        """One counted message from ``src`` sent at ``t_send``, judged now: delivered?"""
 
 
 @dataclass
 class _DumpLink:
     """The downlink of spacecraft ``src`` as its store sees it (``onboard_store.Downlink``)."""
 
-    channel: ChannelModel
+    radio: Radio
     src: str
     plan: ContactPlan
 
     def up(self, t_s: float) -> bool:
-        return self.plan.in_contact(t_s) and self.channel._blocked(self.src, t_s) is None
+        return self.plan.in_contact(t_s) and self.radio.link_up(self.src, t_s)
 
     def lost(self, t_s: float) -> bool:
-        link = self.channel._link(self.src)
-        link.counter.sent += 1
-        lost = self.channel._lost(link, self.src, t_s)
-        if lost:
-            link.counter.dropped_loss += 1
-        else:
-            link.counter.delivered += 1
-        return lost
+        return self.radio.lose(self.src, t_s)
 
     def next_contact(self, t_s: float) -> float:
         return self.plan.next_contact(t_s)
@@ -94,17 +97,17 @@ class SpaceGroundLink:
             return True
         return False
 
-    def released(self, t_now: float, channel: ChannelModel) -> list[Any]:
+    def released(self, t_now: float, radio: Radio) -> list[Any]:
         """The envelopes that reach the receiver by ``t_now`` (s): dumped ones in the order
         their last bits came, then uplinked ones the channel delivers at their acquisition."""
         horizon = t_now - self.delay_s + TIME_TOL_S
         dumped = sorted((t, env.order, env) for src in sorted(self.stores)
                         for t, env in self.stores[src].advance(
-                            horizon, _DumpLink(channel, src, self.plan)))
+                            horizon, _DumpLink(radio, src, self.plan)))
         out = [env for _, _, env in dumped]
         while self.uplink and self.uplink[0][0] < horizon:
             t_go, _, env = self.uplink.pop(0)
-            if channel.delivers(env.src or "", t_go):
+            if radio.delivers(env.src or "", t_go):
                 out.append(env)
         return out
 

@@ -30,7 +30,7 @@ What the Bus guarantees, identically on every transport:
 
 The Bus's parts of their own: the subscription table (``interfaces.runtime.subscriptions``), the
 inbox of deferred messages with the delivery order and the barrier (``interfaces.runtime.inbox``),
-admission (``interfaces.runtime.admission``), the channel stage (``links.channel``)
+admission (``interfaces.runtime.admission``), the link stage (``interfaces.runtime.link_stage``)
 and the schema service (``interfaces.runtime.schemas``).
 """
 
@@ -48,8 +48,8 @@ from pydantic import ValidationError
 from interfaces.contracts import catalogue, topics
 from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
-from links.channel import ChannelModel, Verdict
 from interfaces.runtime.inbox import Envelope, Inbox
+from interfaces.runtime.link_stage import LinkStage
 from interfaces.runtime.recent import RECENT_TICKS, RecentSent, fetch
 from interfaces.runtime.schemas import serve_schemas
 from interfaces.runtime.subscriptions import Route, Sub, SubscriptionTable
@@ -78,7 +78,7 @@ class Bus:
     node: str
     mission: str
     transport: Transport
-    channel: ChannelModel | None = None
+    channel: LinkStage | None = None
     log: logging.Logger = field(default=None)  # type: ignore[assignment]
     stats: BusStats = field(default_factory=BusStats)
     admission: Admission = field(default_factory=Admission)
@@ -97,9 +97,9 @@ class Bus:
         """(key, number) of the messages being taken in on some thread right now."""
         if self.log is None:
             self.log = logging.getLogger(f"insp.bus.{self.node}")
-        if self.channel is not None and self.channel.truth.claim_feed():
-            self.subscribe(catalogue.TRUTH.key(self.mission), TruthState,
-                           self.channel.truth.observe, immediate=True)
+        feed = self.channel.truth_feed() if self.channel is not None else None
+        if feed is not None:
+            self.subscribe(catalogue.TRUTH.key(self.mission), TruthState, feed, immediate=True)
 
     # --- publishing ------------------------------------------------------------------------
 
@@ -308,14 +308,13 @@ class Bus:
         channel = self.channel
         for env in self.inbox.take_due(t_now, include_now, delay):
             if not env.local and channel is not None and self.inbox.crosses_link(env.src):
-                src = env.src or ""
-                if channel.passes is not None and channel.takes(src, env.key, env.msg, env):
-                    continue  # waits on a space-ground link: comes back from ``released``
-                if channel.decide(src, env.msg.t_sim) is not Verdict.DELIVER:
+                fate = channel.transmit(env.src or "", env.key, env.msg, env)
+                if fate == "drop":
                     self.stats.channel_dropped += 1
-                    continue
+                if fate != "deliver":
+                    continue  # dropped, or waits on a link: comes back from ``released``
             delivered += self._deliver(env)
-        if channel is not None and channel.passes is not None:
+        if channel is not None:
             for env in channel.released(t_now):
                 delivered += self._deliver(env)
         return delivered
@@ -387,12 +386,11 @@ class Bus:
             pending = [_pack(e, index) for e in self.inbox.pending]
             admission = self.admission.checkpoint()
             stats = dataclasses.replace(self.stats)
-            passes = (None if self.channel is None or self.channel.passes is None else
-                      self.channel.passes.with_envelopes(lambda e: _pack(e, index)))
         since = min([admission["clock_s"] or 0.0, *(m[0].t_sim for m in pending)])
+        channel = (None if self.channel is None else
+                   self.channel.checkpoint(since, lambda e: _pack(e, index)))
         return {"seq": dict(self._seq), "stats": stats, "admission": admission,
-                "pending": pending, "passes": passes,
-                "channel": None if self.channel is None else self.channel.checkpoint(since)}
+                "pending": pending, "channel": channel}
 
     def restore(self, saved: dict[str, Any]) -> None:
         """Take back a ``checkpoint`` into a Bus wired as the one that took it."""
@@ -404,10 +402,7 @@ class Bus:
             self.admission.restore(saved["admission"])
             self.inbox.pending = [_unpack(p, groups) for p in saved["pending"]]
         if self.channel is not None:
-            self.channel.restore(saved["channel"])
-            if saved.get("passes") is not None:
-                self.channel.passes = saved["passes"].with_envelopes(
-                    lambda p: _unpack(p, groups))
+            self.channel.restore(saved["channel"], lambda p: _unpack(p, groups))
 
     # --- services --------------------------------------------------------------------------
 

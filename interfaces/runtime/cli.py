@@ -15,8 +15,8 @@ from interfaces.contracts import topics
 from interfaces.contracts.topology import topology
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore
-from links.channel import ChannelModel
 from interfaces.runtime.executive import Executive, TickClient
+from interfaces.runtime.link_stage import LinkStageFactory
 from interfaces.runtime.recent import depth_for
 from interfaces.runtime.restart import resume
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
@@ -95,17 +95,18 @@ def run_participant(
     args: argparse.Namespace,
     node: str,
     build: Callable[[Bus, Scenario], Executive],
+    links: LinkStageFactory,
 ) -> int:
     """Main loop of a lockstep node process (a spacecraft or the ground) over Zenoh.
 
-    Joins the network, wires the executive (with the channel model of ``node``), restores it
-    from its critical-data store when started again (``--cds``), serves the message schemas
-    and what it sent lately, announces itself, and runs ticks until the sim finishes (exit 0),
-    the sim disappears (exit 3) or a signal stops it (exit 0).  The Zenoh session is always
-    closed."""
+    Joins the network, wires the executive (with the link stage ``links(node, scenario)``),
+    restores it from its critical-data store when started again (``--cds``), serves the message
+    schemas and what it sent lately, announces itself, and runs ticks until the sim finishes
+    (exit 0), the sim disappears (exit 3) or a signal stops it (exit 0).  The Zenoh session is
+    always closed."""
     start = start_node(args, node)
     bus = Bus(node, start.mission, open_zenoh(args),
-              channel=ChannelModel.of(node, start.scenario),
+              channel=links(node, start.scenario),
               recent_ticks=depth_for(start.scenario.rates.ticks_per("mid")))
     try:
         client = TickClient(build(bus, start.scenario))

@@ -3,8 +3,8 @@ the barrier that waits for announced messages to arrive.
 
 * **Due.** A message of this node or of the sim is due once its send time is ``<= t_now``; one
   from another flight/ground node once it was sent strictly before ``t_now`` (at ``t_now`` too
-  with ``include_now``) and, when it crosses a modelled link (``channel.applies``), the link's
-  delay has elapsed (times in s, compared within ``TIME_TOL_S``).
+  with ``include_now``) and, when it crosses a modelled link (``link_stage.crosses_link``), the
+  link's delay has elapsed (times in s, compared within ``TIME_TOL_S``).
 * **Order.** The due messages are handed over sorted by (send time, key, sequence), whatever
   the order they arrived in.
 * **Barrier.** ``wait`` blocks until every announced key has reached its sequence number.  The
@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from interfaces.contracts import topics
 from interfaces.contracts.messages import Message
 from interfaces.contracts.timing import TIME_TOL_S
-from links.channel import applies
+from interfaces.runtime.link_stage import crosses_link
 from interfaces.runtime.subscriptions import Sub
 
 
@@ -85,7 +85,7 @@ class Inbox:
         """Whether messages from node ``src`` cross a modelled link to this node (cached)."""
         hit = self._crosses.get(src)
         if hit is None:
-            hit = self._crosses[src] = applies(src, self.node)
+            hit = self._crosses[src] = crosses_link(src, self.node)
         return hit
 
     def wait(self, wanted: dict[str, int], seen: dict[str, int], timeout_s: float) -> list[str]:

@@ -24,7 +24,7 @@ def _channel(receiver: str, cuts: list[LinkCut] | None = None) -> ChannelModel:
     ch = ChannelModel(receiver, Comms(range_m=100.0, cuts=cuts or []), seed=3,
                       truth=TruthHistory(horizon_s=1e4), ground=GROUND, contact=PLAN)
     for t in range(0, 500, 10):  # sc1 10 m from the target all along
-        ch.observe_truth(float(t), [1], [[10.0, 0.0, 0.0]])
+        ch.truth.record(float(t), [1], [[10.0, 0.0, 0.0]])
     return ch
 
 
@@ -34,7 +34,7 @@ def _heartbeat(t: float, seq: int) -> Envelope:
 
 
 def _offer(ch: ChannelModel, env: Envelope) -> bool:
-    return ch.takes(env.src or "", env.key, env.msg, env)
+    return ch.transmit(env.src or "", env.key, env.msg, env) == "wait"
 
 
 def test_the_downlink_waits_for_the_pass_and_comes_down_at_the_rate() -> None:
@@ -55,13 +55,13 @@ def test_an_uplink_out_of_contact_waits_for_the_acquisition() -> None:
     ch = _channel("sc1")
     cmd = ProAssignments(sender="ground", seq=1, t_sim=20.0, assignments=[])
     env = Envelope(cmd, "insp/m/ground/planner/assignments", "ground", False, [])
-    assert ch.takes("ground", env.key, cmd, env)
+    assert ch.transmit("ground", env.key, cmd, env) == "wait"
     assert ch.released(99.9) == []
     assert ch.released(100.1) == [env]
     in_pass = cmd.model_copy(update={"t_sim": 150.0, "seq": 2})
-    assert not ch.takes("ground", env.key, in_pass, env)  # judged at once, as any other
+    assert ch.transmit("ground", env.key, in_pass, env) == "deliver"  # judged at once
     (c,) = ch.counters()
-    assert (c.held, c.sent, c.delivered) == (1, 1, 1)
+    assert (c.held, c.sent, c.delivered) == (1, 2, 2)
 
 
 def test_a_link_cut_for_a_whole_pass_keeps_the_data_for_the_next() -> None:
