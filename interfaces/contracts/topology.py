@@ -12,15 +12,22 @@ Apps and builders are named ``"module:attribute"`` so that this contract imports
 sim or ground code; ``interfaces/runtime/assembly.py`` resolves them.  Each app declares its
 own rate group, inputs and outputs (``interfaces/runtime/app.py``); the order here is the
 execution order within a rate group.  ``python -m interfaces.contracts.topology`` prints the
-default scenario's topology.
+default scenario's topology; with ``--graph`` the dataflow, every topic with its publishers and
+readers (``interfaces/contracts/dataflow.py``), with ``--mermaid`` its picture's block and with
+``--write-doc`` that block rewritten in docs/architecture.md.
 """
 
 from __future__ import annotations
 
+import argparse
+import importlib
 from dataclasses import dataclass
+from pathlib import Path
 
 from interfaces.contracts import topics
-from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.scenario import Scenario, load_scenario
+
+REPO = Path(__file__).resolve().parents[2]
 
 SPACECRAFT_APPS: tuple[str, ...] = (
     "fsw.apps.attitude:AttitudeApp",
@@ -141,10 +148,46 @@ def describe(topo: Topology) -> str:
     return "\n".join(f"{r[0]:<{width[0]}}  {r[1]:<{width[1]}}  {r[2]}" for r in rows)
 
 
+DECLARATIONS = "interfaces.runtime.assembly:declarations"
+"""What gathers the apps' declarations for the dataflow, loaded by name (as the apps are)."""
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m interfaces.contracts.topology",
+                                     description="The default scenario's topology.")
+    what = parser.add_mutually_exclusive_group()
+    what.add_argument("--graph", action="store_true",
+                      help="the dataflow: every topic, publishers → readers, with rate groups")
+    what.add_argument("--mermaid", action="store_true",
+                      help="the dataflow picture's block, as docs/architecture.md holds it")
+    what.add_argument("--write-doc", action="store_true",
+                      help="rewrite that block in docs/architecture.md")
+    return parser
+
+
+def _dataflow(args: argparse.Namespace, doc: Path) -> str:
+    """What ``--graph``, ``--mermaid`` or ``--write-doc`` prints (and writes)."""
+    from interfaces.contracts import dataflow  # not at the top: it reads this module's app lists
+
+    module, _, name = DECLARATIONS.partition(":")
+    flows = dataflow.graph(getattr(importlib.import_module(module), name)())
+    if args.graph:
+        return dataflow.edges(flows) + "\n"
+    if args.mermaid:
+        return dataflow.doc_block(flows)
+    changed = dataflow.write_doc(doc, flows)
+    return f"{doc}: {'rewritten' if changed else 'already current'}\n"
+
+
+def main(argv: list[str] | None = None, doc: Path = REPO / "docs" / "architecture.md") -> None:
+    """``python -m interfaces.contracts.topology [--graph | --mermaid | --write-doc]``; ``doc``:
+    the document ``--write-doc`` rewrites."""
+    args = _parser().parse_args(argv)
+    if args.graph or args.mermaid or args.write_doc:
+        print(_dataflow(args, doc), end="")
+    else:
+        print(describe(topology(load_scenario(REPO / "deploy" / "scenarios" / "default.toml"))))
+
+
 if __name__ == "__main__":
-    from pathlib import Path
-
-    from interfaces.contracts.scenario import load_scenario
-
-    default = Path(__file__).resolve().parents[2] / "deploy" / "scenarios" / "default.toml"
-    print(describe(topology(load_scenario(default))))
+    main()

@@ -1,10 +1,10 @@
 """A node's executive assembled from the declared topology (``interfaces/contracts/topology.py``):
 its apps resolved from their ``"module:Class"`` names, each given the node's context, in the
-declared order.
+declared order; and the dataflow's declarations (``declarations``), gathered the same way.
 
 The topology names flight and ground code without importing it; this is the one place that
 loads it, by name, when a node is built (as a flight executive loads the apps its startup table
-lists).
+lists) or when the dataflow is drawn (``python -m interfaces.contracts.topology --graph``).
 """
 
 from __future__ import annotations
@@ -15,12 +15,15 @@ from collections.abc import Callable
 from typing import Any
 
 from gnc.mission import MissionConstants
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import dataflow
+from interfaces.contracts.dataflow import AppSlot, Declared, Read
 from interfaces.contracts.rng import stream
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import Node
 from interfaces.runtime.app import App, AppContext
 from interfaces.runtime.bus import Bus
-from interfaces.runtime.executive import Executive
+from interfaces.runtime.executive import Executive, TickClient
 
 Builder = Callable[[Node, Bus, Scenario], Executive]
 """How a node's executive is built (``Node.executive``)."""
@@ -58,3 +61,22 @@ def executive_of(node: Node, bus: Bus, scenario: Scenario) -> Executive:
     """``node``'s executive, built by the builder it declares (``Node.executive``)."""
     build: Builder = resolve(node.executive)
     return build(node, bus, scenario)
+
+
+def declared_app(slot: AppSlot) -> Declared:
+    """What the app ``slot`` names declares: its NAME, rate group, inputs and outputs."""
+    cls = app_class(slot.name)
+    return Declared(cls.NAME, slot.place, cls.RATE,
+                    tuple(Read(i.topic, i.every_spacecraft) for i in cls.INPUTS),
+                    tuple(o.topic for o in cls.OUTPUTS), slot.when)
+
+
+def declarations() -> tuple[Declared, ...]:
+    """Every reader and writer of the bus, for the dataflow (``interfaces/contracts/dataflow.py``):
+    each app the topology can run, the sim (what it reads from its declaration, named by
+    ``dataflow.SIM``), every node's executive (the lockstep) and its bus's channel model (the
+    truth, ``interfaces/runtime/bus.py``)."""
+    channel = Declared("channel", "node", reads=(Read(cat.TRUTH),))
+    return (*(declared_app(s) for s in dataflow.roster()),
+            dataflow.sim(resolve(dataflow.SIM).SUBSCRIBES),
+            dataflow.executive(TickClient.SUBSCRIBES), channel)
