@@ -32,7 +32,7 @@ from typing import Literal, NamedTuple
 
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.catalogue import Space, Topic
-from interfaces.contracts.topology import (
+from interfaces.contracts.apps import (
     GROUND_APPS,
     NEIGHBOUR_APPS,
     ONBOARD_FDIR_APPS,

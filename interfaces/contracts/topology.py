@@ -24,34 +24,16 @@ import importlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from interfaces.contracts import topics
+from interfaces.contracts import dataflow, topics
+from interfaces.contracts.apps import (
+    GROUND_APPS,
+    NEIGHBOUR_APPS,
+    ONBOARD_FDIR_APPS,
+    SPACECRAFT_APPS,
+)
 from interfaces.contracts.scenario import Scenario, load_scenario
 
 REPO = Path(__file__).resolve().parents[2]
-
-SPACECRAFT_APPS: tuple[str, ...] = (
-    "fsw.apps.attitude:AttitudeApp",
-    "fsw.apps.nav:NavApp",
-    "fsw.apps.camera:CameraApp",
-    "fsw.apps.infocost:InfoCostApp",
-    "fsw.apps.guidance:GuidanceApp",
-)
-"""A spacecraft's onboard apps, in execution order within a rate group."""
-
-ONBOARD_FDIR_APPS: tuple[str, ...] = ("fsw.apps.fdir:OnboardFdirApp",)
-"""Added after them when the scenario turns the agent-level FDIR on (``[onboard_fdir]``)."""
-
-NEIGHBOUR_APPS: tuple[str, ...] = ("fsw.apps.neighbours:NeighboursApp",)
-"""Added after those when the scenario turns the neighbours' FDIR on (``[neighbours]``)."""
-
-GROUND_APPS: tuple[str, ...] = (
-    "ground.apps.planner:MissionPlanner",
-    "ground.apps.telemetry:TelemetryMonitor",
-    "ground.apps.fdir:FdirApp",
-    "ground.apps.baselines:BaselinesApp",
-)
-"""The ground station's apps, in execution order within a rate group."""
-
 
 @dataclass(frozen=True)
 class Node:
@@ -167,8 +149,6 @@ def _parser() -> argparse.ArgumentParser:
 
 def _dataflow(args: argparse.Namespace, doc: Path) -> str:
     """What ``--graph``, ``--mermaid`` or ``--write-doc`` prints (and writes)."""
-    from interfaces.contracts import dataflow  # not at the top: it reads this module's app lists
-
     module, _, name = DECLARATIONS.partition(":")
     flows = dataflow.graph(getattr(importlib.import_module(module), name)())
     if args.graph:

@@ -10,7 +10,7 @@ from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.catalogue import Space, Topic
 from interfaces.contracts.messages import Heartbeat, Message, StateEstimate
-from interfaces.contracts.topology import (
+from interfaces.contracts.apps import (
     GROUND_APPS,
     NEIGHBOUR_APPS,
     ONBOARD_FDIR_APPS,

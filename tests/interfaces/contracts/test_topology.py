@@ -12,10 +12,8 @@ import pytest
 
 from fsw.apps.infocost import InfoCostApp
 from interfaces.contracts import topics
+from interfaces.contracts.apps import GROUND_APPS, ONBOARD_FDIR_APPS, SPACECRAFT_APPS
 from interfaces.contracts.topology import (
-    GROUND_APPS,
-    ONBOARD_FDIR_APPS,
-    SPACECRAFT_APPS,
     Node,
     describe,
     topology,
