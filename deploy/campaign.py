@@ -371,10 +371,10 @@ def _inproc_run(spec: RunSpec, out: Path) -> RunSummary:
     import traceback
 
     from deploy.inproc import run_inproc
-    from harness.summary.digest import LiveDigest, RunDigest
-    from harness.summary.build import write_summary
     from ground.archive.metadata import run_metadata
     from ground.archive.recorder import McapRecorder
+    from harness.summary.build import write_summary
+    from harness.summary.digest import LiveDigest, RunDigest
 
     handler = logging.FileHandler(out / "run.log")
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))

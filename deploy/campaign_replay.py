@@ -25,11 +25,11 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
-from harness.campaign.report import detector_figures, write_campaign_report
-from harness.summary import ReplaySection, RunSummary
-from harness.archive.run_scenario import archived_scenario
 from harness.archive.reader import ArchiveError
+from harness.archive.run_scenario import archived_scenario
+from harness.campaign.report import detector_figures, write_campaign_report
 from harness.replay import replay_run, with_settings
+from harness.summary import ReplaySection, RunSummary
 from interfaces.contracts.scenario import ScenarioError
 
 log = logging.getLogger("insp.campaign")

@@ -16,10 +16,10 @@ from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
-from links.channel import ChannelModel
-from links.truth import history_for
 from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.transport import InprocNetwork, RawHandler, SampleHandler
+from links.channel import ChannelModel
+from links.truth import history_for
 from sim.node import SimNode
 
 

@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
-
 _PR_SET_PDEATHSIG = 1
 
 

@@ -61,11 +61,11 @@ from deploy.campaign import (  # noqa: E402
     record_failure,
 )
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
-from harness.campaign.report import write_campaign_report  # noqa: E402
 from harness.campaign.formation_study import write_formation_study  # noqa: E402
 from harness.campaign.neighbours_study import write_neighbours_study  # noqa: E402
-from harness.summary import RunSummary  # noqa: E402
+from harness.campaign.report import write_campaign_report  # noqa: E402
 from harness.replay import parse_settings, scenario_with  # noqa: E402
+from harness.summary import RunSummary  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
 
 log = logging.getLogger("insp.campaign")

@@ -52,14 +52,14 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
 
 from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor  # noqa: E402
-from harness.summary.digest import LiveDigest, RunDigest, digest_run  # noqa: E402
+from ground.archive.metadata import run_metadata  # noqa: E402
+from ground.archive.recorder_process import RecorderProcess  # noqa: E402
+from ground.archive.segments import remove_segments, run_archive  # noqa: E402
+from harness.archive.reader import ArchiveError  # noqa: E402
 from harness.report import write_report  # noqa: E402
 from harness.summary import AccessAudit, RunSummary  # noqa: E402
 from harness.summary.build import add_recovery_comparison, write_summary  # noqa: E402
-from ground.archive.metadata import run_metadata  # noqa: E402
-from harness.archive.reader import ArchiveError  # noqa: E402
-from ground.archive.recorder_process import RecorderProcess  # noqa: E402
-from ground.archive.segments import remove_segments, run_archive  # noqa: E402
+from harness.summary.digest import LiveDigest, RunDigest, digest_run  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402

@@ -36,14 +36,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from harness.summary import ReplayResults
-from harness.summary.build import fdir_results
-from harness.archive.run_scenario import scenario_from_metadata
-from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
 from ground.archive.segments import run_archive
+from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
+from harness.archive.run_scenario import scenario_from_metadata
+from harness.summary import ReplayResults
+from harness.summary.fdir import fdir_results
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
-from interfaces.contracts.topology import topology
 from interfaces.contracts.messages import (
     BaselineVerdict,
     ConstellationWindow,
@@ -52,11 +51,12 @@ from interfaces.contracts.messages import (
     ProAssignments,
 )
 from interfaces.contracts.scenario import Scenario, ScenarioError
+from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
-from links.channel import ChannelModel
 from interfaces.runtime.executive import TickClient
 from interfaces.runtime.transport import InprocNetwork, Sample
+from links.channel import ChannelModel
 
 SETTABLE = ("fdir.", "rates.fdi_period_s")
 """Settings a replay may change: the ground's detector only.  Anything else changes what the

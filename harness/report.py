@@ -10,14 +10,14 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harness.summary.coverage_eval import Coverage  # noqa: E402
-from harness.summary.digest import RunDigest, digest_run  # noqa: E402
-from harness.summary.control_eval import GncSeries  # noqa: E402
-from harness.summary.nav_eval import NavErrors  # noqa: E402
-from harness.summary import RunSummary, Scores  # noqa: E402
-from harness.summary.truth_table import TruthTable  # noqa: E402
-from harness.archive.reader import ArchiveError, RunArchive  # noqa: E402
 from ground.archive.segments import run_archive  # noqa: E402
+from harness.archive.reader import ArchiveError, RunArchive  # noqa: E402
+from harness.summary import RunSummary, Scores  # noqa: E402
+from harness.summary.control import GncSeries  # noqa: E402
+from harness.summary.coverage import Coverage  # noqa: E402
+from harness.summary.digest import RunDigest, digest_run  # noqa: E402
+from harness.summary.nav import NavErrors  # noqa: E402
+from harness.summary.truth_table import TruthTable  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts.messages import FdirWindow  # noqa: E402
 from interfaces.contracts.scenario import Scenario  # noqa: E402

@@ -126,8 +126,8 @@ def recorded_run(scenario: Scenario, out: Path, *types: type[Message]
     those of ``types`` (as :func:`collector`); returns (collected by type name, the run's
     summary as written to summary.json)."""
     from deploy.inproc import run_inproc
-    from harness.summary.build import write_summary
     from ground.archive.recorder import McapRecorder
+    from harness.summary.build import write_summary
 
     tap, got = collector(*types)
     with McapRecorder(out / "run.mcap", {}) as rec:

@@ -20,7 +20,6 @@ from pathlib import Path
 
 from mcap.records import Header, Schema
 
-from harness.archive.reader import Record, RecordLoader, RecordSink, RunArchive, SegmentInfo
 from ground.archive.recorder import (
     LIBRARY,
     PROFILE,
@@ -28,6 +27,7 @@ from ground.archive.recorder import (
     Pending,
     prepared,
 )
+from harness.archive.reader import Record, RecordLoader, RecordSink, RunArchive, SegmentInfo
 from interfaces.contracts.messages import Message, json_schema, registry
 from interfaces.runtime.transport import Sample
 

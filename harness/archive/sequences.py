@@ -37,7 +37,6 @@ from interfaces.contracts.catalogue import topic_of
 from interfaces.runtime.admission import MAX_FIRST_SEQ, MAX_SEQ_JUMP
 
 
-
 @dataclass(slots=True)
 class _Run:
     """Consecutive sequence numbers of one key in one segment, and their sim times (ns)."""

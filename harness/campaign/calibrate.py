@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from harness.summary import RunSummary
-from harness.archive.reader import ArchiveError, load_run
 from ground.archive.segments import run_archive
 from ground.fdir.threshold import calibrate_floor
+from harness.archive.reader import ArchiveError, load_run
+from harness.summary import RunSummary
 from interfaces.contracts.messages import FdirWindow
 from interfaces.contracts.scenario import Fault
 

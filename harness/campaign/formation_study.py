@@ -5,7 +5,7 @@ each faulty run beside its nominal twin (same formation and seed, no fault).
 
 For every run the global cost H (Eq. 7) and every observer's H_i (Eq. 8, the centralized
 decomposition) are computed from every camera image the sim produced, fused in time order
-(``harness.summary.coverage_eval``), sampled every ``SAMPLE_S``.  The study writes
+(``harness.summary.coverage``), sampled every ``SAMPLE_S``.  The study writes
 ``<out>/study.md`` with, per case (formation size x fault kind):
 
 * a figure of H and every H_i over time, faulty run against twin, and each agent's
@@ -31,10 +31,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harness.summary.coverage_eval import CoverageFuser  # noqa: E402
-from harness.summary import FaultScore, RunSummary  # noqa: E402
-from harness.archive.run_scenario import archived_scenario  # noqa: E402
 from harness.archive.reader import Record, load_run  # noqa: E402
+from harness.archive.run_scenario import archived_scenario  # noqa: E402
+from harness.summary import FaultScore, RunSummary  # noqa: E402
+from harness.summary.coverage import CoverageFuser  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts.scenario import Fault  # noqa: E402
 

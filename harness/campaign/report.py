@@ -35,6 +35,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.stats import beta  # noqa: E402
 
+from ground.fdir.threshold import Persistence  # noqa: E402
 from harness.summary import (  # noqa: E402
     OTHER_TESTS_FLAG,
     Detection,
@@ -44,7 +45,6 @@ from harness.summary import (  # noqa: E402
     SeriesWindow,
 )
 from harness.summary.scoring import EXPECTED_CLASS, Alarm, Judged, score  # noqa: E402
-from ground.fdir.threshold import Persistence  # noqa: E402
 from interfaces.contracts.scenario import Fault  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", "common_mode", None)

@@ -8,42 +8,35 @@ existed still load: the field is filled in with its default and named in
 :attr:`RunSummary.filled`.
 """
 
+from harness.summary.access import AccessAudit
+from harness.summary.archive_info import (
+    BUS_HEADER,
+    ArchiveInfo,
+    LostMessages,
+    MessageCounts,
+    SegmentRecord,
+)
+from harness.summary.control import GncStats
+from harness.summary.coverage import AssignmentRecord, CoverageSummary
 from harness.summary.document import (
     OTHER_TESTS_FLAG,
     RunSummary,
     SummaryError,
 )
+from harness.summary.execution import ExecRecord, PaceRecord, SimRecord
+from harness.summary.fault_events import FaultEventRecord
 from harness.summary.fdir import (
     Detection,
     FailedTests,
-    FaultClass,
-    FaultScore,
     FdirResults,
     ModelZ,
     ReplayResults,
     ReplaySection,
     RunFdirSettings,
-    Scores,
     ThresholdCensus,
     ThresholdSources,
 )
-from harness.summary.figures import (
-    BUS_HEADER,
-    AccessAudit,
-    ArchiveInfo,
-    AssignmentRecord,
-    CoverageSummary,
-    ExecRecord,
-    FaultEventRecord,
-    GncStats,
-    LostMessages,
-    MessageCounts,
-    NavStats,
-    PaceRecord,
-    RecoveryComparison,
-    SegmentRecord,
-    SimRecord,
-)
+from harness.summary.nav import NavStats
 from harness.summary.neighbours import (
     Disagreements,
     NeighboursSummary,
@@ -55,6 +48,8 @@ from harness.summary.onboard import (
     OnboardFdirSummary,
 )
 from harness.summary.records import Figure, SummaryRecord
+from harness.summary.recovery import RecoveryComparison
+from harness.summary.scoring import FaultClass, FaultScore, Scores
 from harness.summary.series import FdirSeries, MainWindow, SeriesWindow
 
 __all__ = [

@@ -3,7 +3,7 @@
 A two-orbit run archives about 4 GB of JSON, 1.7 GB of it camera images and as much again the
 observations that repeat them; held whole and decoded, the summary of such a run needed 13 GB.
 The digest keeps only what the summary and report read: the camera images are fused into the
-coverage as they stream past (:class:`harness.summary.coverage_eval.CoverageFuser`), the cumulative
+coverage as they stream past (:class:`harness.summary.coverage.CoverageFuser`), the cumulative
 counters (ticks, executive and link statistics) keep their last record, the truth is packed into
 arrays (:class:`harness.summary.truth_table.TruthTable`), and the bulk neither reads
 (observations, attitude sensors, wheel commands, lockstep answers, heartbeats) is counted and
@@ -22,13 +22,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
 
-from harness.summary.coverage_eval import Coverage, CoverageFuser, camera_images, coverage
-from harness.summary.control_eval import GncSeries, gnc_series
-from harness.summary.nav_eval import NavErrors, nav_errors
-from harness.summary.truth_table import TruthTable, TruthTableBuilder
+from ground.archive.recorder import Pending, prepared
 from harness.archive.live import LiveArchive
 from harness.archive.reader import Record, RecordSink, RunArchive, load_run
-from ground.archive.recorder import Pending, prepared
+from harness.summary.control import GncSeries, gnc_series
+from harness.summary.coverage import Coverage, CoverageFuser, camera_images, coverage
+from harness.summary.nav import NavErrors, nav_errors
+from harness.summary.truth_table import TruthTable, TruthTableBuilder
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.scenario import Scenario
 from interfaces.runtime.transport import Sample

@@ -7,30 +7,26 @@ from typing import Literal
 
 from pydantic import Field, ValidationError
 
+from harness.summary.access import AccessAudit
+from harness.summary.archive_info import ArchiveInfo, MessageCounts
+from harness.summary.control import GncStats
+from harness.summary.coverage import CoverageSummary
+from harness.summary.execution import ExecRecord, SimRecord
+from harness.summary.fault_events import FaultEventRecord
 from harness.summary.fdir import (
     Detection,
     FdirResults,
     ReplaySection,
     RunFdirSettings,
-    Scores,
     ThresholdCensus,
 )
-from harness.summary.figures import (
-    AccessAudit,
-    ArchiveInfo,
-    CoverageSummary,
-    ExecRecord,
-    FaultEventRecord,
-    GncStats,
-    MessageCounts,
-    NavEntry,
-    RecoveryComparison,
-    SimRecord,
-)
+from harness.summary.ground_contact import GroundContact
+from harness.summary.nav import NavEntry
 from harness.summary.neighbours import NeighboursSummary
 from harness.summary.onboard import OnboardFdirSummary
-from harness.summary.ground_contact import GroundContact
 from harness.summary.records import SummaryRecord, filled_fields
+from harness.summary.recovery import RecoveryComparison
+from harness.summary.scoring import Scores
 from harness.summary.series import FdirSeries
 from interfaces.contracts.messages import LinkCounter, TelemetryStatus
 from interfaces.contracts.scenario import Fault

@@ -2,7 +2,9 @@
 against the injected faults (``scores``, ``baselines``), the decided windows
 (``fdir_series``), what set the thresholds (``fdir_thresholds``) and the detector's settings
 (``fdir_settings``); and a replay's results (``harness.replay``), which a campaign replay
-writes into the run's summary."""
+writes into the run's summary.  The records, and the sections computed from the ground's
+reports, windows and baselines' verdicts in a run's archive (scored by
+``harness.summary.scoring``)."""
 
 from __future__ import annotations
 
@@ -10,13 +12,18 @@ from typing import Any, ClassVar, Literal, Self
 
 from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
 
-from harness.summary.records import Figure, SummaryRecord
-from harness.summary.series import FdirSeries
-from interfaces.contracts.scenario import FaultKind, FdirSettings
-
-FaultClass = Literal["actuator", "camera", "state_sensor", "link", "data_integrity",
-                     "common_mode"]
-"""The classes the ground identifies a fault as (``FaultReport.fault_class``)."""
+from harness.archive.reader import RunArchive
+from harness.summary.records import SummaryRecord
+from harness.summary.scoring import Alarm, FaultClass, Judged, Scores, overlaps_fault, score
+from harness.summary.series import FdirSeries, MainWindow, SeriesWindow
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
+    WINDOW_TESTS,
+    BaselineVerdict,
+    FaultReport,
+    FdirWindow,
+)
+from interfaces.contracts.scenario import FdirSettings, Scenario
 
 
 class Detection(SummaryRecord):
@@ -49,37 +56,8 @@ class Detection(SummaryRecord):
                                   "the flown run's (``replay.faithful_until_s``)")
 
 
-class FaultScore(SummaryRecord):
-    """How a detector did on one injected fault (harness/summary/scoring.py)."""
-
-    FILLABLE: ClassVar[tuple[str, ...]] = ("identification_latency_s",)
-
-    spacecraft: int = Field(ge=0, description="the faulty observer; 0: common mode")
-    kind: FaultKind
-    start_s: float = Field(description="onset, sim s")
-    detected: bool = Field(description="any alarm while the fault was active")
-    isolated: bool = Field(description="an alarm naming its spacecraft")
-    latency_s: float | None = Field(description="onset to the first (isolating) alarm, s")
-    identified_class: FaultClass | None = Field(
-        description="class of the first isolating alarm that names one")
-    expected_class: FaultClass
-    identified_correctly: bool
-    identification_latency_s: float | None = Field(
-        default=None, description="onset to the first alarm naming its class, s")
-    declared_latency_s: float | None = Field(
-        default=None, description="onset to the first (isolating) alarm's declaration, s: "
-                                  "what the ground knew when (with ground passes, the gap "
-                                  "to the pass is in it)")
 
 
-class Scores(SummaryRecord):
-    """A detector's scores over a run: per injected fault and false alarms."""
-
-    per_fault: list[FaultScore] = Field(description="in scenario order")
-    false_alarms: int = Field(ge=0, description="alarms on a spacecraft with no active fault")
-    nominal_cycles: int = Field(ge=0, description="judged FDI windows overlapping no fault")
-    false_alarm_rate: Figure = Field(description="false alarms per nominal cycle")
-    false_alarms_per_hour: Figure = Field(description="per hour of nominal spacecraft time")
 
 
 class Counts(SummaryRecord):
@@ -189,3 +167,89 @@ class ReplaySection(SummaryRecord):
         description="sim time of the first uplink differing from the live run's, s")
     matches_live: bool
     scores_faithful: Scores = Field(description="the main detector's up to faithful_until_s")
+
+
+def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> FdirResults:
+    """``detections`` (the ground FDIR's fault reports) and ``scores`` against the injected
+    faults (harness/summary/scoring.py; grace of one FDI window)."""
+    return fdir_results(archive.of(cat.FAULT_REPORT, mission),
+                        archive.of(cat.FDIR_WINDOW, mission), archive.of(cat.BASELINE, mission),
+                        scenario)
+
+
+def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
+                 verdicts: list[BaselineVerdict], scenario: Scenario) -> FdirResults:
+    """The FDIR part of summary.json from the ground's own output messages (a live run's
+    archive or a replay): detections, scores, baselines, series and settings."""
+    alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class, r.declared_s) for r in reports
+              if r.cause is None]  # a known cause (store overflow) is no alarm of a fault
+    judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
+              if w.exceeded is not None]
+    return FdirResults(
+        detections=[Detection(spacecraft=r.spacecraft, time_s=r.t_sim, fault_class=r.fault_class,
+                              direction=r.direction, metric=r.metric, threshold=r.threshold,
+                              evidence=dict(r.evidence), declared_s=r.declared_s,
+                              declared_by="ground",
+                              **({"cause": r.cause} if r.cause else {}))
+                    for r in reports],
+        scores=score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
+        baselines=baseline_scores(verdicts, scenario),
+        fdir_series=series_of(windows, verdicts),
+        fdir_thresholds=threshold_census(windows, scenario),
+        fdir_settings=RunFdirSettings.model_validate(
+            {"fdi_period_s": scenario.rates.fdi_period_s, **scenario.fdir.model_dump()}))
+
+
+def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> ThresholdCensus:
+    """``fdir_thresholds``: over the nominal windows the main detector decided (no fault of
+    their spacecraft overlapping), what set the threshold in force (the hardware model, Eq.
+    11-12's sampling, or the floor guard), how often each threshold lay above the floor, and
+    which tests failed; with the nominal standardised ratios (x − μ)/σ of the hardware model
+    beyond 2, 3 and 4."""
+    floor = scenario.fdir.floor
+    nominal = [w for w in windows if w.exceeded is not None
+               and not overlaps_fault(scenario.faults, w.spacecraft, w.t_start_s, w.t_end_s)]
+    z = [abs((w.dh / w.dh_pred - w.ratio_mean) / w.ratio_std) for w in nominal
+         if w.dh is not None and w.dh_pred and w.ratio_mean is not None and w.ratio_std]
+    return ThresholdCensus(
+        nominal_windows=len(nominal),
+        threshold_by=ThresholdSources.model_validate(
+            {k: sum(w.threshold_by == k for w in nominal) for k in ("model", "sampled", "floor")}),
+        model_above_floor=sum((w.threshold_model or 0.0) > floor for w in nominal),
+        sampled_above_floor=sum((w.threshold_sampled or 0.0) > floor for w in nominal),
+        failed=FailedTests.model_validate({k: sum(k in w.failed for w in nominal)
+                                            for k in WINDOW_TESTS}),
+        model_z=ModelZ(over_2=sum(v > 2 for v in z), over_3=sum(v > 3 for v in z),
+                       over_4=sum(v > 4 for v in z), windows=len(z)))
+
+
+def series_of(windows: list[FdirWindow], verdicts: list[BaselineVerdict]) -> FdirSeries:
+    """``fdir_series``: every decided window of each detector (``run_summary.series``) --
+    what a campaign needs to re-score at other threshold scales (ROC) without the archives.
+    The main detector's windows record whether they failed a test other than the information
+    test (plan, pointing, Δv rate, NIS: ``FdirWindow.failed``), which no threshold scale
+    moves."""
+    main = [MainWindow(spacecraft=w.spacecraft, t_start_s=w.t_start_s, t_end_s=w.t_end_s,
+                       statistic=w.metric, threshold=w.threshold,
+                       other_tests_failed=any(t != "information" for t in w.failed))
+            for w in windows if w.metric is not None and w.threshold is not None]
+    baselines: dict[str, list[SeriesWindow]] = {}
+    for v in verdicts:
+        if v.statistic is not None and v.threshold is not None:
+            baselines.setdefault(v.detector, []).append(SeriesWindow(
+                spacecraft=v.spacecraft, t_start_s=v.t_start_s, t_end_s=v.t_end_s,
+                statistic=v.statistic, threshold=v.threshold))
+    return FdirSeries(main=main, baselines=baselines)
+
+
+def baseline_scores(verdicts: list[BaselineVerdict], scenario: Scenario) -> dict[str, Scores]:
+    """``baselines``: each baseline detector (ground/apps/baselines.py) scored like the main
+    one, from its per-window verdicts."""
+    out = {}
+    for name in sorted({v.detector for v in verdicts}):
+        mine = [v for v in verdicts if v.detector == name]
+        alarms = [Alarm(v.spacecraft, v.t_end_s, None) for v in mine if v.alarm]
+        judged = [Judged(v.spacecraft, v.t_start_s, v.t_end_s) for v in mine
+                  if v.exceeded is not None]
+        out[name] = score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s)
+    return out

@@ -11,10 +11,12 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Iterator
-from typing import Annotated, Any, ClassVar
+from collections.abc import Iterator, Sequence
+from typing import Annotated, Any, ClassVar, TypeVar
 
 from pydantic import AfterValidator, BaseModel, ConfigDict
+
+B = TypeVar("B", bound=BaseModel)
 
 
 class SummaryRecord(BaseModel):
@@ -75,3 +77,10 @@ def _finite(o: Any) -> Any:
     if isinstance(o, (list, tuple)):
         return [_finite(v) for v in o]
     return o
+
+
+def given_copies(records: Sequence[B], exclude_none: bool = False) -> list[B]:
+    """Copies of ``records`` with every field given (as written: a message decoded from the
+    bus holds only the fields its sender gave, and a summary writes the fields given); with
+    ``exclude_none``, those that are None are left unset (not written)."""
+    return [type(r).model_validate(r.model_dump(exclude_none=exclude_none)) for r in records]

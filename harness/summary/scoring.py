@@ -1,5 +1,6 @@
-"""Scoring a detector against the injected faults (docs/contracts.md, summary.json
-``detections`` and ``scores``).
+"""summary.json's ``scores`` (and each baseline's): a detector scored against the injected
+faults (docs/contracts.md, summary.json ``detections`` and ``scores``), its records and the
+scoring.
 
 Definitions (one run):
 
@@ -22,9 +23,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import ClassVar, Literal
 
-from harness.summary import FaultClass, FaultScore, Scores
-from interfaces.contracts.scenario import Fault
+from pydantic import Field
+
+from harness.summary.records import Figure, SummaryRecord
+from interfaces.contracts.scenario import Fault, FaultKind
 
 EXPECTED_CLASS: dict[str, FaultClass] = {
     "thruster_bias": "actuator", "pointing_actuator": "actuator",
@@ -105,3 +109,41 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
         false_alarm_rate=len(false_alarms) / len(nominal) if nominal else None,
         false_alarms_per_hour=len(false_alarms) / hours if hours > 0 else None,
     )
+
+
+FaultClass = Literal["actuator", "camera", "state_sensor", "link", "data_integrity",
+                     "common_mode"]
+"""The classes the ground identifies a fault as (``FaultReport.fault_class``)."""
+
+
+class FaultScore(SummaryRecord):
+    """How a detector did on one injected fault (harness/summary/scoring.py)."""
+
+    FILLABLE: ClassVar[tuple[str, ...]] = ("identification_latency_s",)
+
+    spacecraft: int = Field(ge=0, description="the faulty observer; 0: common mode")
+    kind: FaultKind
+    start_s: float = Field(description="onset, sim s")
+    detected: bool = Field(description="any alarm while the fault was active")
+    isolated: bool = Field(description="an alarm naming its spacecraft")
+    latency_s: float | None = Field(description="onset to the first (isolating) alarm, s")
+    identified_class: FaultClass | None = Field(
+        description="class of the first isolating alarm that names one")
+    expected_class: FaultClass
+    identified_correctly: bool
+    identification_latency_s: float | None = Field(
+        default=None, description="onset to the first alarm naming its class, s")
+    declared_latency_s: float | None = Field(
+        default=None, description="onset to the first (isolating) alarm's declaration, s: "
+                                  "what the ground knew when (with ground passes, the gap "
+                                  "to the pass is in it)")
+
+
+class Scores(SummaryRecord):
+    """A detector's scores over a run: per injected fault and false alarms."""
+
+    per_fault: list[FaultScore] = Field(description="in scenario order")
+    false_alarms: int = Field(ge=0, description="alarms on a spacecraft with no active fault")
+    nominal_cycles: int = Field(ge=0, description="judged FDI windows overlapping no fault")
+    false_alarm_rate: Figure = Field(description="false alarms per nominal cycle")
+    false_alarms_per_hour: Figure = Field(description="per hour of nominal spacecraft time")

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from faults.hardware import FaultInjector
 from fsw.lib.attitude_control import gains_for, tracking_torque
 from gnc import quat
 from gnc.infocost import Camera
@@ -20,7 +21,6 @@ from interfaces.contracts.scenario import Scenario
 from sim.attitude import AttitudeTruth
 from sim.camera import TruthCameras
 from sim.dynamics import RelativeTruth, circular_chief_eci
-from faults.hardware import FaultInjector
 from sim.hardware import ObserverHardware
 from sim.sensors import RelNavSensor
 

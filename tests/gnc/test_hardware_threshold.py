@@ -11,8 +11,6 @@ import pytest
 from scipy.spatial.transform import Rotation
 from scipy.stats import norm
 
-from gnc.infocost import Camera
-from gnc.poi import sphere_pois
 from gnc.hardware_threshold import (
     RatioModel,
     clipped_noise_moments,
@@ -21,6 +19,8 @@ from gnc.hardware_threshold import (
     small_rotations,
     window_false_alarm,
 )
+from gnc.infocost import Camera
+from gnc.poi import sphere_pois
 from gnc.twin import TwinModel, centre_boresights, delta_h
 from interfaces.contracts.rng import stream
 from sim.camera import TruthCameras

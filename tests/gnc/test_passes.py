@@ -11,19 +11,19 @@ import numpy as np
 import pytest
 
 from gnc.constants import MU_EARTH_M3_S2, R_EARTH_M
-from interfaces.contracts.scenario import parse_scenario
 from gnc.passes import (
     OMEGA_EARTH_RAD_S,
     WGS84_FLATTENING,
     CircularOrbit,
+    ContactPlan,
     GroundStation,
     contact_windows,
     elevation_rad,
     greenwich_sidereal_angle,
-    ContactPlan,
     pass_table,
     scenario_pass_table,
 )
+from interfaces.contracts.scenario import parse_scenario
 
 LEO_M = R_EARTH_M + 500e3
 

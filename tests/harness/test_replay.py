@@ -8,8 +8,8 @@ import pytest
 
 from harness.replay import UNREAD, with_settings
 from interfaces.contracts import catalogue as cat
-from interfaces.contracts.scenario import Scenario, ScenarioError
 from interfaces.contracts.apps import GROUND_APPS
+from interfaces.contracts.scenario import Scenario, ScenarioError
 from interfaces.runtime.assembly import app_class
 from tests.conftest import small_scenario
 

@@ -29,8 +29,9 @@ _NODE_MAIN = ("a node process's entry point (``python -m``): the launcher starts
 _APP = ("a ground app, built by name from the topology: fuzzed with every other app in "
         "tests/interfaces/runtime/test_fuzz_apps.py and flown in tests/missions/; its logic is "
         "tested where it lives ({})")
-_EVALUATION = ("a run's evaluation from its archive, part of summary.json "
-               "(harness/summary/build.py): checked on real runs in {}")
+_EVALUATION = ("a section of summary.json, its record type (re-exported by harness.summary) "
+               "beside its evaluation from the archive (assembled by "
+               "harness/summary/build.py): checked on real runs in {}")
 
 INDIRECT: dict[str, str] = {
     "interfaces.contracts.messages.base": _MESSAGES,
@@ -57,14 +58,14 @@ INDIRECT: dict[str, str] = {
         "sim/hardware.py: tests/sim/test_kernels.py compares them with those classes' numpy "
         "references"),
     "ground.__main__": _NODE_MAIN,
-    "harness.summary.coverage_eval": _EVALUATION.format(
+    "harness.summary.coverage": _EVALUATION.format(
         "tests/missions/test_digest_run.py and tests/missions/test_campaign_run.py"),
-    "harness.summary.control_eval": _EVALUATION.format("tests/missions/test_gnc_run.py"),
-    "harness.summary.onboard_eval": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
-    "harness.summary.neighbours_eval": _EVALUATION.format("tests/missions/test_neighbours_run.py"),
+    "harness.summary.control": _EVALUATION.format("tests/missions/test_gnc_run.py"),
+    "harness.summary.onboard": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
+    "harness.summary.neighbours": _EVALUATION.format("tests/missions/test_neighbours_run.py"),
     **{f"harness.summary.{m}": _SUMMARY
-       for m in ("document", "fdir", "figures", "neighbours", "onboard", "ground_contact",
-                 "records", "series")},
+       for m in ("access", "document", "execution", "fault_events", "recovery", "records",
+                 "series")},
     "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
     "harness.archive.__main__": (
         "``python -m harness.archive``, two lines handing over to harness/archive/cli.py's main "

@@ -10,8 +10,8 @@ import pytest
 from gnc.passes import ContactPlan
 from interfaces.contracts.messages import Heartbeat, ProAssignments
 from interfaces.contracts.scenario import Comms, Ground, LinkCut, Station
-from links.channel import ChannelModel, TruthHistory
 from interfaces.runtime.inbox import Envelope
+from links.channel import ChannelModel, TruthHistory
 from links.onboard_store import message_bytes
 from links.space_ground import SpaceGroundLink
 

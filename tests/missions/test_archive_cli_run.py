@@ -10,10 +10,10 @@ from pathlib import Path
 import pytest
 
 from deploy.inproc import run_inproc
-from harness.archive.cli import export_csv, main
 from ground.archive.metadata import run_metadata, software_version
-from harness.archive.reader import load_run
 from ground.archive.recorder import McapRecorder
+from harness.archive.cli import export_csv, main
+from harness.archive.reader import load_run
 from tests.conftest import small_scenario
 
 

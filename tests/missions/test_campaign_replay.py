@@ -17,7 +17,6 @@ from harness.summary import FdirResults
 from tests.conftest import dask_cluster
 from tests.deploy.test_campaign import BASE, CAMPAIGN
 
-
 FDIR_FIELDS = tuple(FdirResults.model_fields)
 """The fields of a run's summary.json that a replay rewrites."""
 

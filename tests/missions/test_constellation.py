@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
 from mcap.reader import make_reader
 
 from deploy.inproc import run_inproc

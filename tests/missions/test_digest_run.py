@@ -10,6 +10,9 @@ import pytest
 from mcap.reader import make_reader
 
 from deploy.inproc import run_inproc
+from ground.archive.recorder import McapRecorder
+from harness.archive.reader import ArchiveError, Record, load_run
+from harness.summary.build import RunOutcome, build_summary
 from harness.summary.digest import (
     LiveDigest,
     RunDigest,
@@ -17,9 +20,6 @@ from harness.summary.digest import (
     digest_run,
     unread_keys,
 )
-from harness.summary.build import RunOutcome, build_summary
-from harness.archive.reader import ArchiveError, Record, load_run
-from ground.archive.recorder import McapRecorder
 from interfaces.contracts.scenario import Scenario, load_scenario
 from tests.conftest import REPO
 

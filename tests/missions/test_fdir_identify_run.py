@@ -5,7 +5,6 @@ the baselines are scored beside the main detector in summary.json."""
 
 from __future__ import annotations
 
-
 import pytest
 
 from harness.summary import RunSummary

@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 
 from deploy.inproc import run_inproc
-from harness.summary.build import _series
+from harness.summary.fdir import series_of
 from interfaces.contracts.messages import FaultReport, FdirWindow
 from tests.conftest import collector, small_scenario
 
@@ -52,7 +52,7 @@ def test_the_campaign_series_records_a_window_failed_on_its_nis(
     """summary.json's ``fdir_series`` marks the leak's first window as failed on another test:
     its H_m is under τ, so a re-scoring from H_m alone would miss it."""
     first = next(w for w in run[0] if w.spacecraft == 1 and w.exceeded is not None)
-    main = _series(run[0], []).main
+    main = series_of(run[0], []).main
     row = next(r for r in main if r.spacecraft == 1 and r.t_start_s == first.t_start_s)
     assert row.statistic < row.threshold and row.other_tests_failed
     assert row.exceeded(scale=10.0) and row.model_dump()[5] == 1.0  # on disk: the sixth value

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from deploy.campaign import execute_run, load_campaign
-from harness.campaign.formation_study import load_study, twins, write_formation_study
 from harness.archive.reader import load_run
+from harness.campaign.formation_study import load_study, twins, write_formation_study
 from interfaces.contracts import catalogue as cat
 from tests.conftest import REPO
 

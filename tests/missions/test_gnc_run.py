@@ -16,8 +16,8 @@ from fsw.apps.guidance import KEEP_OUT_MARGIN_M
 from gnc.hcw import mean_motion
 from gnc.mission import MissionConstants
 from gnc.pro import Pro
-from harness.archive.reader import load_run
 from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan
+from harness.archive.reader import load_run
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
     AttitudeEstimate,

@@ -7,9 +7,9 @@ import numpy as np
 from scipy.stats import chi2
 
 from deploy.inproc import run_inproc
-from harness.summary.nav_eval import nav_errors
-from harness.archive.reader import load_run
 from ground.archive.recorder import McapRecorder
+from harness.archive.reader import load_run
+from harness.summary.nav import nav_errors
 from tests.conftest import small_scenario
 
 

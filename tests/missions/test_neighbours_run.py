@@ -12,12 +12,11 @@ degraded to β = 0.3 at 300 s, ``[neighbours]`` on.
 
 from __future__ import annotations
 
-
 import pytest
 
 from deploy.campaign import RunSpec, execute_run
-from harness.summary import RunSummary
 from harness.archive.reader import RunArchive, load_run
+from harness.summary import RunSummary
 from interfaces.contracts import catalogue as cat
 from tests.conftest import small_scenario
 

@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 
 from deploy.campaign import RunSpec, execute_run
-from harness.summary import RunSummary
 from harness.archive.reader import load_run
+from harness.summary import RunSummary
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.scenario import Scenario, load_scenario
 from tests.conftest import REPO
@@ -78,8 +78,8 @@ def test_safe_hold_fires_no_thruster_until_the_ground_replans(flown: Path) -> No
 
 
 def test_the_report_tells_the_onboard_story(flown: Path) -> None:
-    from harness.report import write_report
     from harness.archive.run_scenario import archived_scenario
+    from harness.report import write_report
     text = write_report(flown, archived_scenario(flown / "run.mcap")).read_text()
     assert "## Incidents" in text and "### Onboard FDIR" in text
     assert "sc2 pointing_actuator" in text

@@ -23,8 +23,8 @@ import pytest
 
 from deploy.campaign import RunSpec, execute_run
 from gnc.passes import ContactPlan
-from harness.summary import RunSummary
 from harness.archive.reader import load_run
+from harness.summary import RunSummary
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import topology

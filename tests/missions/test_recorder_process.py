@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from harness.archive.reader import load_run
 from ground.archive.recorder import McapRecorder
 from ground.archive.recorder_process import BATCH, RecorderDied, RecorderProcess
+from harness.archive.reader import load_run
 from interfaces.contracts.messages import Heartbeat
 from interfaces.runtime.transport import Sample
 from tests.conftest import REPO

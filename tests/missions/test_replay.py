@@ -7,16 +7,17 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+
 import pytest
 
 from deploy.inproc import run_inproc
+from ground.archive.metadata import run_metadata
+from ground.archive.recorder import McapRecorder
+from harness.archive.reader import ArchiveError, load_run
+from harness.archive.run_scenario import archived_scenario
+from harness.replay import GroundOutput, main, replay_run
 from harness.summary import Detection, RunSummary
 from harness.summary.build import write_summary
-from ground.archive.metadata import run_metadata
-from harness.archive.run_scenario import archived_scenario
-from harness.archive.reader import ArchiveError, load_run
-from ground.archive.recorder import McapRecorder
-from harness.replay import GroundOutput, main, replay_run
 from interfaces.contracts.scenario import Scenario
 from tests.harness.test_replay import _scenario
 

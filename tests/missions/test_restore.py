@@ -18,10 +18,10 @@ from interfaces.contracts.topology import topology
 from interfaces.runtime.app import App
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
-from links.channel import ChannelModel
 from interfaces.runtime.checkpoint import capture, restore
 from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.transport import InprocNetwork
+from links.channel import ChannelModel
 from tests.conftest import canonical, small_scenario
 
 SC = small_scenario(

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from gnc.pro import Pro
-from ground.apps.fdir import FdirApp
 from gnc.twin import FlightPlan
+from ground.apps.fdir import FdirApp
 from interfaces.contracts.messages import (
     FaultReport,
     FdirWindow,

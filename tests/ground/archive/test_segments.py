@@ -15,10 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from harness.archive.live import LiveArchive
 from ground.archive.metadata import run_metadata
-from harness.archive.run_scenario import archived_scenario
-from harness.archive.reader import ArchiveError, Record, load_run
 from ground.archive.recorder import McapRecorder, prepare_raw
 from ground.archive.segments import (
     SEGMENT_RECORD,
@@ -29,6 +26,9 @@ from ground.archive.segments import (
     segment_paths,
     with_segment,
 )
+from harness.archive.live import LiveArchive
+from harness.archive.reader import ArchiveError, Record, load_run
+from harness.archive.run_scenario import archived_scenario
 from interfaces.contracts.messages import Heartbeat, StateEstimate
 from tests.conftest import small_scenario
 

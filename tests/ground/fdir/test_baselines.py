@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
+from gnc.hardware_threshold import window_false_alarm
 from ground.fdir.baselines import NIS_DOF, Cusum, nis_window_test
 from ground.fdir.consistency import MIN_NIS_UPDATES, nis_test
-from gnc.hardware_threshold import window_false_alarm
 
 
 def test_nis_window_false_alarm_rate_matches_alpha() -> None:

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ground.fdir.constellation import ObserverGain, constellation_check, constellation_ratio
 from gnc.hardware_threshold import RatioModel
+from ground.fdir.constellation import ObserverGain, constellation_check, constellation_ratio
 
 PRED = [0.004, 0.002, 0.003, 0.005, 0.001]
 MODELS = [RatioModel(1.0 + 0.002 * i, 0.01 + 0.003 * i, 0.005, 0.01) for i in range(5)]

@@ -12,9 +12,9 @@ import pytest
 from gnc.infocost import Camera, agent_contributions
 from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
+from gnc.twin import TwinModel, centre_boresights, planned_boresights
 from ground.fdir.observer import MAX_JUDGED_LOSS, ObserverState, ground_contributions, loss_limit
 from ground.fdir.threshold import sampled_threshold
-from gnc.twin import TwinModel, centre_boresights, planned_boresights
 
 
 def test_losses_are_counted_from_sequence_gaps() -> None:

@@ -12,19 +12,19 @@ import logging
 import numpy as np
 import pytest
 
+from gnc.hardware_threshold import RatioModel
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro
+from gnc.twin import FlightPlan
 from ground.fdir.constellation import ConstellationVerdict
 from ground.fdir.declaration import Declarer
 from ground.fdir.global_check import GlobalCheck
-from gnc.hardware_threshold import RatioModel
 from ground.fdir.identify import Evidence
 from ground.fdir.information import Judgement
 from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
 from ground.fdir.observer import ObserverState
 from ground.fdir.threshold import WindowThreshold
-from gnc.twin import FlightPlan
 from ground.fdir.window import SettledMap, window_context
 from interfaces.contracts.messages import (
     ConstellationWindow,

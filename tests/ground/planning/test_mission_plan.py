@@ -11,8 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from gnc.poi import sphere_pois
 from gnc.mission import MissionConstants
+from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro, min_distance_between, min_distance_to_origin
 from ground.planning.mission_plan import UPLINK_LEAD_S, MissionPlan

@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from harness.archive.reader import ArchiveError, load_run
 from ground.archive.recorder import LIBRARY, McapRecorder
+from harness.archive.reader import ArchiveError, load_run
 from interfaces.contracts.messages import (
     ExecStats,
     GroupStats,

@@ -15,11 +15,11 @@ from harness.campaign.report import (
     SCALES,
     CampaignRun,
     _alarms_at,
-    load_runs,
     _magnitude_bins,
     _rescore,
     _roc,
     detector_figures,
+    load_runs,
     write_campaign_report,
 )
 from harness.summary import MainWindow, RunSummary, SummaryError

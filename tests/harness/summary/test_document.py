@@ -10,6 +10,8 @@ import json
 import typing
 from pathlib import Path
 
+from ground.archive.recorder import McapRecorder
+from harness.archive.reader import load_run
 from harness.report import _archive_section
 from harness.summary import (
     FailedTests,
@@ -19,9 +21,7 @@ from harness.summary import (
     RunSummary,
     SegmentRecord,
 )
-from harness.summary.build import archive_info
-from harness.archive.reader import load_run
-from ground.archive.recorder import McapRecorder
+from harness.summary.archive_info import archive_info
 from interfaces.contracts.messages import WINDOW_TESTS, FaultReport, StateEstimate
 from interfaces.runtime.encoding import encode
 

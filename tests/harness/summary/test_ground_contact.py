@@ -1,4 +1,4 @@
-"""summary.json's ``ground_contact`` (harness/summary/ground_contact_eval.py): absent for a
+"""summary.json's ``ground_contact`` (harness/summary/ground_contact.py): absent for a
 ground that hears continuously; with passes, the pass table of the scenario, the longest gap in
 the run (checked against the windows by hand) and each spacecraft's store and held uplinks from the
 ground's channel counters."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 
 from gnc.passes import ContactPlan
-from harness.summary.ground_contact_eval import ground_contact, longest_gap
+from harness.summary.ground_contact import ground_contact, longest_gap
 from interfaces.contracts.messages import LinkCounter, StoreCounter
 from tests.conftest import small_scenario
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from harness.summary.truth_table import TruthTable
 from harness.archive.reader import ArchiveError
+from harness.summary.truth_table import TruthTable
 from interfaces.contracts.messages import TruthState
 
 

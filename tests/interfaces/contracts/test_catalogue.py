@@ -8,14 +8,14 @@ import pytest
 
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
-from interfaces.contracts.catalogue import Space, Topic
-from interfaces.contracts.messages import Heartbeat, Message, StateEstimate
 from interfaces.contracts.apps import (
     GROUND_APPS,
     NEIGHBOUR_APPS,
     ONBOARD_FDIR_APPS,
     SPACECRAFT_APPS,
 )
+from interfaces.contracts.catalogue import Space, Topic
+from interfaces.contracts.messages import Heartbeat, Message, StateEstimate
 from interfaces.runtime.app import App
 from interfaces.runtime.assembly import app_class
 from interfaces.runtime.bus import Bus

@@ -11,10 +11,10 @@ from interfaces.contracts.messages import Tick
 from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
-from links.channel import ChannelModel
 from interfaces.runtime.checkpoint import capture, restore
 from interfaces.runtime.executive import TickClient
 from interfaces.runtime.transport import InprocNetwork
+from links.channel import ChannelModel
 from tests.conftest import canonical, small_scenario
 
 SC = small_scenario("ck", duration_s=30.0)

@@ -22,8 +22,8 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 from interfaces.contracts import topics
-from interfaces.contracts.messages import Message, Tick
 from interfaces.contracts.apps import GROUND_APPS, ONBOARD_FDIR_APPS, SPACECRAFT_APPS
+from interfaces.contracts.messages import Message, Tick
 from interfaces.runtime.app import App, AppContext, Input
 from interfaces.runtime.assembly import app_class
 from interfaces.runtime.bus import Bus

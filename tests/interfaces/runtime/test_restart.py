@@ -12,10 +12,10 @@ from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore, read_starts, write_run_key
-from links.channel import ChannelModel
 from interfaces.runtime.executive import TickClient
 from interfaces.runtime.restart import resume
 from interfaces.runtime.transport import InprocNetwork
+from links.channel import ChannelModel
 from tests.conftest import small_scenario
 
 SC = small_scenario("rs", duration_s=30.0)

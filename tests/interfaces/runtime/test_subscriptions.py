@@ -56,9 +56,9 @@ def test_no_node_subscribes_one_key_twice(scenario: str) -> None:
     from interfaces.contracts.topology import topology
     from interfaces.runtime.assembly import executive_of
     from interfaces.runtime.bus import Bus
-    from links.channel import ChannelModel
     from interfaces.runtime.executive import TickClient
     from interfaces.runtime.transport import InprocNetwork
+    from links.channel import ChannelModel
     from tests.conftest import REPO
 
     sc = load_scenario(REPO / "deploy" / "scenarios" / scenario)

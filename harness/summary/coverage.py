@@ -1,18 +1,48 @@
-"""Inspection coverage of a run from its archive: the information cost of everything the
-cameras saw (the sim's images, the truth of what was observed) and the observers' own H_i
-telemetry (Eq. 4, 8)."""
+"""summary.json's ``coverage`` section: the inspection coverage of a run from its archive."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Literal
+
+from pydantic import Field
 
 from gnc.poi_map import PoiMap
-from harness.summary import BUS_HEADER, AssignmentRecord, CoverageSummary
 from harness.archive.reader import Record, RunArchive
+from harness.summary.archive_info import BUS_HEADER
+from harness.summary.records import SummaryRecord
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import AssignmentDecision, CameraImage
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.timing import TIME_TOL_S
+
+
+class AssignmentRecord(SummaryRecord):
+    """An orbit assignment decision of the ground (an ``AssignmentDecision`` less its bus
+    header)."""
+
+    t_sim: float = Field(description="when decided, sim s")
+    phase: str
+    reason: Literal["phase", "saturated", "recovery"]
+    library_indices: list[int] = Field(
+        description="candidate PRO of observer 1, 2, ... (-1: kept its PRO)")
+    expected_gain: float = Field(description="expected information gain (H, dimensionless)")
+    upper_bound: float = Field(description="its online upper bound, same unit")
+    ratio_bound: float = Field(description="expected_gain / upper_bound")
+    current_gain: float | None = Field(description="expected gain of the current PROs")
+    measured_gains: list[float] = Field(description="H decrease per check window")
+    switched: bool = Field(description="whether it was flown")
+
+
+class CoverageSummary(SummaryRecord):
+    """``coverage``: the inspection's information cost H (dimensionless, Eq. 8)."""
+
+    H_initial: float = Field(description="H before any image")
+    H_final: float = Field(description="H at the end")
+    fraction_observed: float = Field(description="share of the POIs observed at least once")
+    H_i_final: dict[str, float] = Field(description="each observer's last reported H_i")
+    H_reduction_fraction: float = Field(description="1 - H_final / H_initial")
+    assignment_decisions: list[AssignmentRecord]
 
 
 @dataclass
@@ -108,4 +138,3 @@ def coverage_summary(c: Coverage) -> CoverageSummary:
         assignment_decisions=[AssignmentRecord.model_validate(d.model_dump(exclude=BUS_HEADER))
                               for d in c.decisions],
     )
-

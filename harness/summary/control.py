@@ -1,30 +1,41 @@
-"""Evaluation of orbit and attitude control from a run's archive, against the sim's truth.
-
-* Δv per observer, all L1 (Σ over axes of |Δv_j|): delivered (sim truth, body axes), commanded
-  (guidance, LVLH) and planned (SCP transfers that were flown).
-* PRO holding: distance of the true position from the assigned PRO while guidance holds it, from
-  the assignment's arrival time on.
-* Safety: the smallest true range to the target's centre once flying (from the first departure;
-  a deployment starts inside the keep-out sphere by design).
-* Pointing: angle between the true camera boresight and the true line of sight to the commanded
-  pointing target, and the attitude knowledge error (estimate against truth).
-"""
+"""summary.json's ``gnc`` section: each observer's orbit and attitude control from a run's
+archive, against the sim's truth."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
+from pydantic import Field
 from scipy.spatial.transform import Rotation
 
 from gnc import hcw
 from gnc.mission import MissionConstants
-from harness.summary import GncStats
-from harness.summary.truth_table import TIME_DECIMALS, TruthTable
 from harness.archive.reader import RunArchive
+from harness.summary.records import Figure, SummaryRecord
+from harness.summary.truth_table import TIME_DECIMALS, TruthTable
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import AttitudeEstimate
 from interfaces.contracts.scenario import Scenario
+
+
+class GncStats(SummaryRecord):
+    """One observer's guidance and attitude figures (``harness.summary.control``)."""
+
+    dv_delivered_l1_mps: float = Field(description="Δv delivered, L1 norm, m/s")
+    dv_commanded_l1_mps: float = Field(description="Δv commanded, L1 norm, m/s")
+    dv_planned_l1_mps: float = Field(description="Δv of the planned transfers, L1 norm, m/s")
+    transfers: int = Field(ge=0, description="transfers planned and solved")
+    min_range_m: Figure = Field(description="closest approach to the target, m")
+    hold_samples: int = Field(ge=0, description="samples of PRO station-keeping")
+    hold_error_rms_m: Figure = Field(description="PRO hold error, RMS, m")
+    hold_error_max_m: Figure = Field(description="PRO hold error, max, m")
+    pointing_samples_track: int = Field(ge=0, description="attitude samples in track mode")
+    pointing_error_mean_deg: Figure = Field(description="in track mode, deg")
+    pointing_error_p95_deg: Figure = Field(description="in track mode, deg")
+    pointing_error_max_deg: Figure = Field(description="in track mode, deg")
+    fraction_tracking: float = Field(description="share of attitude samples in track mode")
+    knowledge_error_rms_arcsec: Figure = Field(description="attitude knowledge error, arcsec")
 
 
 @dataclass

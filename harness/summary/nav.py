@@ -1,17 +1,55 @@
-"""Evaluation of a run from its archive: navigation error against the sim's truth."""
+"""summary.json's ``nav`` section: each observer's navigation error against the sim's truth,
+from its archive."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Annotated, Any
 
 import numpy as np
+from pydantic import (
+    BeforeValidator,
+    Field,
+    SerializerFunctionWrapHandler,
+    WrapSerializer,
+)
 from scipy.stats import chi2
 
 from gnc.kalman import nees
-from harness.summary.truth_table import TruthTable
 from harness.archive.reader import RunArchive
+from harness.summary.records import Figure, SummaryRecord
+from harness.summary.truth_table import TruthTable
 from interfaces.contracts import catalogue as cat
-from interfaces.contracts.messages import StateEstimate
+from interfaces.contracts.messages import (
+    StateEstimate,
+)
+
+
+class NavStats(SummaryRecord):
+    """One observer's navigation errors after the filter's first seconds
+    (``harness.summary.build.NAV_SETTLE_S``)."""
+
+    samples: int = Field(ge=0, description="estimates compared with the truth")
+    pos_rms_m: float
+    pos_max_m: float
+    vel_rms_mps: float
+    nees_mean: float = Field(description="mean normalised estimation error squared (6 dof)")
+    nees_in_95_bounds: float = Field(description="share of NEES within the χ²(6) 95% bounds")
+    nis_mean: Figure = Field(description="mean normalised innovation squared (null: none)")
+
+
+def _none_if_empty(v: Any) -> Any:
+    return None if v == {} else v
+
+
+def _empty_if_none(v: NavStats | None, handler: SerializerFunctionWrapHandler) -> Any:
+    return {} if v is None else handler(v)
+
+
+NavEntry = Annotated[NavStats | None, BeforeValidator(_none_if_empty),
+                     WrapSerializer(_empty_if_none)]
+"""An observer's nav statistics; None (``{}`` on disk) when it has no estimate after the
+settling time."""
 
 
 @dataclass(frozen=True)
@@ -69,3 +107,8 @@ def nav_errors(archive: RunArchive, mission: str,
             t, e, sd, q, nis = zip(*rows)
             out[sc] = NavErrors(np.array(t), np.array(e), np.array(sd), np.array(q), np.array(nis))
     return out
+
+
+def nav_stats(stats: dict[str, float]) -> NavStats | None:
+    """An observer's nav statistics (None: no estimate after the settling time)."""
+    return NavStats.model_validate(stats) if stats else None
