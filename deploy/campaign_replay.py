@@ -27,7 +27,8 @@ from typing import Any
 
 from harness.archive.reader import ArchiveError
 from harness.archive.run_scenario import archived_scenario
-from harness.campaign.report import detector_figures, write_campaign_report
+from harness.campaign.report import write_campaign_report
+from harness.campaign.rescore import detector_figures
 from harness.replay import replay_run, with_settings
 from harness.summary import ReplaySection, RunSummary
 from interfaces.contracts.scenario import ScenarioError

@@ -23,11 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from harness.campaign.report import (  # noqa: E402
-    CampaignRun,
-    false_alarm_bound,
-    load_runs,
-)
+from harness.campaign.rescore import CampaignRun, false_alarm_bound, load_runs
 from harness.summary import FaultScore, RunSummary  # noqa: E402
 
 CENTRAL, NEIGHBOURS = "central", "neighbours"

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from deploy.run_campaign import main as run_campaign
-from harness.campaign.report import detector_figures
+from harness.campaign.rescore import detector_figures
 from harness.summary import FdirResults
 from tests.conftest import dask_cluster
 from tests.deploy.test_campaign import BASE, CAMPAIGN

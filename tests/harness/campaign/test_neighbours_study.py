@@ -50,7 +50,7 @@ def test_the_study_puts_the_ground_alone_beside_the_neighbours(tmp_path: Path) -
             "injected_faults": [], "scores": _scores([], 0, 200),
             "neighbours": _neighbours([], 1, 1000, 0)})),
     ]
-    from harness.campaign.report import load_runs
+    from harness.campaign.rescore import load_runs
     paired = cases(load_runs(tmp_path, ids))
     assert [(c.group, c.index, c.central is not None, c.neighbours is not None)
             for c in paired] == [("nominal", "0000", True, True), ("thruster", "0000", True, True)]

@@ -11,16 +11,15 @@ from typing import Any
 import numpy as np
 import pytest
 
-from harness.campaign.report import (
+from harness.campaign.report import _magnitude_bins, write_campaign_report
+from harness.campaign.rescore import (
     SCALES,
     CampaignRun,
-    _alarms_at,
-    _magnitude_bins,
-    _rescore,
-    _roc,
+    alarms_at,
     detector_figures,
     load_runs,
-    write_campaign_report,
+    rescore,
+    roc,
 )
 from harness.summary import MainWindow, RunSummary, SummaryError
 
@@ -131,7 +130,7 @@ def test_report_figures(campaign: Path) -> None:
 
 
 def test_roc_rescoring(campaign: Path) -> None:
-    fa, det = _roc(load_runs(campaign, ["a", "b", "c"]), "main")
+    fa, det = roc(load_runs(campaign, ["a", "b", "c"]), "main")
     one = int(np.argmin(np.abs(SCALES - 1.0)))
     # at the configured threshold: the camera fault detected, the thruster fault missed; one
     # false alarm (run c) in 4 nominal windows (run a sc1, run c sc1)
@@ -154,7 +153,7 @@ def test_roc_scores_like_the_run(tmp_path: Path) -> None:
     run = _run({"injected_faults": faults, "detections": [_detection(3, 200.0, "link")],
                 "fdir_series": {"main": [[1, 0, 100, 0.2, 0.05], [1, 100, 200, 0.2, 0.05],
                                          [2, 0, 100, 0.01, 0.05], [2, 100, 200, 0.01, 0.05]]}})
-    fa, det = _roc([run], "main")
+    fa, det = roc([run], "main")
     one = int(np.argmin(np.abs(SCALES - 1.0)))
     assert det[one] == 1.0  # sc1's alarm at 200 s falls in sc2's fault: detected
     assert fa[one] == 0.5  # ... and a false alarm on sc1, whose 2 windows are nominal
@@ -182,10 +181,10 @@ def test_m_of_n_persistence() -> None:
                            statistic=h, threshold=0.05) for i, h in enumerate(levels)]
 
     gappy = series([0.1, 0.0, 0.1, 0.1, 0.1, 0.0, 0.0, 0.0, 0.1, 0.0, 0.1])
-    assert [a.t_s for a in _alarms_at(gappy, 1.0, 2, 2)] == [400.0]
-    assert [a.t_s for a in _alarms_at(gappy, 1.0, 2, 3)] == [300.0, 1100.0]
-    assert [a.t_s for a in _alarms_at(gappy, 1.0, 1, 1)] == [100.0, 300.0, 900.0, 1100.0]
-    assert _alarms_at(gappy, 3.0, 1, 1) == []  # threshold scaled above every level
+    assert [a.t_s for a in alarms_at(gappy, 1.0, 2, 2)] == [400.0]
+    assert [a.t_s for a in alarms_at(gappy, 1.0, 2, 3)] == [300.0, 1100.0]
+    assert [a.t_s for a in alarms_at(gappy, 1.0, 1, 1)] == [100.0, 300.0, 900.0, 1100.0]
+    assert alarms_at(gappy, 3.0, 1, 1) == []  # threshold scaled above every level
 
 
 def test_windows_failed_on_other_tests_count_at_every_threshold_scale() -> None:
@@ -194,9 +193,9 @@ def test_windows_failed_on_other_tests_count_at_every_threshold_scale() -> None:
     before the flag) is judged on H_m alone."""
     rows = [[1, 0.0, 30.0, 0.001, 0.05, 1.0], [1, 30.0, 60.0, 0.001, 0.05, 0.0]]
     nis_only = [MainWindow.model_validate(r) for r in rows]
-    assert [a.t_s for a in _alarms_at(nis_only, 1.0, 1, 1)] == [30.0]
-    assert [a.t_s for a in _alarms_at(nis_only, 100.0, 1, 1)] == [30.0]
-    assert _alarms_at([MainWindow.model_validate(r[:5]) for r in rows], 1.0, 1, 1) == []
+    assert [a.t_s for a in alarms_at(nis_only, 1.0, 1, 1)] == [30.0]
+    assert [a.t_s for a in alarms_at(nis_only, 100.0, 1, 1)] == [30.0]
+    assert alarms_at([MainWindow.model_validate(r[:5]) for r in rows], 1.0, 1, 1) == []
 
 
 def test_the_report_says_when_summaries_lack_the_other_tests(tmp_path: Path) -> None:
@@ -220,7 +219,7 @@ def test_the_global_checks_declaration_counts_in_the_rescoring() -> None:
                 "detections": [_detection(0, 3300.0, "common_mode", 0.33, 0.031)],
                 "fdir_series": {"main": [[1, 3270.0, 3300.0, 0.01, 0.05, 0.0]]}})
     for scale, isolated in ((1.0, True), (10.0, True), (11.0, False)):
-        (fault,) = _rescore([run], "main", scale).per_fault
+        (fault,) = rescore([run], "main", scale).per_fault
         assert fault.isolated is isolated, scale
 
 
