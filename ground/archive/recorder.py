@@ -321,11 +321,6 @@ class McapRecorder:
         with self._queue.exclusive():
             return dict(self._file.counts)
 
-    @property
-    def last_log_time_ns(self) -> int:
-        """Last sim time seen, ns (the default log time of a payload without ``t_sim``)."""
-        return self._file.last_log_ns
-
     def __repr__(self) -> str:
         state = "closed" if self._closed else "open"
         return f"McapRecorder({str(self._path)!r}, {state}, recorded={self.recorded})"

@@ -169,6 +169,11 @@ class PoiPrecisions(Message):
             assert cached is not None
         return cached[1], cached[2]
 
+    def share_arrays(self, other: PoiPrecisions) -> None:
+        """Take ``other``'s converted arrays, as they are (None: not converted yet): this
+        message holds ``other``'s own lists."""
+        self.__pydantic_private__["_arrays"] = other._arrays  # type: ignore[index]
+
     def _keep_arrays(self, poi: npt.ArrayLike, precision: npt.ArrayLike) -> None:
         """Keep read-only copies of ``poi`` (int64) and ``precision`` (float64), equal to the
         lists, as what :meth:`arrays` returns."""

@@ -146,7 +146,7 @@ class PoiObservations(PoiPrecisions):
         if pose is not None:
             fields["pose"] = pose
         msg = cls.model_construct(**fields) if header_ok(sender, t_sim) else cls(**fields)
-        msg.__pydantic_private__["_arrays"] = image._arrays  # type: ignore[index]
+        msg.share_arrays(image)
         return msg
 
 
