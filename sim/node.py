@@ -9,6 +9,7 @@ attitude) to t + dt.
 """
 
 from __future__ import annotations
+from interfaces.runtime.recent import recover
 
 import logging
 import threading
@@ -259,7 +260,7 @@ class SimNode:
         of their senders again (``Bus.recover``)."""
         missing = self.bus.wait_for(expect, max(0.0, min(1.0, deadline - time.monotonic())))
         if missing:
-            self.bus.recover(missing)
+            recover(self.bus, missing)
             self.bus.wait_for(expect, max(0.0, deadline - time.monotonic()))
 
     def _send_again(self, tick: Callable[..., Tick], back: list[str]) -> None:

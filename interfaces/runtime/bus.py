@@ -50,7 +50,7 @@ from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
 from interfaces.runtime.inbox import Envelope, Inbox
 from interfaces.runtime.link_stage import LinkStage
-from interfaces.runtime.recent import RECENT_TICKS, RecentSent, fetch
+from interfaces.runtime.recent import RECENT_TICKS, RecentSent
 from interfaces.runtime.schemas import serve_schemas
 from interfaces.runtime.subscriptions import Route, Sub, SubscriptionTable
 from interfaces.runtime.transport import LivenessHandler, RawHandler, Sample, Transport
@@ -178,7 +178,7 @@ class Bus:
         self.stats.received += 1
         key = sample.key
         if sample.message is None and len(sample.payload) > MAX_PAYLOAD_BYTES:
-            self._invalid(key, f"payload of {len(sample.payload)} bytes exceeds "
+            self.drop_invalid(key, f"payload of {len(sample.payload)} bytes exceeds "
                                f"{MAX_PAYLOAD_BYTES}")
             return
         decoded: dict[type[Message], Message] = {}
@@ -263,7 +263,7 @@ class Bus:
             try:
                 msg = msg_type.model_validate_json(sample.payload)
             except ValidationError as e:
-                self._invalid(key, f"not a valid {msg_type.__name__}: {_first_error(e)}")
+                self.drop_invalid(key, f"not a valid {msg_type.__name__}: {_first_error(e)}")
                 return None
         refusal = self.admission.check(key, msg, len(self.inbox.pending))
         if refusal is not None:
@@ -280,7 +280,8 @@ class Bus:
             self.log.warning("%s refused message #%d on %s (%s): %s", self.node, n, key, kind,
                              why)
 
-    def _invalid(self, key: str, why: str) -> None:
+    def drop_invalid(self, key: str, why: str) -> None:
+        """Count and log (rate-limited) an invalid message on ``key``."""
         self.stats.invalid_dropped += 1
         n = self.stats.invalid_dropped
         if n <= 5 or n % 100 == 0:
@@ -333,25 +334,6 @@ class Bus:
         wanted = {k: s for k, s in expect.items()
                   if self.table.awaits(k) and s <= seen.get(k, 0) + MAX_SEQ_JUMP}
         return self.inbox.wait(wanted, seen, timeout_s)
-
-    def recover(self, keys: list[str], timeout_s: float = 2.0) -> int:
-        """Ask the publishers of ``keys`` (announced, not arrived) for what they sent in their
-        last ticks, and take it in as if it had just arrived (``take_in``).  Returns the
-        samples taken in."""
-        owners = sorted({o for k in keys if (o := self.admission.owner(k)) and o != self.node})
-        taken = sum(self.take_in(s) for o in owners for s in self.fetch_recent(o, timeout_s))
-        if owners:
-            self.log.warning("%s asked %s for %d announced key(s) that never came; %d "
-                             "message(s) taken in", self.node, ", ".join(owners), len(keys), taken)
-        return taken
-
-    def fetch_recent(self, owner: str, timeout_s: float = 2.0) -> list[Sample]:
-        """What node ``owner`` sent in its last ticks (``interfaces.runtime.recent``), its own
-        keys only, oldest first; a malformed reply is counted as invalid and skipped."""
-        samples, malformed = fetch(self.transport, self.mission, owner, timeout_s)
-        for why in malformed:
-            self._invalid(topics.recent_queryable(self.mission, owner), why)
-        return samples
 
     def take_in(self, sample: Sample) -> int:
         """Receive ``sample`` as if it had just arrived (validated, admitted: one already held

@@ -36,6 +36,7 @@ from interfaces.contracts.scenario import Scenario
 from interfaces.runtime.admission import MAX_AHEAD_S
 from interfaces.runtime.app import RATE_GROUPS, App
 from interfaces.runtime.bus import Bus
+from interfaces.runtime.recent import recover
 
 
 @dataclass
@@ -151,7 +152,7 @@ class Executive:
         ``barrier_timeout_s``.  Returns the keys still missing."""
         missing = self.bus.wait_for(tick.expect, self.recover_after_s)
         if missing:
-            self.bus.recover(missing)
+            recover(self.bus, missing)
             missing = self.bus.wait_for(tick.expect, self.barrier_timeout_s)
         return missing
 

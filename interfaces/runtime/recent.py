@@ -19,9 +19,12 @@ tick m on, and the sim's ticks themselves.  No other node is past tick k, so the
 from __future__ import annotations
 
 import json
+import logging
 from collections import deque
+from typing import Protocol
 
 from interfaces.contracts import topics
+from interfaces.runtime.admission import Admission
 from interfaces.runtime.transport import Sample, Transport
 
 RECENT_TICKS = 4
@@ -89,3 +92,40 @@ def fetch(transport: Transport, mission: str, owner: str,
         except ValueError as e:
             malformed.append(str(e))
     return samples, malformed
+
+
+class Receiver(Protocol):
+    """What asking for the recent ticks needs of a node's Bus."""
+
+    node: str
+    mission: str
+    transport: Transport
+    log: logging.Logger
+    admission: Admission
+
+    def take_in(self, sample: Sample) -> int:
+        """Receive ``sample`` as if it had just arrived; 1 if it was taken."""
+
+    def drop_invalid(self, key: str, why: str) -> None:
+        """Count and log an invalid message on ``key``."""
+
+
+def fetch_recent(bus: Receiver, owner: str, timeout_s: float = 2.0) -> list[Sample]:
+    """What node ``owner`` sent in its last ticks, its own keys only, oldest first, asked by
+    ``bus``'s node; a malformed reply is counted there as invalid and skipped."""
+    samples, malformed = fetch(bus.transport, bus.mission, owner, timeout_s)
+    for why in malformed:
+        bus.drop_invalid(topics.recent_queryable(bus.mission, owner), why)
+    return samples
+
+
+def recover(bus: Receiver, keys: list[str], timeout_s: float = 2.0) -> int:
+    """Ask the publishers of ``keys`` (announced to ``bus``'s node, not arrived) for what they
+    sent in their last ticks, and take it in as if it had just arrived (``take_in``: what is
+    held already is a duplicate).  Returns the samples taken in."""
+    owners = sorted({o for k in keys if (o := bus.admission.owner(k)) and o != bus.node})
+    taken = sum(bus.take_in(s) for o in owners for s in fetch_recent(bus, o, timeout_s))
+    if owners:
+        bus.log.warning("%s asked %s for %d announced key(s) that never came; %d "
+                        "message(s) taken in", bus.node, ", ".join(owners), len(keys), taken)
+    return taken

@@ -26,6 +26,7 @@ from interfaces.contracts.messages import Tick
 from interfaces.runtime.cds import CriticalDataStore, StartRecord, StoreRefused
 from interfaces.runtime.checkpoint import capture, restore
 from interfaces.runtime.executive import TickClient
+from interfaces.runtime.recent import fetch_recent
 
 
 def resume(client: TickClient, store: CriticalDataStore, others: list[str],
@@ -85,7 +86,7 @@ def _catch_up(client: TickClient, others: list[str], record: StartRecord,
     ticks: dict[int, Tick] = {}
     heard_sim = False
     for owner in others:
-        samples = bus.fetch_recent(owner)
+        samples = fetch_recent(bus, owner)
         heard_sim = heard_sim or (owner == topics.SIM and bool(samples))
         for sample in samples:
             if sample.key != tick_key:

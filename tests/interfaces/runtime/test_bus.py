@@ -11,6 +11,7 @@ import pytest
 from interfaces.contracts import topics
 from interfaces.contracts.messages import Heartbeat, StateEstimate, json_schema
 from interfaces.runtime.bus import Bus
+from interfaces.runtime.recent import fetch_recent, recover
 from interfaces.runtime.transport import InprocNetwork
 from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
 from tests.conftest import settle
@@ -162,10 +163,10 @@ def test_what_a_node_missed_is_sent_again_on_request(pair) -> None:  # noqa: ANN
     bus_b.subscribe(key, Heartbeat, got.append)
     time.sleep(0.3)
     assert bus_b.wait_for({key: 3}, 0.01) == [key]  # announced, never came
-    assert bus_b.recover([key]) == 2
+    assert recover(bus_b, [key]) == 2
     assert bus_b.wait_for({key: 3}, 0.01) == []
-    assert bus_b.recover([key]) == 0 and bus_b.admission.duplicates == 2  # held already
+    assert recover(bus_b, [key]) == 0 and bus_b.admission.duplicates == 2  # held already
     assert bus_b.dispatch(10.0) == 2 and [m.t_sim for m in got] == [2.0, 3.0]
     raw.serve(topics.recent_queryable(M, "sc3"), lambda _k: b'[["x"]]')  # a broken answer
     time.sleep(0.3)
-    assert bus_b.fetch_recent("sc3") == [] and bus_b.stats.invalid_dropped == 1
+    assert fetch_recent(bus_b, "sc3") == [] and bus_b.stats.invalid_dropped == 1
