@@ -39,7 +39,6 @@ from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
 from gnc.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.window import SettledMap, window_context
-from ground.planning.pro_sets import pro_of
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
     AttitudeEstimate,
@@ -130,10 +129,8 @@ class FdirPipeline:
             obs = self.observers.get(a.spacecraft)
             if obs is None or a.assignment_id in obs.plans:
                 continue
-            obs.plans[a.assignment_id] = FlightPlan(
-                max(a.t_depart_s, reach), pro_of(a.pro),
-                self._transfers.get((a.spacecraft, a.assignment_id)),
-                a.t_arrive_s if a.t_arrive_s > a.t_depart_s else None)
+            obs.plans[a.assignment_id] = FlightPlan.of(
+                a, max(a.t_depart_s, reach), self._transfers.get((a.spacecraft, a.assignment_id)))
 
     def telemetry(self, msg: InfoCostTelemetry) -> None:
         j = self.schedule.boundary_at(msg.t_sim)
