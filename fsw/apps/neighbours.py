@@ -24,7 +24,8 @@ import numpy as np
 from gnc.pro import Pro
 from gnc.poi_map import PoiMap
 from gnc.twin import FlightPlan, TwinModel, held_over
-from fsw.lib.neighbour_judge import Exclusions, JudgeSettings, agreed, judge
+from gnc.window_test import WindowTestSettings
+from fsw.lib.neighbour_judge import Exclusions, agreed, judge
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
@@ -60,7 +61,7 @@ class NeighboursApp(App):
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self.twin = TwinModel(k.poi_pos, k.poi_normal, k.camera, sc.target.radius_m,
                               sc.camera.noise_frac)
-        self.cfg = JudgeSettings.of(sc)
+        self.cfg = WindowTestSettings.of(sc)
         self.agree = sc.neighbours.agree
         self.schedule = FdiSchedule(sc.rates.fdi_period_s)
         self.latency_s = sc.fdir.latency_s

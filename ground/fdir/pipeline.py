@@ -31,7 +31,6 @@ from gnc.passes import ContactPlan
 from gnc.poi_map import PoiMap
 from ground.fdir.declaration import Declarer
 from ground.fdir.global_check import GlobalCheck
-from gnc.hardware_threshold import window_false_alarm
 from ground.fdir.information import InformationTest, Judgement
 from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
@@ -80,11 +79,9 @@ class FdirPipeline:
         self.pending: list[PoiObservations] = []
         self.observers = {i: ObserverState() for i in range(1, sc.observers.count + 1)}
         self.boresight_body = constants.boresight_body
-        q_window = window_false_alarm(cfg.false_alarms_per_observer_hour, sc.rates.fdi_period_s,
-                                      cfg.persistence, 2 if cfg.fuse_nis else 1)
         self.links = LinkChecks(sc, node, log)
-        self.information = InformationTest(sc, self.twin, q_window)
-        self.global_check = GlobalCheck(cfg, q_window, node, log)
+        self.information = InformationTest(sc, self.twin)
+        self.global_check = GlobalCheck(cfg, self.information.q_window, node, log)
         self.declarer = Declarer(cfg, node, log)
         self.integrity = IntegrityCheck(cfg, node, log)
         self.rulings = NeighbourRulings(node, log)
