@@ -22,7 +22,7 @@ each draw holds one position offset and one small rotation over the whole window
 conservative choice: no averaging over images).  The pose part is a small Monte Carlo through the
 twin; the camera part is exact given the weights.  Their sum is summarised as a Gaussian
 x ~ N(μ, σ²) and τ solves P(|1 − x| > τ) = q: the tail beyond the samples is the Gaussian's.
-Pure functions; the FDIR app feeds them.
+Pure functions; the window test (``gnc/window_test.py``) feeds them.
 """
 
 from __future__ import annotations
@@ -38,25 +38,6 @@ from scipy.special import ndtr
 from gnc.twin import TwinModel, sample_stride
 
 FloatArray = npt.NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class HardwareSpec:
-    """The nominal noise of one observer's hardware that the ground knows from the scenario.
-
-    Attributes:
-        camera_noise_frac: ν, 1σ multiplicative noise of each measured precision.
-        track_sigma_m: station-keeping accuracy holding a PRO, 1σ per axis, m.
-        transfer_sigma_m: tracking accuracy on a transfer, 1σ per axis, m.
-        pointing_jitter_rad: attitude loop tracking error, 1σ per axis, rad.
-        samples: pose draws per window.
-    """
-
-    camera_noise_frac: float
-    track_sigma_m: float
-    transfer_sigma_m: float
-    pointing_jitter_rad: float
-    samples: int = 16
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ import numpy.typing as npt
 from gnc import hcw
 from gnc.checks import finite_array
 from gnc.constants import MU_EARTH_M3_S2
+from interfaces.contracts.messages import ProElements
 
 __all__ = [
     "Pro",
@@ -66,6 +67,12 @@ class Pro:
         values = (self.rho_x_m, self.alpha_x_rad, self.rho_y_m, self.rho_z_m, self.alpha_z_rad)
         if not all(math.isfinite(float(v)) for v in values):
             raise ValueError(f"PRO parameters must be finite, got {values!r}")
+
+    @classmethod
+    def of(cls, elements: ProElements) -> Pro:
+        """The PRO an assignment's uplinked ``elements`` name (``ProAssignment.pro``)."""
+        return cls(elements.rho_x_m, elements.alpha_x_rad, elements.rho_y_m, elements.rho_z_m,
+                   elements.alpha_z_rad)
 
     def state(self, n: float, t: float) -> FloatArray:
         """HCW state on the PRO at absolute time ``t`` (s); ``n`` in rad/s.  Shape (6,)."""

@@ -19,6 +19,7 @@ Pure functions and frozen dataclasses; the FDIR app holds the state.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,8 +29,10 @@ from gnc.hcw import zoh_matrices
 from gnc.infocost import Camera
 from gnc.infocost_kernels import precision
 from gnc.pro import Pro
+from interfaces.contracts.messages import ProAssignment
 
 FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.intp]
 
 
 @dataclass(frozen=True)
@@ -53,12 +56,29 @@ class FlightPlan:
     t_arrive_s: float | None = None
     """end of the transfer the assignment asks for (None: no transfer)"""
 
+    @classmethod
+    def of(cls, assignment: ProAssignment, from_s: float | None = None,
+           transfer: Transfer | None = None) -> FlightPlan:
+        """The plan of an uplinked ``assignment``, in force from ``from_s`` (s; default its
+        departure), with the ``transfer`` published for it if any."""
+        a = assignment
+        return cls(a.t_depart_s if from_s is None else from_s, Pro.of(a.pro), transfer,
+                   a.t_arrive_s if a.t_arrive_s > a.t_depart_s else None)
+
     @property
     def starts_s(self) -> float:
         """When the observer leaves its previous plan for this one: the first node of the
         transfer it published (it may start later than asked, e.g. after an outage), else
         ``t_from_s``."""
         return float(self.transfer.t_s[0]) if self.transfer is not None else self.t_from_s
+
+    @property
+    def holds_from_s(self) -> float:
+        """When the observer is on its PRO: the end of the transfer it published, else the
+        arrival the assignment asks for, else ``t_from_s``."""
+        if self.transfer is not None:
+            return float(self.transfer.t_s[-1])
+        return self.t_arrive_s if self.t_arrive_s is not None else self.t_from_s
 
     def known(self, t: npt.ArrayLike) -> npt.NDArray[np.bool_]:
         """Whether the plan says where the observer is at each time ``t``: not between the
@@ -93,6 +113,27 @@ class FlightPlan:
             x = np.einsum("tij,tj->ti", phi, tr.x[k]) + np.einsum("tij,tj->ti", gam, tr.u[k])
             out[inside] = x[:, :3]
         return out
+
+
+def plans_in_force(plans: Iterable[FlightPlan], times: npt.ArrayLike
+                   ) -> tuple[list[FlightPlan], IntArray]:
+    """The plan in force at each of ``times`` (s): ``plans`` in the order they take over
+    (``FlightPlan.starts_s``; of two starting together, the later given takes over), and at
+    each time the index of the last to have started by it (−1 before the first)."""
+    ordered = sorted(plans, key=lambda p: p.starts_s)
+    starts = np.array([p.starts_s for p in ordered])
+    return ordered, np.searchsorted(starts, times, side="right") - 1
+
+
+def held_over(plans: Iterable[FlightPlan], a: float, b: float) -> FlightPlan | None:
+    """The plan whose PRO the observer holds over all of [a, b) (s): the one in force at a
+    (:func:`plans_in_force`), none taking over within the window, its transfer over by a.
+    None without a plan in force, or when a transfer or a change of plan falls in [a, b)."""
+    ordered, which = plans_in_force(plans, np.array([a]))
+    if which[0] < 0 or any(a < p.starts_s < b for p in ordered):
+        return None
+    plan = ordered[int(which[0])]
+    return plan if plan.holds_from_s <= a else None
 
 
 def centre_boresights(positions: npt.ArrayLike) -> FloatArray:

@@ -170,8 +170,7 @@ class GuidanceApp(App):
         """Fly assignment ``a`` from now (its transfer is planned in this cycle)."""
         self.previous = (self.assignment, self.pro)
         self.assignment = a
-        p = a.pro
-        self.pro = Pro(p.rho_x_m, p.alpha_x_rad, p.rho_y_m, p.rho_z_m, p.alpha_z_rad)
+        self.pro = Pro.of(a.pro)
 
     def _plan(self, t: float, x: np.ndarray, a: ProAssignment) -> None:
         """Plan the transfer to the assigned PRO.  If no safe plan exists, the assignment is

@@ -23,8 +23,9 @@ import numpy as np
 
 from gnc.pro import Pro
 from gnc.poi_map import PoiMap
-from gnc.twin import TwinModel
-from fsw.lib.neighbour_judge import Exclusions, JudgeSettings, agreed, judge
+from gnc.twin import FlightPlan, TwinModel, held_over
+from gnc.window_test import WindowTestSettings
+from fsw.lib.neighbour_judge import Exclusions, agreed, judge
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
@@ -60,15 +61,15 @@ class NeighboursApp(App):
         self.map = PoiMap.uniform(sc.target.pois, sc.target.prior_variance, sc.observers.count)
         self.twin = TwinModel(k.poi_pos, k.poi_normal, k.camera, sc.target.radius_m,
                               sc.camera.noise_frac)
-        self.cfg = JudgeSettings.of(sc)
+        self.cfg = WindowTestSettings.of(sc)
         self.agree = sc.neighbours.agree
         self.schedule = FdiSchedule(sc.rates.fdi_period_s)
         self.latency_s = sc.fdir.latency_s
         self.decide_after_s = 1.0 / sc.rates.mid_hz
         self.seed = sc.seed
         self.pending: list[PoiObservations] = []
-        self.plans: dict[int, dict[int, tuple[float, float, Pro]]] = defaultdict(dict)
-        """by observer and assignment id: (in force from, arrival of its transfer, PRO)"""
+        self.plans: dict[int, dict[int, FlightPlan]] = defaultdict(dict)
+        """by observer and assignment id"""
         self.verdicts: dict[tuple[int, int], dict[int, bool | None]] = {}
         """(window index, subject) -> judge -> exceeded"""
         self.exclusions = Exclusions()
@@ -85,10 +86,7 @@ class NeighboursApp(App):
 
     def on_assignments(self, msg: ProAssignments) -> None:
         for a in msg.assignments:
-            e = a.pro
-            self.plans[a.spacecraft].setdefault(a.assignment_id, (
-                a.t_depart_s, a.t_arrive_s,
-                Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)))
+            self.plans[a.spacecraft].setdefault(a.assignment_id, FlightPlan.of(a))
 
     def on_judgement(self, msg: NeighbourJudgement) -> None:
         k = self.schedule.boundary_at(msg.t_start_s)  # window k starts at boundary k
@@ -140,12 +138,8 @@ class NeighboursApp(App):
     def _pro(self, subject: int, a: float, b: float) -> Pro | None:
         """The PRO ``subject`` holds over all of [a, b) (s): None without a plan, or when a
         transfer (its path is the subject's own choice) or a change of plan falls in it."""
-        plans = sorted((p[0], aid) for aid, p in self.plans.get(subject, {}).items()
-                       if p[0] < b)
-        if not plans:
-            return None
-        t_from, t_arrive, pro = self.plans[subject][plans[-1][1]]
-        return None if t_from > a or t_arrive > a else pro
+        plan = held_over(self.plans.get(subject, {}).values(), a, b)
+        return plan.pro if plan is not None else None
 
     def _decide(self, k: int, t: float) -> None:
         """Apply the agreement rule to window k's judgements."""

@@ -1,13 +1,8 @@
-"""The main detector's guidance and attitude tests, fused with the information test (issue 15:
-as the map saturates the information metric alone loses the orbit actuator faults).  Each
-compares one item of a window's identification evidence (``ground/fdir/identify.Evidence``)
-with the nominal bound the scenario states for it (``Tolerances``): the nav estimate's distance
-from the plan, the pointing error the attitude estimate reports while tracking, and the Δv the
-observer commands per second while holding its PRO.  The nav's own consistency test
-(:func:`nis_test`) joins them: an orbit actuator fault is an unmodelled force in the nav
-filter, so its innovations grow before the information metric or the Δv spent show it on a
-saturated map.  A window fails the detector when the information test or any of these fails;
-the verdict names which.
+"""The nav's consistency test, fused with the window test (``gnc/window_test.py``: the
+information test and the guidance and attitude tests, issue 15) with ``fdir.fuse_nis``: an
+orbit actuator fault is an unmodelled force in the nav filter, so its innovations grow before
+the information metric or the Δv spent show it on a saturated map.  A window fails the
+detector when the information test or any of these fails; the verdict names which.
 """
 
 from __future__ import annotations
@@ -15,20 +10,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ground.fdir.baselines import nis_window_test
-from ground.fdir.identify import Evidence, Tolerances
-
-
-def failed_tests(ev: Evidence, tol: Tolerances) -> tuple[str, ...]:
-    """Names of the consistency tests the window's evidence fails, by the names a window's
-    verdict gives them (``interfaces.contracts.messages.WINDOW_TESTS``)."""
-    failed = []
-    if (ev.nav_vs_plan_m or 0.0) > tol.position_m:
-        failed.append("plan")
-    if (ev.pointing_error_deg or 0.0) > tol.pointing_deg:
-        failed.append("pointing")
-    if (ev.dv_rate_mps2 or 0.0) > tol.dv_rate_mps2:
-        failed.append("dv_rate")
-    return tuple(failed)
 
 
 MIN_NIS_UPDATES = 5

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 
+from gnc.window_test import exceeded as window_exceeded
 from ground.fdir.constellation import ConstellationVerdict
 from ground.fdir.identify import Evidence, Tolerances, classify
 from ground.fdir.information import Judgement
@@ -44,7 +45,7 @@ class Declarer:
         """The window's verdict (``exceeded`` set) and the fault reports it brings."""
         failed = [f for f in j.window.failed
                   if not (f == "information" and common is not None and common.common_mode)]
-        exceeded = bool(failed) if failed or j.decided else None
+        exceeded = window_exceeded(failed, j.decided)
         w = j.window.model_copy(update={"exceeded": exceeded})
         out: list[Message] = [w]
         if self.persistence.update(sc, exceeded):

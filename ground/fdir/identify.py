@@ -113,6 +113,7 @@ from gnc.infocost import visibility
 from ground.fdir.boresight import boresight_offset
 from gnc.hardware_threshold import clipped_noise_moments
 from gnc.twin import TwinModel, sample_stride
+from gnc.window_test import Observation, WindowPose
 from interfaces.contracts.scenario import FdirSettings
 
 FloatArray = npt.NDArray[np.float64]
@@ -363,10 +364,6 @@ def _alignment(ev: Evidence) -> float | None:
     return ev.offset_alignment
 
 
-Observation = tuple[np.ndarray, np.ndarray]
-"""One image's observations: POI indices and their precisions σ⁻¹."""
-
-
 def located_cameras(twin: TwinModel, images: Sequence[Observation]
                     ) -> list[tuple[int, CameraFix]]:
     """The camera located from each image that allows it (:func:`locate_camera`), by image
@@ -377,33 +374,29 @@ def located_cameras(twin: TwinModel, images: Sequence[Observation]
     return located if len(located) >= MIN_FIXES else []
 
 
-def pose_evidence(located: list[tuple[int, CameraFix]], nav: np.ndarray | None,
-                  attitude: np.ndarray | None, planned: np.ndarray, radius_m: float,
+def pose_evidence(located: list[tuple[int, CameraFix]], pose: WindowPose, radius_m: float,
                   dv_rate: float | None) -> Evidence:
     """The cheap part of a window's identification evidence, judged every window so that its
-    nominal spread is in the archive: the located cameras (``located``), the nav and the
-    attitude against the plan.  ``nav``: reported positions at the image times (LVLH, m);
-    ``attitude``: reported boresight, pointing error and aim point rows; ``planned``: the
-    plan's positions; ``radius_m``: the target's."""
+    nominal spread is in the archive: the located cameras (``located``), the reported nav and
+    attitude against the plan (``pose``: the window test's statistics, ``gnc/window_test.py``).
+    ``radius_m``: the target's."""
+    planned, nav = pose.planned, pose.nav
     betas = np.array([f.beta for _, f in located])
     beta, beta_se = (float(np.median(betas)), median_se(betas)) if located else (None, None)
-    cam_nav = nav_plan = point = align = cam_plan = None
+    cam_nav = align = cam_plan = None
     camera_se: tuple[float | None, float | None] = (None, None)
     if located:
         off_plan = np.array([f.position_m - planned[i] for i, f in located])
         cam_plan = float(np.linalg.norm(np.median(off_plan, axis=0)))
         camera_se = _camera_se(off_plan, planned, radius_m)
-    if nav is not None:
-        nav_plan = float(np.median(np.linalg.norm(nav - planned, axis=1)))
-        if located:
-            d = np.array([f.position_m - nav[i] for i, f in located])
-            cam_nav = float(np.linalg.norm(np.median(d, axis=0)))
-            align = offset_alignment(np.array([f.position_m for _, f in located]),
-                                     nav[[i for i, _ in located]], planned[[i for i, _ in located]])
-    if attitude is not None:
-        point = math.degrees(float(np.median(attitude[:, 3])))
-    return Evidence(beta_hat=beta, camera_vs_nav_m=cam_nav, nav_vs_plan_m=nav_plan,
-                    pointing_error_deg=point, dv_rate_mps2=dv_rate, offset_alignment=align,
+    if nav is not None and located:
+        d = np.array([f.position_m - nav[i] for i, f in located])
+        cam_nav = float(np.linalg.norm(np.median(d, axis=0)))
+        align = offset_alignment(np.array([f.position_m for _, f in located]),
+                                 nav[[i for i, _ in located]], planned[[i for i, _ in located]])
+    return Evidence(beta_hat=beta, camera_vs_nav_m=cam_nav, nav_vs_plan_m=pose.nav_vs_plan_m,
+                    pointing_error_deg=pose.pointing_error_deg, dv_rate_mps2=dv_rate,
+                    offset_alignment=align,
                     camera_vs_plan_m=cam_plan, beta_se=beta_se, camera_se_m=camera_se[0],
                     camera_se_deg=camera_se[1])
 

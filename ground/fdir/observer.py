@@ -14,7 +14,7 @@ import numpy as np
 
 from gnc.infocost import agent_contributions
 from gnc.poi_map import PoiMap
-from gnc.twin import FlightPlan
+from gnc.twin import FlightPlan, plans_in_force
 
 
 class TimeSeries:
@@ -163,11 +163,9 @@ class ObserverState:
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """Planned positions (K, 3) at the image ``times`` (K,), whether each falls on a
         transfer, and whether the plan knows the path there (``FlightPlan.known``), every time
-        under the plan in force at it (a window may straddle a departure; a plan is in force
-        from ``FlightPlan.starts_s``); None when a time precedes every plan."""
-        plans = sorted(self.plans.values(), key=lambda p: p.starts_s)
-        starts = np.array([p.starts_s for p in plans])
-        which = np.searchsorted(starts, times, side="right") - 1
+        under the plan in force at it (``gnc.twin.plans_in_force``: a window may straddle a
+        departure); None when a time precedes every plan."""
+        plans, which = plans_in_force(self.plans.values(), times)
         if not plans or np.any(which < 0):
             return None
         pos = np.empty((len(times), 3))

@@ -31,7 +31,6 @@ from gnc.passes import ContactPlan
 from gnc.poi_map import PoiMap
 from ground.fdir.declaration import Declarer
 from ground.fdir.global_check import GlobalCheck
-from gnc.hardware_threshold import window_false_alarm
 from ground.fdir.information import InformationTest, Judgement
 from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
@@ -39,7 +38,6 @@ from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
 from gnc.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.window import SettledMap, window_context
-from ground.planning.pro_sets import pro_of
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
     AttitudeEstimate,
@@ -81,11 +79,9 @@ class FdirPipeline:
         self.pending: list[PoiObservations] = []
         self.observers = {i: ObserverState() for i in range(1, sc.observers.count + 1)}
         self.boresight_body = constants.boresight_body
-        q_window = window_false_alarm(cfg.false_alarms_per_observer_hour, sc.rates.fdi_period_s,
-                                      cfg.persistence, 2 if cfg.fuse_nis else 1)
         self.links = LinkChecks(sc, node, log)
-        self.information = InformationTest(sc, self.twin, q_window)
-        self.global_check = GlobalCheck(cfg, q_window, node, log)
+        self.information = InformationTest(sc, self.twin)
+        self.global_check = GlobalCheck(cfg, self.information.q_window, node, log)
         self.declarer = Declarer(cfg, node, log)
         self.integrity = IntegrityCheck(cfg, node, log)
         self.rulings = NeighbourRulings(node, log)
@@ -130,10 +126,8 @@ class FdirPipeline:
             obs = self.observers.get(a.spacecraft)
             if obs is None or a.assignment_id in obs.plans:
                 continue
-            obs.plans[a.assignment_id] = FlightPlan(
-                max(a.t_depart_s, reach), pro_of(a.pro),
-                self._transfers.get((a.spacecraft, a.assignment_id)),
-                a.t_arrive_s if a.t_arrive_s > a.t_depart_s else None)
+            obs.plans[a.assignment_id] = FlightPlan.of(
+                a, max(a.t_depart_s, reach), self._transfers.get((a.spacecraft, a.assignment_id)))
 
     def telemetry(self, msg: InfoCostTelemetry) -> None:
         j = self.schedule.boundary_at(msg.t_sim)

@@ -15,6 +15,7 @@ import numpy as np
 from gnc.hardware_threshold import RatioModel
 from gnc.fdi_metric import metric
 from gnc.twin import TwinModel, perturbed_boresights, sample_stride
+from gnc.window_test import HardwareThreshold, floor_guard
 
 
 def adaptive_threshold(dh_samples: Sequence[float], dh_pred: float, h_prev: float = 0.0,
@@ -120,11 +121,17 @@ class WindowThreshold:
     by: Literal["model", "sampled", "floor"] | None
 
     @classmethod
-    def choose(cls, model: RatioModel | None, model_tau: float | None, sampled: float | None,
-               selected: float | None, name: Literal["model", "sampled"],
-               floor: float) -> WindowThreshold:
-        if selected is None:
-            return cls(model, model_tau, sampled, None, None)
-        if floor > selected:
-            return cls(model, model_tau, sampled, floor, "floor")
-        return cls(model, model_tau, sampled, selected, name)
+    def choose(cls, hardware: HardwareThreshold | None, sampled: float | None,
+               name: Literal["model", "sampled"], floor: float) -> WindowThreshold:
+        """The thresholds of the window, the one ``name`` selects in force, raised to the floor
+        guard ``floor`` where it is below (``gnc.window_test.floor_guard``)."""
+        model, model_tau = (hardware.model, hardware.quantile) if hardware else (None, None)
+        if name == "model":
+            if hardware is None:
+                return cls(None, None, sampled, None, None)
+            return cls(model, model_tau, sampled, hardware.tau,
+                       "floor" if hardware.floored else "model")
+        if sampled is None:
+            return cls(model, model_tau, None, None, None)
+        tau, floored = floor_guard(sampled, floor)
+        return cls(model, model_tau, sampled, tau, "floor" if floored else "sampled")

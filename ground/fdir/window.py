@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnc.poi_map import PoiMap
-from ground.fdir.identify import Observation
+from gnc.window_test import Observation, WindowPose
 from ground.fdir.observer import ObserverState
 from interfaces.contracts.messages import PoiObservations
 
@@ -43,8 +43,8 @@ class SettledMap:
 class WindowContext:
     """One observer's window: its bounds (s), the map settled at ``a``, the judged images in
     time order and, at their times (K rows), the plan's positions (LVLH, m), whether any falls
-    on a transfer, the reported attitude rows (``ObserverState.attitude``; None when stale)
-    and nav positions (LVLH, m; None when stale), and what each image saw."""
+    on a transfer, the reported attitude rows (``ObserverState.attitude``; None when stale),
+    nav positions (LVLH, m; None when stale) and nav 1σ, and what each image saw."""
 
     spacecraft: int
     a: float
@@ -56,6 +56,8 @@ class WindowContext:
     moving: bool
     attitude: np.ndarray | None
     nav: np.ndarray | None
+    nav_sigma: np.ndarray | None
+    """the nav's reported position 1σ (K, 1), m (None when stale)"""
     seen: list[Observation]
     """each image's observed POIs and their precisions σ⁻¹"""
     h_prev: float
@@ -68,6 +70,13 @@ class WindowContext:
     @property
     def phi(self) -> np.ndarray:
         return self.settled.phi
+
+    def pose(self) -> WindowPose:
+        """The window's planned and reported pose, as the window test reads it."""
+        att = self.attitude
+        return WindowPose(self.planned, att[:, 4:7] if att is not None else None, self.nav,
+                          self.nav_sigma, att[:, 3] if att is not None else None,
+                          att[:, 7] if att is not None else None, self.moving)
 
 
 
@@ -91,5 +100,5 @@ def window_context(spacecraft: int, obs: ObserverState, images: list[PoiObservat
     times = np.array([m.image_t_s for m in images])
     return WindowContext(spacecraft, a, b, settled, images, times, pos[known],
                          bool(moving[known].any()), obs.attitude.at(times),
-                         obs.nav.at(times), [m.arrays() for m in images],
+                         obs.nav.at(times), obs.nav_sigma.at(times), [m.arrays() for m in images],
                          settled.h_prev(spacecraft)), len(images)

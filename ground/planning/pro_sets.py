@@ -42,14 +42,9 @@ FloatArray = npt.NDArray[np.float64]
 
 
 def elements(pro: Pro) -> ProElements:
-    """The uplink form of a PRO."""
+    """The uplink form of a PRO (the inverse of ``Pro.of``)."""
     return ProElements(rho_x_m=pro.rho_x_m, alpha_x_rad=pro.alpha_x_rad, rho_y_m=pro.rho_y_m,
                        rho_z_m=pro.rho_z_m, alpha_z_rad=pro.alpha_z_rad)
-
-
-def pro_of(e: ProElements) -> Pro:
-    """The PRO of an uplinked assignment (the inverse of :func:`elements`)."""
-    return Pro(e.rho_x_m, e.alpha_x_rad, e.rho_y_m, e.rho_z_m, e.alpha_z_rad)
 
 
 @dataclass
@@ -102,7 +97,7 @@ class ProSetPlanner:
         w = (fused.w_inv + fused.F.sum(axis=0))[::k]
         for i in sorted(dropped):
             if i in pros:
-                w = w + self.expected(pro_of(pros[i]), t_arrive)
+                w = w + self.expected(Pro.of(pros[i]), t_arrive)
         return w, fused.phi[::k] * k
 
     def plan_set(self, t_depart: float, t_arrive: float, w: FloatArray, phi: FloatArray,
@@ -127,7 +122,7 @@ class ProSetPlanner:
             if not group:
                 continue
             keep_out = max([nominal] + [impaired.get(i, 0.0) for i in group])
-            around = ([pro_of(e) for e in fixed.values()]
+            around = ([Pro.of(e) for e in fixed.values()]
                       + [self.library[j] for j in chosen.values()])
             try:
                 picks, g, ub = self._greedy_around(len(group), around, keep_out, t_arrive, w, phi)
@@ -168,5 +163,5 @@ class ProSetPlanner:
         for i in range(self.count):
             e = pros.get(i + 1)
             if e is not None:
-                out[i] = pro_of(e).state(self.n, t)
+                out[i] = Pro.of(e).state(self.n, t)
         return out

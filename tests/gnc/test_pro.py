@@ -26,6 +26,7 @@ from gnc.pro import (
     pro_from_state,
     pro_ring,
 )
+from interfaces.contracts.messages import ProElements
 
 ALT = 500e3
 A_CHIEF = R_EARTH_M + ALT
@@ -41,6 +42,11 @@ def _random_pro(rng: np.random.Generator, scale: float = 100.0) -> Pro:
         float(rng.uniform(0.0, 1.0) * scale),
         float(rng.uniform(-math.pi, math.pi)),
     )
+
+
+def test_the_pro_of_uplinked_elements() -> None:
+    e = ProElements(rho_x_m=12.0, alpha_x_rad=0.3, rho_y_m=-1.0, rho_z_m=20.0, alpha_z_rad=1.1)
+    assert Pro.of(e) == Pro(12.0, 0.3, -1.0, 20.0, 1.1)
 
 
 def test_state_and_states_follow_the_pro_form() -> None:

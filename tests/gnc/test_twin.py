@@ -18,9 +18,12 @@ from gnc.twin import (
     Transfer,
     centre_boresights,
     delta_h,
+    held_over,
     perturbed_boresights,
+    plans_in_force,
     predicted_delta_h,
 )
+from interfaces.contracts.messages import ProAssignment, ProElements
 
 N = mean_motion(500e3)
 
@@ -84,3 +87,33 @@ def test_perturbed_boresights_one_per_row() -> None:
     assert np.all(np.arccos(np.clip(np.sum(d * rows, axis=1), -1, 1)) <= math.radians(2.0) + 1e-12)
     with pytest.raises(ValueError):
         perturbed_boresights(rows, 0.1, 2, np.random.default_rng(1))
+
+
+def _assignment(aid: int, depart: float, arrive: float, rho_x: float) -> ProAssignment:
+    return ProAssignment(spacecraft=1, assignment_id=aid, phase="science", t_depart_s=depart,
+                         t_arrive_s=arrive,
+                         pro=ProElements(rho_x_m=rho_x, alpha_x_rad=0.1, rho_y_m=0.0,
+                                         rho_z_m=15.0, alpha_z_rad=0.2))
+
+
+def test_a_plan_of_an_assignment_flies_its_pro_from_its_departure() -> None:
+    a = _assignment(3, 100.0, 400.0, 12.0)
+    plan = FlightPlan.of(a)
+    assert (plan.t_from_s, plan.t_arrive_s, plan.transfer) == (100.0, 400.0, None)
+    assert plan.pro == Pro(12.0, 0.1, 0.0, 15.0, 0.2)
+    assert FlightPlan.of(a, 250.0).t_from_s == 250.0  # in force from a later contact
+    hold = FlightPlan.of(_assignment(4, 100.0, 100.0, 12.0))
+    assert hold.t_arrive_s is None and hold.holds_from_s == 100.0  # no transfer asked
+
+
+def test_the_plan_in_force_is_the_last_to_have_started() -> None:
+    first = FlightPlan.of(_assignment(1, 0.0, 0.0, 10.0))
+    second = FlightPlan.of(_assignment(2, 100.0, 300.0, 12.0))
+    ordered, which = plans_in_force([second, first], np.array([-1.0, 0.0, 99.0, 100.0, 500.0]))
+    assert ordered == [first, second]
+    assert list(which) == [-1, 0, 0, 1, 1]
+    assert held_over([first, second], 0.0, 100.0) is first  # the change at b is outside
+    assert held_over([first, second], 50.0, 150.0) is None  # a change of plan inside
+    assert held_over([first, second], 150.0, 200.0) is None  # on the transfer to 300 s
+    assert held_over([first, second], 300.0, 330.0) is second
+    assert held_over([], 0.0, 30.0) is None and held_over([second], 0.0, 30.0) is None

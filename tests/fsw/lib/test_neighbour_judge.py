@@ -12,11 +12,12 @@ import math
 import numpy as np
 import pytest
 
-from fsw.lib.neighbour_judge import Exclusions, JudgeSettings, agreed, judge
+from fsw.lib.neighbour_judge import Exclusions, agreed, judge
 from gnc.infocost import Camera
 from gnc.poi import sphere_pois
 from gnc.pro import Pro
 from gnc.twin import TwinModel, centre_boresights
+from gnc.window_test import WindowTestSettings
 from interfaces.contracts.messages import (
     NeighbourDeclaration,
     NeighbourRuling,
@@ -27,7 +28,7 @@ from tests.conftest import small_scenario
 
 N = 0.0011  # rad/s, 500 km
 PRO = Pro(10.0, 0.3, 0.0, 15.0, 1.1)
-CFG = JudgeSettings.of(small_scenario())
+CFG = WindowTestSettings.of(small_scenario())
 TWIN = TwinModel(*sphere_pois(2000, 5.0), Camera(math.radians(12.0), 200.0, 1.0), 5.0, 0.1)
 
 
@@ -84,7 +85,7 @@ def test_the_pose_tests_read_the_reported_nav_and_pointing() -> None:
                            ({"nav_off_m": 0.3, "pointing_rad": math.radians(0.8)}, [])):
         v = judge(2, _images(1.0, rng, **kwargs), PRO, psi, phi, TWIN, N, CFG, rng)
         assert v.failed == failed and v.exceeded is bool(failed), kwargs
-    off = JudgeSettings.of(small_scenario(fdir={"fuse_guidance": False}))
+    off = WindowTestSettings.of(small_scenario(fdir={"fuse_guidance": False}))
     v = judge(2, _images(1.0, rng, nav_off_m=1.0), PRO, psi, phi, TWIN, N, off, rng)
     assert v.failed == [] and v.exceeded is False
 

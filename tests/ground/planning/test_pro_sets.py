@@ -11,7 +11,7 @@ import numpy as np
 from gnc.mission import MissionConstants
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro, min_distance_between
-from ground.planning.pro_sets import ProSetPlanner, elements, pro_of
+from ground.planning.pro_sets import ProSetPlanner, elements
 from interfaces.contracts.scenario import Scenario
 
 SC = Scenario.model_validate({
@@ -27,7 +27,7 @@ def _planner() -> ProSetPlanner:
 
 def test_elements_and_pro_of_are_inverse() -> None:
     pro = Pro(12.0, 0.3, -1.0, 20.0, 1.1)
-    assert pro_of(elements(pro)) == pro
+    assert Pro.of(elements(pro)) == pro
 
 
 def test_weights_subsample_the_map_and_count_the_untasked() -> None:
@@ -49,4 +49,4 @@ def test_a_set_around_an_untasked_observer() -> None:
     assert math.isclose(gain, sets.gain(per_observer, 700.0, w, phi), rel_tol=1e-9)
     sep = SC.assignment.min_separation_m
     for i in (1, 3):
-        assert min_distance_between(pro_of(out[i]), pro_of(pros[2]), sets.n)[0] >= sep
+        assert min_distance_between(Pro.of(out[i]), Pro.of(pros[2]), sets.n)[0] >= sep
