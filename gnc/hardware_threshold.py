@@ -146,7 +146,7 @@ def position_sigma(track_sigma_m: float, nav_sigma_m: float,
     """1σ per axis of the truth about the plan over a window: the station-keeping spec
     (``track_sigma_m``), the nav's reported 1σ, and the per-axis RMS of the offsets from the
     plan the nav itself reports (K, 3), counted up to ``tolerance_m`` (beyond it the detector's
-    plan test speaks, ``ground/fdir/consistency.py``) -- after a transfer the loop settles onto
+    plan test speaks, ``gnc/window_test.py``) -- after a transfer the loop settles onto
     its PRO for a few minutes, off it by more than the spec, and the ground sees it."""
     rms = 0.0
     if nav_offsets_m is not None and len(nav_offsets_m):

@@ -21,7 +21,7 @@ class FdirSettings(Section):
     ``pointing_tol_deg``), propagated through the twin with ``model_samples`` pose draws; or
     Eq. 11-12's (``samples`` pointings within ``eps_deg``).  Both are computed and archived
     every window; ``floor`` is a guard under the one in force.  With ``fuse_guidance`` a window
-    also fails on the nav-vs-plan, pointing and Δv-rate tests (ground/fdir/consistency.py:
+    also fails on the nav-vs-plan, pointing and Δv-rate tests (gnc/window_test.py:
     ``position_tol_m``, ``pointing_tol_deg``, ``dv_rate_tol_mps2``); with ``fuse_nis`` on the
     nav's normalized innovations.  A fault is declared after ``persistence`` failed windows in
     a row
@@ -60,7 +60,7 @@ class FdirSettings(Section):
                                description="pose draws of the hardware threshold per window")
     fuse_guidance: bool = Field(
         default=True, description="the detector also fails a window on its nav-vs-plan, "
-                                  "pointing and Δv-rate tests (ground/fdir/consistency.py)")
+                                  "pointing and Δv-rate tests (gnc/window_test.py)")
     fuse_nis: bool = Field(
         default=True, description="the detector also fails a window when the Σ NIS of the "
                                   "observer's nav updates in it exceeds its χ² quantile at the "
