@@ -373,6 +373,7 @@ def _inproc_run(spec: RunSpec, out: Path) -> RunSummary:
     from deploy.inproc import run_inproc
     from ground.archive.metadata import run_metadata
     from ground.archive.recorder import McapRecorder
+    from harness.foxglove_layout import write_layout
     from harness.summary.build import write_summary
     from harness.summary.digest import LiveDigest, RunDigest
 
@@ -399,8 +400,10 @@ def _inproc_run(spec: RunSpec, out: Path) -> RunSummary:
         root.removeHandler(handler)
         root.setLevel(level)
         handler.close()
-    return write_summary(out, spec.scenario, "inproc", time.monotonic() - t0, status, error,
-                         digest=digest)
+    summary = write_summary(out, spec.scenario, "inproc", time.monotonic() - t0, status, error,
+                            digest=digest)
+    write_layout(out, spec.scenario)
+    return summary
 
 
 def _zenoh_run(spec: RunSpec, out: Path) -> RunSummary:

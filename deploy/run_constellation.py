@@ -6,7 +6,8 @@ recorder as separate OS processes over Zenoh (default), or all in one process (-
         [--compare-recovery] [--live PORT] [--endpoint tcp/127.0.0.1:7447|tls/HOST:PORT]
         [--audit-access] [--external NODE --advertise tls/HOST:PORT --tls-host HOST]
 
-Writes <out>/run.mcap (every bus message, JSON schemas; opens in Foxglove), <out>/summary.json,
+Writes <out>/run.mcap (every bus message, JSON schemas; opens in Foxglove), <out>/run.foxglove.json
+(the Foxglove layout that reads it: harness/foxglove_layout.py), <out>/summary.json,
 <out>/report.md with PNG plots, and <out>/logs/ (one log per process).
 
 Over Zenoh the network is closed (deploy/access.py): the launcher starts the run's router
@@ -56,6 +57,7 @@ from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
 from ground.archive.segments import remove_segments, run_archive  # noqa: E402
 from harness.archive.reader import ArchiveError  # noqa: E402
+from harness.foxglove_layout import write_layout  # noqa: E402
 from harness.report import write_report  # noqa: E402
 from harness.summary import AccessAudit, RunSummary  # noqa: E402
 from harness.summary.build import add_recovery_comparison, write_summary  # noqa: E402
@@ -165,6 +167,7 @@ def main(argv: list[str] | None = None) -> int:
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
                             status=status, error=error, mission=mission, digest=digest,
                             access=_access_audit(out))
+    layout = write_layout(out, scenario, mission)
     if args.compare_recovery and status == "completed":
         summary = _compare_recovery(scenario, mission, out, scenario_text, args, summary)
     if not args.no_report:
@@ -175,7 +178,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time" if rtf else "")
           + (f", at most {args.realtime:g}x" if rtf and args.realtime else "")
           + (")" if rtf else "")
-          + f"\n  {out}/run.mcap"
+          + f"\n  {out}/run.mcap\n  {layout}"
           f"\n  {out}/summary.json" + ("" if args.no_report else f"\n  {out}/report.md"))
     if error:
         print(f"error: {error}", file=sys.stderr)
@@ -246,6 +249,7 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
         status, error = "failed", f"{type(e).__name__}: {e}"
     counter = write_summary(other, flipped, transport="inproc", wall_s=time.monotonic() - wall0,
                             status=status, error=error, mission=mission, digest=digest)
+    write_layout(other, flipped, mission)
     return add_recovery_comparison(out, summary, counter, scenario.fdir.recovery)
 
 
