@@ -31,10 +31,10 @@ class AttitudeSensors(Unit):
         super().__init__(ctx)
         sc, sen = ctx.scenario, ctx.scenario.sensors
         self.dt_s = sc.rates.dt_s
-        self.gyro = Gyro([stream(sc.seed, "gyro", i) for i in ctx.ids], sen.gyro_arw_rad_rts,
+        self.gyro = Gyro([stream(sc.seed, "gyro", i) for i in self.ids], sen.gyro_arw_rad_rts,
                          sen.gyro_bias_rw_rad_s15, sen.gyro_bias_sigma_radps)
         axis = int(np.argmax(np.abs(sc.attitude.boresight_body)))
-        self.star_tracker = StarTracker([stream(sc.seed, "star_tracker", i) for i in ctx.ids],
+        self.star_tracker = StarTracker([stream(sc.seed, "star_tracker", i) for i in self.ids],
                                         sen.star_tracker_cross_arcsec, sen.star_tracker_roll_arcsec,
                                         boresight_axis=axis, rate_hz=sen.star_tracker_hz)
         self.st_sigma_rad = (sen.star_tracker_cross_arcsec * ARCSEC_RAD,
@@ -52,7 +52,7 @@ class AttitudeSensors(Unit):
     def step(self, now: Sensed) -> None:
         gyro, st = self.measure(now)
         cross, roll = self.st_sigma_rad
-        for i, sc_id in enumerate(self.ctx.ids):
+        for i, sc_id in enumerate(self.ids):
             self.publish(cat.ATTITUDE_SENSORS, i, AttitudeMeasurement(
                 sender=topics.SIM, t_sim=now.t_s, spacecraft=sc_id, gyro_radps=gyro[i].tolist(),
                 star_tracker=None if st is None else st[i].tolist(),

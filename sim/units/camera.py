@@ -23,11 +23,11 @@ class Camera(Unit):
         sc, k = ctx.scenario, ctx.constants
         self.cameras = TruthCameras(
             k.poi_pos, k.poi_normal, k.camera, np.array(sc.attitude.boresight_body),
-            sc.camera.noise_frac, [stream(sc.seed, "camera", i) for i in ctx.ids])
+            sc.camera.noise_frac, [stream(sc.seed, "camera", i) for i in self.ids])
         """the cameras (fault hooks ``beta``, ``misalignment``: ``faults/hardware.py``)"""
 
     def step(self, now: Sensed) -> None:
         images = self.cameras.images(now.rel_lvlh[:, :3], now.q_lvlh_body)
-        for i, (sc_id, img) in enumerate(zip(self.ctx.ids, images)):
+        for i, (sc_id, img) in enumerate(zip(self.ids, images)):
             self.publish(cat.CAMERA_IMAGE, i, CameraImage.of_arrays(
                 topics.SIM, now.t_s, sc_id, img.poi, img.precision))

@@ -21,11 +21,11 @@ class RelNav(Unit):
         super().__init__(ctx)
         sc, sen = ctx.scenario, ctx.scenario.sensors
         self.sensors = [RelNavSensor(sen.relnav_sigma_r_m, sen.relnav_sigma_v_mps,
-                                     stream(sc.seed, "relnav", i)) for i in ctx.ids]
+                                     stream(sc.seed, "relnav", i)) for i in self.ids]
         """one per observer (fault hook ``bias_m``: ``faults/hardware.py``)"""
 
     def step(self, now: Sensed) -> None:
-        for i, (sc_id, sensor) in enumerate(zip(self.ctx.ids, self.sensors)):
+        for i, (sc_id, sensor) in enumerate(zip(self.ids, self.sensors)):
             r, v = sensor.measure(now.rel_lvlh[i, :3], now.rel_lvlh[i, 3:])
             self.publish(cat.RELNAV, i, RelNavMeasurement(
                 sender=topics.SIM, t_sim=now.t_s, spacecraft=sc_id, r_m=r.tolist(),

@@ -46,7 +46,7 @@ class UnitContext:
         return list(range(1, self.scenario.observers.count + 1))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Sensed:
     """The truth at tick ``k`` (t = ``t_s``, s) as the units sense it: the observers' relative
     states in the target's LVLH frame (N, 6: m, m/s), their attitudes with respect to LVLH
@@ -95,9 +95,11 @@ class Unit:
 
     def __init__(self, ctx: UnitContext) -> None:
         self.ctx = ctx
+        self.ids = ctx.ids
+        """the observers' spacecraft ids, 1..N (observer ``index`` is ``ids[index]``)"""
         self.every = ctx.scenario.rates.ticks_per(self.RATE)
         """ticks between two steps (1 for the high rate group)"""
-        nodes = [topics.sc_node(i) for i in ctx.ids]
+        nodes = [topics.sc_node(i) for i in self.ids]
         self._keys = {t: [t.key(ctx.bus.mission, n) for n in nodes] for t in self.OUTPUTS}
 
     def __init_subclass__(cls, **kwargs: object) -> None:
