@@ -425,11 +425,6 @@ class RelativeTruth:
         out: FloatArray = self._y[1:].copy()
         return out
 
-    def deputies_eci(self) -> FloatArray:
-        """Absolute deputy ECI states (N, 6), m and m/s."""
-        out: FloatArray = self._y[1:] + self._y[0]
-        return out
-
     def rel_lvlh(self) -> FloatArray:
         """Deputy relative states in the chief's LVLH frame (N, 6), m and m/s."""
         return eci_to_lvlh(self._y[0], self._y[1:])

@@ -1,5 +1,5 @@
-"""The observers' GNC hardware in the sim: thrusters, reaction wheels, rigid-body attitude, gyro
-and star tracker, for all observers at once.
+"""The observers' GNC hardware in the sim: thrusters, reaction wheels and rigid-body attitude, for
+all observers at once (the attitude sensors that read it: ``sim/units/attitude_sensors.py``).
 
 Commands arrive from the flight software (``ThrustCommand``, ``WheelCommand``) and are held:
 a thrust command is realised once, when it arrives, over its whole duration — the thrusters
@@ -24,9 +24,7 @@ from interfaces.contracts.timing import TIME_TOL_S
 from sim import kernels
 from sim.actuators import ThrusterBank, WheelArray
 from sim.attitude import AttitudeTruth
-from sim.sensors import Gyro, StarTracker
 
-ARCSEC_RAD = math.pi / 180.0 / 3600.0
 WHEEL_COMMAND_TIMEOUT_S = 1.0
 """A wheel torque not refreshed for this long is dropped to zero (a flight computer that stops
 commanding must not leave the wheels spinning the body up), s."""
@@ -47,7 +45,7 @@ def initial_attitudes(scenario: Scenario, r_eci_lvlh: Rotation) -> tuple[np.ndar
 
 
 class ObserverHardware:
-    """Thrusters, wheels, attitude truth and attitude sensors of all observers.  ``compiled``:
+    """Thrusters, wheels and attitude truth of all observers.  ``compiled``:
     the frame and thrust glue of the 10 Hz tick run on :mod:`sim.kernels` (the same bits as the
     numpy reference, which ``compiled=False`` runs)."""
 
@@ -56,7 +54,7 @@ class ObserverHardware:
         self.compiled = compiled
         n = sc.observers.count
         ids = range(1, n + 1)
-        act, sen = sc.actuators, sc.sensors
+        act = sc.actuators
         self.n = n
         self.mass_kg = sc.observers.mass_kg
         q0, w0 = initial_attitudes(sc, r_eci_lvlh)
@@ -66,14 +64,6 @@ class ObserverHardware:
                           for i in ids]
         self.wheels = WheelArray(n, act.wheel_max_torque_nm, act.wheel_max_momentum_nms,
                                  compiled=compiled)
-        axis = int(np.argmax(np.abs(sc.attitude.boresight_body)))
-        self.gyro = Gyro([stream(sc.seed, "gyro", i) for i in ids], sen.gyro_arw_rad_rts,
-                         sen.gyro_bias_rw_rad_s15, sen.gyro_bias_sigma_radps)
-        self.star_tracker = StarTracker([stream(sc.seed, "star_tracker", i) for i in ids],
-                                        sen.star_tracker_cross_arcsec, sen.star_tracker_roll_arcsec,
-                                        boresight_axis=axis, rate_hz=sen.star_tracker_hz)
-        self.st_sigma_rad = (sen.star_tracker_cross_arcsec * ARCSEC_RAD,
-                             sen.star_tracker_roll_arcsec * ARCSEC_RAD)
         self.force_body = np.zeros((n, 3))
         self.force_until = np.zeros(n)
         self.force_bias_body = np.zeros((n, 3))
@@ -127,14 +117,6 @@ class ObserverHardware:
             held = np.where((t_s < self.tau_until - TIME_TOL_S)[:, None], self.tau_cmd, 0.0)
         tau = self.wheels.realise(held, self.attitude.h, dt_s)
         self.attitude.step(dt_s, tau)
-
-    def measure(self, t_s: float, dt_s: float) -> tuple[np.ndarray, np.ndarray | None]:
-        """Gyro rates (N, 3) averaged over the last tick and star-tracker quaternions (N, 4) when
-        a fix is due at ``t_s`` (else None)."""
-        gyro = self.gyro.measure(self.attitude.mean_rate, dt_s)
-        if not self.star_tracker.due(t_s):  # no Rotation built on the ticks without a fix
-            return gyro, None
-        return gyro, self.star_tracker.measure(t_s, self.attitude.r_eci_body())
 
     def q_lvlh_body(self, q_lvlh_eci: np.ndarray) -> np.ndarray:
         """True attitudes with respect to LVLH (N, 4), scalar last, given the true ECI -> LVLH

@@ -5,7 +5,8 @@ Tick k announcing them (and what the nodes published in tick k-1), wait for ever
 TickDone(k) — lockstep — or until the per-tick timeout (the missing answer is logged and its
 last command held) or, in real-time mode, until the next tick is due on the wall clock; then
 apply the commands (thrust, wheel torques: ``sim.hardware``) and integrate the truth (orbit and
-attitude) to t + dt.
+attitude) to t + dt.  The hardware is a task list of units (``sim/units``): each publishes its
+sensor's measurements on the ticks it is due, or takes its actuator's commands.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import partial
-from typing import ClassVar, Literal
+from typing import ClassVar, TypeVar
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -28,28 +29,20 @@ from gnc.mission import MissionConstants
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.catalogue import Topic
-from interfaces.contracts.messages import (
-    AttitudeMeasurement,
-    CameraImage,
-    FaultEvent,
-    RelNavMeasurement,
-    SimStatus,
-    ThrustCommand,
-    Tick,
-    TickDone,
-    TruthState,
-    WheelCommand,
-)
-from interfaces.contracts.rng import stream
+from interfaces.contracts.messages import FaultEvent, SimStatus, Tick, TickDone, TruthState
 from interfaces.contracts.scenario import Scenario
 from interfaces.runtime.bus import Bus
-from sim.camera import TruthCameras
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
 from faults.hardware import FaultInjector
 from sim.hardware import ObserverHardware
 from sim.lockstep import Lockstep
 from sim.pacing import Pacer
-from sim.sensors import RelNavSensor
+from sim.units import UNITS
+from sim.units.camera import Camera
+from sim.units.relnav import RelNav
+from sim.units.unit import Sensed, SpacecraftCommand, Unit, UnitContext
+
+U = TypeVar("U", bound=Unit)
 
 
 def initial_states(scenario: Scenario, n: float) -> np.ndarray:
@@ -67,32 +60,30 @@ def initial_states(scenario: Scenario, n: float) -> np.ndarray:
 
 @dataclass(frozen=True)
 class NodeInput:
-    """A sim subscription: ``topic`` on the key of each node ``of`` names (every lockstep
-    participant, or every observer's flight software), to method ``handler``, called with the
-    node's index in that list and the message; ``immediate``: handled on arrival (the lockstep's
-    answers), not queued to the tick."""
+    """A sim subscription: ``topic`` on the key of each lockstep participant, to method
+    ``handler``, called with the participant's index and the message; ``immediate``: handled on
+    arrival (the lockstep's answers), not queued to the tick.  The hardware's commands are the
+    units' (``Unit.COMMANDS``)."""
 
     topic: Topic
     handler: str
-    of: Literal["participants", "spacecraft"]
     immediate: bool = False
 
 
 @dataclass(eq=False)
 class SimNode:
     """The sim's side of the bus: what it publishes, and its inputs, wired from these
-    declarations (``INPUTS``) as an app's are; the participants' answers and liveness are kept
-    by its ``lockstep`` (``sim.lockstep``)."""
+    declarations (``INPUTS``, and its units' ``OUTPUTS`` and ``COMMANDS``) as an app's are; the
+    participants' answers and liveness are kept by its ``lockstep`` (``sim.lockstep``)."""
 
     PUBLISHES: ClassVar[tuple[Topic, ...]] = (
         cat.TICK, cat.SIM_STATUS, cat.TRUTH, cat.FAULT_EVENTS,
-        cat.RELNAV, cat.ATTITUDE_SENSORS, cat.CAMERA_IMAGE)
+        *(t for u in UNITS for t in u.OUTPUTS))
     INPUTS: ClassVar[tuple[NodeInput, ...]] = (
-        NodeInput(cat.TICK_DONE, "_on_done", "participants", immediate=True),
-        NodeInput(cat.THRUST, "_on_thrust", "spacecraft"),
-        NodeInput(cat.WHEELS, "_on_wheels", "spacecraft"),
+        NodeInput(cat.TICK_DONE, "_on_done", immediate=True),
     )
-    SUBSCRIBES: ClassVar[tuple[Topic, ...]] = tuple(i.topic for i in INPUTS)
+    SUBSCRIBES: ClassVar[tuple[Topic, ...]] = (
+        *(i.topic for i in INPUTS), *(c.topic for u in UNITS for c in u.COMMANDS))
 
     bus: Bus
     scenario: Scenario
@@ -117,25 +108,14 @@ class SimNode:
             energy_match=sc.observers.energy_match and sc.observers.start == "pro")
         self.ids = list(range(1, sc.observers.count + 1))
         self.hw = ObserverHardware(sc, Rotation.from_quat(quat.conj(self._q_lvlh_eci())))
-        cam = sc.camera
-        self.cameras = TruthCameras(
-            self.constants.poi_pos, self.constants.poi_normal, self.constants.camera,
-            np.array(sc.attitude.boresight_body), cam.noise_frac,
-            [stream(sc.seed, "camera", i) for i in self.ids])
-        self.sensors = [
-            RelNavSensor(sc.sensors.relnav_sigma_r_m, sc.sensors.relnav_sigma_v_mps,
-                         stream(sc.seed, "relnav", i)) for i in self.ids
-        ]
-        self.faults = FaultInjector(sc, self.hw, self.cameras, self.sensors, self.truth)
+        ctx = UnitContext(self.bus, sc, self.constants, self.hw, self.log)
+        self.units = [unit(ctx) for unit in UNITS]
+        """the task list: stepped in this order on the ticks each is due"""
+        self.faults = FaultInjector(sc, self.hw, self.unit(Camera).cameras,
+                                    self.unit(RelNav).sensors, self.truth)
         m = self.bus.mission
-        nodes = [topics.sc_node(i) for i in self.ids]
-        self._keys = {
-            "tick": cat.TICK.key(m), "status": cat.SIM_STATUS.key(m), "truth": cat.TRUTH.key(m),
-            "faults": cat.FAULT_EVENTS.key(m),
-            "relnav": [cat.RELNAV.key(m, n) for n in nodes],
-            "attitude": [cat.ATTITUDE_SENSORS.key(m, n) for n in nodes],
-            "camera": [cat.CAMERA_IMAGE.key(m, n) for n in nodes],
-        }
+        self._keys = {"tick": cat.TICK.key(m), "status": cat.SIM_STATUS.key(m),
+                      "truth": cat.TRUTH.key(m), "faults": cat.FAULT_EVENTS.key(m)}
         self.pacer = (Pacer(self.realtime_speed, self.hard_deadline, self.log)
                       if self.realtime_speed is not None else None)
         self.lockstep = Lockstep(self.participants, m, sc.n_ticks - 1, lambda: self._t_now,
@@ -146,20 +126,30 @@ class SimNode:
         self._t_now = 0.0
         self._q_now = np.array([0.0, 0.0, 0.0, 1.0])  # ECI -> LVLH now (set each tick)
         self._dt = sc.rates.dt_s
-        self._wire(nodes)
+        self._wire()
 
-    def _wire(self, spacecraft_nodes: list[str]) -> None:
-        """Subscribe the declared inputs (``INPUTS``) on each of their nodes' keys."""
-        of = {"participants": self.participants, "spacecraft": spacecraft_nodes}
+    def unit(self, kind: type[U]) -> U:
+        """The sim's unit of class ``kind``."""
+        return next(u for u in self.units if isinstance(u, kind))
+
+    def _wire(self) -> None:
+        """Subscribe the declared inputs (``INPUTS``) on each participant's key, then each
+        unit's commands (``Unit.COMMANDS``) on each observer's."""
+        m = self.bus.mission
         for i in self.INPUTS:
             handler = getattr(self, i.handler)
-            for index, node in enumerate(of[i.of]):
-                self.bus.subscribe(i.topic.key(self.bus.mission, node), i.topic.type,
-                                   partial(handler, index), immediate=i.immediate)
+            for index, node in enumerate(self.participants):
+                self.bus.subscribe(i.topic.key(m, node), i.topic.type, partial(handler, index),
+                                   immediate=i.immediate)
+        for u in self.units:
+            for c in u.COMMANDS:
+                for index, sc_id in enumerate(self.ids):
+                    self.bus.subscribe(c.topic.key(m, topics.sc_node(sc_id)), c.topic.type,
+                                       partial(self._command, getattr(u, c.handler), index))
 
     # --- commands to the hardware ---------------------------------------------------------
 
-    def _accept(self, index: int, msg: ThrustCommand | WheelCommand) -> bool:
+    def _accept(self, index: int, msg: SpacecraftCommand) -> bool:
         """A command is applied only if it is of the current tick (a replayed, stale or
         future-dated one is refused) and names the spacecraft whose key it came on (the key
         space itself is the publisher's, enforced by the Bus and access control).  Refusals are
@@ -176,13 +166,11 @@ class SimNode:
                                  self.rejected_commands)
         return not why
 
-    def _on_thrust(self, index: int, msg: ThrustCommand) -> None:
+    def _command(self, handler: Callable[[int, SpacecraftCommand], None], index: int,
+                 msg: SpacecraftCommand) -> None:
+        """A command of observer ``index`` to a unit: to its ``handler`` if accepted."""
         if self._accept(index, msg):
-            self.hw.command_thrust(index, msg.force_body_n, msg.duration_s, msg.t_sim)
-
-    def _on_wheels(self, index: int, msg: WheelCommand) -> None:
-        if self._accept(index, msg):
-            self.hw.command_wheels(index, msg.torque_body_nm, msg.t_sim)
+            handler(index, msg)
 
     def _q_lvlh_eci(self) -> np.ndarray:
         """Quaternion (scalar last) of the rotation taking ECI vectors into the true LVLH frame
@@ -257,7 +245,7 @@ class SimNode:
     def _commands_in(self, expect: dict[str, int], deadline: float) -> None:
         """Wait until ``deadline`` (wall) for the commands the answers announce; those still
         missing after a second (lost with the network while the router restarted) are asked
-        of their senders again (``Bus.recover``)."""
+        of their senders again (``recent.recover``)."""
         missing = self.bus.wait_for(expect, max(0.0, min(1.0, deadline - time.monotonic())))
         if missing:
             recover(self.bus, missing)
@@ -271,6 +259,17 @@ class SimNode:
                          announce=False)
 
     def _publish_hardware(self, k: int, t: float) -> None:
+        """What the sim publishes before tick k (t, s): the faults switching, the truth, then
+        each unit due, in the order of the task list."""
+        self._switch_faults(t)
+        now = self._publish_truth(k, t)
+        for unit in self.units:
+            if unit.due(k):
+                unit.step(now)
+
+    def _switch_faults(self, t: float) -> None:
+        """Switch the faults due at ``t`` (s), publishing each switch, and move the truth by
+        the state disturbances acting on this tick."""
         for s in self.faults.update(t):
             f = s.fault
             self.log.warning("fault %s on sc%d %s at t=%.1f s (magnitude %s)", f.kind,
@@ -280,6 +279,9 @@ class SimNode:
                 active=s.active, magnitude=f.magnitude, start_s=f.start_s, end_s=f.end_s,
                 detail=s.detail))
         self.faults.disturb(t)
+
+    def _publish_truth(self, k: int, t: float) -> Sensed:
+        """Publish the truth of tick k (t, s) and return it as the units sense it."""
         rel = self.truth.rel_lvlh()
         hw = self.hw
         self._q_now = self._q_lvlh_eci()  # reused for the thrust of this tick
@@ -289,21 +291,7 @@ class SimNode:
             r_lvlh_m=rel[:, :3].tolist(), v_lvlh_mps=rel[:, 3:].tolist(),
             q_lvlh_body=q_lvlh_body.tolist(),
             w_body_radps=hw.attitude.w.tolist(), dv_mps=hw.dv_mps.tolist()))
-        gyro, st = hw.measure(t, self.scenario.rates.dt_s)
-        for i, sc_id in enumerate(self.ids):
-            self.bus.publish(self._keys["attitude"][i], AttitudeMeasurement(
-                sender=topics.SIM, t_sim=t, spacecraft=sc_id, gyro_radps=gyro[i].tolist(),
-                star_tracker=None if st is None else st[i].tolist(),
-                st_sigma_cross_rad=hw.st_sigma_rad[0], st_sigma_roll_rad=hw.st_sigma_rad[1]))
-        if k % self.scenario.rates.ticks_per("mid") == 0:
-            for i, img in enumerate(self.cameras.images(rel[:, :3], q_lvlh_body)):
-                self.bus.publish(self._keys["camera"][i], CameraImage.of_arrays(
-                    topics.SIM, t, self.ids[i], img.poi, img.precision))
-            for i, sensor in enumerate(self.sensors):
-                r, v = sensor.measure(rel[i, :3], rel[i, 3:])
-                self.bus.publish(self._keys["relnav"][i], RelNavMeasurement(
-                    sender=topics.SIM, t_sim=t, spacecraft=self.ids[i], r_m=r.tolist(),
-                    v_mps=v.tolist(), sigma_r_m=sensor.sigma_r_m, sigma_v_mps=sensor.sigma_v_mps))
+        return Sensed(k, t, rel, q_lvlh_body, hw.attitude)
 
     def _status(self, state: str, k: int, reason: str = "") -> None:
         t = k * self.scenario.rates.dt_s

@@ -14,6 +14,8 @@ from interfaces.runtime.bus import Bus
 from interfaces.runtime.transport import InprocNetwork
 from sim.hardware import WHEEL_COMMAND_TIMEOUT_S
 from sim.node import SimNode
+from sim.units.thrusters import Thrusters
+from sim.units.wheels import Wheels
 from tests.conftest import small_scenario
 
 M = "ld"
@@ -28,17 +30,18 @@ def test_sim_refuses_stale_future_and_forged_commands() -> None:
     sim = _sim()
     sim._t_now = 100.0
     good = WheelCommand(sender="sc1", t_sim=100.0, spacecraft=1, torque_body_nm=[1e-3, 0, 0])
-    sim._on_wheels(0, good)
+    wheels = sim.unit(Wheels).on_command
+    sim._command(wheels, 0, good)
     assert sim.hw.tau_cmd[0, 0] == 1e-3 and sim.rejected_commands == 0
     for bad in (good.model_copy(update={"t_sim": 99.0, "torque_body_nm": [5e-3, 0, 0]}),  # stale
                 good.model_copy(update={"t_sim": 101.0, "torque_body_nm": [5e-3, 0, 0]}),  # future
                 good.model_copy(update={"spacecraft": 2, "torque_body_nm": [5e-3, 0, 0]}),
                 good.model_copy(update={"sender": "sc2", "torque_body_nm": [5e-3, 0, 0]})):
-        sim._on_wheels(0, bad)
+        sim._command(wheels, 0, bad)
     assert sim.rejected_commands == 4 and sim.hw.tau_cmd[0, 0] == 1e-3
     replay = ThrustCommand(sender="sc1", t_sim=0.0, spacecraft=1, force_body_n=[0.02, 0, 0],
                            duration_s=3600.0)
-    sim._on_thrust(0, replay)
+    sim._command(sim.unit(Thrusters).on_command, 0, replay)
     assert sim.rejected_commands == 5 and not sim.hw.force_until.any()
 
 
