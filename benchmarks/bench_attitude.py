@@ -167,7 +167,8 @@ def bench_slew(slews: int) -> None:
     for n_nodes, w_max in ((31, 0.05), (31, 0.03), (61, 0.03), (121, 0.03), (31, 0.014)):
         plans: list[SlewPlan] = []
 
-        def call(n_nodes: int = n_nodes, w_max: float = w_max) -> object:
+        def call(n_nodes: int = n_nodes, w_max: float = w_max,
+                 plans: list[SlewPlan] = plans) -> object:
             plans.append(scp_slew(r0, r1, 60.0, n_nodes, w_max, w0=zero, w1=zero))
             return plans[-1]
 

@@ -238,7 +238,7 @@ def _expand_group(campaign: Campaign, group: Group, variant: Variant | None,
     for seed in _seeds(group.seeds if group.seeds is not None else campaign.seeds):
         for combo in combos:
             chosen: dict[int, dict[str, Any]] = {}
-            for (i, field_name, _), value in zip(axes, combo):
+            for (i, field_name, _), value in zip(axes, combo, strict=True):
                 chosen.setdefault(i, {})[field_name] = value
             data = _merge(base, group.overrides)
             data["seed"] = seed

@@ -48,7 +48,7 @@ def write_tls_files(directory: Path, hosts: tuple[str, ...] = ()) -> TlsFiles:
 def _certificate(subject: x509.Name, issuer: x509.Name, public_key: ec.EllipticCurvePublicKey,
                  signer: ec.EllipticCurvePrivateKey, is_ca: bool,
                  names: tuple[str, ...]) -> x509.Certificate:
-    now = dt.datetime.now(dt.timezone.utc)
+    now = dt.datetime.now(dt.UTC)
     builder = (x509.CertificateBuilder().subject_name(subject).issuer_name(issuer)
                .public_key(public_key).serial_number(x509.random_serial_number())
                .not_valid_before(now - dt.timedelta(minutes=5))

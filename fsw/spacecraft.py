@@ -3,8 +3,8 @@
 
 from __future__ import annotations
 
-from fsw.apps.infocost import InfoCostApp
 from faults.software import reported_h_factor
+from fsw.apps.infocost import InfoCostApp
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import Node
 from interfaces.runtime.assembly import build_executive

@@ -28,7 +28,7 @@ import bisect
 import functools
 import math
 from dataclasses import dataclass
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 import numpy as np
 import numpy.typing as npt
@@ -44,7 +44,7 @@ OMEGA_EARTH_RAD_S = 7.292115146706979e-5
 """Earth's sidereal rotation rate, rad/s (WGS-84)."""
 WGS84_FLATTENING = 1.0 / 298.257223563
 """WGS-84 flattening of the reference ellipsoid."""
-_J2000 = datetime(2000, 1, 1, 12, 0, 0, tzinfo=timezone.utc)
+_J2000 = datetime(2000, 1, 1, 12, 0, 0, tzinfo=UTC)
 
 
 @dataclass(frozen=True)
@@ -171,7 +171,7 @@ def contact_windows(orbit: CircularOrbit, station: GroundStation, theta0_rad: fl
     crossings = [brentq(above, t[k], t[k + 1], xtol=1e-3) for k in edges]
     bounds = ([0.0] if up[0] else []) + crossings + ([duration_s] if up[-1] else [])
     return [_window(orbit, station, theta0_rad, a, b)
-            for a, b in zip(bounds[0::2], bounds[1::2])]
+            for a, b in zip(bounds[0::2], bounds[1::2], strict=False)]
 
 
 def _window(orbit: CircularOrbit, station: GroundStation, theta0_rad: float, aos: float,

@@ -110,7 +110,7 @@ class Replay:
         when none does."""
         live = [_plan(m) for m in self.live.assignments]
         mine = [_plan(m) for m in self.replayed.assignments]
-        for a, b in zip(live, mine):
+        for a, b in zip(live, mine, strict=False):  # then the longer one's next differs
             if a != b:
                 return min(a[0], b[0])
         if len(live) != len(mine):
@@ -150,7 +150,7 @@ def _plan(msg: ProAssignments) -> tuple[float, list[dict[str, Any]]]:
 def _same(a: list[Any], b: list[Any]) -> bool:
     skip = {"t_wall"}
     return len(a) == len(b) and all(x.model_dump(exclude=skip) == y.model_dump(exclude=skip)
-                                    for x, y in zip(a, b))
+                                    for x, y in zip(a, b, strict=True))
 
 
 # --- settings ---------------------------------------------------------------------------------

@@ -70,8 +70,8 @@ def _trajectory_section(out: Path, truth: TruthTable) -> list[str]:
     for i, sc in enumerate(truth.spacecraft):
         axes[0].plot(r[:, i, 1], r[:, i, 0], label=f"sc{sc}")
         axes[1].plot(r[:, i, 1], r[:, i, 2], label=f"sc{sc}")
-    for ax, (yl, title) in zip(axes, (("radial x (m)", "in-plane"),
-                                      ("cross-track z (m)", "along-track / cross-track"))):
+    titles = (("radial x (m)", "in-plane"), ("cross-track z (m)", "along-track / cross-track"))
+    for ax, (yl, title) in zip(axes, titles, strict=True):
         ax.plot(0, 0, "k*", ms=12, label="target")
         ax.set_xlabel("along-track y (m)")
         ax.set_ylabel(yl)
@@ -91,7 +91,7 @@ def _nav_section(out: Path, errs: dict[int, NavErrors], summary: RunSummary) -> 
         return ["No navigation estimates recorded.", ""]
     fig, axes = plt.subplots(len(errs), 1, figsize=(10, 2.2 * len(errs)), sharex=True,
                              squeeze=False)
-    for ax, (sc, e) in zip(axes[:, 0], errs.items()):
+    for ax, (sc, e) in zip(axes[:, 0], errs.items(), strict=True):
         pos = np.linalg.norm(e.error[:, :3], axis=1)
         bound = 3 * np.sqrt(np.sum(e.sigma[:, :3] ** 2, axis=1))
         ax.semilogy(e.t_s, pos, lw=0.8, label="|position error|")
@@ -209,7 +209,7 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: RunSumm
     fig, axes = plt.subplots(len(ids), 1, figsize=(10, 1.8 * len(ids) + 1), sharex=True,
                              squeeze=False)
     floor = 1e-6  # log of a zero metric
-    for ax, sc in zip(axes[:, 0], ids):
+    for ax, sc in zip(axes[:, 0], ids, strict=True):
         mine = [w for w in judged if w.spacecraft == sc]
         t = [w.t_end_s for w in mine]
         ax.plot(t, np.log10([max(w.metric, floor) for w in mine]), "o-", ms=3, lw=1.0,

@@ -79,7 +79,7 @@ class TruthHistory:
             if isinstance(pos, tuple):
                 spacecraft, r_lvlh_m = pos
                 pos = {f"sc{sc}": np.asarray(r, dtype=float)
-                       for sc, r in zip(spacecraft, r_lvlh_m)}
+                       for sc, r in zip(spacecraft, r_lvlh_m, strict=True)}
                 pos[GROUND] = np.zeros(3)
                 self._pos[i - 1] = pos
             return pos

@@ -10,7 +10,6 @@ sensor's measurements on the ticks it is due, or takes its actuator's commands.
 """
 
 from __future__ import annotations
-from interfaces.runtime.recent import recover
 
 import logging
 import threading
@@ -23,6 +22,7 @@ from typing import ClassVar, TypeVar
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from faults.hardware import FaultInjector
 from gnc import quat
 from gnc.hcw import pro_state
 from gnc.mission import MissionConstants
@@ -32,8 +32,8 @@ from interfaces.contracts.catalogue import Topic
 from interfaces.contracts.messages import FaultEvent, SimStatus, Tick, TickDone, TruthState
 from interfaces.contracts.scenario import Scenario
 from interfaces.runtime.bus import Bus
+from interfaces.runtime.recent import recover
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
-from faults.hardware import FaultInjector
 from sim.hardware import ObserverHardware
 from sim.lockstep import Lockstep
 from sim.pacing import Pacer

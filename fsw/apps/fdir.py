@@ -31,17 +31,6 @@ from __future__ import annotations
 
 from typing import Literal
 
-from interfaces.contracts import catalogue as cat
-from interfaces.contracts.messages import (
-    AttitudeEstimate,
-    FaultReport,
-    GuidanceStatus,
-    NeighbourDeclaration,
-    OnboardCommand,
-    OnboardFdirEvent,
-    PoiObservations,
-    StateEstimate,
-)
 from fsw.lib.onboard_fdir import (
     SEQUENCES,
     WATCHPOINT_CLASS,
@@ -52,6 +41,17 @@ from fsw.lib.onboard_fdir import (
     pointing_deg,
     thrust_duty,
     watch,
+)
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts.messages import (
+    AttitudeEstimate,
+    FaultReport,
+    GuidanceStatus,
+    NeighbourDeclaration,
+    OnboardCommand,
+    OnboardFdirEvent,
+    PoiObservations,
+    StateEstimate,
 )
 from interfaces.runtime.app import App, AppContext, Input, Output
 

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from fsw.lib.neighbour_judge import Exclusions
 from gnc.poi_map import PoiMap
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.fdi_schedule import FdiSchedule
-from fsw.lib.neighbour_judge import Exclusions
 from interfaces.contracts.messages import (
     InfoCostTelemetry,
     NeighbourDeclaration,

@@ -21,11 +21,11 @@ from collections import defaultdict
 
 import numpy as np
 
-from gnc.pro import Pro
+from fsw.lib.neighbour_judge import Exclusions, agreed, judge
 from gnc.poi_map import PoiMap
+from gnc.pro import Pro
 from gnc.twin import FlightPlan, TwinModel, held_over
 from gnc.window_test import WindowTestSettings
-from fsw.lib.neighbour_judge import Exclusions, agreed, judge
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (

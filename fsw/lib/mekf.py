@@ -137,7 +137,7 @@ def _phi_coefficients(x: float | FloatArray) -> tuple[Any, Any, Any]:
     xs = np.where(small, 1.0, x)
     sin_a, cos_a = np.sin(xs), np.cos(xs)
     closed = (sin_a / xs, (1.0 - cos_a) / (xs * xs), (xs - sin_a) / (xs * xs * xs))
-    s0, c1, c2 = (np.where(small, a, b) for a, b in zip(series, closed))
+    s0, c1, c2 = (np.where(small, a, b) for a, b in zip(series, closed, strict=True))
     return s0, c1, c2
 
 

@@ -23,8 +23,8 @@ import threading
 import time
 from typing import Any
 
-from ground.archive.metadata import run_metadata
 from ground.archive.mcap_file import Pending
+from ground.archive.metadata import run_metadata
 from ground.archive.recorder import McapRecorder, prepare_raw
 from ground.archive.segments import claim_segment, with_segment
 from interfaces.contracts import catalogue as cat

@@ -11,7 +11,6 @@ from collections.abc import Sequence
 
 from ground.fdir.baselines import nis_window_test
 
-
 MIN_NIS_UPDATES = 5
 """Fewer nav updates than this in a window give no NIS verdict (a window cut by a reset or a
 data gap)."""

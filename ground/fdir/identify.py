@@ -109,11 +109,11 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
-from gnc.infocost import visibility
-from ground.fdir.boresight import boresight_offset
 from gnc.hardware_threshold import clipped_noise_moments
+from gnc.infocost import visibility
 from gnc.twin import TwinModel, sample_stride
 from gnc.window_test import Observation, WindowPose
+from ground.fdir.boresight import boresight_offset
 from interfaces.contracts.scenario import FdirSettings
 
 FloatArray = npt.NDArray[np.float64]
@@ -490,6 +490,7 @@ def _gap_evidence(twin: TwinModel, images: Sequence[Observation], nav: np.ndarra
     explained_loc = explained_fraction(gap[0], gap[1], twin.predicted(where, bore, psi, phi))
     k = sample_stride(len(images))
     vis = visibility(nav[::k], bore[::k], twin.poi_pos, twin.poi_normal, twin.camera)
-    ratios = [seen_overlap(poi, np.flatnonzero(v)) for (poi, _), v in zip(images[::k], vis)]
+    ratios = [seen_overlap(poi, np.flatnonzero(v))
+              for (poi, _), v in zip(images[::k], vis, strict=True)]
     valid = [r for r in ratios if r is not None]
     return explained, explained_loc, float(np.median(valid)) if valid else None

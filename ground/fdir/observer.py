@@ -9,6 +9,7 @@ from __future__ import annotations
 import bisect
 import math
 from dataclasses import dataclass, field
+from itertools import pairwise
 
 import numpy as np
 
@@ -148,7 +149,7 @@ class ObserverState:
         """Commanded Δv per second (m/s²) over the parts of [a, b] between two consecutive
         guidance reports that both say ``hold``; None without any."""
         rep = [g for g in self.guidance if a <= g[0] <= b]
-        pairs = [(g0, g1) for g0, g1 in zip(rep, rep[1:]) if g0[2] and g1[2] and g1[0] > g0[0]]
+        pairs = [(g0, g1) for g0, g1 in pairwise(rep) if g0[2] and g1[2] and g1[0] > g0[0]]
         if not pairs:
             return None
         return (sum(g1[1] - g0[1] for g0, g1 in pairs)

@@ -29,6 +29,7 @@ from gnc import quat
 from gnc.mission import MissionConstants
 from gnc.passes import ContactPlan
 from gnc.poi_map import PoiMap
+from gnc.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.declaration import Declarer
 from ground.fdir.global_check import GlobalCheck
 from ground.fdir.information import InformationTest, Judgement
@@ -36,8 +37,8 @@ from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
 from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
-from gnc.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.window import SettledMap, window_context
+from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
     AttitudeEstimate,
@@ -54,7 +55,6 @@ from interfaces.contracts.messages import (
     StateEstimate,
     TransferPlanMsg,
 )
-from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.contracts.topics import spacecraft_of

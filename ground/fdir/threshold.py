@@ -12,8 +12,8 @@ from typing import Literal
 
 import numpy as np
 
-from gnc.hardware_threshold import RatioModel
 from gnc.fdi_metric import metric
+from gnc.hardware_threshold import RatioModel
 from gnc.twin import TwinModel, perturbed_boresights, sample_stride
 from gnc.window_test import HardwareThreshold, floor_guard
 

@@ -94,7 +94,7 @@ def window_context(spacecraft: int, obs: ObserverState, images: list[PoiObservat
     if planned is None:  # no plan in force at an image time: nothing to compare with
         return None, received
     pos, moving, known = planned  # unknown: on a transfer whose plan was lost
-    images = [m for m, k in zip(images, known) if k]
+    images = [m for m, k in zip(images, known, strict=True) if k]
     if not images:
         return None, 0
     times = np.array([m.image_t_s for m in images])

@@ -470,7 +470,7 @@ def match_to_observers(current_states: npt.ArrayLike, pros: Sequence[Pro], n: fl
     cost = np.linalg.norm(states[:, None, :3] - slots[None, :, :], axis=2)
     rows, cols = linear_sum_assignment(cost)
     result = [0] * shape[0]
-    for r, c in zip(rows, cols):
+    for r, c in zip(rows, cols, strict=True):
         result[int(r)] = int(c)
     return result
 

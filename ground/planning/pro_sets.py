@@ -136,7 +136,7 @@ class ProSetPlanner:
                 w = w + self.expected(self.library[j], t_arrive)
             states = self._states_at(t_depart, pros)[[i - 1 for i in group]]
             order = match_to_observers(states, [self.library[j] for j in picks], self.n, t_depart)
-            chosen.update({sc: picks[j] for sc, j in zip(group, order)})
+            chosen.update({sc: picks[j] for sc, j in zip(group, order, strict=True)})
             gain, bound = gain + g, bound + ub
         out = {**fixed, **{i: elements(self.library[j]) for i, j in chosen.items()}}
         per_observer = tuple(chosen.get(i, -1) for i in range(1, self.count + 1))

@@ -23,6 +23,7 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 
 import matplotlib
@@ -183,7 +184,7 @@ def claims(pairs: Sequence[tuple[StudyRun, Moves]]) -> list[str]:
 def _trend(kind: str, medians: list[tuple[int, float, float]]) -> str:
     """Whether the faulty agent's H_i move, relative to H's, grows with the formation size."""
     ratios = [r for _, _, r in medians]
-    grows = all(b > a for a, b in zip(ratios, ratios[1:]))
+    grows = all(b > a for a, b in pairwise(ratios))
     sizes = ", ".join(f"{n}: {r:.1f}" for n, _, r in medians)
     verdict = ("holds" if grows else "does not hold here") if len(ratios) > 1 else \
         "cannot be judged (one formation size)"

@@ -298,7 +298,7 @@ def _confusion(out: Path, rows: list[dict[str, Any]]) -> list[str]:
     labels = [c or "none/missed" for c in CLASSES]
     out_lines = ["| injected \\ identified | " + " | ".join(labels) + " |",
                  "|---|" + "---|" * len(labels)]
-    for k, row in zip(kinds, m):
+    for k, row in zip(kinds, m, strict=True):
         out_lines.append(f"| {k} (→ {EXPECTED_CLASS[k]}) | " + " | ".join(map(str, row)) + " |")
     if not kinds:
         return out_lines + ["", "(no fault injected)"]
@@ -337,7 +337,7 @@ def _latency_plot(out: Path, rows: list[dict[str, Any]], detectors: list[str],
         ax.boxplot(data, positions=pos, widths=0.9 * width, patch_artist=True,
                    boxprops={"facecolor": c, "alpha": 0.6}, medianprops={"color": "k"},
                    flierprops={"markersize": 3})
-        for x, m in zip(pos, missed):
+        for x, m in zip(pos, missed, strict=True):
             ax.annotate(f"{m}", (x, 0), xycoords=("data", "axes fraction"),
                         xytext=(0, 3), textcoords="offset points", ha="center", fontsize=7,
                         color=c)

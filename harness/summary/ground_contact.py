@@ -57,4 +57,4 @@ def ground_contact(scenario: Scenario, links: list[LinkCounter]) -> GroundContac
 def longest_gap(plan: ContactPlan, duration_s: float) -> float:
     """The longest stretch of [0, duration_s] out of contact, s."""
     edges = [0.0, *(t for w in plan.windows for t in w), duration_s]
-    return max((b - a for a, b in zip(edges[0::2], edges[1::2])), default=duration_s)
+    return max((b - a for a, b in zip(edges[0::2], edges[1::2], strict=False)), default=duration_s)

@@ -104,7 +104,7 @@ def nav_errors(archive: RunArchive, mission: str,
             rows.append((est.t_sim, x - x_true, np.sqrt(np.diag(P)), nees(x, P, x_true),
                          np.nan if est.nis is None else est.nis))
         if rows:
-            t, e, sd, q, nis = zip(*rows)
+            t, e, sd, q, nis = zip(*rows, strict=True)
             out[sc] = NavErrors(np.array(t), np.array(e), np.array(sd), np.array(q), np.array(nis))
     return out
 

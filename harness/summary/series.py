@@ -44,7 +44,7 @@ class SeriesWindow(SummaryRecord):
             count = f"{least} or {len(names)}" if least < len(names) else f"{len(names)}"
             raise ValueError(f"a row of {count} values ({', '.join(names)}) expected, "
                              f"got {len(data)}")
-        return dict(zip(names, data))
+        return dict(zip(names, data, strict=False))  # an older row lacks the last columns
 
     @model_serializer(mode="plain")
     def _to_row(self) -> list[float | int]:

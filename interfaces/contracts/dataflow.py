@@ -31,13 +31,13 @@ from pathlib import Path
 from typing import Literal, NamedTuple
 
 from interfaces.contracts import catalogue as cat
-from interfaces.contracts.catalogue import Space, Topic
 from interfaces.contracts.apps import (
     GROUND_APPS,
     NEIGHBOUR_APPS,
     ONBOARD_FDIR_APPS,
     SPACECRAFT_APPS,
 )
+from interfaces.contracts.catalogue import Space, Topic
 
 Place = Literal["sc", "ground", "sim", "node"]
 """Where a reader or writer runs: on each spacecraft, on the ground, in the sim, or on every

@@ -10,8 +10,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.contracts import topics
+from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.contracts.topology import topology
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore

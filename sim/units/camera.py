@@ -28,6 +28,6 @@ class Camera(Unit):
 
     def step(self, now: Sensed) -> None:
         images = self.cameras.images(now.rel_lvlh[:, :3], now.q_lvlh_body)
-        for i, (sc_id, img) in enumerate(zip(self.ids, images)):
+        for i, (sc_id, img) in enumerate(zip(self.ids, images, strict=True)):
             self.publish(cat.CAMERA_IMAGE, i, CameraImage.of_arrays(
                 topics.SIM, now.t_s, sc_id, img.poi, img.precision))

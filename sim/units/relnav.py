@@ -25,7 +25,7 @@ class RelNav(Unit):
         """one per observer (fault hook ``bias_m``: ``faults/hardware.py``)"""
 
     def step(self, now: Sensed) -> None:
-        for i, (sc_id, sensor) in enumerate(zip(self.ids, self.sensors)):
+        for i, (sc_id, sensor) in enumerate(zip(self.ids, self.sensors, strict=True)):
             r, v = sensor.measure(now.rel_lvlh[i, :3], now.rel_lvlh[i, 3:])
             self.publish(cat.RELNAV, i, RelNavMeasurement(
                 sender=topics.SIM, t_sim=now.t_s, spacecraft=sc_id, r_m=r.tolist(),

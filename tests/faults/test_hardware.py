@@ -205,7 +205,7 @@ def test_state_disturbance_noise_walks_with_sqrt_time_and_repeats_from_the_seed(
     assert steps[:, :3].std() == pytest.approx(0.5 * math.sqrt(0.1), rel=0.03)
     assert steps[:, 3:].std() == pytest.approx(0.001 * math.sqrt(0.1), rel=0.03)
     _, again = _disturbed(fault, 50)
-    assert all(np.array_equal(a, b) for a, b in zip(again, deltas[:50]))
+    assert all(np.array_equal(a, b) for a, b in zip(again, deltas[:50], strict=True))
 
 
 def test_the_truth_takes_a_disturbance_in_lvlh_exactly() -> None:

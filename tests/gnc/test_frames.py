@@ -16,7 +16,7 @@ def test_onboard_lvlh_matches_truth_frame_over_an_orbit() -> None:
     n = mean_motion(alt)
     truth = RelativeTruth(circular_chief_eci(alt, inc), np.zeros((1, 6)), energy_match=False)
     worst = 0.0
-    for k in range(12):
+    for _ in range(12):
         t = truth.t_s
         c_true = lvlh_basis(truth.chief_eci)           # rows: LVLH axes in ECI
         c_model = quat.to_matrix(lvlh_to_eci_quat(t, n, inc)).T

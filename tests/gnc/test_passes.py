@@ -5,7 +5,7 @@ sun-synchronous node rate."""
 from __future__ import annotations
 
 import math
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 import numpy as np
 import pytest
@@ -68,7 +68,7 @@ def test_the_pass_edges_are_at_the_mask_and_the_pass_is_above_it() -> None:
     orbit = CircularOrbit(LEO_M, math.radians(51.6), raan_rad=0.7, j2=True)
     station = GroundStation("gs", math.radians(40.0), math.radians(-4.0), 650.0,
                             math.radians(5.0))
-    theta0 = greenwich_sidereal_angle(datetime(2026, 3, 1, tzinfo=timezone.utc))
+    theta0 = greenwich_sidereal_angle(datetime(2026, 3, 1, tzinfo=UTC))
     windows = contact_windows(orbit, station, theta0, 86400.0)
     assert windows
     for w in windows:
@@ -93,9 +93,9 @@ def test_a_pass_open_at_the_start_is_clipped_there() -> None:
 
 
 def test_the_sidereal_angle_at_j2000_and_a_day_later() -> None:
-    j2000 = datetime(2000, 1, 1, 12, tzinfo=timezone.utc)
+    j2000 = datetime(2000, 1, 1, 12, tzinfo=UTC)
     assert math.degrees(greenwich_sidereal_angle(j2000)) == pytest.approx(280.46061837, abs=1e-9)
-    later = datetime(2000, 1, 2, 12, tzinfo=timezone.utc)
+    later = datetime(2000, 1, 2, 12, tzinfo=UTC)
     advance = math.degrees(greenwich_sidereal_angle(later)) - 280.46061837
     assert advance == pytest.approx(360.98564736629 - 360.0, abs=1e-6)
     with pytest.raises(ValueError, match="timezone"):

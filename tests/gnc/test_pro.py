@@ -54,7 +54,7 @@ def test_state_and_states_follow_the_pro_form() -> None:
     t = np.linspace(0.0, 2.3 * PERIOD, 17)
     batch = p.states(N, t)
     assert batch.shape == (17, 6)
-    for ti, row in zip(t, batch):
+    for ti, row in zip(t, batch, strict=True):
         np.testing.assert_allclose(p.state(N, float(ti)), row, rtol=0, atol=1e-12)
     # PRO form written out here, plus its derivative by central differences
     x = 30.0 * np.sin(N * t + 0.4)
@@ -162,7 +162,7 @@ def _two_body_lvlh(state: np.ndarray, times: np.ndarray) -> np.ndarray:
                     rtol=1e-12, atol=1e-9, t_eval=times)
     assert sol.success
     out = np.empty((times.size, 3))
-    for i, (t, s) in enumerate(zip(sol.t, sol.y.T)):
+    for i, (t, s) in enumerate(zip(sol.t, sol.y.T, strict=True)):
         c, sn = math.cos(N * t), math.sin(N * t)
         eci_to_lvlh = np.array([[c, sn, 0.0], [-sn, c, 0.0], [0.0, 0.0, 1.0]])
         out[i] = eci_to_lvlh @ s[:3] - np.array([A_CHIEF, 0.0, 0.0])

@@ -56,7 +56,7 @@ def test_frame_has_the_readers_messages_indexed_by_sim_time(
     assert "t_sim" not in frame.columns and "key" not in frame.columns
     for name in ("sender", "seq", "t_wall", "spacecraft", "resets"):
         assert list(frame[name]) == [getattr(m, name) for m in messages], name
-    assert all(_same(v, m.nis) for v, m in zip(frame["nis"], messages))
+    assert all(_same(v, m.nis) for v, m in zip(frame["nis"], messages, strict=True))
 
 
 def test_fixed_vectors_get_one_column_per_element(archive_path: Path,
@@ -83,7 +83,7 @@ def test_nested_models_in_a_dict_get_dotted_columns(archive_path: Path,
         for field in ("runs", "cycle_slips", "max_exec_ms", "budget_ms"):
             want = [getattr(m.groups[g], field) if g in m.groups else None for m in messages]
             column = frame[f"groups.{g}.{field}"]
-            assert all(_same(v, w) for v, w in zip(column, want)), (g, field)
+            assert all(_same(v, w) for v, w in zip(column, want, strict=True)), (g, field)
 
 
 def test_lists_of_varying_length_stay_whole(archive_path: Path, archive: RunArchive) -> None:
@@ -103,14 +103,14 @@ def test_a_pattern_over_several_spacecraft_keeps_key_and_spacecraft(
     assert list(frame.columns[:2]) == ["key", "spacecraft"]
     assert sorted(set(frame["key"])) == keys
     assert len(frame) == sum(len(archive.records(k)) for k in keys)
-    assert all(k == f"insp/fr/sc/{sc}/nav/estimate" for k, sc in zip(frame["key"],
-                                                                      frame["spacecraft"]))
+    assert all(k == f"insp/fr/sc/{sc}/nav/estimate"
+               for k, sc in zip(frame["key"], frame["spacecraft"], strict=True))
     assert frame.index.is_monotonic_increasing
     # equal times keep the archive's order (the reader's: log time, then file order)
     records = archive.records(NAV_ALL)
     expected = [(m.t_sim, r.key, m.seq) for r in records
                 for m in [r.decode(StateEstimate)]]
-    assert list(zip(frame.index, frame["key"], frame["seq"])) == expected
+    assert list(zip(frame.index, frame["key"], frame["seq"], strict=True)) == expected
     assert frame.index.has_duplicates  # the two spacecraft publish at the same sim times
 
 

@@ -4,6 +4,7 @@ within communication range, H_i telemetry decomposes H exactly, and the cost goe
 from __future__ import annotations
 
 import math
+from itertools import pairwise
 
 import numpy as np
 
@@ -45,7 +46,7 @@ def test_observations_are_shared_only_in_range_and_h_decomposes() -> None:
     for m in telemetry:  # Eq. 8: H = prior term + Σ H_j, to round-off
         assert abs(m.h_local - m.prior_term - sum(m.contributions.values())) < 1e-12
     h = [m.h_local for m in mine]
-    assert abs(h[0] - 1.0) < 1e-12 and all(b <= a for a, b in zip(h, h[1:])) and h[-1] < 0.95
+    assert abs(h[0] - 1.0) < 1e-12 and all(b <= a for a, b in pairwise(h)) and h[-1] < 0.95
 
 
 def test_max_variance_aim_moves_continuously_and_is_tracked() -> None:
@@ -80,7 +81,7 @@ def test_max_variance_aim_moves_continuously_and_is_tracked() -> None:
     ends = [i for i in range(1, len(aims)) if np.any(rate[i - 1] != 0.0) and np.all(rate[i] == 0.0)]
     assert len(ends) >= 5
     assert all(np.min(np.linalg.norm(pois - pos[i], axis=1)) < 1e-9 for i in ends)
-    assert all(aims[j].t_sim - aims[i].t_sim >= RETARGET_S - 1e-9 for i, j in zip(ends, ends[1:]))
+    assert all(aims[j].t_sim - aims[i].t_sim >= RETARGET_S - 1e-9 for i, j in pairwise(ends))
     err = [math.degrees(e.pointing_error_rad) for e in estimates
            if e.mode == "track" and e.t_sim >= 120.0]
     assert len(err) > 100 and float(np.percentile(err, 95)) < 2.0, np.percentile(err, 95)

@@ -27,7 +27,7 @@ def test_nees_and_nis_consistent_over_monte_carlo_runs(tmp_path) -> None:  # noq
         with McapRecorder(path) as rec:
             run_inproc(sc, tap=rec.record, ground=False)
         for e in nav_errors(load_run(path), sc.name).values():
-            for t, q, nis in zip(e.t_s, e.nees, e.nis):
+            for t, q, nis in zip(e.t_s, e.nees, e.nis, strict=True):
                 if t >= settle_s:
                     nees_by_t.setdefault(round(t, 3), []).append(q)
                     if np.isfinite(nis):

@@ -64,7 +64,7 @@ def _changed(ran: App, fresh: App) -> set[str]:
 @pytest.mark.parametrize("node", ["sc2", "ground"])
 def test_every_attribute_an_app_changes_is_declared(node: str) -> None:
     fresh, _ = _fresh(node)
-    for ran, new in zip(_ran()[node].apps, fresh.executive.apps):
+    for ran, new in zip(_ran()[node].apps, fresh.executive.apps, strict=True):
         declared = {c.split(".")[0] for c in ran.CRITICAL} | set(ran.REBUILT)
         assert _changed(ran, new) <= declared, f"{ran.NAME}: undeclared state"
     assert _changed(_ran()[node].apps[0], fresh.executive.apps[0])  # it ran: something changed

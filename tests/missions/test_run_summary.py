@@ -67,7 +67,7 @@ def test_window_series_are_named_in_memory_and_positional_on_disk(
         "main", "chi2_nis", "cusum", "fixed_threshold"]
     main = summary.fdir_series.main
     assert [len(r) for r in on_disk["main"]] == [6] * len(main) and len(main) >= 10
-    for row, w in zip(on_disk["main"], main):
+    for row, w in zip(on_disk["main"], main, strict=True):
         assert row == [w.spacecraft, w.t_start_s, w.t_end_s, w.statistic, w.threshold,
                        1.0 if w.other_tests_failed else 0.0]
         assert type(row[0]) is int and type(row[5]) is float

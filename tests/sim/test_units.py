@@ -114,7 +114,7 @@ def test_relnav_publishes_its_sensors_measurement_of_the_truth_bias_included() -
     rel = sim.truth.rel_lvlh()
     sim._publish_hardware(0, 0.0)
     msgs = _of(kept, RelNavMeasurement)
-    for m, twin, truth in zip(msgs, twins, rel):
+    for m, twin, truth in zip(msgs, twins, rel, strict=True):
         r, v = twin.measure(truth[:3], truth[3:])
         assert (m.r_m, m.v_mps) == (r.tolist(), v.tolist())
         assert (m.sigma_r_m, m.sigma_v_mps) == (twin.sigma_r_m, twin.sigma_v_mps)

@@ -4,7 +4,6 @@ guidance status and transfer plans, observations and the information cost it rep
 from __future__ import annotations
 
 import math
-
 from typing import ClassVar, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator

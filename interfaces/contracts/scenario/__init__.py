@@ -7,8 +7,8 @@ from interfaces.contracts.scenario.base import Section
 from interfaces.contracts.scenario.comms import Burst, Comms, LinkCut
 from interfaces.contracts.scenario.faults import COMMON_MODE_KINDS, Fault, FaultKind
 from interfaces.contracts.scenario.fdir import FdirSettings
-from interfaces.contracts.scenario.ground import Ground, Station
 from interfaces.contracts.scenario.flight import Actuators, Attitude, Guidance, Nav, Sensors
+from interfaces.contracts.scenario.ground import Ground, Station
 from interfaces.contracts.scenario.mission import CameraSettings, Orbit, Target
 from interfaces.contracts.scenario.model import (
     Scenario,
@@ -16,8 +16,8 @@ from interfaces.contracts.scenario.model import (
     load_scenario,
     parse_scenario,
 )
-from interfaces.contracts.scenario.observers import ObserverOverride, Observers, Phase
 from interfaces.contracts.scenario.neighbours import Neighbours
+from interfaces.contracts.scenario.observers import ObserverOverride, Observers, Phase
 from interfaces.contracts.scenario.onboard import (
     DEFAULT_WATCHPOINTS,
     OnboardFdir,

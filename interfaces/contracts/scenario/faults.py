@@ -9,7 +9,6 @@ from pydantic import Field, model_validator
 
 from interfaces.contracts.scenario.base import Section
 
-
 FaultKind = Literal[
     "thruster_bias",
     "pointing_actuator",

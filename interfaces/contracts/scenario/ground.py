@@ -7,7 +7,7 @@ through the target; ``"passes"`` hears only while a station sees the target
 
 from __future__ import annotations
 
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
@@ -32,7 +32,7 @@ class Station(Section):
 class Ground(Section):
     contact: Literal["continuous", "passes"] = "continuous"
     epoch: datetime = Field(
-        default=datetime(2026, 3, 20, 12, 0, 0, tzinfo=timezone.utc),
+        default=datetime(2026, 3, 20, 12, 0, 0, tzinfo=UTC),
         description="UTC at t = 0: the Earth's sidereal angle then (where the stations are)")
     stations: list[Station] = Field(default_factory=list)
     downlink_bps: float = Field(
@@ -45,7 +45,7 @@ class Ground(Section):
     def _utc(cls, v: datetime) -> datetime:
         if v.tzinfo is None:
             raise ValueError("epoch needs a time zone (e.g. 2026-03-20T12:00:00Z)")
-        return v.astimezone(timezone.utc)
+        return v.astimezone(UTC)
 
     @model_validator(mode="after")
     def _stations(self) -> Ground:

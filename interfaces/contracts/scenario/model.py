@@ -21,8 +21,8 @@ from interfaces.contracts.scenario.fdir import FdirSettings
 from interfaces.contracts.scenario.flight import Actuators, Attitude, Guidance, Nav, Sensors
 from interfaces.contracts.scenario.ground import Ground
 from interfaces.contracts.scenario.mission import CameraSettings, Orbit, Target
-from interfaces.contracts.scenario.observers import Observers, Phase
 from interfaces.contracts.scenario.neighbours import Neighbours
+from interfaces.contracts.scenario.observers import Observers, Phase
 from interfaces.contracts.scenario.onboard import OnboardFdir
 from interfaces.contracts.scenario.planning import AssignmentSettings
 from interfaces.contracts.scenario.rates import Rates

@@ -54,7 +54,7 @@ def _images(app: NeighboursApp, sc: int, beta: float) -> list[PoiObservations]:
     pos = PROS[sc].states(app.n, times)[:, :3]
     prec = app.twin.precision(pos, centre_boresights(pos))
     out = []
-    for t, p, row in zip(times, pos, prec):
+    for t, p, row in zip(times, pos, prec, strict=True):
         seen = np.flatnonzero(row > 0.0)
         pose = ReportedPose(nav_m=list(p), nav_sigma_m=0.05, aim_m=[0.0, 0.0, 0.0],
                             knowledge_rad=1e-4, tracking_rad=2e-4, tracking_s=500.0)

@@ -35,7 +35,7 @@ def test_mekf_propagate_matches_reference(seed: int) -> None:
     dt = float(rng.uniform(0.01, 1.0))
     ref = mekf.mekf_propagate(q, b, P, w, dt, 1e-5, 1e-7)
     fast = kern.mekf_propagate(q, b, P, w, dt, 1e-5, 1e-7)
-    for r, f in zip(ref, fast):
+    for r, f in zip(ref, fast, strict=True):
         np.testing.assert_allclose(f, r, rtol=1e-11, atol=TOL)
 
 
@@ -47,7 +47,7 @@ def test_mekf_update_matches_reference(seed: int) -> None:
     R = np.diag(rng.uniform(1e-9, 1e-7, size=3))
     ref = mekf.mekf_update(q, b, P, q_meas, R)
     fast = kern.mekf_update(q, b, P, q_meas, R)
-    for r, f in zip(ref, fast):
+    for r, f in zip(ref, fast, strict=True):
         np.testing.assert_allclose(f, r, rtol=1e-9, atol=TOL)
 
 

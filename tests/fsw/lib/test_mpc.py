@@ -82,7 +82,7 @@ def test_truth_propagator_matches_ode() -> None:
     for _ in range(3):
         x = rng.normal(0.0, [30, 30, 30, 0.03, 0.03, 0.03])
         u = rng.uniform(-U_MAX, U_MAX, 3)
-        sol = solve_ivp(lambda _t, s: a @ s + b @ u, (0.0, DT), x, rtol=1e-12, atol=1e-13,
+        sol = solve_ivp(lambda _t, s, u=u: a @ s + b @ u, (0.0, DT), x, rtol=1e-12, atol=1e-13,
                         method="DOP853")
         np.testing.assert_allclose(truth.step(x, u), sol.y[:, -1], rtol=1e-10, atol=1e-11)
 

@@ -42,7 +42,7 @@ def _images(beta: float, rng: np.random.Generator, tracking_s: float = 100.0,
     pos = PRO.states(N, times)[:, :3]
     prec = TWIN.precision(pos, centre_boresights(pos))
     out = []
-    for t, p, row in zip(times, pos, prec):
+    for t, p, row in zip(times, pos, prec, strict=True):
         seen = np.flatnonzero(row > 0.0)
         noisy = beta * row[seen] * np.maximum(0.0, 1.0 + TWIN.noise_frac
                                               * rng.standard_normal(seen.size))

@@ -17,7 +17,7 @@ Q = 1e-4
 
 def _gains(ratios: list[float]) -> list[ObserverGain]:
     return [ObserverGain(i + 1, r * p, p, m)
-            for i, (r, p, m) in enumerate(zip(ratios, PRED, MODELS))]
+            for i, (r, p, m) in enumerate(zip(ratios, PRED, MODELS, strict=False))]  # a few
 
 
 def test_constellation_model_matches_monte_carlo() -> None:

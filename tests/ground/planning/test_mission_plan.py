@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from itertools import pairwise
 
 import numpy as np
 import pytest
@@ -145,7 +146,7 @@ def test_keeps_the_current_set_unless_the_new_one_is_better_by_the_margin() -> N
     assert [a.phase for a in plan.issued] == ["initial", "insp"]
     # each kept decision restarts the measurement: a later decision needs two new windows
     assert len(saturated) >= 2
-    for prev, d in zip(saturated, saturated[1:]):
+    for prev, d in pairwise(saturated):
         assert len(d.measured_gains) >= 2
         assert d.t_s - prev.t_s >= len(d.measured_gains) * sc.assignment.check_period_s - 1e-9
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from itertools import pairwise
 
 import numpy as np
 import pytest
@@ -121,7 +122,7 @@ def test_monotone_and_diminishing_returns_on_random_sets() -> None:
         t_size = int(rng.integers(1, 6))
         s_size = int(rng.integers(0, t_size + 1))
         big, small, e = perm[:t_size], perm[:s_size], perm[t_size]
-        f = lambda idx: set_gain(pool[list(idx)], phi, w)  # noqa: E731
+        f = lambda idx, pool=pool, phi=phi, w=w: set_gain(pool[list(idx)], phi, w)  # noqa: E731
         f_s, f_t = f(small), f(big)
         f_se, f_te = f([*small, e]), f([*big, e])
         tol = 1e-9 * max(1.0, f_te)
@@ -150,7 +151,7 @@ def test_greedy_against_exhaustive_search() -> None:
     equal = total = 0
     worst_ratio = 1.0
     worst_certified = 1.0
-    for trial in range(8):
+    for _ in range(8):
         subset = np.sort(rng.choice(len(LIB), size=10, replace=False))
         lib = [LIB[i] for i in subset]
         phi = rng.uniform(0.5, 2.0, m)
@@ -226,7 +227,8 @@ def test_match_to_observers_equals_brute_force() -> None:
         assert sorted(got) == [0, 1, 2, 3]
         slots = [p.state(N_MEAN, t)[:3] for p in pros]
 
-        def cost(perm: tuple[int, ...] | list[int]) -> float:
+        def cost(perm: tuple[int, ...] | list[int], states: np.ndarray = states,
+                 slots: list[np.ndarray] = slots) -> float:
             return sum(float(np.linalg.norm(states[i, :3] - slots[j])) for i, j in enumerate(perm))
 
         best = min(cost(perm) for perm in itertools.permutations(range(4)))
@@ -249,7 +251,7 @@ def test_gain_saturated_rule() -> None:
     for _ in range(6):
         gains.append(set_gain(PREC[[0, 9]], 1.0, w))
         w = w + PREC[0] + PREC[9]
-    assert all(b < a for a, b in zip(gains, gains[1:]))
+    assert all(b < a for a, b in pairwise(gains))
     first_below = next(i for i, g in enumerate(gains) if g < 0.2 * gains[0])
     flags = [gain_saturated(gains[: k + 1], 0.2) for k in range(6)]
     assert flags == [k >= first_below for k in range(6)]

@@ -159,7 +159,7 @@ def test_file_structure_with_the_mcap_library(tmp_path: Path) -> None:
         for channel in summary.channels.values():
             assert channel.message_encoding == "json"
         n = 0
-        for schema, channel, message in reader.iter_messages(log_time_order=True):
+        for schema, _channel, message in reader.iter_messages(log_time_order=True):
             assert schema is not None
             registry()[schema.name].model_validate_json(message.data)
             assert message.log_time % 250_000_000 == 0
