@@ -52,7 +52,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
     lines += _fdir_section(out, archive, mission, summary)
     lines += _contact_section(summary) + _neighbours_section(summary)
     lines += _links_section(summary) + _exec_section(summary) + _incidents_section(summary)
-    lines += _archive_section(summary)
+    lines += archive_section(summary)
     return _write(out, lines)
 
 
@@ -453,7 +453,7 @@ def _onboard_lines(summary: RunSummary) -> list[str]:
     return rows
 
 
-def _archive_section(summary: RunSummary) -> list[str]:
+def archive_section(summary: RunSummary) -> list[str]:
     """The archive's segments (a restarted recorder) and the messages lost, by topic; nothing
     for a run archived whole in one file."""
     info = summary.archive

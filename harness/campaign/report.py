@@ -222,7 +222,7 @@ def _magnitude_lines(rows: list[dict[str, Any]], detectors: list[str],
     lines = ["", "## Per fault kind and magnitude", "",
              "| kind | magnitude | detector | faults | detected | missed | isolated | "
              "latency median / p90 / max (s) |", "|---|---|---|---|---|---|---|---|"]
-    bins = _magnitude_bins([r for r in rows if r["kind"] != "none" and r["detector"] == "main"])
+    bins = magnitude_bins([r for r in rows if r["kind"] != "none" and r["detector"] == "main"])
     for (kind, label), members in bins.items():
         for d in detectors:
             sel = [r for r in rows if r["detector"] == d and r["kind"] == kind
@@ -267,7 +267,7 @@ def _rescoring_lines(runs: list[CampaignRun]) -> list[str]:
     return lines + [""] + _persistence_table(runs)
 
 
-def _magnitude_bins(rows: list[dict[str, Any]], most: int = 4
+def magnitude_bins(rows: list[dict[str, Any]], most: int = 4
                     ) -> dict[tuple[str, str], set[tuple[str, int]]]:
     """Faults grouped by kind and magnitude, in kind then magnitude order: each distinct
     magnitude when a kind has at most ``most`` of them, else three equal-width bins (dispersed

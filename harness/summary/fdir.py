@@ -224,7 +224,7 @@ def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> Threshold
 
 
 def series_of(windows: list[FdirWindow], verdicts: list[BaselineVerdict]) -> FdirSeries:
-    """``fdir_series``: every decided window of each detector (``run_summary.series``) --
+    """``fdir_series``: every decided window of each detector (``harness.summary.series``) --
     what a campaign needs to re-score at other threshold scales (ROC) without the archives.
     The main detector's windows record whether they failed a test other than the information
     test (plan, pointing, Δv rate, NIS: ``FdirWindow.failed``), which no threshold scale

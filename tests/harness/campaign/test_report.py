@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from harness.campaign.report import _magnitude_bins, write_campaign_report
+from harness.campaign.report import magnitude_bins, write_campaign_report
 from harness.campaign.rescore import (
     SCALES,
     CampaignRun,
@@ -166,10 +166,10 @@ def test_roc_scores_like_the_run(tmp_path: Path) -> None:
 def test_magnitude_bins() -> None:
     rows = [{"kind": "k", "magnitude": m, "run": str(i), "fault_index": 0}
             for i, m in enumerate([4.0, 5.5, 7.0, 8.5, 10.0, 13.0])]
-    bins = _magnitude_bins(rows)
+    bins = magnitude_bins(rows)
     assert list(bins) == [("k", "4–7"), ("k", "7–10"), ("k", "10–13")]  # numeric order
     assert [len(v) for v in bins.values()] == [2, 2, 2]
-    few = _magnitude_bins(rows[:3])
+    few = magnitude_bins(rows[:3])
     assert list(few) == [("k", "4"), ("k", "5.5"), ("k", "7")]
 
 

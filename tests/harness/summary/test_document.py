@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ground.archive.recorder import McapRecorder
 from harness.archive.reader import load_run
-from harness.report import _archive_section
+from harness.report import archive_section
 from harness.summary import (
     FailedTests,
     FaultClass,
@@ -67,7 +67,7 @@ def test_a_clean_archive_says_what_it_always_said(tmp_path: Path) -> None:
     _archive(tmp_path / "run.mcap", [1, 2, 3])
     info = archive_info(load_run(tmp_path / "run.mcap"))
     assert info.to_json(indent=0) == '{\n"truncated": false\n}'
-    assert _archive_section(RunSummary(scenario="x", seed=1, status="completed", error=None,
+    assert archive_section(RunSummary(scenario="x", seed=1, status="completed", error=None,
                                        injected_faults=[], archive=info)) == []
 
 
@@ -85,5 +85,5 @@ def test_segments_and_lost_messages_are_named_by_topic(tmp_path: Path) -> None:
     summary.write(tmp_path / "summary.json")
     again = RunSummary.read(tmp_path / "summary.json")
     assert again.archive == info and again.filled == []
-    assert "| nav/estimate | 3 |" in _archive_section(again)
-    assert "Segments: run.mcap, run-1.mcap." in _archive_section(again)
+    assert "| nav/estimate | 3 |" in archive_section(again)
+    assert "Segments: run.mcap, run-1.mcap." in archive_section(again)
