@@ -39,6 +39,8 @@ from interfaces.contracts.messages import Message, OverflowRun, StoreCounter
 RETRY_S = 1.0
 """In a pass with the link down (cut, out of range), the radio tries again this often, s."""
 PRIORITIES = 3
+JUDGED_PRIORITIES = 2
+"""Priorities below this carry what the ground FDIR judges (``catalogue.downlink_priority``)."""
 
 
 def message_bytes(msg: Message) -> int:
@@ -196,8 +198,13 @@ class OnboardStore:
         c.onboard_bytes = sum(self._bytes) + sum(i.size for i in flying)
         # each queue holds its messages in send order (a lost one goes back to its front), so
         # the oldest aboard is a queue's head or the one on the air: O(1) per call, every tick
-        c.onboard_since_s = min([*(q[0].t for q in self._queues if q), *(i.t for i in flying)],
-                                default=None)
+        c.onboard_since_s = self._oldest(PRIORITIES, flying)
+        c.judged_since_s = self._oldest(JUDGED_PRIORITIES, flying)
+
+    def _oldest(self, priorities: int, flying: list[_Item]) -> float | None:
+        """Send time of the oldest message aboard of priority below ``priorities`` (s)."""
+        return min([*(q[0].t for q in self._queues[:priorities] if q),
+                    *(i.t for i in flying if i.priority < priorities)], default=None)
 
     def with_envelopes(self, fn: Callable[[Any], Any]) -> OnboardStore:
         """A copy whose messages carry ``fn(envelope)`` instead (a node's critical-data store

@@ -26,7 +26,7 @@ import numpy as np
 from gnc.poi_map import PoiMap
 from ground.fdir.observer import ObserverState, ground_contributions
 from ground.fdir.threshold import Persistence
-from interfaces.contracts.messages import FaultReport, InfoCostTelemetry
+from interfaces.contracts.messages import FaultReport, InfoCostTelemetry, Unjudged
 from interfaces.contracts.scenario import FdirSettings
 
 
@@ -38,7 +38,8 @@ class IntegrityCheck:
         self.node = node
         self.log = log
         self.persistence = Persistence(cfg.checks_persistence)
-        self.unjudged = 0
+        self.unjudged: dict[Unjudged, int] = {}
+        """reports not judged, by reason"""
         self._reported: dict[tuple[int, int], float] = {}  # (observer, boundary) -> H_i
 
     def reported(self, msg: InfoCostTelemetry, boundary: int) -> None:
@@ -46,22 +47,30 @@ class IntegrityCheck:
         self._reported[(msg.spacecraft, boundary)] = msg.h_i
 
     def check(self, j: int, b: float, settled: PoiMap, observers: dict[int, ObserverState],
-              excludes: Callable[[int], bool] = lambda sc: False) -> list[FaultReport]:
+              excludes: Callable[[int], bool] = lambda sc: False
+              ) -> tuple[list[FaultReport], dict[int, Unjudged]]:
         """Judge the reports at boundary ``j`` (time b, s) against ``settled``, the ground's
-        map holding every image before b; returns the data-integrity faults declared.  An
-        observer that ``excludes`` a neighbour its neighbours declared fuses less than the
-        ground: its report is not judged (counted in ``unjudged``)."""
+        map holding every image before b that came down; returns the data-integrity faults
+        declared and, by observer, why its report was not judged (module docstring).  No
+        report is judged while any observer's reports before b are still aboard (the map
+        lacks them), or more of any observer's observations are lost than
+        ``fdir.integrity_max_loss`` (on the link or to its store's overflow); nor is the
+        report of an observer that ``excludes`` a neighbour its neighbours declared (it fuses
+        less than the ground)."""
         lost = np.array([o.lost_fraction() for o in observers.values()])
         ground = ground_contributions(settled, lost)
-        judgeable = float(lost.max(initial=0.0)) <= self.cfg.integrity_max_loss
+        why = self._blocked(b, lost, observers)
         out: list[FaultReport] = []
+        unjudged: dict[int, Unjudged] = {}
         for sc in observers:
             reported = self._reported.pop((sc, j), None)
             mine = float(ground[sc - 1])
             if reported is None or mine <= 0.0:
                 continue
-            if not judgeable or excludes(sc):
-                self._unjudged(sc, lost)
+            reason = why or ("excluded" if excludes(sc) else None)
+            if reason is not None:
+                unjudged[sc] = reason
+                self._unjudged(sc, reason, lost)
                 continue
             deviation = abs(reported / mine - 1.0)
             if self.persistence.update(sc, deviation > self.cfg.integrity_tol):
@@ -71,12 +80,20 @@ class IntegrityCheck:
                     sender=self.node, t_sim=b, spacecraft=sc, fault_class="data_integrity",
                     metric=deviation, threshold=self.cfg.integrity_tol, window_end_s=b))
         self._reported = {k: v for k, v in self._reported.items() if k[1] > j}
-        return out
+        return out, unjudged
 
-    def _unjudged(self, sc: int, lost: np.ndarray) -> None:
-        self.unjudged += 1
-        if self.unjudged == 1 or self.unjudged % 100 == 0:
-            self.log.info("FDIR: sc%d's H_i report not judged: %.0f%% of sc%d's observations "
-                          "lost (data integrity needs at most %.0f%%; %d unjudged so far)", sc,
-                          100 * lost.max(), int(np.argmax(lost)) + 1,
-                          100 * self.cfg.integrity_max_loss, self.unjudged)
+    def _blocked(self, b: float, lost: np.ndarray, observers: dict[int, ObserverState]
+                 ) -> Unjudged | None:
+        """Why no report at b (s) can be judged: reports still aboard, or too much lost."""
+        if any(o.aboard_before(b) for o in observers.values()):
+            return "aboard"
+        return "lost" if float(lost.max(initial=0.0)) > self.cfg.integrity_max_loss else None
+
+    def _unjudged(self, sc: int, reason: Unjudged, lost: np.ndarray) -> None:
+        self.unjudged[reason] = self.unjudged.get(reason, 0) + 1
+        count = sum(self.unjudged.values())
+        if count == 1 or count % 100 == 0:
+            self.log.info("FDIR: sc%d's H_i report not judged (%s): %.0f%% of sc%d's "
+                          "observations lost (data integrity needs at most %.0f%%; %d unjudged "
+                          "so far)", sc, reason, 100 * lost.max(initial=0.0),
+                          int(np.argmax(lost)) + 1, 100 * self.cfg.integrity_max_loss, count)

@@ -79,6 +79,11 @@ class ObserverState:
     overflow: list[tuple[float, float]] = field(default_factory=list)
     """send times (first, last; s) of its FDIR reports its onboard store lost (ground passes)"""
     overflow_declared: bool = False
+    overflow_observations: int = 0
+    """its observations its onboard store lost to overflow (ground passes), since the start"""
+    aboard_since_s: float | None = None
+    """send time of its oldest report the ground FDIR judges still aboard (ground passes;
+    None: none aboard), from its store's accounting"""
     resync: bool = False
     """the next judged window numbers its observations afresh (the store lost some before)"""
     heard_s: float = -math.inf
@@ -98,6 +103,11 @@ class ObserverState:
         """Whether its store lost FDIR reports sent in the window [a, b) (s)."""
         return any(first < b and a <= last for first, last in self.overflow)
 
+    def aboard_before(self, b: float) -> bool:
+        """Whether reports it sent before ``b`` (s) are still aboard (ground passes): a window
+        ending at b is then judged on part of its data."""
+        return self.aboard_since_s is not None and self.aboard_since_s < b
+
     def heard(self, t_s: float) -> None:
         """A nav, attitude or image report sent at ``t_s`` (s) came in."""
         self.heard_s, self.fresh = max(self.heard_s, t_s), True
@@ -112,9 +122,11 @@ class ObserverState:
         return lost
 
     def lost_fraction(self) -> float:
-        """Share of its observations that never reached the ground, since the start."""
-        total = self.received + self.lost
-        return self.lost / total if total else 0.0
+        """Share of its observations that never reached the ground, since the start: lost on
+        the link (sequence gaps) or to its store's overflow."""
+        missing = self.lost + self.overflow_observations
+        total = self.received + missing
+        return missing / total if total else 0.0
 
     def camera_off_before(self, b: float) -> bool:
         """Whether its camera was turned off onboard before the window ending at b (s): such a

@@ -38,7 +38,7 @@ from ground.fdir.link_checks import LinkChecks
 from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
 from ground.fdir.window import SettledMap, window_context
-from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS
+from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS, OBSERVATIONS
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
     AttitudeEstimate,
@@ -54,10 +54,13 @@ from interfaces.contracts.messages import (
     ProAssignments,
     StateEstimate,
     TransferPlanMsg,
+    Unjudged,
 )
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.contracts.topics import spacecraft_of
+
+OBSERVATIONS_TOPIC = f"{OBSERVATIONS.app}/{OBSERVATIONS.name}"
 
 
 class FdirPipeline:
@@ -171,13 +174,18 @@ class FdirPipeline:
             self.rulings.declaration(msg)
 
     def link_stats(self, msg: LinkStats) -> None:
-        """The ground's own channel counters: with ground passes, the FDIR topics' overflow
-        runs of each observer's onboard store (docs/fdir.md, "Ground passes")."""
+        """The ground's own channel counters: with ground passes, each observer's onboard store
+        as its housekeeping reports it in a pass (docs/fdir.md, "Ground passes"): the FDIR
+        topics' overflow runs, the observations lost to overflow, and the oldest report the
+        FDIR judges still aboard."""
         for c in msg.links:
             obs = self.observers.get(spacecraft_of(c.src) or 0)
-            if obs is not None and c.dst == self.node and c.store is not None:
-                obs.overflow = [(r.first_s, r.last_s) for r in c.store.overflow_runs
-                                if r.topic in FDIR_DOWNLINK_TOPICS]
+            if obs is None or c.dst != self.node or c.store is None:
+                continue
+            runs = c.store.overflow_runs
+            obs.overflow = [(r.first_s, r.last_s) for r in runs if r.topic in FDIR_DOWNLINK_TOPICS]
+            obs.overflow_observations = sum(r.count for r in runs if r.topic == OBSERVATIONS_TOPIC)
+            obs.aboard_since_s = c.store.judged_since_s
 
     def guidance(self, msg: GuidanceStatus) -> None:
         obs = self.observers.get(msg.spacecraft)
@@ -233,20 +241,22 @@ class FdirPipeline:
         judged: dict[int, Judgement] = {}
         for sc, obs in self.observers.items():
             mine = sorted((m for m in inside if m.spacecraft == sc), key=lambda m: m.image_t_s)
-            planned = obs.plan_at(a) is not None and not obs.camera_off_before(b)
-            if obs.overflowed(a, b):  # data lost aboard, of known cause: not judged
-                out += self.links.overflow(sc, obs, b)
-                out.append(FdirWindow(sender=self.node, t_sim=b, spacecraft=sc, t_start_s=a,
-                                      t_end_s=b, images=len(mine), lost=0))
+            window = FdirWindow(sender=self.node, t_sim=b, spacecraft=sc, t_start_s=a,
+                                t_end_s=b, images=len(mine))
+            lost_aboard = self._lost_aboard(sc, obs, a, b)
+            if lost_aboard is not None:  # data lost or still aboard, of known cause
+                out += [*lost_aboard[1], window.model_copy(update={"unjudged": lost_aboard[0]})]
                 continue
+            planned = obs.plan_at(a) is not None and not obs.camera_off_before(b)
             lost, reports = self.links.judge(sc, obs, mine, planned, b)
             out += reports
-            window = FdirWindow(sender=self.node, t_sim=b, spacecraft=sc, t_start_s=a,
-                                t_end_s=b, images=len(mine), lost=lost)
-            ctx, images = (window_context(sc, obs, mine, a, b, settled, self.n, self.settle_s)
-                           if planned and mine else (None, len(mine)))
+            window = window.model_copy(update={"lost": lost})
+            ctx, images, why = (window_context(sc, obs, mine, a, b, settled, self.n,
+                                               self.settle_s)
+                                if planned and mine else (None, len(mine), None))
             if ctx is None:
-                out.append(window.model_copy(update={"images": images}))
+                out.append(window.model_copy(update={
+                    "images": images, "unjudged": why or _unplanned(obs, b, mine)}))
                 continue
             judged[sc] = self.information.judge(
                 ctx, obs, window.model_copy(update={"images": images}),
@@ -258,9 +268,23 @@ class FdirPipeline:
         out += self.rulings.rule(b, {w.spacecraft: w.exceeded for w in out
                                      if isinstance(w, FdirWindow)})
         self._settle(inside, b)
-        out += self.integrity.check(k + 1, b, self.settled, self.observers,
-                                    self.rulings.excludes)
-        return out
+        reports, unjudged = self.integrity.check(k + 1, b, self.settled, self.observers,
+                                                 self.rulings.excludes)
+        return [m.model_copy(update={"integrity_unjudged": unjudged[m.spacecraft]})
+                if isinstance(m, FdirWindow) and m.spacecraft in unjudged else m
+                for m in out] + reports
+
+    def _lost_aboard(self, sc: int, obs: ObserverState, a: float, b: float
+                     ) -> tuple[Unjudged, list[FaultReport]] | None:
+        """Why observer ``sc``'s window [a, b) cannot be judged on what came down, with the
+        ground passes: its store lost its reports (a link fault of known cause, once per
+        episode) or still holds some (docs/fdir.md, "Lost is not corrupt"); None: neither."""
+        if obs.overflowed(a, b):
+            return "store_overflow", self.links.overflow(sc, obs, b)
+        if obs.aboard_before(b):  # what came down is counted afresh once it is all in
+            obs.resync = True
+            return "aboard", []
+        return None
 
     def _settle(self, inside: list[PoiObservations], b: float) -> None:
         """The judged window's images join the ground's map; what no later window needs goes."""
@@ -273,3 +297,10 @@ class FdirPipeline:
     def _cost(self) -> float:
         """H of the ground's fused map (Eq. 4, 7)."""
         return float(np.sum(self.settled.phi * self.settled.variance()))
+
+
+def _unplanned(obs: ObserverState, b: float, images: list[PoiObservations]) -> Unjudged:
+    """Why a window without a context was not judged, before its images were looked at."""
+    if obs.camera_off_before(b):
+        return "camera_off"
+    return "no_images" if not images else "no_plan"

@@ -17,7 +17,7 @@ import numpy as np
 from gnc.poi_map import PoiMap
 from gnc.window_test import Observation, WindowPose
 from ground.fdir.observer import ObserverState
-from interfaces.contracts.messages import PoiObservations
+from interfaces.contracts.messages import PoiObservations, Unjudged
 
 
 @dataclass(frozen=True)
@@ -82,23 +82,23 @@ class WindowContext:
 
 def window_context(spacecraft: int, obs: ObserverState, images: list[PoiObservations],
                    a: float, b: float, settled: SettledMap, n: float, settle_s: float
-                   ) -> tuple[WindowContext | None, int]:
+                   ) -> tuple[WindowContext | None, int, Unjudged | None]:
     """The context of a window with a plan and images (``images``: those received, in time
-    order), and the count of images the window message reports; no context when none can be
-    judged.  ``n``: the mean motion (rad/s) the plans' PROs fly."""
+    order), the count of images the window message reports, and why there is no context when
+    none can be judged.  ``n``: the mean motion (rad/s) the plans' PROs fly."""
     received = len(images)
     images = [m for m in images if obs.tracking_at(m.image_t_s, settle_s)]
     if not images:
-        return None, 0
+        return None, 0, "not_tracking"
     planned = obs.planned(n, np.array([m.image_t_s for m in images]))
     if planned is None:  # no plan in force at an image time: nothing to compare with
-        return None, received
+        return None, received, "no_plan"
     pos, moving, known = planned  # unknown: on a transfer whose plan was lost
     images = [m for m, k in zip(images, known, strict=True) if k]
     if not images:
-        return None, 0
+        return None, 0, "plan_unknown"
     times = np.array([m.image_t_s for m in images])
     return WindowContext(spacecraft, a, b, settled, images, times, pos[known],
                          bool(moving[known].any()), obs.attitude.at(times),
                          obs.nav.at(times), obs.nav_sigma.at(times), [m.arrays() for m in images],
-                         settled.h_prev(spacecraft)), len(images)
+                         settled.h_prev(spacecraft)), len(images), None

@@ -97,9 +97,31 @@ class ModelZ(Counts):
     windows: int = Field(description="nominal windows with a ratio")
 
 
+class UnjudgedCounts(Counts):
+    """Windows (or H_i reports) with no decision, by reason (``messages.Unjudged``; docs/fdir.md,
+    "Lost is not corrupt")."""
+
+    store_overflow: int = 0
+    aboard: int = 0
+    lost: int = 0
+    no_plan: int = 0
+    camera_off: int = 0
+    no_images: int = 0
+    not_tracking: int = 0
+    plan_unknown: int = 0
+    excluded: int = 0
+
+    @classmethod
+    def of(cls, reasons: list[str | None]) -> UnjudgedCounts:
+        return cls.model_validate({r: reasons.count(r) for r in set(reasons) if r is not None})
+
+
 class ThresholdCensus(Counts):
     """``fdir_thresholds``: over the nominal windows the main detector decided, what set the
-    threshold, how often each threshold lay above the floor and which tests failed."""
+    threshold, how often each threshold lay above the floor and which tests failed; and over
+    every window, why those without a decision had none."""
+
+    FILLABLE: ClassVar[tuple[str, ...]] = ("unjudged", "integrity_unjudged")
 
     nominal_windows: int
     threshold_by: ThresholdSources
@@ -107,6 +129,12 @@ class ThresholdCensus(Counts):
     sampled_above_floor: int
     failed: FailedTests
     model_z: ModelZ
+    unjudged: UnjudgedCounts = Field(
+        default_factory=UnjudgedCounts,
+        description="windows of every observer the information test could not decide, by reason")
+    integrity_unjudged: UnjudgedCounts = Field(
+        default_factory=UnjudgedCounts,
+        description="H_i reports the data-integrity check did not judge, by reason")
 
 
 class RunFdirSettings(FdirSettings):
@@ -220,7 +248,9 @@ def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> Threshold
         failed=FailedTests.model_validate({k: sum(k in w.failed for w in nominal)
                                             for k in WINDOW_TESTS}),
         model_z=ModelZ(over_2=sum(v > 2 for v in z), over_3=sum(v > 3 for v in z),
-                       over_4=sum(v > 4 for v in z), windows=len(z)))
+                       over_4=sum(v > 4 for v in z), windows=len(z)),
+        unjudged=UnjudgedCounts.of([w.unjudged for w in windows]),
+        integrity_unjudged=UnjudgedCounts.of([w.integrity_unjudged for w in windows]))
 
 
 def series_of(windows: list[FdirWindow], verdicts: list[BaselineVerdict]) -> FdirSeries:

@@ -73,6 +73,7 @@ from interfaces.contracts.messages.ground import (
     ProAssignments,
     ProElements,
     TelemetryStatus,
+    Unjudged,
     WindowTest,
 )
 from interfaces.contracts.messages.lockstep import (
@@ -152,6 +153,7 @@ __all__ = [
     "OnboardFdirEvent",
     "MAX_PRO_SIZE_M",
     "MAX_TRANSFER_S",
+    "Unjudged",
     "WindowTest",
     "WINDOW_TESTS",
     "ProElements",

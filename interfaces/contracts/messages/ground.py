@@ -63,6 +63,15 @@ threshold), the guidance and attitude consistency tests and the nav's NIS test
 
 WINDOW_TESTS: tuple[str, ...] = get_args(WindowTest)
 
+Unjudged = Literal["store_overflow", "aboard", "lost", "no_plan", "camera_off", "no_images",
+                   "not_tracking", "plan_unknown", "excluded"]
+"""Why a window, or the H_i report at its end, has no decision (docs/fdir.md, "Lost is not
+corrupt"): its reports lost to the store's overflow (``store_overflow``) or still aboard
+(``aboard``); too many of the observers' observations lost for the report's recomputation
+(``lost``); no plan in force; its camera turned off aboard; no image received; no image taken
+while tracking; a transfer whose plan never reached the ground (``plan_unknown``); an observer
+its neighbours left out of their fusion (``excluded``)."""
+
 
 class FdirWindow(Message):
     """The FDIR's verdict on one observer over one FDI window [t_start_s, t_end_s): the
@@ -103,6 +112,12 @@ class FdirWindow(Message):
     failed: list[WindowTest] = Field(
         default_factory=list, max_length=len(WINDOW_TESTS),
         description="the detector's tests this window failed (ground/fdir/consistency.py)")
+    unjudged: Unjudged | None = Field(
+        default=None, description="why the window has no decision (None: judged, or a "
+                                  "decision was possible)")
+    integrity_unjudged: Unjudged | None = Field(
+        default=None, description="why the H_i the observer reported at the window's end was "
+                                  "not judged for data integrity (None: judged, or none came)")
 
 
 class ConstellationWindow(Message):

@@ -125,6 +125,9 @@ class StoreCounter(BaseModel):
     onboard_since_s: float | None = Field(
         default=None, description="send time of the oldest message still aboard, s (None: "
                                   "none aboard)")
+    judged_since_s: float | None = Field(
+        default=None, description="send time of the oldest message aboard of the topics the "
+                                  "ground FDIR judges (priorities 0 and 1), s (None: none)")
     overflow_runs: list[OverflowRun] = Field(default_factory=list, max_length=100_000)
 
 

@@ -79,15 +79,17 @@ def test_window_context_judges_tracked_images_under_a_plan() -> None:
     settled = SettledMap.of(PoiMap.uniform(10, 1.0, 1))
     images = [_obs(1, t, i) for i, t in enumerate((50.0, 69.0, 71.0, 75.0), 1)]
     n = 1.1e-3
-    ctx, count = window_context(1, obs, images, 60.0, 80.0, settled, n, settle_s=30.0)
-    assert count == 2 and ctx is not None  # tracking since 40 s: judged from 70 s on
+    ctx, count, reason = window_context(1, obs, images, 60.0, 80.0, settled, n, settle_s=30.0)
+    # tracking since 40 s: judged from 70 s on
+    assert count == 2 and ctx is not None and reason is None
     assert list(ctx.times) == [71.0, 75.0]
     assert np.allclose(ctx.planned, obs.plans[1].positions(n, ctx.times))
     assert ctx.attitude is None and ctx.nav is None  # nothing reported: no pose
     assert ctx.h_prev == 0.0  # nothing fused yet
-    assert window_context(1, obs, images[:2], 60.0, 80.0, settled, n, 30.0) == (None, 0)
+    assert window_context(1, obs, images[:2], 60.0, 80.0, settled, n, 30.0) == (None, 0,
+                                                                                  "not_tracking")
     obs.plans.clear()
-    assert window_context(1, obs, images, 60.0, 80.0, settled, n, 30.0) == (None, 4)
+    assert window_context(1, obs, images, 60.0, 80.0, settled, n, 30.0) == (None, 4, "no_plan")
 
 
 def _judgement(sc: int, metric: float, evidence: Evidence, model: RatioModel | None = None,
@@ -139,14 +141,16 @@ def test_a_class_found_on_a_later_window_and_common_mode_not_held_against_one() 
     assert out[0].exceeded is False and len(out) == 1
 
 
-def test_a_reported_h_i_off_the_grounds_recomputation_is_a_data_integrity_fault() -> None:
+def _integrity_over_two_boundaries(observers: dict[int, ObserverState]
+                                   ) -> list[tuple[list[FaultReport], dict[int, str]]]:
+    """The data-integrity check at boundaries 1 and 2 (10 s, 20 s) of two observers whose map
+    the ground holds, sc1 reporting its H_i 1.5 times what its observations give."""
     cfg = small_scenario(fdir={"checks_persistence": 2, "integrity_tol": 0.2}).fdir
     check = IntegrityCheck(cfg, "ground", LOG)
     settled = PoiMap.uniform(10, 1.0, 2)
     settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
     settled.add(2, np.array([2, 3]), np.array([0.5, 0.5]))
     truth = settled.contributions()
-    observers = {1: ObserverState(), 2: ObserverState()}
     out = []
     for j in (1, 2):
         for sc, factor in ((1, 1.5), (2, 1.0)):  # sc1 inflates its H_i by half
@@ -155,6 +159,34 @@ def test_a_reported_h_i_off_the_grounds_recomputation_is_a_data_integrity_fault(
                 h_i=factor * float(truth[sc - 1]), h_local=1.0, prior_term=0.5,
                 pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=0), j)
         out.append(check.check(j, 10.0 * j, settled, observers))
-    assert [len(r) for r in out] == [0, 1]
-    assert out[1][0].spacecraft == 1 and out[1][0].fault_class == "data_integrity"
-    assert out[1][0].metric == pytest.approx(0.5)
+    return out
+
+
+def test_a_reported_h_i_off_the_grounds_recomputation_is_a_data_integrity_fault() -> None:
+    out = _integrity_over_two_boundaries({1: ObserverState(), 2: ObserverState()})
+    assert [len(r) for r, _ in out] == [0, 1]
+    assert [u for _, u in out] == [{}, {}]
+    report = out[1][0][0]
+    assert report.spacecraft == 1 and report.fault_class == "data_integrity"
+    assert report.metric == pytest.approx(0.5)
+
+
+def test_no_integrity_verdict_rests_on_observations_lost_to_a_stores_overflow() -> None:
+    """Lost is not corrupt: with 20% of sc2's observations lost aboard (its store's overflow
+    runs), the ground's map cannot give what its observers fused, so no report is judged, and
+    each says why."""
+    observers = {1: ObserverState(received=100), 2: ObserverState(received=80,
+                                                                 overflow_observations=20)}
+    assert observers[2].lost_fraction() == pytest.approx(0.2)
+    out = _integrity_over_two_boundaries(observers)
+    assert [r for r, _ in out] == [[], []]
+    assert [u for _, u in out] == [{1: "lost", 2: "lost"}] * 2
+
+
+def test_no_integrity_verdict_while_reports_before_the_boundary_are_still_aboard() -> None:
+    """sc2's store still holds a report sent at 15 s: the boundary at 10 s is judged, the one
+    at 20 s is not (its images are not all in the ground's map)."""
+    observers = {1: ObserverState(), 2: ObserverState(aboard_since_s=15.0)}
+    out = _integrity_over_two_boundaries(observers)
+    assert [u for _, u in out] == [{}, {1: "aboard", 2: "aboard"}]
+    assert [r for r, _ in out] == [[], []]  # the first failed report alone does not persist
