@@ -4,15 +4,17 @@ other detector settings.
     python -m harness.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR]
 
 RUN is a run directory (holding ``run.mcap``) or an archive (its first segment: the segments
-after it, a restarted recorder's, are read with it as one run).  The ground node itself, built
-from the declared topology as a run builds it (``interfaces.contracts.topology``: planner,
-telemetry monitor, FDIR, baselines -- the code the live ground runs, not a copy) is fed, on
-the in-process bus, every archived message of the other nodes that the ground subscribes to,
-in the lockstep's order: all messages of sim time t, then the sim's Tick at t.  Its own
-channel model (the scenario's comms, seed, cuts and link faults) decides again, in the same
-deterministic order, which of them reached it, so losses and range cuts replay as they
-happened.  What it publishes -- FDI windows, fault reports, baseline verdicts --
-is scored as ``summary.json`` scores the live run (``harness.summary.build.fdir_results``);
+after it, a restarted recorder's, are read with it as one run); any other path is refused, one
+line each, exit status 2, before anything is replayed (``harness/archive/locate.py``).
+
+The ground node itself, built from the declared topology as a run builds it
+(``interfaces.contracts.topology``: planner, telemetry monitor, FDIR, baselines -- the code the
+live ground runs, not a copy) is fed, on the in-process bus, every archived message of the other
+nodes that the ground subscribes to, in the lockstep's order: all messages of sim time t, then the
+sim's Tick at t.  Its own channel model (the scenario's comms, seed, cuts and link faults) decides
+again, in the same deterministic order, which of them reached it, so losses and range cuts replay
+as they happened.  What it publishes -- FDI windows, fault reports, baseline verdicts -- is scored
+as ``summary.json`` scores the live run (``harness.summary.build.fdir_results``);
 ``scores_faithful`` scores only what it declared and judged up to ``faithful_until_s``.
 
 Faithfulness.  With the run's own settings the replay reproduces the live detections, their
@@ -36,7 +38,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ground.archive.segments import run_archive
+from harness.archive.locate import ArchivePathError, archive_file
 from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
 from harness.archive.run_scenario import scenario_from_metadata
 from harness.summary import ReplayResults
@@ -195,11 +197,12 @@ def scenario_with(scenario: Scenario, settings: dict[str, str]) -> Scenario:
 
 def replay_run(path: Path, settings: dict[str, str] | None = None,
                scenario: Scenario | None = None) -> Replay:
-    """Replay the ground of the run archived at ``path`` (module docstring).  ``scenario``:
-    the run's scenario when its archive carries none; ``settings``: detector settings changed
-    from the run's."""
+    """Replay the ground of the run archived at ``path`` (its archive or its folder; module
+    docstring).  ``scenario``: the run's scenario when its archive carries none; ``settings``:
+    detector settings changed from the run's.  Raises ArchiveError (ArchivePathError for a path
+    naming no archive), ScenarioError."""
     start = time.perf_counter()
-    archive = load_run(path, stream={t.any_mission(): _drop for t in UNREAD})
+    archive = load_run(archive_file(path), stream={t.any_mission(): _drop for t in UNREAD})
     replay_scenario = with_settings(scenario or scenario_of(archive), settings or {})
     mission = archive.mission()
     replayed = _run_ground(archive, mission, replay_scenario)
@@ -250,10 +253,6 @@ def _send_group(group: list[Record], player: Any) -> None:
 # --- command line -------------------------------------------------------------------------------
 
 
-def _archive_path(run: Path) -> Path:
-    return run_archive(run) if run.is_dir() else run
-
-
 def parse_settings(pairs: list[str]) -> dict[str, str]:
     """``SECTION.KEY=VALUE`` strings as a settings dict (ScenarioError if malformed)."""
     out = {}
@@ -279,22 +278,29 @@ def main(argv: list[str] | None = None) -> int:
         settings = parse_settings(args.settings)
     except ScenarioError as e:
         p.error(str(e))
+    try:
+        files = [archive_file(run) for run in args.runs]
+    except ArchivePathError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     failed = 0
-    for run in args.runs:
+    for run, file in zip(args.runs, files, strict=True):
         try:
-            replay = replay_run(_archive_path(run), settings)
+            replay = replay_run(file, settings)
         except (ArchiveError, ScenarioError, OSError) as e:
             print(f"{run}: {e}", file=sys.stderr)
             failed += 1
             continue
-        _write(replay, run, args.out)
+        _write(replay, run, file, args.out)
     return 1 if failed else 0
 
 
-def _write(replay: Replay, run: Path, out: Path | None) -> None:
+def _write(replay: Replay, run: Path, file: Path, out: Path | None) -> None:
+    """Write the replay's results beside ``file`` (the archive of ``run``, as given) or into
+    ``out``, and say what it found in one line."""
     res = replay.results()
     name = (run if run.is_dir() else run.parent).name or "run"
-    dest = (out / f"{name}.replay.json") if out else _archive_path(run).parent / "replay.json"
+    dest = (out / f"{name}.replay.json") if out else file.parent / "replay.json"
     dest.parent.mkdir(parents=True, exist_ok=True)
     dest.write_text(res.to_json(indent=1))
     dets = ", ".join(f"sc{d.spacecraft} {d.fault_class or 'unidentified'} at {d.time_s:.0f} s"
