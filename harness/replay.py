@@ -24,6 +24,18 @@ replan after a declaration made at another time, or not made -- the replay judge
 trajectory that its own uplinks did not command.  ``faithful_until_s`` is the sim time of the
 first such difference (the run's end when there is none); what the replay reports after it is
 kept, and marked, and left out of ``scores_faithful``.
+
+An archive that lost data.  A replay judges what the archive holds, and no further: its end,
+``archive_end_s``, is the sim time of its last message (``RunArchive.end_s``).  When that is
+before the run's end (its last tick, at ``duration_s``: a file cut short -- no footer, read up
+to the cut -- or a whole file of a run that stopped early), the archive's last instant may
+itself be torn (part of its messages in the lost bytes), so only what the ground did before it
+counts: a window (and its baselines' verdicts) whose end plus ``fdir.latency_s`` is not before
+``archive_end_s``, a report declared then, an uplink sent then, is dropped from both the replay
+and the live run before they are compared and scored, and ``faithful_until_s`` is at most
+``archive_end_s``.  The command line then says "archive ends at X s (run lasted Y s): judged
+nothing past it".  The reader reports a file cut short too (a warning naming the byte it stops
+at and the sim time its data ends at).
 """
 
 from __future__ import annotations
@@ -41,6 +53,7 @@ from typing import Any
 from harness.archive.locate import ArchivePathError, archive_file
 from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
 from harness.archive.run_scenario import scenario_from_metadata
+from harness.archive.span import ArchiveSpan
 from harness.summary import ReplayResults
 from harness.summary.fdir import fdir_results
 from interfaces.contracts import catalogue as cat
@@ -97,17 +110,39 @@ class GroundOutput:
                    archive.of(cat.BASELINE, mission), archive.of(cat.ASSIGNMENTS, mission),
                    archive.of(cat.CONSTELLATION_WINDOW, mission))
 
+    def within(self, span: ArchiveSpan, latency_s: float) -> GroundOutput:
+        """What the ground did while ``span`` holds its inputs: windows (and the verdicts and
+        constellation windows on them) due, their end plus ``latency_s`` (s), reports declared
+        (their window's end plus ``latency_s`` when not stamped) and uplinks sent by then."""
+        def due(t_end_s: float) -> bool:
+            return span.holds(t_end_s + latency_s)
+
+        return GroundOutput(
+            [w for w in self.windows if due(w.t_end_s)],
+            [r for r in self.reports
+             if span.holds(r.declared_s if r.declared_s is not None else r.t_sim + latency_s)],
+            [v for v in self.verdicts if due(v.t_end_s)],
+            [a for a in self.assignments if span.holds(a.t_sim)],
+            [c for c in self.constellation if due(c.t_end_s)])
+
 
 @dataclass
 class Replay:
-    """One replayed run: the scenario it ran with, the replay's and the live ground's output."""
+    """One replayed run: the scenario it ran with, the replay's and the live ground's output
+    (both only as far as the archive holds the ground's inputs: ``span``)."""
 
     scenario: Scenario
     live: GroundOutput
     replayed: GroundOutput
     wall_s: float
+    span: ArchiveSpan
 
     def faithful_until_s(self) -> float:
+        """Sim time of the first uplink that differs from the live run's (s); the run's end
+        when none does; never past the archive's end."""
+        return min(self._diverged_s(), self.span.end_s)
+
+    def _diverged_s(self) -> float:
         """Sim time of the first uplink that differs from the live run's (s); the run's end
         when none does."""
         live = [_plan(m) for m in self.live.assignments]
@@ -140,7 +175,8 @@ class Replay:
                                 self.scenario)
         census = {"fdir_thresholds": faithful.fdir_thresholds}  # the census: faithful span
         return ReplayResults(scenario=self.scenario.name, seed=self.scenario.seed,
-                             replay_wall_s=round(self.wall_s, 3), faithful_until_s=horizon,
+                             replay_wall_s=round(self.wall_s, 3),
+                             archive_end_s=self.span.end_s, faithful_until_s=horizon,
                              matches_live=self.matches_live(), **(dict(out) | census),
                              scores_faithful=faithful.scores)
 
@@ -198,16 +234,19 @@ def scenario_with(scenario: Scenario, settings: dict[str, str]) -> Scenario:
 def replay_run(path: Path, settings: dict[str, str] | None = None,
                scenario: Scenario | None = None) -> Replay:
     """Replay the ground of the run archived at ``path`` (its archive or its folder; module
-    docstring).  ``scenario``: the run's scenario when its archive carries none; ``settings``:
-    detector settings changed from the run's.  Raises ArchiveError (ArchivePathError for a path
-    naming no archive), ScenarioError."""
+    docstring), judging nothing past the archive's end.  ``scenario``: the run's scenario when
+    its archive carries none; ``settings``: detector settings changed from the run's.
+    Raises ArchiveError (ArchivePathError for a path naming no archive), ScenarioError."""
     start = time.perf_counter()
     archive = load_run(archive_file(path), stream={t.any_mission(): _drop for t in UNREAD})
-    replay_scenario = with_settings(scenario or scenario_of(archive), settings or {})
+    flown = scenario or scenario_of(archive)
+    replay_scenario = with_settings(flown, settings or {})
     mission = archive.mission()
-    replayed = _run_ground(archive, mission, replay_scenario)
-    return Replay(replay_scenario, GroundOutput.of_archive(archive, mission), replayed,
-                  time.perf_counter() - start)
+    span = ArchiveSpan.of(archive, flown)
+    replayed = _run_ground(archive, mission, replay_scenario).within(
+        span, replay_scenario.fdir.latency_s)
+    live = GroundOutput.of_archive(archive, mission).within(span, flown.fdir.latency_s)
+    return Replay(replay_scenario, live, replayed, time.perf_counter() - start, span)
 
 
 def _run_ground(archive: RunArchive, mission: str, scenario: Scenario) -> GroundOutput:
@@ -306,7 +345,8 @@ def _write(replay: Replay, run: Path, file: Path, out: Path | None) -> None:
     dets = ", ".join(f"sc{d.spacecraft} {d.fault_class or 'unidentified'} at {d.time_s:.0f} s"
                      + ("" if d.faithful else " (after divergence)")
                      for d in res.detections) or "no detection"
-    print(f"{run}: {dets}; "
+    note = replay.span.note()
+    print(f"{run}: {note + '; ' if note else ''}{dets}; "
           f"{'matches the live run' if res.matches_live else 'differs from the live run'}"
           f"; faithful until {res.faithful_until_s:.0f} s; "
           f"{res.replay_wall_s:.1f} s -> {dest}")
