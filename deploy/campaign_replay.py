@@ -3,7 +3,7 @@
 Every run of ``<out>/runs/`` is replayed (``harness.replay``: the ground station itself
 on the run's archive) with the settings given; its ``summary.json`` is rewritten with the
 replay's FDIR fields (detections, scores, baselines, series, settings) and a ``replay`` section
-(settings, ``faithful_until_s``, ``matches_live``, replay wall time) into
+(settings, ``archive_end_s``, ``faithful_until_s``, ``matches_live``, replay wall time) into
 ``<dest>/runs/<id>/``, and the campaign report is written over them in ``<dest>``.  A sweep
 does the same for every value of one setting and adds one table: detection, isolation,
 identification, latency median/p90 and false alarms with their counts, per value.
@@ -49,13 +49,14 @@ def replay_job(run_dir: str, settings: dict[str, str], dest_root: str) -> dict[s
         shutil.copyfile(src / "campaign.json", dest / "campaign.json")
     if summary.status == "completed":
         try:
-            replay = replay_run(src / "run.mcap", settings)
+            replay = replay_run(src, settings)
         except (ArchiveError, OSError) as e:
             summary.status, summary.error = "failed", f"replay: {e}"
         else:
             res = replay.results()
             summary.set_fdir(res)
             summary.replay = ReplaySection(settings=settings, wall_s=res.replay_wall_s,
+                                           archive_end_s=res.archive_end_s,
                                            faithful_until_s=res.faithful_until_s,
                                            matches_live=res.matches_live,
                                            scores_faithful=res.scores_faithful)

@@ -4,15 +4,17 @@ other detector settings.
     python -m harness.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR]
 
 RUN is a run directory (holding ``run.mcap``) or an archive (its first segment: the segments
-after it, a restarted recorder's, are read with it as one run).  The ground node itself, built
-from the declared topology as a run builds it (``interfaces.contracts.topology``: planner,
-telemetry monitor, FDIR, baselines -- the code the live ground runs, not a copy) is fed, on
-the in-process bus, every archived message of the other nodes that the ground subscribes to,
-in the lockstep's order: all messages of sim time t, then the sim's Tick at t.  Its own
-channel model (the scenario's comms, seed, cuts and link faults) decides again, in the same
-deterministic order, which of them reached it, so losses and range cuts replay as they
-happened.  What it publishes -- FDI windows, fault reports, baseline verdicts --
-is scored as ``summary.json`` scores the live run (``harness.summary.build.fdir_results``);
+after it, a restarted recorder's, are read with it as one run); any other path is refused, one
+line each, exit status 2, before anything is replayed (``harness/archive/locate.py``).
+
+The ground node itself, built from the declared topology as a run builds it
+(``interfaces.contracts.topology``: planner, telemetry monitor, FDIR, baselines -- the code the
+live ground runs, not a copy) is fed, on the in-process bus, every archived message of the other
+nodes that the ground subscribes to, in the lockstep's order: all messages of sim time t, then the
+sim's Tick at t.  Its own channel model (the scenario's comms, seed, cuts and link faults) decides
+again, in the same deterministic order, which of them reached it, so losses and range cuts replay
+as they happened.  What it publishes -- FDI windows, fault reports, baseline verdicts -- is scored
+as ``summary.json`` scores the live run (``harness.summary.build.fdir_results``);
 ``scores_faithful`` scores only what it declared and judged up to ``faithful_until_s``.
 
 Faithfulness.  With the run's own settings the replay reproduces the live detections, their
@@ -22,6 +24,18 @@ replan after a declaration made at another time, or not made -- the replay judge
 trajectory that its own uplinks did not command.  ``faithful_until_s`` is the sim time of the
 first such difference (the run's end when there is none); what the replay reports after it is
 kept, and marked, and left out of ``scores_faithful``.
+
+An archive that lost data.  A replay judges what the archive holds, and no further: its end,
+``archive_end_s``, is the sim time of its last message (``RunArchive.end_s``).  When that is
+before the run's end (its last tick, at ``duration_s``: a file cut short -- no footer, read up
+to the cut -- or a whole file of a run that stopped early), the archive's last instant may
+itself be torn (part of its messages in the lost bytes), so only what the ground did before it
+counts: a window (and its baselines' verdicts) whose end plus ``fdir.latency_s`` is not before
+``archive_end_s``, a report declared then, an uplink sent then, is dropped from both the replay
+and the live run before they are compared and scored, and ``faithful_until_s`` is at most
+``archive_end_s``.  The command line then says "archive ends at X s (run lasted Y s): judged
+nothing past it".  The reader reports a file cut short too (a warning naming the byte it stops
+at and the sim time its data ends at).
 """
 
 from __future__ import annotations
@@ -36,9 +50,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ground.archive.segments import run_archive
+from harness.archive.locate import ArchivePathError, archive_file
 from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
 from harness.archive.run_scenario import scenario_from_metadata
+from harness.archive.span import ArchiveSpan
 from harness.summary import ReplayResults
 from harness.summary.fdir import fdir_results
 from interfaces.contracts import catalogue as cat
@@ -95,17 +110,39 @@ class GroundOutput:
                    archive.of(cat.BASELINE, mission), archive.of(cat.ASSIGNMENTS, mission),
                    archive.of(cat.CONSTELLATION_WINDOW, mission))
 
+    def within(self, span: ArchiveSpan, latency_s: float) -> GroundOutput:
+        """What the ground did while ``span`` holds its inputs: windows (and the verdicts and
+        constellation windows on them) due, their end plus ``latency_s`` (s), reports declared
+        (their window's end plus ``latency_s`` when not stamped) and uplinks sent by then."""
+        def due(t_end_s: float) -> bool:
+            return span.holds(t_end_s + latency_s)
+
+        return GroundOutput(
+            [w for w in self.windows if due(w.t_end_s)],
+            [r for r in self.reports
+             if span.holds(r.declared_s if r.declared_s is not None else r.t_sim + latency_s)],
+            [v for v in self.verdicts if due(v.t_end_s)],
+            [a for a in self.assignments if span.holds(a.t_sim)],
+            [c for c in self.constellation if due(c.t_end_s)])
+
 
 @dataclass
 class Replay:
-    """One replayed run: the scenario it ran with, the replay's and the live ground's output."""
+    """One replayed run: the scenario it ran with, the replay's and the live ground's output
+    (both only as far as the archive holds the ground's inputs: ``span``)."""
 
     scenario: Scenario
     live: GroundOutput
     replayed: GroundOutput
     wall_s: float
+    span: ArchiveSpan
 
     def faithful_until_s(self) -> float:
+        """Sim time of the first uplink that differs from the live run's (s); the run's end
+        when none does; never past the archive's end."""
+        return min(self._diverged_s(), self.span.end_s)
+
+    def _diverged_s(self) -> float:
         """Sim time of the first uplink that differs from the live run's (s); the run's end
         when none does."""
         live = [_plan(m) for m in self.live.assignments]
@@ -138,7 +175,8 @@ class Replay:
                                 self.scenario)
         census = {"fdir_thresholds": faithful.fdir_thresholds}  # the census: faithful span
         return ReplayResults(scenario=self.scenario.name, seed=self.scenario.seed,
-                             replay_wall_s=round(self.wall_s, 3), faithful_until_s=horizon,
+                             replay_wall_s=round(self.wall_s, 3),
+                             archive_end_s=self.span.end_s, faithful_until_s=horizon,
                              matches_live=self.matches_live(), **(dict(out) | census),
                              scores_faithful=faithful.scores)
 
@@ -195,16 +233,20 @@ def scenario_with(scenario: Scenario, settings: dict[str, str]) -> Scenario:
 
 def replay_run(path: Path, settings: dict[str, str] | None = None,
                scenario: Scenario | None = None) -> Replay:
-    """Replay the ground of the run archived at ``path`` (module docstring).  ``scenario``:
-    the run's scenario when its archive carries none; ``settings``: detector settings changed
-    from the run's."""
+    """Replay the ground of the run archived at ``path`` (its archive or its folder; module
+    docstring), judging nothing past the archive's end.  ``scenario``: the run's scenario when
+    its archive carries none; ``settings``: detector settings changed from the run's.
+    Raises ArchiveError (ArchivePathError for a path naming no archive), ScenarioError."""
     start = time.perf_counter()
-    archive = load_run(path, stream={t.any_mission(): _drop for t in UNREAD})
-    replay_scenario = with_settings(scenario or scenario_of(archive), settings or {})
+    archive = load_run(archive_file(path), stream={t.any_mission(): _drop for t in UNREAD})
+    flown = scenario or scenario_of(archive)
+    replay_scenario = with_settings(flown, settings or {})
     mission = archive.mission()
-    replayed = _run_ground(archive, mission, replay_scenario)
-    return Replay(replay_scenario, GroundOutput.of_archive(archive, mission), replayed,
-                  time.perf_counter() - start)
+    span = ArchiveSpan.of(archive, flown)
+    replayed = _run_ground(archive, mission, replay_scenario).within(
+        span, replay_scenario.fdir.latency_s)
+    live = GroundOutput.of_archive(archive, mission).within(span, flown.fdir.latency_s)
+    return Replay(replay_scenario, live, replayed, time.perf_counter() - start, span)
 
 
 def _run_ground(archive: RunArchive, mission: str, scenario: Scenario) -> GroundOutput:
@@ -250,10 +292,6 @@ def _send_group(group: list[Record], player: Any) -> None:
 # --- command line -------------------------------------------------------------------------------
 
 
-def _archive_path(run: Path) -> Path:
-    return run_archive(run) if run.is_dir() else run
-
-
 def parse_settings(pairs: list[str]) -> dict[str, str]:
     """``SECTION.KEY=VALUE`` strings as a settings dict (ScenarioError if malformed)."""
     out = {}
@@ -279,28 +317,36 @@ def main(argv: list[str] | None = None) -> int:
         settings = parse_settings(args.settings)
     except ScenarioError as e:
         p.error(str(e))
+    try:
+        files = [archive_file(run) for run in args.runs]
+    except ArchivePathError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     failed = 0
-    for run in args.runs:
+    for run, file in zip(args.runs, files, strict=True):
         try:
-            replay = replay_run(_archive_path(run), settings)
+            replay = replay_run(file, settings)
         except (ArchiveError, ScenarioError, OSError) as e:
             print(f"{run}: {e}", file=sys.stderr)
             failed += 1
             continue
-        _write(replay, run, args.out)
+        _write(replay, run, file, args.out)
     return 1 if failed else 0
 
 
-def _write(replay: Replay, run: Path, out: Path | None) -> None:
+def _write(replay: Replay, run: Path, file: Path, out: Path | None) -> None:
+    """Write the replay's results beside ``file`` (the archive of ``run``, as given) or into
+    ``out``, and say what it found in one line."""
     res = replay.results()
     name = (run if run.is_dir() else run.parent).name or "run"
-    dest = (out / f"{name}.replay.json") if out else _archive_path(run).parent / "replay.json"
+    dest = (out / f"{name}.replay.json") if out else file.parent / "replay.json"
     dest.parent.mkdir(parents=True, exist_ok=True)
     dest.write_text(res.to_json(indent=1))
     dets = ", ".join(f"sc{d.spacecraft} {d.fault_class or 'unidentified'} at {d.time_s:.0f} s"
                      + ("" if d.faithful else " (after divergence)")
                      for d in res.detections) or "no detection"
-    print(f"{run}: {dets}; "
+    note = replay.span.note()
+    print(f"{run}: {note + '; ' if note else ''}{dets}; "
           f"{'matches the live run' if res.matches_live else 'differs from the live run'}"
           f"; faithful until {res.faithful_until_s:.0f} s; "
           f"{res.replay_wall_s:.1f} s -> {dest}")

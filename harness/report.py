@@ -12,6 +12,7 @@ import numpy as np  # noqa: E402
 
 from ground.archive.segments import run_archive  # noqa: E402
 from harness.archive.reader import ArchiveError, RunArchive  # noqa: E402
+from harness.archive.span import seconds  # noqa: E402
 from harness.summary import RunSummary, Scores  # noqa: E402
 from harness.summary.control import GncSeries  # noqa: E402
 from harness.summary.coverage import Coverage  # noqa: E402
@@ -39,6 +40,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
              ""]
     if summary.error:
         lines += ["```", summary.error, "```", ""]
+    lines += archive_end(summary)
     try:
         digest = digest or digest_run(run_archive(out), scenario, mission)
     except (ArchiveError, OSError) as e:
@@ -466,6 +468,17 @@ def archive_section(summary: RunSummary) -> list[str]:
         rows += ["| topic | lost |", "|---|---|",
                  *(f"| {t} | {n} |" for t, n in info.lost.by_topic.items()), ""]
     return rows
+
+
+def archive_end(summary: RunSummary) -> list[str]:
+    """Where an archive that ends before its run does, and why; nothing for a whole one."""
+    info, duration_s = summary.archive, summary.duration_s
+    if info is None or info.end_s is None:
+        return []
+    run = f" of the run's {seconds(duration_s)} s" if duration_s is not None else ""
+    cut = f" ({info.cut})" if info.cut else ""
+    return [f"The archive ends at {seconds(info.end_s)} s{run}{cut}: this report covers what "
+            "it holds, nothing after.", ""]
 
 
 def _exec_section(summary: RunSummary) -> list[str]:

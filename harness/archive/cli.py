@@ -1,8 +1,12 @@
 """Archive tools: list, summarize and export any run archive (run.mcap).
 
-    python -m harness.archive list RUN.mcap [RUN2.mcap ...]
-    python -m harness.archive summary RUN.mcap
-    python -m harness.archive export RUN.mcap --topic KEY_EXPR [--out FILE.csv|FILE.parquet]
+    python -m harness.archive list RUN [RUN2 ...]
+    python -m harness.archive summary RUN
+    python -m harness.archive export RUN --topic KEY_EXPR [--out FILE.csv|FILE.parquet]
+
+RUN is a run folder (holding ``run.mcap``) or an archive file; anything else (a missing path, a
+folder without ``run.mcap``, a file that is not MCAP) is refused with one line saying so, exit
+status 2 (``harness/archive/locate.py``).
 
 ``list`` prints each key with its message type, count and sim-time span; ``summary`` the
 metadata the recorder wrote (scenario, seed, transport, software version), the message counts
@@ -12,7 +16,8 @@ fields flattened (``r_m.0``, ``P.2.3``), to ``--out`` or stdout; an ``--out`` en
 ``.parquet`` (or ``.pq``) gets instead the topic's DataFrame (harness/archive/frame.py: indexed
 by sim time ``t_sim_s``, lists of varying length kept whole) as Parquet, which
 ``pandas.read_parquet`` reads back as it was.  A damaged archive is read up to its last
-complete chunk (harness/archive/reader.py) and said so.  ``RUN.mcap`` is a run's first segment:
+complete chunk (harness/archive/reader.py) and said so: where the file was cut and the sim time
+its data ends at.  ``RUN.mcap`` is a run's first segment:
 the segments after it (``run-1.mcap``, ...: a restarted recorder's) are read with it as one
 run, and ``list`` and ``summary`` name them and the messages lost, by topic.
 """
@@ -28,8 +33,10 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from harness.archive.frame import topic_frame
+from harness.archive.locate import ArchivePathError, archive_file
 from harness.archive.reader import ArchiveError, RunArchive, load_run
 from harness.archive.sequences import by_topic
+from harness.archive.span import cut_of, seconds
 
 PARQUET_SUFFIXES = (".parquet", ".pq")
 """``export --out`` file suffixes that choose Parquet over CSV."""
@@ -63,9 +70,15 @@ def _continuity(archive: RunArchive, out: TextIO) -> None:
               + "".join(f", {t} {n}" for t, n in lost.items()) + "\n")
 
 
+def extent(archive: RunArchive) -> str:
+    """Where the archive's data ends (s), and for a file cut short where it was cut."""
+    ends = "no message" if archive.end_s is None else f"ends at {seconds(archive.end_s)} s"
+    cut = cut_of(archive)
+    return ends if cut is None else f"{ends}, TRUNCATED ({cut})"
+
+
 def list_topics(archive: RunArchive, out: TextIO) -> None:
-    out.write(f"{archive.path}: {len(archive)} messages"
-              + (f", TRUNCATED ({archive.stop_reason})" if archive.truncated else "") + "\n")
+    out.write(f"{archive.path}: {len(archive)} messages, {extent(archive)}\n")
     _continuity(archive, out)
     for key, (type_name, count) in archive.topics().items():
         t0, t1 = _span(archive, key)
@@ -74,7 +87,7 @@ def list_topics(archive: RunArchive, out: TextIO) -> None:
 
 def summarize(archive: RunArchive, out: TextIO) -> None:
     out.write(f"{archive.path}: {len(archive)} messages, "
-              + ("truncated: " + str(archive.stop_reason) if archive.truncated else "complete")
+              + (extent(archive) if archive.truncated else f"complete, {extent(archive)}")
               + "\n")
     _continuity(archive, out)
     run = archive.metadata.get("run", {})
@@ -130,22 +143,30 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m harness.archive", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    sub.add_parser("list", help="keys, types, counts").add_argument("runs", nargs="+", type=Path)
-    sub.add_parser("summary", help="metadata, counts, faults").add_argument("run", type=Path)
+    run_help = "a run folder (holding run.mcap) or an archive file"
+    sub.add_parser("list", help="keys, types, counts").add_argument("runs", nargs="+", type=Path,
+                                                                    help=run_help)
+    sub.add_parser("summary", help="metadata, counts, faults").add_argument("run", type=Path,
+                                                                           help=run_help)
     e = sub.add_parser("export", help="CSV or Parquet of a key expression")
-    e.add_argument("run", type=Path)
+    e.add_argument("run", type=Path, help=run_help)
     e.add_argument("--topic", required=True, help="key expression, e.g. 'insp/*/sc/1/nav/**'")
     e.add_argument("--out", type=Path,
                    help="CSV file (default: stdout), or Parquet if it ends in .parquet or .pq")
     args = p.parse_args(argv)
     try:
+        runs = [archive_file(r) for r in (args.runs if args.command == "list" else [args.run])]
+    except ArchivePathError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    try:
         if args.command == "list":
-            for run in args.runs:
+            for run in runs:
                 list_topics(load_run(run), sys.stdout)
         elif args.command == "summary":
-            summarize(load_run(args.run), sys.stdout)
+            summarize(load_run(runs[0]), sys.stdout)
         else:
-            n = export(args.run, args.topic, args.out)
+            n = export(runs[0], args.topic, args.out)
             print(f"{n} messages exported", file=sys.stderr)
             if n == 0:
                 print(f"warning: no message matches {args.topic!r}; `list` shows the keys",

@@ -7,7 +7,9 @@ file whose writer was killed:
 * a finished file is read up to its footer and closing magic: ``truncated=False``;
 * an unfinished file (no summary, no footer; the recorder was SIGKILLed) is read record by record
   until the first record that is incomplete or damaged; everything before it is kept and
-  ``truncated=True`` (``stop_reason`` says why reading stopped).  Because the recorder writes
+  ``truncated=True`` (``stop_reason`` says why reading stopped, and at which byte: the end of
+  the last record read whole, :attr:`SegmentInfo.cut_at_byte`; a warning is logged naming it
+  and the sim time the archive then ends at).  Because the recorder writes
   messages only inside chunks and a chunk is decoded (decompressed and CRC-checked) as a whole
   before any of its messages is taken, the recovered messages are exactly those of the complete
   chunks (a chunk cut short fails its length, zstd frame or CRC check and is dropped whole).
@@ -18,9 +20,10 @@ file whose writer was killed:
 * a file that does not start with the MCAP magic raises :class:`ArchiveError`.
 
 The archive is held in memory: :class:`Record` s ordered by log time (mission elapsed time, ns),
-ties in file order.  Keys given to ``load_run(stream=...)`` are not held: their records go, in
-file order, to a sink as they are read (a two-orbit run's camera images alone are 1.7 GB of
-JSON); they are counted all the same.  Records are filtered by key expression with
+ties in file order; :attr:`RunArchive.end_s` is the sim time of its last message (streamed ones
+included), where a cut archive's data ends.  Keys given to ``load_run(stream=...)`` are not held:
+their records go, in file order, to a sink as they are read (a two-orbit run's camera images alone
+are 1.7 GB of JSON); they are counted all the same.  Records are filtered by key expression with
 :func:`interfaces.contracts.topics.matches` (``*`` one chunk, ``**`` any number) and decoded
 through the message registry on demand.
 
@@ -37,6 +40,7 @@ numbers (:mod:`harness.archive.sequences`).
 from __future__ import annotations
 
 import io
+import logging
 import os
 import struct
 from collections.abc import Callable, Mapping
@@ -68,6 +72,8 @@ from interfaces.contracts.messages import Message, registry
 from interfaces.contracts.topics import matches
 
 MCAP_MAGIC: Final = b"\x89MCAP0\r\n"
+
+log = logging.getLogger("insp.archive")
 
 M = TypeVar("M", bound=Message)
 
@@ -122,6 +128,11 @@ class SegmentInfo:
     """It ends before its footer, or in a damaged record (what precedes is kept)."""
     stop_reason: str | None
     """Why reading it stopped early (None: read to its footer)."""
+    cut_at_byte: int | None = None
+    """Where reading stopped: the offset (bytes) just past its last record read whole, what is
+    kept (None: read to its footer, or not read at all)."""
+    size_bytes: int | None = None
+    """Its size when read (bytes; None: not read)."""
 
 
 def _decode(record: Record, model: type[M]) -> M:
@@ -156,7 +167,8 @@ class RunArchive:
     :class:`SegmentInfo`), ``truncated`` (some segment is), ``stop_reason`` (the first
     truncated segment's, named when there are several; None when none is), ``lost`` (messages
     lost per key, from the sequence numbers: ``harness/archive/sequences.py``), ``duplicates``
-    (messages a later segment repeated, kept once), ``library`` and ``profile`` of the header.
+    (messages a later segment repeated, kept once), ``library`` and ``profile`` of the header,
+    ``end_s`` (the sim time of its last message, s).
     """
 
     def __init__(
@@ -172,9 +184,12 @@ class RunArchive:
         streamed: dict[str, int] | None = None,
         lost: dict[str, int] | None = None,
         duplicates: int = 0,
+        end_ns: int | None = None,
     ) -> None:
         """Build from parsed content; ``records`` must already be in log-time order;
-        ``streamed``: records per key handed to a sink at load and not held."""
+        ``streamed``: records per key handed to a sink at load and not held; ``end_ns``: the
+        latest log time of every record read, streamed ones too (ns; default: the last held
+        record's)."""
         self.path = path
         self.metadata = metadata
         self.schemas = schemas
@@ -190,6 +205,14 @@ class RunArchive:
         self._match_cache: dict[str, frozenset[str]] = {}
         self._decoded: dict[tuple[str, type[Message]], list[Message]] = {}
         self._streamed = dict(streamed or {})
+        self._end_ns = end_ns if end_ns is not None else (
+            records[-1].log_time_ns if records else None)
+
+    @property
+    def end_s(self) -> float | None:
+        """Sim time of the archive's last message (s): where its data ends, the run's end for a
+        whole archive.  None when it holds no message."""
+        return None if self._end_ns is None else self._end_ns / 1e9
 
     def __len__(self) -> int:
         return len(self._records) + sum(self._streamed.values())
@@ -322,12 +345,15 @@ class _ExactReader:
 
     def __init__(self, file: IO[bytes]) -> None:
         self._file = file
+        self.offset = 0
+        """Bytes read so far: the offset of the next byte."""
 
     def read(self, n: int = -1) -> bytes:
         """Read exactly ``n`` bytes (``n < 0``: the rest of the file)."""
         data = self._file.read(n)
         if n >= 0 and len(data) != n:
             raise EndOfFile()
+        self.offset += len(data)
         return data
 
 
@@ -397,6 +423,8 @@ class RecordLoader:
         self.footer_seen = False
         self.segment = -1
         """Index of the segment being read (-1 before the first)."""
+        self.end_ns: int | None = None
+        """The latest log time taken so far (ns; None before the first message)."""
 
     def begin_segment(self, more_follow: bool) -> None:
         """Start reading the next file of the run (its channel and schema ids are its own);
@@ -422,6 +450,8 @@ class RecordLoader:
         a record of an earlier segment (its key, ``sequence`` and log time) is dropped."""
         if not self.sequences.admit(record.key, sequence, record.log_time_ns):
             return
+        if self.end_ns is None or record.log_time_ns > self.end_ns:
+            self.end_ns = record.log_time_ns
         if sink is None:
             self.records.append(record)
         else:
@@ -446,7 +476,7 @@ class RecordLoader:
             metadata=self.metadata, schemas={**self.schemas, **self._schema_infos()},
             segments=segments, library=header.library if header is not None else "",
             profile=header.profile if header is not None else "", streamed=self.streamed,
-            lost=self.sequences.lost, duplicates=self.sequences.duplicates)
+            lost=self.sequences.lost, duplicates=self.sequences.duplicates, end_ns=self.end_ns)
 
     def item(self, rec: object) -> str | None:
         """Take one record or chunk item; a stop reason if reading must stop."""
@@ -486,29 +516,34 @@ class RecordLoader:
             self.metadata.setdefault(rec.name, dict(rec.metadata))
 
 
-def _read_records(reader: StreamReader, loader: RecordLoader) -> str | None:
+def _read_records(reader: StreamReader, loader: RecordLoader, source: _ExactReader
+                  ) -> tuple[str | None, int]:
     """Feed every record of the file to ``loader``; the reason reading stopped early, if it
-    did (a chunk is taken whole or not at all)."""
+    did (a chunk is taken whole or not at all), and the offset just past the last record
+    taken whole (bytes)."""
     stream = iter(reader.records)
+    kept = 0
     while True:
         try:
             rec = next(stream)
             items = _chunk_items(rec) if isinstance(rec, Chunk) else [rec]
         except StopIteration:
-            return None
+            return None, kept
         except (EndOfFile, RecordLengthLimitExceeded):  # the limit is the file size
-            return "file ends before its footer (writer killed or still running)"
+            return "file ends before its footer (writer killed or still running)", kept
         except _READ_ERRORS as exc:
-            return f"damaged record: {type(exc).__name__}: {exc}"
+            return f"damaged record: {type(exc).__name__}: {exc}", kept
         for item in items:
             stop = loader.item(item)
             if stop is not None:
-                return stop
+                return stop, kept
+        kept = source.offset
 
 
 def _read_segment(path: Path, loader: RecordLoader) -> SegmentInfo:
-    """Read one file of a run into ``loader``.  Raises :class:`ArchiveError` if it is not
-    MCAP, ``OSError`` if it cannot be read."""
+    """Read one file of a run into ``loader``; a file cut short is read up to its cut, which a
+    warning names.  Raises :class:`ArchiveError` if it is not MCAP, ``OSError`` if it cannot be
+    read."""
     with open(path, "rb") as file:
         head = file.read(len(MCAP_MAGIC))
         if head != MCAP_MAGIC:
@@ -517,17 +552,29 @@ def _read_segment(path: Path, loader: RecordLoader) -> SegmentInfo:
             )
         file.seek(0)
         size = os.fstat(file.fileno()).st_size
+        source = _ExactReader(file)
         reader = StreamReader(
-            _ExactReader(file),  # type: ignore[arg-type]  # duck-typed binary stream
+            source,  # type: ignore[arg-type]  # duck-typed binary stream
             skip_magic=False,
             emit_chunks=True,
             validate_crcs=True,
             record_size_limit=max(size, 1),
         )
-        stop_reason = _read_records(reader, loader)
+        stop_reason, kept = _read_records(reader, loader, source)
     if stop_reason is None and not loader.footer_seen:  # pragma: no cover - StreamReader
         stop_reason = "no footer"  # stops at the footer
-    return SegmentInfo(path, stop_reason is not None, stop_reason)
+    if stop_reason is None:
+        return SegmentInfo(path, False, None, size_bytes=size)
+    _warn_cut(path, stop_reason, kept, size, loader.end_ns)
+    return SegmentInfo(path, True, stop_reason, cut_at_byte=kept, size_bytes=size)
+
+
+def _warn_cut(path: Path, reason: str, kept: int, size: int, end_ns: int | None) -> None:
+    """Log where a file cut short stops: the byte its records were read whole up to, of its
+    size, and the sim time its run's data then ends at."""
+    ends = "no message" if end_ns is None else f"its data ends at t = {end_ns / 1e9:.1f} s"
+    log.warning("%s: %s; read up to byte %d of %d, what precedes kept (%s)",
+                path, reason, kept, size, ends)
 
 
 def _read_later_segment(path: Path, loader: RecordLoader) -> SegmentInfo:

@@ -4,12 +4,12 @@ nominal runs for a chosen false-alarm rate").
     python -m harness.campaign.calibrate runs/nominal [runs/nominal-seed2 ...] [--rate 1e-3]
         [--persistence 2] [--skip-s 0]
 
-Reads every ``ground/fdir/window`` verdict of the given run directories (``run.mcap`` and the
-segments after it; windows overlapping a fault of their spacecraft, as listed in the run's
-``summary.json``, are left out), prints the distribution of the nominal metric H_m,i, the
-floor that gives the chosen false-alarm probability per FDI window under the persistence rule
-(:func:`threshold.calibrate_floor`), and how far the largest nominal metric is below each
-run's configured floor.
+Reads every ``ground/fdir/window`` verdict of the given runs (each a run folder holding
+``run.mcap``, or the archive itself; the segments after it too; windows overlapping a fault of
+their spacecraft, as listed in the ``summary.json`` beside the archive, are left out), prints the
+distribution of the nominal metric H_m,i, the floor that gives the chosen false-alarm probability
+per FDI window under the persistence rule (:func:`threshold.calibrate_floor`), and how far the
+largest nominal metric is below each run's configured floor.
 """
 
 from __future__ import annotations
@@ -20,21 +20,23 @@ from pathlib import Path
 
 import numpy as np
 
-from ground.archive.segments import run_archive
 from ground.fdir.threshold import calibrate_floor
+from harness.archive.locate import ArchivePathError, archive_file
 from harness.archive.reader import ArchiveError, load_run
 from harness.summary import RunSummary
 from interfaces.contracts.messages import FdirWindow
 from interfaces.contracts.scenario import Fault
 
 
-def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[FdirWindow]:
-    """The judged FDIR windows of a run that end after ``skip_s`` and overlap no fault of
-    their spacecraft (``summary.json`` ``injected_faults``, when the run has one)."""
-    archive = load_run(run_archive(run_dir))
+def nominal_metrics(run: Path, skip_s: float = 0.0) -> list[FdirWindow]:
+    """The judged FDIR windows of a run (its folder or its archive) that end after ``skip_s``
+    (s) and overlap no fault of their spacecraft (``summary.json`` ``injected_faults``, when
+    the run has one).  Raises ArchiveError (ArchivePathError for a path naming no archive)."""
+    file = archive_file(run)
+    archive = load_run(file)
     faults: list[Fault] = []
-    if (run_dir / "summary.json").exists():
-        faults = RunSummary.read(run_dir / "summary.json").injected_faults
+    if (file.parent / "summary.json").exists():
+        faults = RunSummary.read(file.parent / "summary.json").injected_faults
 
     def faulty(w: FdirWindow) -> bool:
         return any(f.spacecraft == w.spacecraft and f.start_s < w.t_end_s
@@ -49,12 +51,19 @@ def nominal_metrics(run_dir: Path, skip_s: float = 0.0) -> list[FdirWindow]:
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m harness.campaign.calibrate", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("runs", type=Path, nargs="+", help="run directories of nominal runs")
+    p.add_argument("runs", type=Path, nargs="+",
+                   help="nominal runs: run folders (holding run.mcap) or archive files")
     p.add_argument("--rate", type=float, default=1e-3,
                    help="false-alarm probability per FDI window (default 1e-3)")
     p.add_argument("--persistence", type=int, default=2, help="windows in a row (default 2)")
     p.add_argument("--skip-s", type=float, default=0.0, help="ignore windows ending before")
     args = p.parse_args(argv)
+    try:
+        for run in args.runs:
+            archive_file(run)
+    except ArchivePathError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     windows: list[FdirWindow] = []
     for run in args.runs:
         try:

@@ -73,7 +73,7 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str,
     links = _last_of(digest, LinkStats)
     tlm = archive.of(cat.TLM_STATUS, mission)
     summary = summary_head(scenario, outcome)
-    summary.archive = archive_info(archive)
+    summary.archive = archive_info(archive, scenario)
     summary.ticks = digest.counters.counts.get(tick_key, 0)
     t_final = last_tick.decode(Tick).t_sim if last_tick is not None else 0.0
     summary.t_sim_final_s = t_final
@@ -149,7 +149,7 @@ def write_summary(out: Path, scenario: Scenario, transport: Literal["inproc", "z
     except (ArchiveError, OSError) as e:
         summary = summary_head(scenario, outcome)
         if digest is not None:  # read, then found damaged
-            summary.archive = archive_info(digest.archive)
+            summary.archive = archive_info(digest.archive, scenario)
         summary.archive_error = str(e)
     if access is not None:
         summary.access = access

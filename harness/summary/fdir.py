@@ -163,20 +163,29 @@ class FdirResults(SummaryRecord):
     fdir_settings: RunFdirSettings
 
 
+ARCHIVE_END = ("sim time of the archive's last message, s: where the replay stopped judging "
+               "(the run's end for a whole archive; before it, for one cut short or of a run "
+               "stopped early, nothing due at or after it is judged or compared: "
+               "harness/replay.py)")
+"""What a replay's ``archive_end_s`` is."""
+
+
 class ReplayResults(FdirResults):
     """A replay's results (replay.json, ``harness.replay``): the FDIR sections as the
     replayed ground gives them (``detections`` marked ``faithful``; ``fdir_thresholds`` over
     the faithful span), and its faithfulness."""
 
-    HEAD: ClassVar[tuple[str, ...]] = ("scenario", "seed", "replay_wall_s", "faithful_until_s",
-                                       "matches_live")
+    HEAD: ClassVar[tuple[str, ...]] = ("scenario", "seed", "replay_wall_s", "archive_end_s",
+                                       "faithful_until_s", "matches_live")
     """The fields written before the FDIR sections."""
 
     scenario: str
     seed: int
     replay_wall_s: float = Field(description="the replay's wall time, s")
+    archive_end_s: float = Field(description=ARCHIVE_END)
     faithful_until_s: float = Field(
-        description="sim time of the first uplink differing from the live run's, s")
+        description="sim time of the first uplink differing from the live run's (at most "
+                    "archive_end_s), s")
     matches_live: bool = Field(description="every window, report and verdict as live")
     scores_faithful: Scores = Field(description="the main detector's up to faithful_until_s")
 
@@ -191,8 +200,11 @@ class ReplaySection(SummaryRecord):
 
     settings: dict[str, str] = Field(description="the settings changed (--set), as given")
     wall_s: float = Field(description="the replay's wall time, s")
+    archive_end_s: float | None = Field(
+        default=None, description=ARCHIVE_END + " (absent: a replay before it was recorded)")
     faithful_until_s: float = Field(
-        description="sim time of the first uplink differing from the live run's, s")
+        description="sim time of the first uplink differing from the live run's (at most "
+                    "archive_end_s), s")
     matches_live: bool
     scores_faithful: Scores = Field(description="the main detector's up to faithful_until_s")
 

@@ -360,6 +360,31 @@ def test_file_cut_anywhere_reads_back_a_prefix_without_raising(tmp_path: Path) -
     assert previous == 120  # the data section was complete before the summary was cut
 
 
+def test_a_cut_file_says_where_it_was_cut_and_where_its_data_ends(
+        tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """Cut at half its bytes (no footer, a chunk torn): read up to the last whole record, the
+    byte and the sim time of its last message given, and logged."""
+    path = tmp_path / "full.mcap"
+    key = _key("sim", "sensors", "sc1", "relnav")
+    with McapRecorder(path, chunk_size=1024) as rec:
+        for i in range(200):
+            rec.record(key, "RelNavMeasurement", _relnav_payload(i))
+    assert load_run(path).end_s == pytest.approx(19.9)
+    data = path.read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[:len(data) // 2])
+    with caplog.at_level("WARNING", logger="insp.archive"):
+        run = load_run(cut, stream={key: lambda _rec: None})  # streamed records count too
+    (segment,) = run.segments
+    assert segment.truncated and segment.size_bytes == len(data) // 2
+    assert segment.cut_at_byte is not None and 8 < segment.cut_at_byte < len(data) // 2
+    kept = load_run(cut).messages(key, RelNavMeasurement)
+    assert 0 < len(kept) < 200 and run.end_s == pytest.approx(kept[-1].t_sim)
+    assert f"read up to byte {segment.cut_at_byte} of {len(data) // 2}" in caplog.text
+    assert f"ends at t = {kept[-1].t_sim:.1f} s" in caplog.text
+    assert load_run(path).segments[0].cut_at_byte is None
+
+
 def test_damaged_chunk_stops_reading_at_the_previous_chunk(tmp_path: Path) -> None:
     path = tmp_path / "run.mcap"
     key = _key("sim", "sensors", "sc1", "relnav")

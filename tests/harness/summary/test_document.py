@@ -12,7 +12,7 @@ from pathlib import Path
 
 from ground.archive.recorder import McapRecorder
 from harness.archive.reader import load_run
-from harness.report import archive_section
+from harness.report import archive_end, archive_section
 from harness.summary import (
     FailedTests,
     FaultClass,
@@ -87,3 +87,31 @@ def test_segments_and_lost_messages_are_named_by_topic(tmp_path: Path) -> None:
     assert again.archive == info and again.filled == []
     assert "| nav/estimate | 3 |" in archive_section(again)
     assert "Segments: run.mcap, run-1.mcap." in archive_section(again)
+
+
+def test_a_cut_archive_says_where_it_ends(tmp_path: Path) -> None:
+    """A file cut at half its bytes: summary.json's ``archive`` gives the sim time of its last
+    message and where the file was cut, and the report says it before anything else."""
+    with McapRecorder(tmp_path / "full.mcap", chunk_size=1024) as rec:
+        for seq in range(1, 400):
+            msg = StateEstimate(sender="sc1", seq=seq, t_sim=seq / 10, spacecraft=1,
+                                x=[seq * 0.1234567 + i for i in range(6)],
+                                P=[[float(i == j) for j in range(6)] for i in range(6)])
+            rec.record("insp/m/sc/1/nav/estimate", "StateEstimate", encode(msg))
+    data = (tmp_path / "full.mcap").read_bytes()
+    (tmp_path / "run.mcap").write_bytes(data[:len(data) // 2])
+    archive = load_run(tmp_path / "run.mcap")
+    info = archive_info(archive)
+    assert info.truncated and info.end_s == archive.end_s and 0.0 < (info.end_s or 0) < 39.9
+    assert info.cut is not None and info.cut.startswith("run.mcap read up to byte ")
+    assert f"of {len(data) // 2}: file ends before its footer" in info.cut
+    summary = RunSummary(scenario="x", seed=1, duration_s=39.9, status="completed", error=None,
+                         injected_faults=[], archive=info)
+    summary.write(tmp_path / "summary.json")
+    again = RunSummary.read(tmp_path / "summary.json")
+    assert again.archive == info
+    (line, _) = archive_end(again)
+    assert line.startswith(f"The archive ends at {info.end_s} s of the run's 39.9 s (run.mcap ")
+    assert archive_end(RunSummary(scenario="x", seed=1, status="completed", error=None,
+                                  injected_faults=[],
+                                  archive=archive_info(load_run(tmp_path / "full.mcap")))) == []
