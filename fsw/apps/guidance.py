@@ -275,6 +275,7 @@ class GuidanceApp(App):
         self.publish("status", GuidanceStatus(
             sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, mode=mode,  # type: ignore[arg-type]
             assignment_id=a.assignment_id if a else 0, phase=a.phase if a else "",
+            pro=a.pro if a else None,
             pos_error_m=float(np.linalg.norm(err[:3])) if err is not None else 0.0,
             vel_error_mps=float(np.linalg.norm(err[3:])) if err is not None else 0.0,
             accel_lvlh_mps2=(u if u is not None else np.zeros(3)).tolist(),

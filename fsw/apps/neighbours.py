@@ -2,8 +2,9 @@
 their agreement (docs/fdir.md, "Neighbours judge each other"; ``[neighbours]``).
 
 Rate group mid.  Inputs: every observer's shared observations (a neighbour's only within
-range, each with its reported pose), the ground's PRO assignments, every observer's
-judgements (its own come back through the bus), and the ground's rulings.  Outputs: this
+range, each with its reported pose), every observer's guidance status (the assignment, mode
+and PRO it flies: the plan in force as flown, whenever the ground's uplink reached it), every
+observer's judgements (its own come back through the bus), and the ground's rulings.  Outputs: this
 observer's ``NeighbourJudgement`` of each FDI window, on the crosslinks, and a
 ``NeighbourDeclaration`` when the judgements of a neighbour's window agree
 (``fsw/lib/neighbour_judge.py``), sent to every app of this spacecraft and to the ground.
@@ -12,7 +13,8 @@ Timing, per window [a, b): judged ``fdir.latency_s`` after b (the neighbours' ob
 b are in); the judgements of the others arrive one tick later, and the agreement is applied
 one ω_mid cycle after the judging.  ψ is held at a on this observer's own fused map, which
 takes each window's observations once the window is judged, leaving out the observers its
-neighbours declared (until the ground overrules them).
+neighbours declared (until the ground overrules them, or ``[neighbours] clear_windows`` of
+their windows in a row are agreed passing: a declared observer is still judged).
 """
 
 from __future__ import annotations
@@ -21,19 +23,20 @@ from collections import defaultdict
 
 import numpy as np
 
-from fsw.lib.neighbour_judge import Exclusions, agreed, judge
+from fsw.lib.neighbour_judge import Exclusions, FlownReport, agreed, cleared, held_pro, judge
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro
-from gnc.twin import FlightPlan, TwinModel, held_over
+from gnc.twin import TwinModel
 from gnc.window_test import WindowTestSettings
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
+    GuidanceStatus,
     NeighbourDeclaration,
     NeighbourJudgement,
     NeighbourRuling,
     PoiObservations,
-    ProAssignments,
+    Unjudged,
 )
 from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.runtime.app import App, AppContext, Input, Output
@@ -44,14 +47,14 @@ class NeighboursApp(App):
     RATE = "mid"
     INPUTS = (
         Input(cat.OBSERVATIONS, "on_observations", every_spacecraft=True),
-        Input(cat.ASSIGNMENTS, "on_assignments"),
+        Input(cat.GUIDANCE_STATUS, "on_guidance", every_spacecraft=True),
         Input(cat.NEIGHBOUR_JUDGEMENT, "on_judgement", every_spacecraft=True),
         Input(cat.NEIGHBOUR_RULING, "on_ruling"),
     )
     OUTPUTS = (Output("judgement", cat.NEIGHBOUR_JUDGEMENT),
                Output("declaration", cat.NEIGHBOUR_DECLARATION))
-    CRITICAL = ("map", "pending", "plans", "verdicts", "exclusions", "declared", "next_judge",
-                "next_decide")
+    CRITICAL = ("map", "pending", "flown", "verdicts", "exclusions", "declared", "passing",
+                "next_judge", "next_decide")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -68,8 +71,13 @@ class NeighboursApp(App):
         self.decide_after_s = 1.0 / sc.rates.mid_hz
         self.seed = sc.seed
         self.pending: list[PoiObservations] = []
-        self.plans: dict[int, dict[int, FlightPlan]] = defaultdict(dict)
-        """by observer and assignment id"""
+        self.flown: dict[int, list[FlownReport]] = defaultdict(list)
+        """what each observer's guidance status says it flies, in time order"""
+        self.max_gap_s = 2.0 / sc.rates.low_hz + TIME_TOL_S
+        """reports further apart than two of their periods leave the plan unknown"""
+        self.clear_windows = sc.neighbours.clear_windows
+        self.passing: dict[int, int] = {}
+        """declared subjects: their windows agreed passing in a row"""
         self.verdicts: dict[tuple[int, int], dict[int, bool | None]] = {}
         """(window index, subject) -> judge -> exceeded"""
         self.exclusions = Exclusions()
@@ -84,9 +92,12 @@ class NeighboursApp(App):
         if 1 <= msg.spacecraft <= self.map.n_agents:
             self.pending.append(msg)
 
-    def on_assignments(self, msg: ProAssignments) -> None:
-        for a in msg.assignments:
-            self.plans[a.spacecraft].setdefault(a.assignment_id, FlightPlan.of(a))
+    def on_guidance(self, msg: GuidanceStatus) -> None:
+        if 1 <= msg.spacecraft <= self.map.n_agents:
+            reports = self.flown[msg.spacecraft]
+            reports.append(FlownReport.of(msg))
+            if len(reports) > 1 and reports[-2].t_s > msg.t_sim:
+                reports.sort(key=lambda r: r.t_s)
 
     def on_judgement(self, msg: NeighbourJudgement) -> None:
         k = self.schedule.boundary_at(msg.t_start_s)  # window k starts at boundary k
@@ -98,10 +109,15 @@ class NeighboursApp(App):
 
     def on_ruling(self, msg: NeighbourRuling) -> None:
         if msg.verdict == "overruled" and msg.subject in self.declared:
-            self.declared.discard(msg.subject)
-            self.pending += self.exclusions.readmit(msg.subject)
+            self._readmit(msg.subject)
             self.log.warning("the ground overruled the neighbours on sc%d: fused again",
                              msg.subject)
+
+    def _readmit(self, subject: int) -> None:
+        """``subject``'s declaration ends: it is fused again, with what was held of it."""
+        self.declared.discard(subject)
+        self.passing.pop(subject, None)
+        self.pending += self.exclusions.readmit(subject)
 
     # --- the cycle ----------------------------------------------------------------------------
 
@@ -120,7 +136,7 @@ class NeighboursApp(App):
         inside = [m for m in self.pending if a <= m.image_t_s < b]
         psi, phi = self.map.variance() ** 2, self.map.phi
         verdicts = []
-        for subject in sorted({m.spacecraft for m in inside} - {self.sc_id} - self.declared):
+        for subject in sorted({m.spacecraft for m in inside} - {self.sc_id}):
             images = sorted((m for m in inside if m.spacecraft == subject),
                             key=lambda m: m.image_t_s)
             rng = np.random.default_rng([self.seed, self.sc_id, subject, k])
@@ -134,18 +150,22 @@ class NeighboursApp(App):
             if m.spacecraft == self.sc_id or self.exclusions.admits(m):
                 self.map.add(m.spacecraft, *m.arrays())
         self.pending = [m for m in self.pending if m.image_t_s >= b]
+        for subject, reports in self.flown.items():  # keep what the next window needs
+            self.flown[subject] = [r for r in reports if r.t_s >= b - self.max_gap_s]
 
-    def _pro(self, subject: int, a: float, b: float) -> Pro | None:
-        """The PRO ``subject`` holds over all of [a, b) (s): None without a plan, or when a
-        transfer (its path is the subject's own choice) or a change of plan falls in it."""
-        plan = held_over(self.plans.get(subject, {}).values(), a, b)
-        return plan.pro if plan is not None else None
+    def _pro(self, subject: int, a: float, b: float) -> Pro | Unjudged:
+        """The PRO ``subject`` held over all of [a, b] (s) by its own guidance reports, or why
+        none (``fsw.lib.neighbour_judge.held_pro``)."""
+        return held_pro(self.flown.get(subject, []), a, b, self.max_gap_s)
 
     def _decide(self, k: int, t: float) -> None:
         """Apply the agreement rule to window k's judgements."""
         a, b = self.schedule.start(k), self.schedule.end(k)
         for (kk, subject), by_judge in sorted(self.verdicts.items()):
-            if kk != k or subject in self.declared:
+            if kk != k:
+                continue
+            if subject in self.declared:
+                self._still_declared(subject, by_judge, b)
                 continue
             judges = agreed(by_judge, self.agree)
             if judges is None:
@@ -160,3 +180,15 @@ class NeighboursApp(App):
                 sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, subject=subject,
                 t_start_s=a, t_end_s=b, judges=judges, decided=decided))
         self.verdicts = {key: v for key, v in self.verdicts.items() if key[0] > k}
+
+    def _still_declared(self, subject: int, by_judge: dict[int, bool | None], b: float) -> None:
+        """A declared subject's window, judged again: ``clear_windows`` in a row agreed
+        passing clear the declaration aboard (a later fault is then declared anew)."""
+        if not cleared(by_judge, self.agree):
+            self.passing[subject] = 0
+            return
+        self.passing[subject] = self.passing.get(subject, 0) + 1
+        if self.passing[subject] >= self.clear_windows:
+            self._readmit(subject)
+            self.log.warning("neighbours clear sc%d at %.0f s: %d windows in a row passed",
+                             subject, b, self.clear_windows)

@@ -29,6 +29,7 @@ one decided, that one suffices.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from itertools import pairwise
 
 import numpy as np
 
@@ -43,24 +44,27 @@ from gnc.window_test import (
     information,
 )
 from interfaces.contracts.messages import (
+    GuidanceStatus,
     NeighbourDeclaration,
     NeighbourRuling,
     NeighbourVerdict,
     PoiObservations,
     ReportedPose,
+    Unjudged,
 )
 
 
-def judge(subject: int, images: list[PoiObservations], pro: Pro | None, psi: np.ndarray,
+def judge(subject: int, images: list[PoiObservations], pro: Pro | Unjudged, psi: np.ndarray,
           phi: np.ndarray, twin: TwinModel, n_rad_s: float, cfg: WindowTestSettings,
           rng: np.random.Generator) -> NeighbourVerdict:
-    """The verdict on ``subject``'s window from the ``images`` it shared (time order), its
-    PRO in force over the whole window (``pro``; None: no plan, or a transfer), ψ and φ of
-    the judge's map at the window start: the window test (``gnc/window_test.py``) on the pose
-    the images report, at the information test's false-alarm share."""
+    """The verdict on ``subject``'s window from the ``images`` it shared (time order), the PRO
+    it held over the whole window (``pro``; else why there is none: :func:`held_pro`), ψ and
+    φ of the judge's map at the window start: the window test (``gnc/window_test.py``) on the
+    pose the images report, at the information test's false-alarm share."""
     usable = [m for m in images if m.pose is not None and m.pose.tracking_s >= cfg.settle_s]
-    if pro is None or not usable:
-        return NeighbourVerdict(subject=subject, images=len(usable))
+    if not isinstance(pro, Pro) or not usable:
+        why = pro if not isinstance(pro, Pro) else "not_tracking"
+        return NeighbourVerdict(subject=subject, images=len(usable), unjudged=why)
     times = np.array([m.image_t_s for m in usable])
     pose = reported_pose(pro.states(n_rad_s, times)[:, :3],
                          [m.pose for m in usable if m.pose is not None])
@@ -84,6 +88,44 @@ def reported_pose(planned: np.ndarray, poses: list[ReportedPose]) -> WindowPose:
                       np.array([p.knowledge_rad for p in poses]))
 
 
+@dataclass(frozen=True)
+class FlownReport:
+    """What a neighbour's guidance status says it flies at ``t_s`` (s): the assignment, the
+    mode and the PRO (``GuidanceStatus``)."""
+
+    t_s: float
+    assignment_id: int
+    mode: str
+    pro: Pro | None
+
+    @classmethod
+    def of(cls, msg: GuidanceStatus) -> FlownReport:
+        return cls(msg.t_sim, msg.assignment_id, msg.mode,
+                   Pro.of(msg.pro) if msg.pro is not None else None)
+
+
+def held_pro(reports: list[FlownReport], a: float, b: float, max_gap_s: float
+             ) -> Pro | Unjudged:
+    """The PRO a neighbour held over all of [a, b] (s) by its own reports (time order), or why
+    none: ``plan_unknown`` unless reports at most ``max_gap_s`` apart cover [a, b] (one before
+    or at a, one within ``max_gap_s`` of b); ``transfer`` when one of them is a transfer or a
+    change of assignment; ``no_plan`` when one flies none (idle, safe hold).  The neighbours
+    judge only held PROs: a transfer's path is the neighbour's own (docs/fdir.md, "Neighbours
+    judge each other")."""
+    before = [r for r in reports if r.t_s <= a]
+    inside = [r for r in reports if a < r.t_s <= b]
+    if not before or a - before[-1].t_s > max_gap_s:
+        return "plan_unknown"
+    span = [before[-1], *inside]
+    times = [r.t_s for r in span] + [b]
+    if max(t1 - t0 for t0, t1 in pairwise(times)) > max_gap_s:
+        return "plan_unknown"
+    if any(r.mode == "transfer" or r.assignment_id != span[0].assignment_id for r in span):
+        return "transfer"
+    pro = span[0].pro
+    return pro if pro is not None and all(r.mode == "hold" for r in span) else "no_plan"
+
+
 def agreed(verdicts: dict[int, bool | None], agree: int) -> list[int] | None:
     """The judges that declare the subject's window failed (sorted), or None when they do not
     agree: ``verdicts`` by judge (None: undecided); at least ``agree`` failed and more than
@@ -92,6 +134,13 @@ def agreed(verdicts: dict[int, bool | None], agree: int) -> list[int] | None:
     failed = sorted(j for j, v in verdicts.items() if v)
     need = 1 if len(decided) == 1 else max(agree, len(decided) // 2 + 1)
     return failed if failed and len(failed) >= need else None
+
+
+def cleared(verdicts: dict[int, bool | None], agree: int) -> bool:
+    """Whether the judges agree that a declared subject's window passed: the agreement rule
+    (:func:`agreed`) applied to the verdicts that found it passing."""
+    return agreed({j: None if v is None else not v for j, v in verdicts.items()},
+                  agree) is not None
 
 
 @dataclass

@@ -109,6 +109,7 @@ class UnjudgedCounts(Counts):
     no_images: int = 0
     not_tracking: int = 0
     plan_unknown: int = 0
+    transfer: int = 0
     excluded: int = 0
 
     @classmethod

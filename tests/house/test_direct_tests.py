@@ -77,9 +77,6 @@ INDIRECT: dict[str, str] = {
         "the FDIR's stages in their order, driven by the FDIR app: "
         "tests/ground/apps/test_fdir.py feeds it message by message, "
         "tests/ground/fdir/test_stages.py tests each stage"),
-    "deploy.campaign_replay": (
-        "a finished campaign re-judged by replay, run by deploy/run_campaign.py's --replay and "
-        "--sweep: tests/missions/test_campaign_replay.py"),
     "deploy.processes": (
         "the launcher's supervision of OS processes: tests/missions/test_constellation.py "
         "(dead, stalled and restarted processes, a terminated launcher)"),

@@ -39,6 +39,7 @@ from interfaces.contracts.messages.base import (
     State6,
     Time,
     Torque,
+    Unjudged,
     Velocity,
     stamp,
 )
@@ -73,7 +74,6 @@ from interfaces.contracts.messages.ground import (
     ProAssignments,
     ProElements,
     TelemetryStatus,
-    Unjudged,
     WindowTest,
 )
 from interfaces.contracts.messages.lockstep import (

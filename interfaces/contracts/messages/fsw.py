@@ -23,9 +23,11 @@ from interfaces.contracts.messages.base import (
     State6,
     Time,
     Torque,
+    Unjudged,
     Velocity,
     header_ok,
 )
+from interfaces.contracts.messages.ground import ProElements
 from interfaces.contracts.messages.sim import CameraImage
 
 
@@ -109,6 +111,10 @@ class GuidanceStatus(Message):
     dv_commanded_mps: float = Field(default=0.0, ge=0.0)
     mpc_status: str = ""
     mpc_ms: float = Field(default=0.0, ge=0.0)
+    pro: ProElements | None = Field(
+        default=None, description="the PRO of the assignment it flies (None: none): with the "
+                                  "assignment id and the mode, the plan its neighbours judge it "
+                                  "against (docs/fdir.md, \"Neighbours judge each other\")")
 
 
 class ReportedPose(BaseModel):
@@ -253,6 +259,8 @@ class NeighbourVerdict(BaseModel):
     direction: Literal["improved", "degraded"] | None = None
     failed: list[Literal["information", "plan", "pointing"]] = Field(
         default_factory=list, max_length=3, description="the tests the window failed")
+    unjudged: Unjudged | None = Field(default=None,
+                                      description="why the window has no decision (None: judged)")
 
 
 class NeighbourJudgement(Message):

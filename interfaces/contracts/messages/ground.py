@@ -7,7 +7,7 @@ from typing import Annotated, Literal, get_args
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from interfaces.contracts.messages.base import Message, Time
+from interfaces.contracts.messages.base import Message, Time, Unjudged
 
 MAX_PRO_SIZE_M = 1.0e5
 """Largest PRO amplitude or offset a command may carry, m (far beyond the HCW model's range)."""
@@ -63,14 +63,6 @@ threshold), the guidance and attitude consistency tests and the nav's NIS test
 
 WINDOW_TESTS: tuple[str, ...] = get_args(WindowTest)
 
-Unjudged = Literal["store_overflow", "aboard", "lost", "no_plan", "camera_off", "no_images",
-                   "not_tracking", "plan_unknown", "excluded"]
-"""Why a window, or the H_i report at its end, has no decision (docs/fdir.md, "Lost is not
-corrupt"): its reports lost to the store's overflow (``store_overflow``) or still aboard
-(``aboard``); too many of the observers' observations lost for the report's recomputation
-(``lost``); no plan in force; its camera turned off aboard; no image received; no image taken
-while tracking; a transfer whose plan never reached the ground (``plan_unknown``); an observer
-its neighbours left out of their fusion (``excluded``)."""
 
 
 class FdirWindow(Message):

@@ -6,6 +6,7 @@ hears, and a fault is declared aboard by their agreement.
     enabled = true
     agree = 2          # judges that must find a window failed (one, when only one judged it)
     action = "none"    # what the declared observer's own FDIR starts when told
+    clear_windows = 3  # windows in a row found passing that clear a declaration aboard
 
 Off by default, so that a scenario without it flies as before.
 """
@@ -31,3 +32,8 @@ class Neighbours(Section):
         default="none", description="the stored sequence the declared observer's onboard FDIR "
                                     "starts when its neighbours declare it (with "
                                     "[onboard_fdir] on; none: an event only)")
+    clear_windows: int = Field(
+        default=3, ge=1, le=1000,
+        description="a declared neighbour is still judged; this many of its windows in a row "
+                    "found passing by the same agreement clear the declaration aboard (it is "
+                    "fused again), so a later fault is declared anew")

@@ -1,8 +1,10 @@
 """The neighbours' FDIR app (fsw/apps/neighbours.py) fed by hand, as observer 1 of three: it
 judges each neighbour's window ``fdir.latency_s`` after it closes (observer 2's camera at
 β = 0.3 fails, observer 3 passes), shares its verdicts, and one ω_mid cycle later declares
-observer 2 with observer 3's agreeing verdict; the plan in force over a window is none while a
-transfer or a change of plan falls in it; the ground's overruling fuses the held observations
+observer 2 with observer 3's agreeing verdict; the plan a neighbour flies is the one its
+guidance status reports (none while a transfer or a change of assignment falls in the window,
+nor while its reports are too sparse to tell); a declared neighbour is still judged, and
+cleared after windows agreed passing; the ground's overruling fuses the held observations
 again."""
 
 from __future__ import annotations
@@ -13,14 +15,13 @@ from fsw.apps.neighbours import NeighboursApp
 from gnc.pro import Pro
 from gnc.twin import centre_boresights
 from interfaces.contracts.messages import (
+    GuidanceStatus,
     Message,
     NeighbourDeclaration,
     NeighbourJudgement,
     NeighbourRuling,
     NeighbourVerdict,
     PoiObservations,
-    ProAssignment,
-    ProAssignments,
     ProElements,
     ReportedPose,
 )
@@ -34,18 +35,19 @@ PROS = {2: Pro(10.0, 0.3, 0.0, 15.0, 1.1), 3: Pro(10.0, 2.4, 0.0, 15.0, 3.2)}
 
 def _app() -> tuple[NeighboursApp, list[Message]]:
     app, sent = app_alone(NeighboursApp, SC)
-    app.on_assignments(_assignments({sc: (0.0, 0.0) for sc in PROS}))
+    for t in np.arange(0.0, 70.0, 10.0):
+        for sc in PROS:
+            app.on_guidance(_status(sc, float(t)))
     return app, sent
 
 
-def _assignments(times: dict[int, tuple[float, float]], aid: int = 1) -> ProAssignments:
-    return ProAssignments(sender="ground", seq=aid, t_sim=0.0, assignments=[
-        ProAssignment(spacecraft=sc, assignment_id=aid, phase="p",
-                      pro=ProElements(rho_x_m=p.rho_x_m, alpha_x_rad=p.alpha_x_rad,
-                                      rho_y_m=p.rho_y_m, rho_z_m=p.rho_z_m,
-                                      alpha_z_rad=p.alpha_z_rad),
-                      t_depart_s=times[sc][0], t_arrive_s=times[sc][1])
-        for sc, p in PROS.items() if sc in times])
+def _status(sc: int, t: float, aid: int = 1, mode: str = "hold") -> GuidanceStatus:
+    """Observer ``sc``'s guidance status at ``t`` (s): flying assignment ``aid`` to its PRO."""
+    p = PROS[sc]
+    return GuidanceStatus(sender=f"sc{sc}", seq=int(t) + 1, t_sim=t, spacecraft=sc, mode=mode,
+                          assignment_id=aid, pro=ProElements(
+                              rho_x_m=p.rho_x_m, alpha_x_rad=p.alpha_x_rad, rho_y_m=p.rho_y_m,
+                              rho_z_m=p.rho_z_m, alpha_z_rad=p.alpha_z_rad))
 
 
 def _images(app: NeighboursApp, sc: int, beta: float) -> list[PoiObservations]:
@@ -86,14 +88,54 @@ def test_it_judges_its_neighbours_and_declares_by_agreement() -> None:
     assert app.declared == {2} and app.exclusions.since_s == {2: 60.0}
 
 
-def test_no_plan_is_in_force_over_a_transfer_or_a_change_of_plan() -> None:
+def test_a_neighbour_is_judged_on_the_pro_its_guidance_reports_holding() -> None:
     app, _ = _app()
     assert app._pro(2, 30.0, 60.0) == PROS[2]
-    app.on_assignments(_assignments({2: (40.0, 40.0)}, aid=2))  # a new plan from 40 s
-    assert app._pro(2, 30.0, 60.0) is None and app._pro(2, 60.0, 90.0) == PROS[2]
-    app.on_assignments(_assignments({3: (70.0, 200.0)}, aid=2))  # a transfer to 200 s
-    assert app._pro(3, 90.0, 120.0) is None and app._pro(3, 210.0, 240.0) == PROS[3]
-    assert app._pro(4, 30.0, 60.0) is None  # no plan known
+    app.on_guidance(_status(2, 70.0, aid=2, mode="transfer"))  # a new assignment from 70 s
+    for t in (80.0, 90.0):
+        app.on_guidance(_status(2, t, aid=2))
+    assert app._pro(2, 60.0, 90.0) == "transfer"  # a transfer in the window
+    app.on_guidance(_status(2, 100.0, aid=3))  # a change of assignment without a transfer
+    assert app._pro(2, 90.0, 120.0) == "transfer"
+    for t in (70.0, 80.0, 90.0):
+        app.on_guidance(_status(3, t))
+    for t in (100.0, 110.0, 120.0):
+        app.on_guidance(_status(3, t, mode="safe"))
+    assert app._pro(3, 90.0, 120.0) == "no_plan"  # in safe hold: flies no plan
+    assert app._pro(3, 150.0, 180.0) == "plan_unknown"  # nothing reported since 120 s
+    assert app._pro(4, 30.0, 60.0) == "plan_unknown"  # never heard
+
+
+def test_a_lost_report_leaves_the_plan_known_a_lost_pair_does_not() -> None:
+    app, sent = _app()
+    for t in (70.0, 90.0):  # the report at 80 s was lost
+        app.on_guidance(_status(2, t))
+    assert app._pro(2, 60.0, 90.0) == PROS[2]
+    app.on_guidance(_status(2, 120.0))  # those at 100 and 110 s too
+    assert app._pro(2, 90.0, 120.0) == "plan_unknown"
+    for m in _images(app, 2, 1.0):
+        app.on_observations(m.model_copy(update={"image_t_s": m.image_t_s + 60.0}))
+    app.step(120.0 + SC.fdir.latency_s)
+    (verdict,) = [v for j in sent for v in j.verdicts if j.t_start_s == 90.0]
+    assert verdict.exceeded is None and verdict.unjudged == "plan_unknown"
+
+
+def test_a_declared_neighbour_is_still_judged_and_cleared_when_it_passes() -> None:
+    app, sent = _app()
+    app.declared.add(2)
+    app.exclusions.exclude(2, 30.0)
+    for m in _images(app, 2, 1.0):
+        app.on_observations(m)
+    app.step(60.0 + SC.fdir.latency_s)
+    (judgement,) = sent
+    assert {v.subject: v.exceeded for v in judgement.verdicts} == {2: False}
+    for k in range(1, SC.neighbours.clear_windows + 1):  # windows agreed passing, in a row
+        app.on_judgement(judgement.model_copy(update={"t_start_s": 30.0 * k,
+                                                      "t_end_s": 30.0 * (k + 1)}))
+        app.next_judge = k + 1
+        assert app.declared == {2}
+        app.step(30.0 * (k + 1) + SC.fdir.latency_s + 1.0 / SC.rates.mid_hz)
+    assert app.declared == set() and app.exclusions.since_s == {}
 
 
 def test_an_overruled_neighbour_is_fused_again() -> None:
