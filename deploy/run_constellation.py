@@ -70,6 +70,7 @@ from interfaces.contracts.topology import RECORDER, ROUTER, SIM, topology  # noq
 from interfaces.runtime.cds import read_starts, write_run_key  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
+from links.data_budget import budget  # noqa: E402
 
 if TYPE_CHECKING:
     from ground.tools.live import LiveView
@@ -137,6 +138,9 @@ def main(argv: list[str] | None = None) -> int:
     except ScenarioError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    data_budget = budget(scenario)
+    for warning in data_budget.warnings() if data_budget is not None else []:
+        log.warning("%s", warning)
     if args.realtime is not None and not args.realtime > 0.0:
         print(f"error: --realtime takes a positive speed (times real time), not {args.realtime}",
               file=sys.stderr)

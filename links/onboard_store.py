@@ -132,6 +132,8 @@ class OnboardStore:
         c = self.counter
         if self._inflight is None and not any(self._bytes):
             self._clock_s = max(self._clock_s, item.t)
+        by_topic = c.offered_bytes_by_topic
+        by_topic[item.topic] = by_topic.get(item.topic, 0) + item.size
         used = sum(self._bytes) + (self._inflight[0].size if self._inflight else 0)
         lower = sum(self._bytes[item.priority + 1:])
         if used - lower + item.size > self.capacity_bytes:
@@ -147,6 +149,7 @@ class OnboardStore:
         self._bytes[item.priority] += item.size
         c.stored += 1
         c.stored_bytes += item.size
+        c.peak_bytes = max(c.peak_bytes, used + item.size)
 
     def _transmit(self, link: Downlink) -> None:
         t = self._clock_s

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
+import zlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
@@ -64,6 +65,25 @@ class _DumpLink:
         return self.plan.next_contact(t_s)
 
 
+@dataclass(frozen=True)
+class Aboard:
+    """A message as a store keeps it aboard: its JSON, compressed, and its type.  Hours of
+    images wait aboard between passes; as objects (lists of Python numbers) they took about
+    3.4 times their JSON bytes (a 3,900 s run of the default mission under two stations' passes
+    peaked at 3.4 GB).  The message that comes down is equal to the one sent, field by field
+    (JSON round-trips every field, floats included)."""
+
+    cls: type[Message]
+    packed: bytes
+
+    @classmethod
+    def of(cls, msg: Message) -> Aboard:
+        return cls(type(msg), zlib.compress(msg.model_dump_json().encode(), 1))
+
+    def message(self) -> Message:
+        return self.cls.model_validate_json(zlib.decompress(self.packed))
+
+
 def _topic(key: str) -> str:
     """``app/name`` of a spacecraft key."""
     return "/".join(key.rsplit("/", 2)[-2:])
@@ -89,6 +109,7 @@ class SpaceGroundLink:
         False: the channel judges it now, as any other."""
         if self.receiver == GROUND and spacecraft_of(src) is not None:
             self._store(src).offer(env, msg, _topic(key), catalogue.downlink_priority(key))
+            env.msg = Aboard.of(msg)  # until it comes down (``released``)
             return True
         if src == GROUND and not self.plan.in_contact(msg.t_sim):
             bisect.insort(self.uplink, (self.plan.next_contact(msg.t_sim),
@@ -105,6 +126,8 @@ class SpaceGroundLink:
                         for t, env in self.stores[src].advance(
                             horizon, _DumpLink(radio, src, self.plan)))
         out = [env for _, _, env in dumped]
+        for env in out:
+            env.msg = env.msg.message()
         while self.uplink and self.uplink[0][0] < horizon:
             t_go, _, env = self.uplink.pop(0)
             if radio.delivers(env.src or "", t_go):

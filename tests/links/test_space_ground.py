@@ -13,7 +13,7 @@ from interfaces.contracts.scenario import Comms, Ground, LinkCut, Station
 from interfaces.runtime.inbox import Envelope
 from links.channel import ChannelModel, TruthHistory
 from links.onboard_store import message_bytes
-from links.space_ground import SpaceGroundLink
+from links.space_ground import Aboard, SpaceGroundLink
 
 GROUND = Ground(contact="passes", downlink_bps=8000.0,
                 stations=[Station(name="st", latitude_deg=48.0, longitude_deg=11.0)])
@@ -40,11 +40,14 @@ def _offer(ch: ChannelModel, env: Envelope) -> bool:
 def test_the_downlink_waits_for_the_pass_and_comes_down_at_the_rate() -> None:
     ch = _channel("ground")
     envs = [_heartbeat(t, k + 1) for k, t in enumerate((10.0, 20.0))]
+    sent = [e.msg for e in envs]
+    air = message_bytes(sent[0]) / 1000.0  # s at 8 kbit/s
     assert all(_offer(ch, e) for e in envs)
+    assert all(isinstance(e.msg, Aboard) for e in envs)  # kept as compressed JSON aboard
     assert ch.released(99.0) == []
-    air = message_bytes(envs[0].msg) / 1000.0  # s at 8 kbit/s
     assert ch.released(100.0 + 1.5 * air) == envs[:1]
     assert ch.released(100.0 + 2.5 * air) == envs[1:]
+    assert [e.msg for e in envs] == sent  # what comes down is what was sent, field by field
     (c,) = ch.counters()
     assert c.store is not None
     assert (c.sent, c.delivered, c.store.stored, c.store.dumped, c.store.onboard) == (
@@ -106,7 +109,7 @@ def test_what_waits_is_packed_and_unpacked_with_every_envelope() -> None:
     ch.released(100.0)  # the first on the air
     link = ch.passes
     assert isinstance(link, SpaceGroundLink)
-    packed = link.with_envelopes(lambda e: e.msg.seq)
+    packed = link.with_envelopes(lambda e: e.msg.message().seq)  # kept as sent (Aboard)
     assert packed.stores["sc1"].held() == [1, 2] and link.stores["sc1"].held() == envs
     restored = packed.with_envelopes(lambda seq: envs[seq - 1])
     assert restored.stores["sc1"].held() == envs

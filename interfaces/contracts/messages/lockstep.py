@@ -129,6 +129,10 @@ class StoreCounter(BaseModel):
         default=None, description="send time of the oldest message aboard of the topics the "
                                   "ground FDIR judges (priorities 0 and 1), s (None: none)")
     overflow_runs: list[OverflowRun] = Field(default_factory=list, max_length=100_000)
+    offered_bytes_by_topic: dict[str, int] = Field(
+        default_factory=dict, max_length=256,
+        description="what was offered to it (stored or lost to overflow), by topic (app/name)")
+    peak_bytes: int = Field(default=0, ge=0, description="the most it held at once")
 
 
 class LinkCounter(BaseModel):

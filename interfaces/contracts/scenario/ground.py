@@ -36,9 +36,13 @@ class Ground(Section):
         description="UTC at t = 0: the Earth's sidereal angle then (where the stations are)")
     stations: list[Station] = Field(default_factory=list)
     downlink_bps: float = Field(
-        default=2.0e6, gt=0.0, description="each spacecraft's dump rate in a pass, bit/s")
+        default=50.0e6, gt=0.0,
+        description="each spacecraft's dump rate in a pass, bit/s (an X-band small-spacecraft "
+                    "transmitter: docs/architecture.md, \"Data budget\")")
     store_bytes: int = Field(
-        default=64 * 2 ** 20, gt=0, description="each spacecraft's telemetry store, bytes")
+        default=8 * 2 ** 30, gt=0,
+        description="each spacecraft's telemetry store, bytes (a small spacecraft's mass "
+                    "memory: docs/architecture.md, \"Data budget\")")
 
     @field_validator("epoch")
     @classmethod
