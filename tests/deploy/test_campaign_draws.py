@@ -3,7 +3,8 @@ deploy/campaign_file.py, deploy/campaign.py): the same file gives the same draws
 in their bounds, a subset's elements are distinct and in list order, the existing campaigns
 expand to exactly the runs they did before, bad drawn values are refused at load naming
 them, faults follow the drawn set-up (any observer, an onset in a phase it has, a magnitude per
-kind), and every run records what it drew."""
+kind), every run records what it drew, and deploy/campaigns/space.toml expands into valid runs
+over every bin of every dimension."""
 
 from __future__ import annotations
 
@@ -20,6 +21,8 @@ from deploy.campaign_file import FaultSpec
 from deploy.draws import Choice, Record, Uniform, draw_tree, parse_tree, rng_for
 from deploy.onsets import phase_spans
 from deploy.run_campaign import main as run_campaign
+from harness.campaign.dimensions import Binning, campaign_domains
+from harness.campaign.rescore import CampaignRun
 from harness.summary import RunSummary
 from interfaces.contracts.scenario import load_scenario
 from tests.deploy.test_campaign import BASE
@@ -281,3 +284,25 @@ def test_variants_fly_the_same_drawn_set_up(tmp_path: Path) -> None:
     pairs = [(by[r.id], by[r.id.replace("-a-", "-b-")]) for r in runs if "-a-" in r.id]
     assert pairs and all(a.drawn == b.drawn and a.scenario.faults == b.scenario.faults
                          for a, b in pairs)
+
+
+def test_space_campaign_covers_every_bin_of_every_dimension() -> None:
+    """deploy/campaigns/space.toml: at least 300 valid runs (load_campaign validates each),
+    faulty and nominal, with a run in every bin of every drawn dimension."""
+    campaign, runs = load_campaign(CAMPAIGNS / "space.toml")
+    assert campaign.name == "space" and len(runs) >= 300
+    assert sum(not r.scenario.faults for r in runs) >= 50
+    fake = [CampaignRun(r.id, r.group, "-", RunSummary(scenario=r.id, seed=r.seed,
+                                                       status="completed", error=None,
+                                                       injected_faults=[]),
+                        r.drawn, r.domains) for r in runs]
+    domains = campaign_domains(fake)
+    assert {"mission", "observers.count", "camera.half_angle_deg", "target.pois",
+            "comms.packet_loss", "orbit.raan_deg", "orbit.arg_latitude_deg",
+            "neighbours.enabled", "onboard_fdir.enabled", "ground.contact", "ground.stations",
+            "fault.kind", "fault.phase"} <= set(domains)
+    assert len(domains["fault.kind"]["choose"]) == 8
+    for name, domain in domains.items():
+        binning = Binning(domain)
+        hit = {binning.index(r.drawn[name]) for r in runs if name in r.drawn}
+        assert hit == set(range(len(binning.labels()))), name
