@@ -30,7 +30,7 @@ import inspect
 import json
 import types
 import typing
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -154,8 +154,7 @@ def _count(count: Any, n: int, where: str) -> int | Uniform:
         raise DrawError(f"{where}: must be an integer or {{ min, max }}, got {count!r}")
     if isinstance(parsed, Uniform) and not parsed.integer:
         raise DrawError(f"{where}: a count's bounds must be integers")
-    lo, hi = (int(parsed.low), int(parsed.high)) if isinstance(parsed, Uniform) else (parsed,
-                                                                                      parsed)
+    lo, hi = (parsed, parsed) if isinstance(parsed, int) else (int(parsed.low), int(parsed.high))
     if lo < 1 or hi > n:
         text = str(lo) if lo == hi else f"{lo} to {hi}"
         raise DrawError(f"{where}: {text} of a list of {n}: a count must be between 1 and "
@@ -226,10 +225,17 @@ def _check(annotation: Any, value: Any, where: str) -> None:
                                 f"{', '.join(model.model_fields)})")
             _check(model.model_fields[key].annotation, v, f"{where}.{key}")
         return
-    inner = _inner(annotation, list if isinstance(value, list) else dict)
+    if isinstance(value, list):
+        _check_items(_inner(annotation, list), enumerate(value), where, "[{}]")
+    elif isinstance(value, dict):
+        _check_items(_inner(annotation, dict), value.items(), where, ".{}")
+
+
+def _check_items(inner: Any, items: Iterable[tuple[Any, Any]], where: str, key: str) -> None:
+    """Each item of a list or a dict setting against its element type (None: unchecked)."""
     if inner is not None:
-        for k, v in (enumerate(value) if isinstance(value, list) else value.items()):
-            _check(inner, v, f"{where}[{k}]" if isinstance(value, list) else f"{where}.{k}")
+        for k, v in items:
+            _check(inner, v, where + key.format(k))
 
 
 def _check_choice(annotation: Any, choice: Choice, where: str) -> None:
