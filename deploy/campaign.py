@@ -25,7 +25,8 @@ A campaign TOML names a base scenario and groups of runs::
 report (harness/campaign/formation_study.py).
 
 ``[[variants]]`` (optional) flies every group once per variant, each with its own scenario
-overrides, the same seeds and the same drawn faults: group ``g`` becomes ``g-<variant>``::
+overrides, the same seeds, the same drawn set-up and the same drawn faults: group ``g``
+becomes ``g-<variant>``::
 
     [[variants]]
     name = "central"
@@ -37,8 +38,45 @@ overrides, the same seeds and the same drawn faults: group ``g`` becomes ``g-<va
 Each group expands to (its seeds) × (the Cartesian product of every list-valued fault field,
 in file order); every range is then drawn from a generator seeded by (campaign name, group,
 run index), so the list is the same on every machine and every restart.  A group may also
-override scenario sections (``[groups.overrides]``, e.g. ``fdir = { floor = 0.04 }``).
-Unknown fields, bad values and runs whose scenario does not validate are errors, raised by
+override scenario sections (``[groups.overrides]``, e.g. ``fdir = { floor = 0.04 }``), and so
+may the campaign for every group (a top-level ``[overrides]``) and a variant; a group's
+override wins over a variant's, a variant's over the campaign's.
+
+**Drawn set-ups.**  Any override value may be drawn per run (``deploy/draws.py``): a range
+``{ min = a, max = b }`` (an integer when both bounds are), a choice ``{ choose = [...] }``,
+or a subset ``{ choose = [...], count = n or { min, max } }`` (distinct values, in list
+order); and a group's ``scenario`` (or the campaign's ``base``) may be a choice of files, the
+``mission`` (each keeps its own duration unless the campaign sets ``duration_s``)::
+
+    [overrides]
+    observers = { count = { min = 2, max = 8 } }
+    ground = { contact = { choose = ["continuous", "passes"] },
+               stations = { choose = [{ name = "Kiruna", latitude_deg = 67.86,
+                                        longitude_deg = 20.96 }, ...],
+                            count = { min = 1, max = 3 } } }
+    [[groups]]
+    name = "anything"
+    scenario = { choose = ["../scenarios/nominal.toml", "../scenarios/default.toml"] }
+    [[groups.faults]]
+    spacecraft = "any"                    # one of the run's observers
+    kind = { choose = ["thruster_bias", "link_loss"] }
+    start_s = { during = ["transfer", "inspection", "after_pass"] }
+    magnitude = { per_kind = { thruster_bias = { min = 0.1, max = 0.7 } } }
+
+Each drawn setting has a generator of its own (seeded by campaign, group, run index and the
+setting's path), apart from the faults' generator: adding a drawn setting changes no other
+draw.  The set-up is drawn first, so a fault may depend on it: ``spacecraft = "any"``,
+``start_s = { during = [...] }`` (deployment, transfer, inspection, after_pass:
+``deploy/onsets.py``; a phase the set-up lacks is re-drawn among those it has),
+``kind = { choose }`` and ``magnitude = { per_kind }`` (``deploy/campaign_file.py``).  Each
+run records what it drew (:attr:`RunSpec.drawn`: ``mission``, ``observers.count``,
+``ground.stations`` (the count) and ``ground.stations.names``, ``fault.phase``, ``fault.kind``,
+...; ``drawn.json`` in its directory), and the report breaks every figure down by each drawn
+dimension.
+
+Unknown fields, bad values (a range whose min exceeds its max, an empty choice, a count out of
+its list, a setting the scenario does not have, a spacecraft index above the smallest drawn
+observer count) and runs whose scenario does not validate are errors, raised by
 :func:`load_campaign` before any run starts.
 """
 
@@ -49,102 +87,27 @@ import itertools
 import json
 import logging
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import ValidationError
 
+from deploy.campaign_file import Campaign, Group, ScenarioChoice, draw_fault, grid_axes, seeds
+from deploy.draws import (
+    Choice,
+    DrawError,
+    Record,
+    Uniform,
+    check_settings,
+    draw_tree,
+    parse_tree,
+    rng_for,
+)
+from deploy.onsets import OnsetError
 from harness.summary import RunSummary
-from interfaces.contracts.scenario import FaultKind, Scenario
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class Range(_Strict):
-    """A value drawn uniformly in [min, max] for each run."""
-
-    min: float
-    max: float
-
-    @model_validator(mode="after")
-    def _order(self) -> Range:
-        if not self.max >= self.min:
-            raise ValueError(f"range max {self.max} is below min {self.min}")
-        return self
-
-
-class Seeds(_Strict):
-    """Seeds first, first + 1, ..., first + count - 1."""
-
-    first: int = Field(ge=0)
-    count: int = Field(ge=1, le=100_000)
-
-    def values(self) -> list[int]:
-        return list(range(self.first, self.first + self.count))
-
-
-Number = float | list[float] | Range
-
-
-class FaultSpec(_Strict):
-    """One injected fault per run, its fields fixed, gridded (lists) or drawn (ranges)."""
-
-    spacecraft: int | list[int]
-    kind: FaultKind | list[FaultKind]
-    start_s: Number
-    end_s: Number | None = None
-    magnitude: Number | None = None
-    velocity_mps: Number | None = None
-    disturbance: Literal["bias", "noise"] | list[Literal["bias", "noise"]] | None = None
-
-
-class Group(_Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=64)
-    scenario: str | None = None
-    seeds: Annotated[list[int], Field(min_length=1)] | Seeds | None = None
-    nominal: bool = False
-    faults: list[FaultSpec] = Field(default_factory=list)
-    overrides: dict[str, dict[str, Any]] = Field(default_factory=dict)
-
-    @model_validator(mode="after")
-    def _nominal(self) -> Group:
-        if self.nominal and self.faults:
-            raise ValueError(f"group {self.name}: nominal = true with faults")
-        return self
-
-
-class Variant(_Strict):
-    """One way every group is flown (``[[variants]]``): its name and scenario overrides."""
-
-    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=32)
-    overrides: dict[str, dict[str, Any]] = Field(default_factory=dict)
-
-
-class Campaign(_Strict):
-    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", max_length=64)
-    base: str
-    seeds: Annotated[list[int], Field(min_length=1)] | Seeds = Field(default_factory=lambda: [1])
-    duration_s: float | None = Field(default=None, gt=0.0)
-    study: Literal["formations", "neighbours"] | None = None
-    """a study report written beside report.md (``formations``: study.md,
-    harness/campaign/formation_study.py; ``neighbours``: study.md,
-    harness/campaign/neighbours_study.py)"""
-    groups: list[Group] = Field(min_length=1)
-    variants: list[Variant] = Field(default_factory=list)
-
-    @model_validator(mode="after")
-    def _unique(self) -> Campaign:
-        names = [g.name for g in self.groups]
-        if len(set(names)) != len(names):
-            raise ValueError(f"group names must be unique: {names}")
-        variants = [v.name for v in self.variants]
-        if len(set(variants)) != len(variants):
-            raise ValueError(f"variant names must be unique: {variants}")
-        return self
+from interfaces.contracts.scenario import Scenario
 
 
 class CampaignError(ValueError):
@@ -154,46 +117,19 @@ class CampaignError(ValueError):
 @dataclass(frozen=True)
 class RunSpec:
     """One run of a campaign: its id (``<group>-<index>``, also its directory name), group,
-    and the validated scenario it runs (with its seed)."""
+    the validated scenario it runs (with its seed), what it drew (dimension → value: the
+    drawn settings by dotted path, ``mission``, ``fault.phase``...) and each drawn
+    dimension's domain (``deploy/draws.py``)."""
 
     id: str
     group: str
     scenario: Scenario
+    drawn: dict[str, Any] = field(default_factory=dict)
+    domains: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     @property
     def seed(self) -> int:
         return self.scenario.seed
-
-
-def _seeds(value: list[int] | Seeds) -> list[int]:
-    return value.values() if isinstance(value, Seeds) else list(value)
-
-
-def _axes(faults: list[FaultSpec]) -> list[tuple[int, str, list[Any]]]:
-    """(fault index, field, values) of every list-valued field, in file order."""
-    out = []
-    for i, f in enumerate(faults):
-        for name in FaultSpec.model_fields:
-            v = getattr(f, name)
-            if isinstance(v, list):
-                out.append((i, name, v))
-    return out
-
-
-def _rng(campaign: str, group: str, index: int) -> np.random.Generator:
-    digest = hashlib.sha256(f"{campaign}/{group}/{index}".encode()).digest()
-    return np.random.default_rng(int.from_bytes(digest[:8], "little"))
-
-
-def _fault(spec: FaultSpec, chosen: dict[str, Any], rng: np.random.Generator) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for name in FaultSpec.model_fields:
-        v = chosen.get(name, getattr(spec, name))
-        if isinstance(v, Range):
-            v = float(rng.uniform(v.min, v.max))
-        if v is not None:
-            out[name] = v
-    return out
 
 
 def _read_toml(path: Path) -> dict[str, Any]:
@@ -205,59 +141,163 @@ def _read_toml(path: Path) -> dict[str, Any]:
         raise CampaignError(f"{path}: not valid TOML: {e}") from e
 
 
-def _merge(data: dict[str, Any], overrides: dict[str, dict[str, Any]]) -> dict[str, Any]:
+def _merge(data: dict[str, Any], overrides: dict[str, Any]) -> dict[str, Any]:
+    """``data`` with each section of ``overrides`` merged into its own (a whole section drawn:
+    replaced)."""
     out = dict(data)
     for section, values in overrides.items():
         base = out.get(section, {})
         if not isinstance(base, dict):
             raise CampaignError(f"overrides.{section}: not a scenario table")
-        out[section] = {**base, **values}
+        out[section] = {**base, **values} if isinstance(values, dict) else values
     return out
+
+
+@dataclass(frozen=True)
+class GroupDraws:
+    """What a group, flown as one variant, draws for each run: its base scenario (one file, or
+    a choice of them: ``mission``) and its overrides, with their drawn values parsed."""
+
+    campaign: str
+    group: str
+    scenarios: tuple[str, ...]
+    drawn_scenario: bool
+    files: dict[str, dict[str, Any]]
+    overrides: dict[str, Any]
+
+    def draw(self, index: int) -> tuple[dict[str, Any], Record]:
+        """Run ``index``'s scenario table (its faults not drawn yet) and what it drew."""
+        record = Record()
+
+        def stream(path: str) -> np.random.Generator:
+            return rng_for(self.campaign, self.group, index, "setup", path)
+
+        path = self.scenarios[0]
+        if self.drawn_scenario:
+            path = self.scenarios[int(stream("mission").integers(len(self.scenarios)))]
+            record.add("mission", Path(path).stem,
+                       {"choose": [Path(p).stem for p in self.scenarios]})
+        return _merge(self.files[path], draw_tree(self.overrides, stream, record)), record
+
+
+def _parsed(tree: dict[str, Any], where: str) -> dict[str, Any]:
+    """An overrides table with its drawn values parsed, every setting checked against the
+    scenario; DrawError names the first bad one (``where``: its place in the file)."""
+    parsed = parse_tree(tree, where)
+    check_settings(parsed, where)
+    return parsed
+
+
+def _group_draws(campaign: Campaign, gi: int, layers: dict[str, Any], root: Path
+                 ) -> GroupDraws:
+    """Group ``gi``'s draws over the overrides ``layers`` (the campaign's, merged with the
+    variant's, parsed), checked: DrawError names the first bad drawn value or setting."""
+    group = campaign.groups[gi]
+    spec = _merge(layers, _parsed(group.overrides, f"groups[{gi}].overrides"))
+    _check_spacecraft(campaign, gi, spec)
+    scenario = group.scenario or campaign.base
+    paths = tuple(scenario.choose) if isinstance(scenario, ScenarioChoice) else (scenario,)
+    return GroupDraws(campaign.name, group.name, paths, isinstance(scenario, ScenarioChoice),
+                      {p: _read_toml(root / p) for p in dict.fromkeys(paths)}, spec)
+
+
+def _check_spacecraft(campaign: Campaign, gi: int, spec: dict[str, Any]) -> None:
+    """No fault of group ``gi`` names a spacecraft above the smallest observer count drawn."""
+    observers = spec.get("observers")
+    count = observers.get("count") if isinstance(observers, dict) else None
+    if isinstance(count, Uniform):
+        lowest = count.low
+    elif isinstance(count, Choice) and count.count is None:
+        lowest = min((v for v in count.values if isinstance(v, int)), default=None)
+    else:
+        lowest = None
+    if lowest is None:
+        return
+    for j, f in enumerate(campaign.groups[gi].faults):
+        over = [sc for sc in f.fixed_spacecraft() if sc > lowest]
+        if over:
+            raise DrawError(f"groups[{gi}].faults[{j}].spacecraft: {over[0]} but observers.count "
+                            f"is drawn from {lowest:g}: use spacecraft = \"any\" or an index "
+                            "every drawn count has")
 
 
 def expand(campaign: Campaign, root: Path) -> list[RunSpec]:
     """The campaign's runs, in a deterministic order (module docstring); ``root``: the
     directory scenario paths are relative to."""
+    try:
+        common = _parsed(campaign.overrides, "overrides")
+        layers: dict[int | None, dict[str, Any]] = {
+            vi: _merge(common, _parsed(v.overrides, f"variants[{vi}].overrides"))
+            for vi, v in enumerate(campaign.variants)} or {None: common}
+    except DrawError as e:
+        raise CampaignError(str(e)) from None
     runs: list[RunSpec] = []
-    for group in campaign.groups:
-        for variant in campaign.variants or [None]:
-            runs += _expand_group(campaign, group, variant, root)
+    for gi, group in enumerate(campaign.groups):
+        for vi, layer in layers.items():
+            try:
+                draws = _group_draws(campaign, gi, layer, root)
+            except DrawError as e:
+                raise CampaignError(f"group {group.name}: {e}") from None
+            runs += _expand_group(campaign, group, vi, draws)
     return runs
 
 
-def _expand_group(campaign: Campaign, group: Group, variant: Variant | None,
-                  root: Path) -> list[RunSpec]:
-    """One group's runs, flown as ``variant`` (None: the campaign has no variants); the fault
+def _expand_group(campaign: Campaign, group: Group, vi: int | None,
+                  draws: GroupDraws) -> list[RunSpec]:
+    """One group's runs, flown as variant ``vi`` (None: the campaign has no variants); the
     draws depend on the group and the run's index, never on the variant."""
-    label = group.name if variant is None else f"{group.name}-{variant.name}"
-    base = _merge(_read_toml(root / (group.scenario or campaign.base)),
-                  variant.overrides if variant is not None else {})
-    axes = _axes(group.faults)
+    label = group.name if vi is None else f"{group.name}-{campaign.variants[vi].name}"
+    axes = grid_axes(group.faults)
     combos = list(itertools.product(*(values for _, _, values in axes))) or [()]
     runs: list[RunSpec] = []
-    for seed in _seeds(group.seeds if group.seeds is not None else campaign.seeds):
+    for seed in seeds(group.seeds if group.seeds is not None else campaign.seeds):
         for combo in combos:
             chosen: dict[int, dict[str, Any]] = {}
             for (i, field_name, _), value in zip(axes, combo, strict=True):
                 chosen.setdefault(i, {})[field_name] = value
-            data = _merge(base, group.overrides)
+            run_id = f"{label}-{len(runs):04d}"
+            data, record = draws.draw(len(runs))
             data["seed"] = seed
             if campaign.duration_s is not None:
                 data["duration_s"] = campaign.duration_s
+            data["name"] = f"{campaign.name}-{run_id}"
             if group.nominal:
                 data["faults"] = []
             elif group.faults:
-                rng = _rng(campaign.name, group.name, len(runs))
-                data["faults"] = [_fault(f, chosen.get(i, {}), rng)
-                                  for i, f in enumerate(group.faults)]
-            run_id = f"{label}-{len(runs):04d}"
-            data["name"] = f"{campaign.name}-{run_id}"
-            runs.append(RunSpec(run_id, label, _validated(run_id, data)))
+                data["faults"] = _faults(campaign, group, len(runs), chosen, data, run_id,
+                                         record)
+            runs.append(RunSpec(run_id, label, _validated(run_id, data, record),
+                                record.values, record.domains))
     return runs
 
 
-def _validated(run_id: str, data: dict[str, Any]) -> Scenario:
-    """Run ``run_id``'s scenario; CampaignError says what is wrong with it."""
+def _faults(campaign: Campaign, group: Group, index: int, chosen: dict[int, dict[str, Any]],
+            data: dict[str, Any], run_id: str, record: Record) -> list[dict[str, Any]]:
+    """Run ``index``'s faults, drawn against its set-up ``data`` (validated first when a fault
+    depends on it)."""
+    rng = rng_for(campaign.name, group.name, index)
+    setup = _validated(run_id, {**data, "faults": []}, record) \
+        if any(f.needs_setup() for f in group.faults) else None
+    prefixes = ["fault"] if len(group.faults) == 1 else \
+        [f"fault{i + 1}" for i in range(len(group.faults))]
+    try:
+        return [draw_fault(f, chosen.get(i, {}), rng, setup, record, prefix)
+                for i, (f, prefix) in enumerate(zip(group.faults, prefixes, strict=True))]
+    except OnsetError as e:
+        raise CampaignError(f"run {run_id}: {e}{_drawn_text(record)}") from None
+
+
+def _drawn_text(record: Record) -> str:
+    """`` (drawn: a = 1, ...)``, or nothing when the run drew no set-up."""
+    if not record.values:
+        return ""
+    return " (drawn: " + ", ".join(f"{k} = {v}" for k, v in record.values.items()) + ")"
+
+
+def _validated(run_id: str, data: dict[str, Any], record: Record | None = None) -> Scenario:
+    """Run ``run_id``'s scenario; CampaignError says what is wrong with it (and what the run
+    drew)."""
+    drawn = _drawn_text(record) if record is not None else ""
     try:
         scenario = Scenario.model_validate(data)
         late = [f for f in scenario.faults if f.start_s >= scenario.duration_s]
@@ -266,10 +306,10 @@ def _validated(run_id: str, data: dict[str, Any]) -> Scenario:
                              f"the end of the run ({scenario.duration_s:g} s)")
     except ValueError as e:
         if not isinstance(e, ValidationError):
-            raise CampaignError(f"run {run_id}: {e}") from None
+            raise CampaignError(f"run {run_id}: {e}{drawn}") from None
         raise CampaignError(f"run {run_id}: invalid scenario: "
                             + "; ".join(f"{'.'.join(map(str, err['loc']))}: {err['msg']}"
-                                        for err in e.errors())) from None
+                                        for err in e.errors()) + drawn) from None
     return scenario
 
 
@@ -325,9 +365,18 @@ def _attempt_dir(runs: Path, run_id: str, kind: str) -> Path:
 
 
 def fingerprint(spec: RunSpec) -> str:
-    """A hash of the run's resolved scenario: a finished run directory is reused on resume only
-    for the same run (an edited campaign file changes it)."""
-    return hashlib.sha256(spec.scenario.model_dump_json().encode()).hexdigest()[:16]
+    """A hash of the run's resolved scenario and, when it drew its set-up, of its record
+    (``drawn.json``): a finished run directory is reused on resume only for the same run (an
+    edited campaign file changes it)."""
+    text = spec.scenario.model_dump_json()
+    if spec.drawn:
+        text += json.dumps(_drawn_json(spec), sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _drawn_json(spec: RunSpec) -> dict[str, Any]:
+    """``drawn.json``: what the run drew and each drawn dimension's domain."""
+    return {"drawn": spec.drawn, "domains": spec.domains}
 
 
 def finished(spec: RunSpec, out_root: Path) -> bool:
@@ -349,6 +398,8 @@ def _finish(spec: RunSpec, partial: Path, final: Path, transport: str) -> None:
         {"run": spec.id, "group": spec.group, "seed": spec.seed, "transport": transport,
          "fingerprint": fingerprint(spec), "software_version": software_version()},
         indent=2) + "\n")
+    if spec.drawn:
+        (partial / "drawn.json").write_text(json.dumps(_drawn_json(spec), indent=1) + "\n")
     shutil.rmtree(final, ignore_errors=True)
     partial.rename(final)
 

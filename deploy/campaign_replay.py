@@ -45,8 +45,9 @@ def replay_job(run_dir: str, settings: dict[str, str], dest_root: str) -> dict[s
     dest = Path(dest_root) / "runs" / src.name
     dest.mkdir(parents=True, exist_ok=True)
     summary = RunSummary.read(src / "summary.json")
-    if (src / "campaign.json").exists():  # the run's group and software version
-        shutil.copyfile(src / "campaign.json", dest / "campaign.json")
+    for meta in ("campaign.json", "drawn.json"):  # its group, software version, drawn set-up
+        if (src / meta).exists():
+            shutil.copyfile(src / meta, dest / meta)
     if summary.status == "completed":
         try:
             replay = replay_run(src, settings)

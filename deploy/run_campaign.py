@@ -10,12 +10,13 @@ from one campaign file, on a local process pool or a Dask cluster, resumable.
 
 Each run goes in-process (deploy/inproc.py; --transport zenoh: multi-process, each run on its
 own loopback port and key space) into <out>/runs/<id>/ (run.mcap, summary.json,
-run.log); a run directory appears only when its run has finished (each attempt writes its own
-<id>.partial-<random>, then renames it), so a campaign started again with the same --out skips
-finished runs and redoes
+run.log, and drawn.json when the campaign draws the set-up); a run directory appears only
+when its run has finished (each attempt writes its own <id>.partial-<random>, then renames
+it), so a campaign started again with the same --out skips finished runs and redoes
 half-written ones.  A run that crashes is recorded as failed, with its error, and the campaign
 goes on.  ``--set`` changes a scenario setting of every run flown (e.g.
-``onboard_fdir.enabled=true``: the same campaign with the onboard FDIR on; use another --out).
+``onboard_fdir.enabled=true``: the same campaign with the onboard FDIR on; use another --out;
+a setting the campaign draws per run is refused).
 SIGINT or SIGTERM stops the campaign: running runs are abandoned (redone next time)
 and the report is written over what has finished.  --cluster sends the runs to an existing
 Dask distributed scheduler (its workers must import this repository and see --out).
@@ -44,6 +45,7 @@ import time
 from collections.abc import Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from dataclasses import replace
 from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
@@ -215,7 +217,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         campaign, runs = load_campaign(args.campaign)
         settings = parse_settings(args.settings)
-        runs = [RunSpec(r.id, r.group, scenario_with(r.scenario, settings)) for r in runs]
+        _refuse_drawn(settings, runs)
+        runs = [replace(r, scenario=scenario_with(r.scenario, settings)) for r in runs]
     except (CampaignError, ScenarioError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
@@ -234,6 +237,15 @@ def main(argv: list[str] | None = None) -> int:
     if status == 0 and any(_failed(args.out, r.id) for r in runs):
         return 1
     return status
+
+
+def _refuse_drawn(settings: dict[str, str], runs: list[RunSpec]) -> None:
+    """A ``--set`` of a setting the campaign draws would fly every run with one value while
+    the runs' records say otherwise: refused."""
+    drawn = {k for r in runs for k in r.drawn}
+    clash = sorted(k for k in settings if k in drawn)
+    if clash:
+        raise CampaignError(f"--set {clash[0]}: the campaign draws this setting per run")
 
 
 def _reports(out: Path, name: str, ids: list[str], study: str | None) -> None:

@@ -5,7 +5,9 @@ re-scoring under other rules, are computed in ``harness/campaign/rescore.py``.
 
 Reads ``<out>/runs/<id>/summary.json`` of every run and writes ``<out>/results.csv`` (one row
 per injected fault and detector, plus one per nominal run and detector), ``<out>/report.md``
-(figures over all runs, per campaign group, per fault kind and magnitude) and its plots:
+(figures over all runs, per campaign group, by each dimension a campaign drew per run --
+``harness/campaign/dimensions.py``, also in ``<out>/dimensions.json`` -- per fault kind and
+magnitude) and its plots:
 latency distributions per group, the confusion matrix of identified class against
 injected kind, and a ROC curve per detector from sweeping a scale on its threshold
 (re-scored from each run's ``fdir_series`` with the detector's persistence), a table of
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 import csv
 import functools
+import json
 import math
 import operator
 from collections.abc import Sequence
@@ -33,6 +36,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from harness.campaign.dimensions import BinFigures, Dimension, by_dimension  # noqa: E402
 from harness.campaign.rescore import (  # noqa: E402
     PERSISTENCE_RULES,
     SCALES,
@@ -160,6 +164,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     lines += _side_by_side_lines(rows, detectors, hours)
     groups = list(dict.fromkeys(r.group for r in runs))
     lines += _group_lines(runs, rows, detectors, groups)
+    lines += _dimension_lines(out, by_dimension(loaded, rows))
     lines += _magnitude_lines(rows, detectors, hours)
     lines += _identification_lines(out, rows, hours["main"])
     lines += _rescoring_lines(runs)
@@ -215,6 +220,38 @@ def _group_lines(runs: list[CampaignRun], rows: list[dict[str, Any]], detectors:
                         nominal_hours(mine, d))
             lines.append(f"| {g} | {d} | " + _cells(d, st))
     return lines
+
+
+def _dimension_lines(out: Path, dimensions: list[Dimension]) -> list[str]:
+    """"By drawn dimension": one table per dimension the campaign drew (none if it drew
+    nothing), also written to ``dimensions.json``."""
+    if not dimensions:
+        return []
+    (out / "dimensions.json").write_text(json.dumps(
+        {d.name: d.to_json() for d in dimensions}, indent=1) + "\n")
+    lines = ["", "## By drawn dimension", "",
+             "Each setting the campaign drew per run, its runs in bins (a choice: by value; a "
+             "range: four equal-width bins over its [min, max]); main detector. Latency from "
+             "onset of the isolated faults; false alarms per nominal observer-window and the "
+             "neighbours' per nominal neighbour-window, with their 95% upper bounds. The worst "
+             "bin (most failed runs, then fewest isolated, identified, then the highest "
+             "false-alarm bound, then the longest p90) is in bold "
+             "(harness/campaign/dimensions.py)."]
+    for d in dimensions:
+        lines += ["", f"### {d.name}", "",
+                  "| bin | runs | failed | faults | detected & isolated | identified | latency "
+                  "median / p90 (s) | false alarms per observer-window | neighbours' false "
+                  "alarms per neighbour-window |", "|---|---|---|---|---|---|---|---|---|"]
+        lines += [_bin_row(b) for b in d.bins]
+    return lines
+
+
+def _bin_row(b: BinFigures) -> str:
+    label = f"**{b.label}** (worst)" if b.worst else b.label
+    return (f"| {label} | {b.runs} | {b.failed} | {b.faults} | {_pct(b.isolated, b.faults)} | "
+            f"{_pct(b.identified, b.faults)} | {_fmt(b.latency_median_s)} / "
+            f"{_fmt(b.latency_p90_s)} | {_rate(b.false_alarms, b.windows)} | "
+            f"{_rate(b.neighbour_false_alarms, b.neighbour_windows)} |")
 
 
 def _magnitude_lines(rows: list[dict[str, Any]], detectors: list[str],

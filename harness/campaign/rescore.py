@@ -36,12 +36,21 @@ SCALES = np.geomspace(0.1, 10.0, 41)
 @dataclass(frozen=True)
 class CampaignRun:
     """A finished run of the campaign: its id, campaign group, the software version that ran
-    it, and its summary."""
+    it, its summary, and what it drew of its set-up (``drawn.json``: dimension → value, and
+    each dimension's domain; ``deploy/draws.py``)."""
 
     id: str
     group: str
     version: str
     summary: RunSummary
+    drawn: dict[str, Any] = field(default_factory=dict)
+    domains: dict[str, dict[str, Any]] = field(default_factory=dict)
+
+
+def _json_beside(summary: Path, name: str) -> dict[str, Any]:
+    """A JSON file of the run's directory, or {} when it has none."""
+    path = summary.parent / name
+    return json.loads(path.read_text()) if path.exists() else {}
 
 
 def load_runs(out: Path, ids: Sequence[str]) -> list[CampaignRun]:
@@ -52,11 +61,11 @@ def load_runs(out: Path, ids: Sequence[str]) -> list[CampaignRun]:
     for rid in ids:
         p = out / "runs" / rid / "summary.json"
         if p.exists():
-            meta_path = p.parent / "campaign.json"
-            meta = json.loads(meta_path.read_text()) if meta_path.exists() else {}
+            meta, drawn = _json_beside(p, "campaign.json"), _json_beside(p, "drawn.json")
             runs.append(CampaignRun(rid, meta.get("group") or rid.rsplit("-", 1)[0],
                                     meta.get("software_version", "unknown"),
-                                    RunSummary.read(p)))
+                                    RunSummary.read(p), drawn.get("drawn", {}),
+                                    drawn.get("domains", {})))
     return runs
 
 

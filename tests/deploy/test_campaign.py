@@ -179,7 +179,7 @@ def test_every_shipped_campaign_expands() -> None:
     """Each file of deploy/campaigns/ loads and expands into valid runs (counts as their
     headers state)."""
     counts = {"paper": 200, "hard": 58, "beyond": 64, "formations": 48, "identify": 184,
-              "passes": 52}
+              "passes": 52, "space": 360}
     root = Path(__file__).resolve().parents[2] / "deploy" / "campaigns"
     for path in sorted(root.glob("*.toml")):
         campaign, runs = load_campaign(path)
