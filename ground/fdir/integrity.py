@@ -2,11 +2,13 @@
 (``InfoCostTelemetry``) at an FDI window boundary against the contribution the ground computes
 from the observations it received.
 
-The ground's map then holds every image before the boundary; every observer's precision is
-scaled up by the share of its observations lost on the way (sequence gaps,
-``observer.ground_contributions``), so ψ is as consistent as the ground can make it: the
-observer's H_i holds all of its images.  The two views then differ only by what each has fused
-(range-limited sharing), so a relative difference above ``fdir.integrity_tol`` is an
+The ground's map then holds every image before the boundary that came down.  Each observer's
+report is recomputed on the view it fused (``fused_views.py``: its own images and those of
+the observers in crosslink range when they were taken), every observer's precision scaled up
+by the share of its observations lost on the way (sequence gaps, and its store's overflow),
+so ψ is as consistent as the ground can make it: the observer's H_i holds all of its images.
+The two then differ only by the crosslinks' loss, so a relative difference above
+``fdir.integrity_tol`` is an
 inconsistent report, and ``fdir.checks_persistence`` of them in a row a data-integrity fault.
 
 The recomputation holds only while the ground has nearly every observation: ψ depends on every
@@ -24,7 +26,8 @@ from collections.abc import Callable
 import numpy as np
 
 from gnc.poi_map import PoiMap
-from ground.fdir.observer import ObserverState, ground_contributions
+from ground.fdir.fused_views import FusedViews
+from ground.fdir.observer import ObserverState
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, InfoCostTelemetry, Unjudged
 from interfaces.contracts.scenario import FdirSettings
@@ -46,11 +49,13 @@ class IntegrityCheck:
         """Keep the H_i ``msg`` reports at window boundary ``boundary``."""
         self._reported[(msg.spacecraft, boundary)] = msg.h_i
 
-    def check(self, j: int, b: float, settled: PoiMap, observers: dict[int, ObserverState],
+    def check(self, j: int, b: float, settled: PoiMap, views: FusedViews,
+              observers: dict[int, ObserverState],
               excludes: Callable[[int], bool] = lambda sc: False
               ) -> tuple[list[FaultReport], dict[int, Unjudged]]:
         """Judge the reports at boundary ``j`` (time b, s) against ``settled``, the ground's
-        map holding every image before b that came down; returns the data-integrity faults
+        map holding every image before b that came down, each on the view its observer fused
+        (``views``: ``fused_views.py``); returns the data-integrity faults
         declared and, by observer, why its report was not judged (module docstring).  No
         report is judged while any observer's reports before b are still aboard (the map
         lacks them), or more of any observer's observations are lost than
@@ -58,15 +63,16 @@ class IntegrityCheck:
         report of an observer that ``excludes`` a neighbour its neighbours declared (it fuses
         less than the ground)."""
         lost = np.array([o.lost_fraction() for o in observers.values()])
-        ground = ground_contributions(settled, lost)
+        reports = {sc: self._reported.pop((sc, j), None) for sc in observers}
+        ground = views.contributions(settled, lost)
         why = self._blocked(b, lost, observers)
         out: list[FaultReport] = []
         unjudged: dict[int, Unjudged] = {}
-        for sc in observers:
-            reported = self._reported.pop((sc, j), None)
+        for sc, report in reports.items():
             mine = float(ground[sc - 1])
-            if reported is None or mine <= 0.0:
+            if report is None or mine <= 0.0:
                 continue
+            reported = report
             reason = why or ("excluded" if excludes(sc) else None)
             if reason is not None:
                 unjudged[sc] = reason
@@ -97,3 +103,4 @@ class IntegrityCheck:
                           "observations lost (data integrity needs at most %.0f%%; %d unjudged "
                           "so far)", sc, reason, 100 * lost.max(initial=0.0),
                           int(np.argmax(lost)) + 1, 100 * self.cfg.integrity_max_loss, count)
+

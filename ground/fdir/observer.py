@@ -105,8 +105,11 @@ class ObserverState:
 
     def aboard_before(self, b: float) -> bool:
         """Whether reports it sent before ``b`` (s) are still aboard (ground passes): a window
-        ending at b is then judged on part of its data."""
-        return self.aboard_since_s is not None and self.aboard_since_s < b
+        ending at b is then judged on part of its data.  The store's accounting comes with the
+        ground's link counters, once a cycle; a report sent at or after b that came down says
+        more recently that all before it did (its topics come down in send order)."""
+        return (self.aboard_since_s is not None and self.aboard_since_s < b
+                and self.heard_s < b)
 
     def heard(self, t_s: float) -> None:
         """A nav, attitude or image report sent at ``t_s`` (s) came in."""

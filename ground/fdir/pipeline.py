@@ -31,6 +31,7 @@ from gnc.passes import ContactPlan
 from gnc.poi_map import PoiMap
 from gnc.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.declaration import Declarer
+from ground.fdir.fused_views import FusedViews
 from ground.fdir.global_check import GlobalCheck
 from ground.fdir.information import InformationTest, Judgement
 from ground.fdir.integrity import IntegrityCheck
@@ -79,6 +80,8 @@ class FdirPipeline:
                               sc.target.radius_m, sc.camera.noise_frac)
         self.settled = PoiMap.uniform(sc.target.pois, sc.target.prior_variance,
                                       sc.observers.count)
+        self.views = FusedViews.of(sc.observers.count, sc.target.pois, sc.comms.range_m)
+        """what each observer fused, for the data-integrity check"""
         self.pending: list[PoiObservations] = []
         self.observers = {i: ObserverState() for i in range(1, sc.observers.count + 1)}
         self.boresight_body = constants.boresight_body
@@ -109,6 +112,7 @@ class FdirPipeline:
             self.pending.append(msg)
         else:  # too late for its window's verdict, not for the ground's map
             self.settled.add(msg.spacecraft, *msg.arrays())
+            self.views.add(msg, self.observers)
 
     def transfer(self, msg: TransferPlanMsg) -> None:
         if msg.spacecraft not in self.observers or len(msg.t_s) < 2:
@@ -123,14 +127,19 @@ class FdirPipeline:
 
     def assignments(self, msg: ProAssignments) -> None:
         """The ground's own assignments.  With ground passes one sent out of contact waits for
-        the next pass, so the plan is in force from then at the earliest."""
+        the next pass, so the plan is in force from then at the earliest; of those held for
+        the same pass an observer flies only the newest, so an older plan that would start no
+        earlier than a newer one is dropped (superseded before it started)."""
         reach = self.contact.next_contact(msg.t_sim) if self.contact is not None else 0.0
         for a in msg.assignments:
             obs = self.observers.get(a.spacecraft)
             if obs is None or a.assignment_id in obs.plans:
                 continue
-            obs.plans[a.assignment_id] = FlightPlan.of(
-                a, max(a.t_depart_s, reach), self._transfers.get((a.spacecraft, a.assignment_id)))
+            plan = FlightPlan.of(a, max(a.t_depart_s, reach),
+                                 self._transfers.get((a.spacecraft, a.assignment_id)))
+            obs.plans = {k: p for k, p in obs.plans.items()
+                         if k > a.assignment_id or p.starts_s < plan.starts_s - TIME_TOL_S}
+            obs.plans[a.assignment_id] = plan
 
     def telemetry(self, msg: InfoCostTelemetry) -> None:
         j = self.schedule.boundary_at(msg.t_sim)
@@ -268,8 +277,8 @@ class FdirPipeline:
         out += self.rulings.rule(b, {w.spacecraft: w.exceeded for w in out
                                      if isinstance(w, FdirWindow)})
         self._settle(inside, b)
-        reports, unjudged = self.integrity.check(k + 1, b, self.settled, self.observers,
-                                                 self.rulings.excludes)
+        reports, unjudged = self.integrity.check(k + 1, b, self.settled, self.views,
+                                                 self.observers, self.rulings.excludes)
         return [m.model_copy(update={"integrity_unjudged": unjudged[m.spacecraft]})
                 if isinstance(m, FdirWindow) and m.spacecraft in unjudged else m
                 for m in out] + reports
@@ -287,11 +296,13 @@ class FdirPipeline:
         return None
 
     def _settle(self, inside: list[PoiObservations], b: float) -> None:
-        """The judged window's images join the ground's map; what no later window needs goes."""
-        for obs in self.observers.values():
-            obs.forget_before(b)
+        """The judged window's images join the ground's map and the views their observers
+        fused (by the nav positions of the window: first); what no later window needs goes."""
         for m in inside:
             self.settled.add(m.spacecraft, *m.arrays())
+            self.views.add(m, self.observers)
+        for obs in self.observers.values():
+            obs.forget_before(b)
         self.pending = [m for m in self.pending if m.image_t_s >= b]
 
     def _cost(self) -> float:

@@ -20,6 +20,9 @@ from interfaces.contracts.messages import (
     Message,
     OnboardFdirEvent,
     PoiObservations,
+    ProAssignment,
+    ProAssignments,
+    ProElements,
 )
 from interfaces.runtime.app import AppContext
 from interfaces.runtime.bus import Bus
@@ -93,3 +96,53 @@ def test_a_camera_turned_off_onboard_is_not_a_link_fault(camera_off: bool) -> No
     assert reports == ([] if camera_off else [(2, "link", 30.0)])
     windows = [m for m in sent if isinstance(m, FdirWindow) and m.spacecraft == 2]
     assert len(windows) == 4 and all(w.metric is None for w in windows)
+
+
+def _passes_app() -> FdirApp:
+    """The FDIR of two observers under one station's passes (29-498 s, then 5,963 s)."""
+    sc = small_scenario("fp", duration_s=6400.0, target={"pois": 200},
+                        rates={"fdi_period_s": 30.0},
+                        observers={"count": 2},
+                        orbit={"inclination_deg": 51.6, "raan_deg": 255.0,
+                               "arg_latitude_deg": 90.0},
+                        ground={"contact": "passes", "stations": [
+                            {"name": "mid", "latitude_deg": 48.08, "longitude_deg": 11.28}]})
+    bus = Bus("ground", "fp", InprocNetwork().endpoint())
+    return FdirApp(AppContext(bus=bus, scenario=sc, node="ground", spacecraft=None,
+                              rng=np.random.default_rng(0), log=logging.getLogger("t")))
+
+
+def _assignment(aid: int, t_sim: float, t_depart: float) -> ProAssignments:
+    pro = ProElements(rho_x_m=10.0 + aid, alpha_x_rad=0.0, rho_y_m=0.0, rho_z_m=15.0,
+                      alpha_z_rad=0.0)
+    return ProAssignments(sender="ground", seq=aid, t_sim=t_sim, assignments=[ProAssignment(
+        spacecraft=1, assignment_id=aid, phase="p", pro=pro, t_depart_s=t_depart,
+        t_arrive_s=t_depart + 600.0)])
+
+
+def test_assignments_held_for_a_pass_leave_only_the_newest_in_force() -> None:
+    """Sent out of contact, each waits for the pass at 5,963 s; the observer flies only the
+    newest, so the older ones, superseded before they started, are no plan of the twin's."""
+    pipeline = _passes_app().pipeline
+    pipeline.assignments(_assignment(1, 10.0, 100.0))  # in contact: in force from 100 s
+    pipeline.assignments(_assignment(2, 1000.0, 1100.0))  # held: from the next acquisition
+    pipeline.assignments(_assignment(3, 2000.0, 2100.0))
+    plans = pipeline.observers[1].plans
+    assert sorted(plans) == [1, 3]
+    assert plans[1].t_from_s == 100.0 and plans[3].t_from_s == pytest.approx(5963.0, abs=1.0)
+
+
+def test_a_window_whose_reports_are_lost_or_aboard_is_not_judged_and_says_why() -> None:
+    pipeline = _passes_app().pipeline
+    obs = pipeline.observers
+    obs[1].plans[1] = obs[2].plans[1] = FlightPlan(0.0, Pro(20.0, 0.0, 0.0, 25.0, 0.0))
+    obs[1].overflow = [(40.0, 50.0)]  # sc1's store lost its reports of [30, 60)
+    obs[2].aboard_since_s = 45.0  # sc2's reports from 45 s are still aboard
+    out = [*pipeline.evaluate(0), *pipeline.evaluate(1)]
+    windows = {(w.spacecraft, w.t_start_s): w for w in out if isinstance(w, FdirWindow)}
+    assert windows[(1, 30.0)].unjudged == "store_overflow"
+    assert windows[(2, 30.0)].unjudged == "aboard"
+    assert windows[(2, 0.0)].unjudged == "no_images"  # before: nothing received, a silence
+    assert all(w.exceeded is None for w in windows.values())
+    reports = [r for r in out if isinstance(r, FaultReport)]
+    assert [(r.spacecraft, r.cause) for r in reports] == [(1, "store_overflow")]

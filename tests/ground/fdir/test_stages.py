@@ -18,6 +18,7 @@ from gnc.pro import Pro
 from gnc.twin import FlightPlan
 from ground.fdir.constellation import ConstellationVerdict
 from ground.fdir.declaration import Declarer
+from ground.fdir.fused_views import FusedViews
 from ground.fdir.global_check import GlobalCheck
 from ground.fdir.identify import Evidence
 from ground.fdir.information import Judgement
@@ -151,6 +152,7 @@ def _integrity_over_two_boundaries(observers: dict[int, ObserverState]
     settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
     settled.add(2, np.array([2, 3]), np.array([0.5, 0.5]))
     truth = settled.contributions()
+    views = FusedViews(80.0, np.tile(settled.F.sum(axis=0), (2, 1)))  # each fused everything
     out = []
     for j in (1, 2):
         for sc, factor in ((1, 1.5), (2, 1.0)):  # sc1 inflates its H_i by half
@@ -158,7 +160,7 @@ def _integrity_over_two_boundaries(observers: dict[int, ObserverState]
                 sender=f"sc{sc}", t_sim=10.0 * j, spacecraft=sc,
                 h_i=factor * float(truth[sc - 1]), h_local=1.0, prior_term=0.5,
                 pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=0), j)
-        out.append(check.check(j, 10.0 * j, settled, observers))
+        out.append(check.check(j, 10.0 * j, settled, views, observers))
     return out
 
 
