@@ -83,7 +83,11 @@ class ObserverState:
     """its observations its onboard store lost to overflow (ground passes), since the start"""
     aboard_since_s: float | None = None
     """send time of its oldest report the ground FDIR judges still aboard (ground passes;
-    None: none aboard), from its store's accounting"""
+    None: none aboard), from its store's accounting as it came down with its dump"""
+    aboard_pass: int = -1
+    """index of the contact in which that accounting came down"""
+    dumped_seen: int = 0
+    """messages its store had dumped when the ground last took its accounting"""
     resync: bool = False
     """the next judged window numbers its observations afresh (the store lost some before)"""
     heard_s: float = -math.inf

@@ -194,7 +194,10 @@ class FdirPipeline:
             runs = c.store.overflow_runs
             obs.overflow = [(r.first_s, r.last_s) for r in runs if r.topic in FDIR_DOWNLINK_TOPICS]
             obs.overflow_observations = sum(r.count for r in runs if r.topic == OBSERVATIONS_TOPIC)
-            obs.aboard_since_s = c.store.judged_since_s
+            if c.store.dumped > obs.dumped_seen and self.contact is not None:
+                # what is aboard is known from what comes down: a cut link tells nothing
+                obs.dumped_seen, obs.aboard_since_s = c.store.dumped, c.store.judged_since_s
+                obs.aboard_pass = self.contact.pass_index(msg.t_sim)
 
     def guidance(self, msg: GuidanceStatus) -> None:
         obs = self.observers.get(msg.spacecraft)
@@ -216,6 +219,8 @@ class FdirPipeline:
             for o in self.observers.values():
                 o.heard_pass = now if o.fresh else o.heard_pass
                 o.fresh = False
+                if o.aboard_pass < now:  # not heard of in this pass: not known to be aboard
+                    o.aboard_since_s = None
         while (t >= self.schedule.end(self.next_window) + self.latency_s - TIME_TOL_S
                and self._data_in(self.next_window, t)):
             k = self.next_window

@@ -192,7 +192,7 @@ def test_missing_or_foreign_file_is_a_clear_error(tmp_path: Path,
     out = tmp_path / "x.parquet"
     assert archive_main(["export", str(tmp_path / "none.mcap"), "--topic", NAV_1,
                          "--out", str(out)]) == 2
-    assert "no such archive" in capsys.readouterr().err and not out.exists()
+    assert "no such file or folder" in capsys.readouterr().err and not out.exists()
 
 
 def test_invalid_payloads_raise_or_are_skipped(archive: RunArchive, tmp_path: Path) -> None:

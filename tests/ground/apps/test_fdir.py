@@ -17,12 +17,15 @@ from ground.apps.fdir import FdirApp
 from interfaces.contracts.messages import (
     FaultReport,
     FdirWindow,
+    LinkCounter,
+    LinkStats,
     Message,
     OnboardFdirEvent,
     PoiObservations,
     ProAssignment,
     ProAssignments,
     ProElements,
+    StoreCounter,
 )
 from interfaces.runtime.app import AppContext
 from interfaces.runtime.bus import Bus
@@ -146,3 +149,22 @@ def test_a_window_whose_reports_are_lost_or_aboard_is_not_judged_and_says_why() 
     assert all(w.exceeded is None for w in windows.values())
     reports = [r for r in out if isinstance(r, FaultReport)]
     assert [(r.spacecraft, r.cause) for r in reports] == [(1, "store_overflow")]
+
+
+def test_what_is_aboard_is_known_only_from_what_comes_down() -> None:
+    """The store's accounting counts once its dump brought something down (a cut link tells
+    the ground nothing), and only in the pass it came in."""
+    pipeline = _passes_app().pipeline
+    obs = pipeline.observers[1]
+
+    def stats(t: float, dumped: int, since: float | None) -> LinkStats:
+        store = StoreCounter(dumped=dumped, judged_since_s=since)
+        return LinkStats(sender="ground", t_sim=t, node="ground", links=[
+            LinkCounter(src="sc1", dst="ground", store=store)])
+
+    pipeline.link_stats(stats(100.0, 0, 40.0))  # nothing came down: unknown
+    assert obs.aboard_since_s is None
+    pipeline.link_stats(stats(110.0, 5, 40.0))
+    assert obs.aboard_since_s == 40.0 and obs.aboard_before(60.0)
+    pipeline.due(6000.0)  # the next pass, in which nothing of sc1 came down
+    assert obs.aboard_since_s is None and not obs.aboard_before(60.0)
