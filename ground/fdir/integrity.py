@@ -90,9 +90,13 @@ class IntegrityCheck:
 
     def _blocked(self, b: float, lost: np.ndarray, observers: dict[int, ObserverState]
                  ) -> Unjudged | None:
-        """Why no report at b (s) can be judged: reports still aboard, or too much lost."""
+        """Why no report at b (s) can be judged: reports still aboard; too much lost; or an
+        observer gone silent (its images before the silence may have reached its neighbours
+        over the crosslinks and never the ground: the views cannot be rebuilt)."""
         if any(o.aboard_before(b) for o in observers.values()):
             return "aboard"
+        if any(o.silent > 0 or o.link_declared for o in observers.values()):
+            return "lost"
         return "lost" if float(lost.max(initial=0.0)) > self.cfg.integrity_max_loss else None
 
     def _unjudged(self, sc: int, reason: Unjudged, lost: np.ndarray) -> None:

@@ -192,3 +192,11 @@ def test_no_integrity_verdict_while_reports_before_the_boundary_are_still_aboard
     out = _integrity_over_two_boundaries(observers)
     assert [u for _, u in out] == [{}, {1: "aboard", 2: "aboard"}]
     assert [r for r, _ in out] == [[], []]  # the first failed report alone does not persist
+
+
+def test_no_integrity_verdict_while_an_observer_is_silent() -> None:
+    """sc2 went silent (a cut link): what it shared with its neighbours before the cut may
+    never reach the ground, so no report is judged until it is heard again."""
+    out = _integrity_over_two_boundaries({1: ObserverState(), 2: ObserverState(silent=1)})
+    assert [u for _, u in out] == [{1: "lost", 2: "lost"}] * 2
+    assert [r for r, _ in out] == [[], []]
