@@ -21,6 +21,7 @@ observations are missing, no report is judged (counted in ``unjudged``, logged).
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -36,8 +37,11 @@ from interfaces.contracts.scenario import FdirSettings
 class IntegrityCheck:
     """The observers' H_i reports awaiting their boundary, and the check's persistence."""
 
-    def __init__(self, cfg: FdirSettings, node: str, log: logging.Logger) -> None:
+    def __init__(self, cfg: FdirSettings, node: str, log: logging.Logger,
+                 period_s: float = math.inf) -> None:
         self.cfg = cfg
+        self.period_s = period_s
+        """the FDI window's length, s (inf: every observer counts as heard)"""
         self.node = node
         self.log = log
         self.persistence = Persistence(cfg.checks_persistence)
@@ -65,7 +69,7 @@ class IntegrityCheck:
         lost = np.array([o.lost_fraction() for o in observers.values()])
         reports = {sc: self._reported.pop((sc, j), None) for sc in observers}
         ground = views.contributions(settled, lost)
-        why = self._blocked(b, lost, observers)
+        why = self._blocked(b, self.period_s, lost, observers)
         out: list[FaultReport] = []
         unjudged: dict[int, Unjudged] = {}
         for sc, report in reports.items():
@@ -88,14 +92,15 @@ class IntegrityCheck:
         self._reported = {k: v for k, v in self._reported.items() if k[1] > j}
         return out, unjudged
 
-    def _blocked(self, b: float, lost: np.ndarray, observers: dict[int, ObserverState]
-                 ) -> Unjudged | None:
+    def _blocked(self, b: float, period_s: float, lost: np.ndarray,
+                 observers: dict[int, ObserverState]) -> Unjudged | None:
         """Why no report at b (s) can be judged: reports still aboard; too much lost; or an
-        observer gone silent (its images before the silence may have reached its neighbours
-        over the crosslinks and never the ground: the views cannot be rebuilt)."""
+        observer not heard from since the window's start ``b - period_s`` (its images may
+        have reached its neighbours over the crosslinks and never the ground, or not yet: the
+        views cannot be rebuilt)."""
         if any(o.aboard_before(b) for o in observers.values()):
             return "aboard"
-        if any(o.silent > 0 or o.link_declared for o in observers.values()):
+        if any(o.heard_s < b - period_s for o in observers.values()):
             return "lost"
         return "lost" if float(lost.max(initial=0.0)) > self.cfg.integrity_max_loss else None
 

@@ -194,9 +194,22 @@ def test_no_integrity_verdict_while_reports_before_the_boundary_are_still_aboard
     assert [r for r, _ in out] == [[], []]  # the first failed report alone does not persist
 
 
-def test_no_integrity_verdict_while_an_observer_is_silent() -> None:
-    """sc2 went silent (a cut link): what it shared with its neighbours before the cut may
-    never reach the ground, so no report is judged until it is heard again."""
-    out = _integrity_over_two_boundaries({1: ObserverState(), 2: ObserverState(silent=1)})
-    assert [u for _, u in out] == [{1: "lost", 2: "lost"}] * 2
-    assert [r for r, _ in out] == [[], []]
+def test_no_integrity_verdict_while_an_observer_is_not_heard_from() -> None:
+    """sc2 sent nothing that reached the ground since the window's start (a cut link, or its
+    dump still to come): what it shared with its neighbours may never reach the ground, so no
+    report is judged until it is heard again."""
+    cfg = small_scenario(fdir={"checks_persistence": 1}).fdir
+    check = IntegrityCheck(cfg, "ground", LOG, period_s=10.0)
+    settled = PoiMap.uniform(10, 1.0, 2)
+    settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
+    views = FusedViews(80.0, np.tile(settled.F.sum(axis=0), (2, 1)))
+    observers = {1: ObserverState(heard_s=19.0), 2: ObserverState(heard_s=5.0)}
+    report = InfoCostTelemetry(
+        sender="sc1", t_sim=20.0, spacecraft=1, h_i=9.0, h_local=1.0, prior_term=0.5,
+        pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=0)  # far off
+    check.reported(report, 2)
+    assert check.check(2, 20.0, settled, views, observers) == ([], {1: "lost"})
+    observers[2].heard_s = 12.0  # heard in the window: judged, and found off
+    check.reported(report, 2)
+    reports, unjudged = check.check(2, 20.0, settled, views, observers)
+    assert unjudged == {} and [r.fault_class for r in reports] == ["data_integrity"]
