@@ -32,18 +32,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from gnc.passes import ContactPlan
+from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import PoiObservations
 from interfaces.contracts.scenario import Scenario
 from links.onboard_store import message_bytes
 
-OBSERVATIONS = "camera/observations"
+OBSERVATIONS = cat.OBSERVATIONS.path
 
 FIXED_BYTES: dict[str, tuple[str, float]] = {
-    "nav/estimate": ("mid", 770.0),
-    "attitude/estimate": ("mid", 725.0),
-    "exec/heartbeat": ("mid", 165.0),
-    "guidance/status": ("low", 500.0),
-    "infocost/telemetry": ("fdi", 400.0),
+    cat.NAV_ESTIMATE.path: ("mid", 770.0),
+    cat.ATTITUDE_ESTIMATE.path: ("mid", 725.0),
+    cat.HEARTBEAT.path: ("mid", 165.0),
+    cat.GUIDANCE_STATUS.path: ("low", 500.0),
+    cat.INFO_COST.path: ("fdi", 400.0),
 }
 """Fixed-size topics each observer stores for the ground: (rate group, JSON bytes per message,
 as ``message_bytes`` counts them on the default mission).  Rare ones (transfer plans, FDIR
@@ -156,14 +157,23 @@ class DataBudget:
         return self.peak_bytes <= self.store_bytes
 
     def warnings(self) -> list[str]:
-        """What the launcher warns about at load: a store that cannot hold the peak."""
-        if self.holds:
-            return []
-        return [f"[ground] store_bytes = {self.store_bytes:,} cannot hold what accumulates "
+        """What the launcher warns about at load: a store that cannot hold the peak, and
+        passes too short to dump what accumulates."""
+        out = []
+        if not self.holds:
+            out.append(
+                f"[ground] store_bytes = {self.store_bytes:,} cannot hold what accumulates "
                 f"between dumps: about {self.total_Bps:,.0f} B/s per observer "
                 f"({self.rates_Bps[OBSERVATIONS]:,.0f} of them observations) peaks at "
                 f"{self.peak_bytes:,.0f} bytes aboard at {self.downlink_bps:,.0f} bit/s; the "
-                "store will overflow (housekeeping first, the FDIR's data last)"]
+                "store will overflow (housekeeping first, the FDIR's data last)")
+        if self.aboard_after_last_pass_bytes > 0.0:
+            out.append(
+                f"[ground] downlink_bps = {self.downlink_bps:,.0f}: the passes cannot dump "
+                f"what accumulates (about {self.total_Bps:,.0f} B/s per observer); "
+                f"{self.aboard_after_last_pass_bytes:,.0f} bytes stay aboard after the last "
+                "pass, and the ground's judgement falls behind")
+        return out
 
 
 def budget(scenario: Scenario) -> DataBudget | None:

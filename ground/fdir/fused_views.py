@@ -23,35 +23,47 @@ from interfaces.contracts.messages import PoiObservations
 
 @dataclass
 class FusedViews:
-    """The precision each observer has fused per POI (N, M), its own and its neighbours'."""
+    """The precision each observer has fused per POI (N, M), its own and its neighbours', and
+    how many of each observer's images each fused (N receivers, N observers)."""
 
     range_m: float
     fused: np.ndarray
+    images: np.ndarray
 
     @classmethod
     def of(cls, observers: int, pois: int, range_m: float) -> FusedViews:
-        return cls(range_m, np.zeros((observers, pois)))
+        return cls(range_m, np.zeros((observers, pois)), np.zeros((observers, observers)))
 
-    def add(self, msg: PoiObservations, observers: dict[int, ObserverState]) -> None:
-        """Image ``msg`` joins its observer's view, and the view of every observer that was in
-        range of it at the image time (both nav positions known: ``ObserverState.nav``)."""
-        idx, prec = msg.arrays()
-        t = np.array([msg.image_t_s])
-        here = observers[msg.spacecraft].nav.at(t)
+    def add(self, images: list[PoiObservations], observers: dict[int, ObserverState]) -> None:
+        """``images`` join their observers' views, and the view of every observer that was in
+        range of theirs at the image time (both nav positions known: ``ObserverState.nav``,
+        looked up once per observer for all the images)."""
+        if not images:
+            return
+        times = np.array([m.image_t_s for m in images])
+        pos = np.full((len(self.fused), len(images), 3), np.nan)
         for sc, obs in observers.items():
-            if sc != msg.spacecraft:
-                there = obs.nav.at(t)
-                if here is None or there is None or (
-                        float(np.linalg.norm(there - here)) > self.range_m):
-                    continue
-            self.fused[sc - 1, idx] += prec
+            values = obs.nav.at_each(times)
+            if values is not None:
+                pos[sc - 1] = values
+        k = np.arange(len(images))
+        own = np.array([m.spacecraft - 1 for m in images])
+        reach = np.linalg.norm(pos - pos[own, k][None, :, :], axis=2) <= self.range_m
+        reach[own, k] = True
+        for m, rows in zip(images, reach.T, strict=True):
+            idx, prec = m.arrays()
+            self.fused[np.ix_(np.flatnonzero(rows), idx)] += prec
+            self.images[rows, m.spacecraft - 1] += 1
 
     def contributions(self, settled: PoiMap, lost: np.ndarray) -> np.ndarray:
-        """Each observer's H_i (N,) on its own view: ψ from what it fused, its own precision
-        scaled up by the share of its observations lost on the way to the ground (``lost``,
-        capped at ``MAX_JUDGED_LOSS``: such an observer is not judged), as it holds them all."""
-        scale = 1.0 / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS))
-        own = settled.F * scale[:, None]
-        view = self.fused + settled.F * (scale - 1.0)[:, None]
+        """Each observer's H_i (N,) on its own view: ψ from what it fused, every observer's
+        precision scaled up by the share of its observations lost on the way to the ground
+        (``lost``, capped at ``MAX_JUDGED_LOSS``: such an observer is not judged), in each
+        view by the share of its images that view holds."""
+        extra = 1.0 / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS)) - 1.0
+        held = np.divide(self.images, np.diag(self.images)[None, :],
+                         out=np.zeros_like(self.images), where=np.diag(self.images) > 0)
+        view = self.fused + (held * extra[None, :]) @ settled.F
         psi = 1.0 / (settled.w_inv[None, :] + view) ** 2
+        own = settled.F * (1.0 + extra)[:, None]
         return np.einsum("im,im->i", own, psi * settled.phi[None, :])

@@ -13,8 +13,6 @@ from itertools import pairwise
 
 import numpy as np
 
-from gnc.infocost import agent_contributions
-from gnc.poi_map import PoiMap
 from gnc.twin import FlightPlan, plans_in_force
 
 
@@ -37,16 +35,22 @@ class TimeSeries:
     def at(self, times: np.ndarray) -> np.ndarray | None:
         """Values (K, d) at ``times`` (K,), or None unless every time is within ``MAX_GAP_S``
         of a sample."""
+        values = self.at_each(times)
+        return None if values is None or np.isnan(values).any() else values
+
+    def at_each(self, times: np.ndarray) -> np.ndarray | None:
+        """Values (K, d) at ``times`` (K,), NaN at a time farther than ``MAX_GAP_S`` from
+        every sample; None without any sample."""
         if not self.t:
             return None
         t = np.array(self.t)
         j = np.searchsorted(t, times)
         before = np.abs(times - t[np.clip(j - 1, 0, len(t) - 1)])
         after = np.abs(t[np.clip(j, 0, len(t) - 1)] - times)
-        if np.any(np.minimum(before, after) > self.MAX_GAP_S):
-            return None
         v = np.array(self.v)
-        return np.stack([np.interp(times, t, v[:, j]) for j in range(v.shape[1])], axis=1)
+        out = np.stack([np.interp(times, t, v[:, j]) for j in range(v.shape[1])], axis=1)
+        out[np.minimum(before, after) > self.MAX_GAP_S] = np.nan
+        return out
 
     def forget_before(self, t: float) -> None:
         """Drop samples no later window needs (keep the last one before t)."""
@@ -217,12 +221,3 @@ def loss_limit(packet_loss: float, burst_packets: float, loss_tol: float, sent: 
 MAX_JUDGED_LOSS = 0.9
 """An observer with a larger share of its observations lost has no data-integrity verdict."""
 
-
-def ground_contributions(settled: PoiMap, lost: np.ndarray) -> np.ndarray:
-    """Each observer's contribution H_i as the ground computes it from the observations it
-    received (Eq. 8), with every observer's precision scaled up by the share of its observations
-    lost on the way (``lost``, per observer), so ψ is as consistent as the ground can make it:
-    an observer's own H_i holds all of its images.  Shares above ``MAX_JUDGED_LOSS`` are
-    capped (such an observer is not judged)."""
-    scaled = settled.F / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS))[:, None]
-    return agent_contributions(settled.phi, settled.w_inv, scaled)

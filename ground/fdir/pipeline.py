@@ -61,8 +61,6 @@ from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.contracts.topics import spacecraft_of
 
-OBSERVATIONS_TOPIC = f"{OBSERVATIONS.app}/{OBSERVATIONS.name}"
-
 
 class FdirPipeline:
     """The FDIR's state and its window-by-window judgement, for ``scenario`` (whose constants
@@ -112,7 +110,7 @@ class FdirPipeline:
             self.pending.append(msg)
         else:  # too late for its window's verdict, not for the ground's map
             self.settled.add(msg.spacecraft, *msg.arrays())
-            self.views.add(msg, self.observers)
+            self.views.add([msg], self.observers)
 
     def transfer(self, msg: TransferPlanMsg) -> None:
         if msg.spacecraft not in self.observers or len(msg.t_s) < 2:
@@ -193,7 +191,7 @@ class FdirPipeline:
                 continue
             runs = c.store.overflow_runs
             obs.overflow = [(r.first_s, r.last_s) for r in runs if r.topic in FDIR_DOWNLINK_TOPICS]
-            obs.overflow_observations = sum(r.count for r in runs if r.topic == OBSERVATIONS_TOPIC)
+            obs.overflow_observations = sum(r.count for r in runs if r.topic == OBSERVATIONS.path)
             if c.store.dumped > obs.dumped_seen and self.contact is not None:
                 # what is aboard is known from what comes down: a cut link tells nothing
                 obs.dumped_seen, obs.aboard_since_s = c.store.dumped, c.store.judged_since_s
@@ -305,7 +303,7 @@ class FdirPipeline:
         fused (by the nav positions of the window: first); what no later window needs goes."""
         for m in inside:
             self.settled.add(m.spacecraft, *m.arrays())
-            self.views.add(m, self.observers)
+        self.views.add(inside, self.observers)
         for obs in self.observers.values():
             obs.forget_before(b)
         self.pending = [m for m in self.pending if m.image_t_s >= b]

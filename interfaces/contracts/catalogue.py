@@ -87,8 +87,13 @@ class Topic(Generic[M]):
             raise ValueError(f"{self} is not per spacecraft")
         return topics.all_spacecraft(mission, self.app, self.name)
 
+    @property
+    def path(self) -> str:
+        """``app/name``: the topic as the onboard stores and their accounting name it."""
+        return f"{self.app}/{self.name}"
+
     def __str__(self) -> str:
-        return f"{self.app}/{self.name} ({self.type.__name__})"
+        return f"{self.path} ({self.type.__name__})"
 
 
 # --- the sim: time master, truth and hardware -------------------------------------------------
@@ -168,7 +173,7 @@ DOWNLINK_FDIR = (NAV_ESTIMATE, ATTITUDE_ESTIMATE, OBSERVATIONS)
 """Dumped next: the rest of what the ground FDIR judges (the poses and the images)."""
 
 
-FDIR_DOWNLINK_TOPICS = frozenset(f"{t.app}/{t.name}" for t in (*DOWNLINK_FIRST, *DOWNLINK_FDIR))
+FDIR_DOWNLINK_TOPICS = frozenset(t.path for t in (*DOWNLINK_FIRST, *DOWNLINK_FDIR))
 """``app/name`` of every topic the ground FDIR judges from the dump."""
 
 

@@ -79,3 +79,16 @@ def test_a_store_too_small_for_the_gap_is_warned_about_naming_the_figures() -> N
         update={"store_bytes": 8 * 2**30})}))
     assert big is not None and big.holds and big.warnings() == []
     assert budget(small_scenario()) is None  # the ground hears always
+
+
+def test_passes_too_slow_to_dump_are_warned_about() -> None:
+    """At 100 bit/s a pass cannot empty the store: what stays aboard after it is named."""
+    sc = small_scenario(duration_s=4000.0, ground={
+        "contact": "passes", "downlink_bps": 100.0,
+        "stations": [{"name": "hi", "latitude_deg": 19.0, "longitude_deg": -155.7}]},
+        orbit={"raan_deg": 195.0})
+    b = budget(sc)
+    assert b is not None and b.holds and b.aboard_after_last_pass_bytes > 0.0
+    (warning,) = b.warnings()
+    assert "downlink_bps = 100" in warning
+    assert f"{b.aboard_after_last_pass_bytes:,.0f} bytes stay aboard" in warning

@@ -11,7 +11,7 @@ import pytest
 from gnc.infocost import agent_contributions
 from gnc.poi_map import PoiMap
 from ground.fdir.fused_views import FusedViews
-from ground.fdir.observer import ObserverState
+from ground.fdir.observer import MAX_JUDGED_LOSS, ObserverState
 from interfaces.contracts.messages import PoiObservations
 
 
@@ -32,12 +32,12 @@ def _image(sc: int, poi: list[int], prec: list[float]) -> PoiObservations:
 def test_an_image_joins_the_views_of_the_observers_in_range() -> None:
     observers = _at((0.0, 0.0, 0.0), (50.0, 0.0, 0.0), (0.0, 90.0, 0.0))
     views = FusedViews.of(3, 4, range_m=80.0)
-    views.add(_image(1, [0, 2], [0.5, 0.25]), observers)
+    views.add([_image(1, [0, 2], [0.5, 0.25])], observers)
     assert views.fused.tolist() == [[0.5, 0, 0.25, 0], [0.5, 0, 0.25, 0], [0, 0, 0, 0]]
-    views.add(_image(3, [3], [1.0]), observers)  # 90 m from sc1, 103 m from sc2: alone
+    views.add([_image(3, [3], [1.0])], observers)  # 90 m from sc1, 103 m from sc2: alone
     assert views.fused[:, 3].tolist() == [0.0, 0.0, 1.0]
     del observers[2].nav.t[:], observers[2].nav.v[:]  # sc2's position unknown: not shared
-    views.add(_image(1, [1], [2.0]), observers)
+    views.add([_image(1, [1], [2.0])], observers)
     assert views.fused[:, 1].tolist() == [2.0, 0.0, 0.0]
 
 
@@ -46,11 +46,40 @@ def test_h_i_on_a_view_of_everything_is_the_grounds_and_less_fused_raises_it() -
     m = PoiMap.uniform(30, 2.0, 2)
     for agent in (1, 2):
         m.add(agent, np.arange(30), rng.uniform(0.2, 1.0, 30))
-    everything = FusedViews(80.0, np.tile(m.F.sum(axis=0), (2, 1)))
+    everything = FusedViews(80.0, np.tile(m.F.sum(axis=0), (2, 1)), np.ones((2, 2)))
     ground = agent_contributions(m.phi, m.w_inv, m.F)
     assert everything.contributions(m, np.zeros(2)) == pytest.approx(ground)
-    alone = FusedViews(80.0, m.F.copy())  # each fused only its own: ψ larger
+    alone = FusedViews(80.0, m.F.copy(), np.eye(2))  # each fused only its own: ψ larger
     own = alone.contributions(m, np.zeros(2))
     assert np.all(own > ground)
     expected = [float(np.sum(m.phi * m.F[i] / (m.w_inv + m.F[i]) ** 2)) for i in range(2)]
     assert own == pytest.approx(expected)
+
+
+def test_a_window_of_images_is_added_as_one_image_at_a_time_would() -> None:
+    observers = _at((0.0, 0.0, 0.0), (50.0, 0.0, 0.0), (0.0, 90.0, 0.0))
+    images = [_image(1, [0, 2], [0.5, 0.25]), _image(3, [3], [1.0]), _image(2, [1, 2], [0.1, 0.2])]
+    together, alone = FusedViews.of(3, 4, 80.0), FusedViews.of(3, 4, 80.0)
+    together.add(images, observers)
+    for m in images:
+        alone.add([m], observers)
+    assert together.fused.tolist() == alone.fused.tolist()
+    assert together.images.tolist() == alone.images.tolist() == [[1, 1, 0], [1, 1, 0], [0, 0, 1]]
+    assert together.fused[:, 1].tolist() == [0.1, 0.1, 0.0]  # sc2's image: sc1 in range
+
+
+def test_what_was_lost_on_the_way_is_scaled_up_on_each_view() -> None:
+    """Half of sc1's observations lost on the way to the ground: its precision doubled, in its
+    own H_i and in every view; a share above MAX_JUDGED_LOSS is capped."""
+    rng = np.random.default_rng(2)
+    m = PoiMap.uniform(50, 4.0, 3)
+    for agent in range(1, 4):
+        m.add(agent, rng.choice(50, 20, replace=False), rng.uniform(0.5, 2.0, 20))
+    views = FusedViews(80.0, np.tile(m.F.sum(axis=0), (3, 1)), np.ones((3, 3)))
+    assert views.contributions(m, np.zeros(3)) == pytest.approx(
+        agent_contributions(m.phi, m.w_inv, m.F))
+    for lost, scale in ((0.5, 2.0), (0.99, 1.0 / (1.0 - MAX_JUDGED_LOSS))):
+        scaled = m.F.copy()
+        scaled[0] *= scale
+        assert views.contributions(m, np.array([lost, 0.0, 0.0])) == pytest.approx(
+            agent_contributions(m.phi, m.w_inv, scaled))

@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from gnc.infocost import Camera, agent_contributions
+from gnc.infocost import Camera
 from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
 from gnc.twin import TwinModel, centre_boresights, planned_boresights
-from ground.fdir.observer import MAX_JUDGED_LOSS, ObserverState, ground_contributions, loss_limit
+from ground.fdir.observer import ObserverState, TimeSeries, loss_limit
 from ground.fdir.threshold import sampled_threshold
 
 
@@ -35,21 +35,17 @@ def test_loss_limit_is_the_nominal_loss_plus_tolerance_and_two_sigma() -> None:
     assert loss_limit(0.9, 1.0, 0.5, 1) == 1.0
 
 
-def test_ground_contributions_scale_up_what_was_lost() -> None:
-    rng = np.random.default_rng(2)
-    m = PoiMap.uniform(50, 4.0, 3)
-    for agent in range(1, 4):
-        m.add(agent, rng.choice(50, 20, replace=False), rng.uniform(0.5, 2.0, 20))
-    none = ground_contributions(m, np.zeros(3))
-    assert none == pytest.approx(agent_contributions(m.phi, m.w_inv, m.F))
-    half = ground_contributions(m, np.array([0.5, 0.0, 0.0]))
-    doubled = m.F.copy()
-    doubled[0] *= 2.0
-    assert half == pytest.approx(agent_contributions(m.phi, m.w_inv, doubled))
-    capped = ground_contributions(m, np.array([0.99, 0.0, 0.0]))
-    cap = m.F.copy()
-    cap[0] /= 1.0 - MAX_JUDGED_LOSS
-    assert capped == pytest.approx(agent_contributions(m.phi, m.w_inv, cap))
+def test_a_series_is_nan_where_it_is_stale_and_none_where_any_is() -> None:
+    series = TimeSeries()
+    for t in (0.0, 2.0, 20.0):
+        series.add(t, np.array([t, -t]))
+    each = series.at_each(np.array([1.0, 10.0, 21.0]))
+    assert each is not None
+    assert each[0].tolist() == [1.0, -1.0] and each[2].tolist() == [20.0, -20.0]
+    assert np.isnan(each[1]).all()  # 8 s from every sample
+    assert series.at(np.array([1.0, 10.0])) is None
+    assert series.at(np.array([1.0, 21.0])).tolist() == [[1.0, -1.0], [20.0, -20.0]]
+    assert TimeSeries().at_each(np.array([1.0])) is None
 
 
 def test_twin_points_at_the_reported_aim_or_the_centre() -> None:

@@ -152,7 +152,8 @@ def _integrity_over_two_boundaries(observers: dict[int, ObserverState]
     settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
     settled.add(2, np.array([2, 3]), np.array([0.5, 0.5]))
     truth = settled.contributions()
-    views = FusedViews(80.0, np.tile(settled.F.sum(axis=0), (2, 1)))  # each fused everything
+    views = FusedViews(80.0, np.tile(settled.F.sum(axis=0), (2, 1)),
+                       np.ones((2, 2)))  # each fused everything
     out = []
     for j in (1, 2):
         for sc, factor in ((1, 1.5), (2, 1.0)):  # sc1 inflates its H_i by half
@@ -202,7 +203,8 @@ def test_no_integrity_verdict_while_an_observer_is_not_heard_from() -> None:
     check = IntegrityCheck(cfg, "ground", LOG, period_s=10.0)
     settled = PoiMap.uniform(10, 1.0, 2)
     settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
-    views = FusedViews(80.0, np.tile(settled.F.sum(axis=0), (2, 1)))
+    views = FusedViews(80.0, np.tile(settled.F.sum(axis=0), (2, 1)),
+                       np.ones((2, 2)))
     observers = {1: ObserverState(heard_s=19.0), 2: ObserverState(heard_s=5.0)}
     report = InfoCostTelemetry(
         sender="sc1", t_sim=20.0, spacecraft=1, h_i=9.0, h_local=1.0, prior_term=0.5,
