@@ -50,10 +50,11 @@ order); and a group's ``scenario`` (or the campaign's ``base``) may be a choice 
 
     [overrides]
     observers = { count = { min = 2, max = 8 } }
-    ground = { contact = { choose = ["continuous", "passes"] },
-               stations = { choose = [{ name = "Kiruna", latitude_deg = 67.86,
-                                        longitude_deg = 20.96 }, ...],
-                            count = { min = 1, max = 3 } } }
+    [overrides.ground]
+    contact = { choose = ["continuous", "passes"] }
+    [overrides.ground.stations]
+    count = { min = 1, max = 3 }
+    choose = [{ name = "Kiruna", latitude_deg = 67.86, longitude_deg = 20.96 }, ...]
     [[groups]]
     name = "anything"
     scenario = { choose = ["../scenarios/nominal.toml", "../scenarios/default.toml"] }

@@ -47,7 +47,7 @@ class ArchiveSpan:
     def of(cls, archive: RunArchive, scenario: Scenario) -> ArchiveSpan:
         """The span of ``archive``, a run of ``scenario`` (its last tick: the last multiple of
         the high-rate period within ``duration_s``)."""
-        last_tick_s = (scenario.n_ticks - 1) / scenario.rates.high_hz
+        last_tick_s = (scenario.n_ticks - 1) * scenario.rates.dt_s
         return cls(archive.end_s or 0.0, last_tick_s, archive.truncated)
 
     @property

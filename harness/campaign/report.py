@@ -231,10 +231,12 @@ def _dimension_lines(out: Path, dimensions: list[Dimension]) -> list[str]:
         {d.name: d.to_json() for d in dimensions}, indent=1) + "\n")
     lines = ["", "## By drawn dimension", "",
              "Each setting the campaign drew per run, its runs in bins (a choice: by value; a "
-             "range: four equal-width bins over its [min, max]); main detector. Latency from "
+             "range: four equal-width bins over its [min, max], an integer range of up to four "
+             "values by value); main detector. Latency from "
              "onset of the isolated faults; false alarms per nominal observer-window and the "
              "neighbours' per nominal neighbour-window, with their 95% upper bounds. The worst "
-             "bin (most failed runs, then fewest isolated, identified, then the highest "
+             "bin (the largest share of failed runs, then the fewest isolated, identified, then "
+             "the highest "
              "false-alarm bound, then the longest p90) is in bold "
              "(harness/campaign/dimensions.py)."]
     for d in dimensions:
