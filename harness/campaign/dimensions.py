@@ -32,7 +32,12 @@ from typing import Any
 
 import numpy as np
 
-from harness.campaign.rescore import CampaignRun, false_alarm_bound
+from harness.campaign.rescore import (
+    CampaignRun,
+    detector_stats,
+    false_alarm_bound,
+    isolated_latencies,
+)
 
 
 def value_label(value: Any) -> str:
@@ -176,17 +181,12 @@ def _bin_figures(label: str, mine: Sequence[CampaignRun], failed: int,
     detector's results.csv ``rows``."""
     ids = {r.id for r in mine}
     own = [r for r in rows if r["run"] in ids and r["detector"] == "main"]
-    faults = [r for r in own if r["kind"] != "none"]
-    per_run = {r["run"]: r for r in own}.values()
+    st = detector_stats(own, 0.0)
     nb = [r.summary.neighbours.scores for r in mine if r.summary.neighbours is not None]
     return BinFigures(
-        label, runs=len(mine), failed=failed, faults=len(faults),
-        isolated=sum(bool(r["detected"] and r["isolated"]) for r in faults),
-        identified=sum(r.get("identified_class") == r["expected_class"] for r in faults),
-        latencies_s=tuple(r["latency_s"] for r in faults
-                          if r["isolated"] and r["latency_s"] is not None),
-        false_alarms=sum(r["false_alarms"] for r in per_run),
-        windows=sum(r["nominal_cycles"] for r in per_run),
+        label, runs=len(mine), failed=failed, faults=st["faults"], isolated=st["isolated"],
+        identified=st["identified"], latencies_s=tuple(isolated_latencies(own)),
+        false_alarms=st["false_alarms"], windows=st["nominal_cycles"],
         neighbour_false_alarms=sum(s.false_alarms for s in nb),
         neighbour_windows=sum(s.nominal_cycles for s in nb))
 

@@ -129,7 +129,13 @@ def spread(lat: Sequence[float]) -> str:
     return f"{np.median(lat):.0f} / {np.quantile(lat, 0.9):.0f} / {max(lat):.0f}"
 
 
-def detector_stats(rows: list[dict[str, Any]], hours: float) -> dict[str, Any]:
+def isolated_latencies(rows: Sequence[dict[str, Any]]) -> list[float]:
+    """Onset-to-declaration latencies (s) of the isolated faults among results.csv ``rows``."""
+    return [r["latency_s"] for r in rows if r["kind"] != "none" and r["isolated"]
+            and r["latency_s"] is not None]
+
+
+def detector_stats(rows: Sequence[dict[str, Any]], hours: float) -> dict[str, Any]:
     faults = [r for r in rows if r["kind"] != "none"]
     fa = sum(r["false_alarms"] for r in {(r["run"]): r for r in rows}.values())
     cycles = sum(r["nominal_cycles"] for r in {(r["run"]): r for r in rows}.values())
@@ -156,8 +162,7 @@ def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> d
     runs = load_runs(out, ids)
     rows = [r for r in fault_rows(runs) if r["detector"] == detector]
     st = detector_stats(rows, 0.0)
-    lat = [r["latency_s"] for r in rows if r["kind"] != "none" and r["isolated"]
-           and r["latency_s"] is not None]
+    lat = isolated_latencies(rows)
     faithful = sum(_faithful_to_the_end(r.summary) for r in runs)
     spans = [_detector_scores(_main_scores(r.summary), r.summary, detector) for r in runs]
     whole = [_detector_scores(r.summary.scores, r.summary, detector) for r in runs]
