@@ -7,6 +7,8 @@ A campaign TOML names a base scenario and groups of runs::
     base = "../scenarios/nominal.toml"    # relative to this file
     seeds = { first = 1, count = 10 }     # or a list: [1, 2, 3]
     duration_s = 800.0                    # optional override of every run
+    extend_to_pass_s = 6000.0             # optional: with passes, lengthen a run (by at most
+                                          # this) until the ground hears its fault's windows
 
     [[groups]]
     name = "fig23"
@@ -106,7 +108,7 @@ from deploy.draws import (
     parse_tree,
     rng_for,
 )
-from deploy.onsets import OnsetError
+from deploy.onsets import OnsetError, heard_by_s
 from harness.summary import RunSummary
 from interfaces.contracts.scenario import Scenario
 
@@ -267,6 +269,7 @@ def _expand_group(campaign: Campaign, group: Group, vi: int | None,
             elif group.faults:
                 data["faults"] = _faults(campaign, group, len(runs), chosen, data, run_id,
                                          record)
+                _lengthen(campaign, run_id, data, record)
             runs.append(RunSpec(run_id, label, _validated(run_id, data, record),
                                 record.values, record.domains))
     return runs
@@ -286,6 +289,18 @@ def _faults(campaign: Campaign, group: Group, index: int, chosen: dict[int, dict
                 for i, (f, prefix) in enumerate(zip(group.faults, prefixes, strict=True))]
     except OnsetError as e:
         raise CampaignError(f"run {run_id}: {e}{_drawn_text(record)}") from None
+
+
+def _lengthen(campaign: Campaign, run_id: str, data: dict[str, Any], record: Record) -> None:
+    """With ``extend_to_pass_s``, lengthen the run until the ground has heard the windows after
+    its faults' onsets (``deploy.onsets.heard_by_s``), recorded as ``run.lengthened_s``."""
+    if campaign.extend_to_pass_s is None:
+        return
+    scenario = _validated(run_id, data, record)
+    end = heard_by_s(scenario, [f.start_s for f in scenario.faults], campaign.extend_to_pass_s)
+    if end > scenario.duration_s:
+        record.add("run.lengthened_s", round(end - scenario.duration_s, 3), None)
+        data["duration_s"] = end
 
 
 def _drawn_text(record: Record) -> str:

@@ -159,6 +159,9 @@ class Campaign(Strict):
     base: str | ScenarioChoice
     seeds: Annotated[list[int], Field(min_length=1)] | Seeds = Field(default_factory=lambda: [1])
     duration_s: float | None = Field(default=None, gt=0.0)
+    extend_to_pass_s: float | None = Field(default=None, gt=0.0)
+    """with ground passes, lengthen a run by at most this (s) until the ground has heard the
+    windows after its faults' onsets (``deploy.onsets.heard_by_s``; None: never)"""
     study: Literal["formations", "neighbours"] | None = None
     """a study report written beside report.md (``formations``: study.md,
     harness/campaign/formation_study.py; ``neighbours``: study.md,

@@ -14,6 +14,10 @@ The phases of a scenario, as spans of sim time (s):
 
 Every span ends ``WINDOWS_AFTER`` FDI windows before the run's end at the latest, so a fault
 always has windows to be judged in.
+
+With ground passes the ground judges a window only once its data came down, in a pass after
+it; :func:`heard_by_s` says how long a run must last for that (``extend_to_pass_s`` in a
+campaign file lengthens the run to it).
 """
 
 from __future__ import annotations
@@ -117,6 +121,27 @@ def draw_onset(scenario: Scenario, phases: Sequence[OnsetPhase], rng: np.random.
                          + "; ".join(_why_not(scenario, p) for p in spans))
     phase = have[int(rng.integers(len(have)))]
     return phase, _uniform_in(spans[phase], rng)
+
+
+def heard_by_s(scenario: Scenario, onsets_s: Sequence[float], max_extension_s: float) -> float:
+    """How long a run with ground passes must last (s) for the ground to hear the
+    ``WINDOWS_AFTER`` FDI windows after each of ``onsets_s``: for each onset, the first pass
+    that lasts that long past it; when it does not begin ``WINDOWS_AFTER`` windows before the
+    run's end, the run must last until its loss of signal plus ``WINDOWS_AFTER`` windows (its
+    dump judged).  The run's own duration when it is long enough, when the ground hears
+    continuously, or when that would lengthen it by more than ``max_extension_s`` (the fault is
+    then counted as one no window could judge)."""
+    base = scenario.duration_s
+    plan = ContactPlan.of(scenario.model_copy(update={"duration_s": base + max_extension_s}))
+    if plan is None or not onsets_s:
+        return base
+    margin = WINDOWS_AFTER * scenario.rates.fdi_period_s
+    need = base
+    for onset in onsets_s:
+        after = [(aos, los) for aos, los in plan.windows if los > onset + margin]
+        if after and after[0][0] + margin > base:
+            need = max(need, after[0][1] + margin)
+    return need if need - base <= max_extension_s else base
 
 
 def _uniform_in(spans: Sequence[Span], rng: np.random.Generator) -> float:

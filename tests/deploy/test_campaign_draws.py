@@ -19,7 +19,7 @@ import pytest
 from deploy.campaign import CampaignError, RunSpec, fingerprint, finished, load_campaign
 from deploy.campaign_file import FaultSpec
 from deploy.draws import Choice, Record, Uniform, draw_tree, parse_tree, rng_for
-from deploy.onsets import phase_spans
+from deploy.onsets import heard_by_s, phase_spans
 from deploy.run_campaign import main as run_campaign
 from harness.campaign.dimensions import Binning, campaign_domains
 from harness.campaign.rescore import CampaignRun
@@ -241,6 +241,38 @@ def test_onset_phases_of_the_shipped_scenarios() -> None:
     assert phase_spans(nominal, "deployment") == phase_spans(nominal, "transfer") == []
     ((a, b),) = phase_spans(load_scenario(SCENARIOS / "passes.toml"), "after_pass")
     assert a == pytest.approx(498.0, abs=1.0) and b == pytest.approx(a + 60.0)
+
+
+def test_a_passes_run_lasts_until_the_ground_hears_its_fault() -> None:
+    """passes.toml's passes: 29-498 s and 5,963-6,367 s.  An onset in the first pass is heard
+    in it; one after its loss of signal needs the second pass, until its loss of signal plus
+    three FDI windows (90 s), unless that lengthens the run by more than allowed."""
+    passes = load_scenario(SCENARIOS / "passes.toml")
+    short = passes.model_copy(update={"duration_s": 1200.0})
+    assert heard_by_s(short, [300.0], 6000.0) == 1200.0
+    assert heard_by_s(short, [450.0], 6000.0) == pytest.approx(6367.09 + 90.0, abs=0.5)
+    assert heard_by_s(short, [300.0, 600.0], 6000.0) == pytest.approx(6457.1, abs=0.5)
+    assert heard_by_s(short, [600.0], 5000.0) == 1200.0  # beyond the allowance
+    continuous = short.model_copy(update={"ground": short.ground.model_copy(
+        update={"contact": "continuous"})})
+    assert heard_by_s(continuous, [600.0], 6000.0) == 1200.0
+
+
+def test_a_campaign_lengthens_its_passes_runs(tmp_path: Path) -> None:
+    """``extend_to_pass_s``: a fault run is lengthened as heard_by_s says, recorded as
+    ``run.lengthened_s``; nominal runs and runs that need nothing keep their length."""
+    text = DRAWN.format(spacecraft='"any"').replace("duration_s = 200.0",
+                                                   "duration_s = 200.0\nextend_to_pass_s = 9000.0")
+    _, plain = load_campaign(_drawn_campaign(tmp_path))
+    _, runs = load_campaign(_write(tmp_path, text))
+    for a, b in zip(plain, runs, strict=True):
+        need = heard_by_s(a.scenario, [f.start_s for f in a.scenario.faults], 9000.0)
+        assert b.scenario.duration_s == pytest.approx(need)
+        assert b.drawn.get("run.lengthened_s") == (None if need == 200.0
+                                                   else pytest.approx(need - 200.0, abs=1e-3))
+        assert b.scenario.faults == a.scenario.faults
+    assert any("run.lengthened_s" in r.drawn for r in runs)
+    assert all(r.scenario.duration_s == 200.0 for r in runs if r.group == "n")
 
 
 def test_the_fault_spec_accepts_every_drawn_form() -> None:
