@@ -12,14 +12,16 @@ order), or the range from the smallest min to the largest max.  A run goes into 
 own value; a fault's phase or kind (``fault.phase``) is its run's.
 
 Per bin, for the main detector as in the rest of the report (results.csv's rows): runs (that
-completed; failed ones counted apart), faults, detected and isolated, identified (the right
-class), latency from onset of the isolated faults (median and p90, s), false alarms per
-nominal observer-window and, over the runs with the neighbours' FDIR on, per nominal
-neighbour-window, each with its one-sided 95% upper bound (``rescore.false_alarm_bound``).
+completed; failed ones counted apart), faults, those no window could judge (``unjudged``:
+between passes, none came down in the run), and of the others: detected and isolated,
+identified (the right class), latency of the isolated faults from the first judgeable window
+and from onset to the ground's declaration (median and p90, s); false alarms per nominal
+observer-window and, over the runs with the neighbours' FDIR on, per nominal neighbour-window,
+each with its one-sided 95% upper bound (``rescore.false_alarm_bound``).
 
 The worst bin of a dimension (of two or more bins with runs) is the one with the largest share
-of failed runs, then the smallest share of faults isolated, then identified, then the highest
-false-alarm bound (the ground's, then the neighbours'), then the longest p90 latency.
+of failed runs, then the smallest share of judgeable faults isolated, then identified, then the
+highest false-alarm bound (the ground's, then the neighbours'), then the longest p90 latency.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from harness.campaign.rescore import (
     CampaignRun,
     detector_stats,
     false_alarm_bound,
-    isolated_latencies,
+    neighbour_false_alarms,
 )
 
 
@@ -117,15 +119,19 @@ def campaign_domains(runs: Sequence[CampaignRun]) -> dict[str, dict[str, Any]]:
 
 @dataclass(frozen=True)
 class BinFigures:
-    """One bin's figures (module docstring); latencies from onset, s."""
+    """One bin's figures (module docstring): ``isolated`` and ``identified`` of the
+    ``faults`` less the ``unjudged``; latencies from the first judgeable window
+    (``latencies_s``) and from onset to the ground's declaration (``onset_latencies_s``), s."""
 
     label: str
     runs: int = 0
     failed: int = 0
     faults: int = 0
+    unjudged: int = 0
     isolated: int = 0
     identified: int = 0
     latencies_s: tuple[float, ...] = ()
+    onset_latencies_s: tuple[float, ...] = ()
     false_alarms: int = 0
     windows: int = 0
     neighbour_false_alarms: int = 0
@@ -141,6 +147,14 @@ class BinFigures:
         return float(np.quantile(self.latencies_s, 0.9)) if self.latencies_s else None
 
     @property
+    def judgeable(self) -> int:
+        return self.faults - self.unjudged
+
+    @property
+    def onset_latency_median_s(self) -> float | None:
+        return float(np.median(self.onset_latencies_s)) if self.onset_latencies_s else None
+
+    @property
     def false_alarm_bound(self) -> float | None:
         """95% upper bound of the false alarms per observer-window (None: no window)."""
         return false_alarm_bound(self.false_alarms, self.windows) if self.windows else None
@@ -153,9 +167,11 @@ class BinFigures:
 
     def to_json(self) -> dict[str, Any]:
         return {"bin": self.label, "runs": self.runs, "failed": self.failed,
-                "faults": self.faults, "detected_isolated": self.isolated,
-                "identified": self.identified, "latency_median_s": self.latency_median_s,
-                "latency_p90_s": self.latency_p90_s, "false_alarms": self.false_alarms,
+                "faults": self.faults, "unjudged": self.unjudged,
+                "detected_isolated": self.isolated, "identified": self.identified,
+                "latency_median_s": self.latency_median_s, "latency_p90_s": self.latency_p90_s,
+                "onset_latency_median_s": self.onset_latency_median_s,
+                "false_alarms": self.false_alarms,
                 "observer_windows": self.windows, "false_alarm_bound": self.false_alarm_bound,
                 "neighbour_false_alarms": self.neighbour_false_alarms,
                 "neighbour_windows": self.neighbour_windows,
@@ -182,13 +198,19 @@ def _bin_figures(label: str, mine: Sequence[CampaignRun], failed: int,
     ids = {r.id for r in mine}
     own = [r for r in rows if r["run"] in ids and r["detector"] == "main"]
     st = detector_stats(own, 0.0)
-    nb = [r.summary.neighbours.scores for r in mine if r.summary.neighbours is not None]
+    nfa, nwin = neighbour_false_alarms(mine)
+    judged = [r for r in own if r["kind"] != "none" and not r["unjudged"]]
     return BinFigures(
-        label, runs=len(mine), failed=failed, faults=st["faults"], isolated=st["isolated"],
-        identified=st["identified"], latencies_s=tuple(isolated_latencies(own)),
+        label, runs=len(mine), failed=failed, faults=st["faults"], unjudged=st["unjudged"],
+        isolated=st["isolated_judgeable"], identified=st["identified_judgeable"],
+        latencies_s=_values(judged, "window_latency_s"),
+        onset_latencies_s=_values(judged, "declared_latency_s"),
         false_alarms=st["false_alarms"], windows=st["nominal_cycles"],
-        neighbour_false_alarms=sum(s.false_alarms for s in nb),
-        neighbour_windows=sum(s.nominal_cycles for s in nb))
+        neighbour_false_alarms=nfa, neighbour_windows=nwin)
+
+
+def _values(rows: Sequence[dict[str, Any]], key: str) -> tuple[float, ...]:
+    return tuple(r[key] for r in rows if r.get(key) is not None)
 
 
 def _badness(b: BinFigures) -> tuple[float, ...]:
@@ -196,8 +218,8 @@ def _badness(b: BinFigures) -> tuple[float, ...]:
     def share(n: int, d: int) -> float:
         return n / d if d else 1.0
 
-    return (-share(b.failed, b.runs + b.failed), share(b.isolated, b.faults),
-            share(b.identified, b.faults), -(b.false_alarm_bound or 0.0),
+    return (-share(b.failed, b.runs + b.failed), share(b.isolated, b.judgeable),
+            share(b.identified, b.judgeable), -(b.false_alarm_bound or 0.0),
             -(b.neighbour_false_alarm_bound or 0.0), -(b.latency_p90_s or 0.0))
 
 

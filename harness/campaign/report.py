@@ -42,10 +42,8 @@ from harness.campaign.rescore import (  # noqa: E402
     SCALES,
     CampaignRun,
     detector_stats,
-    false_alarm_bound,
     fault_rows,
     information_only,
-    latency_summary,
     load_runs,
     nominal_hours,
     persistence_of,
@@ -54,6 +52,7 @@ from harness.campaign.rescore import (  # noqa: E402
     spread,
     window_margins,
 )
+from harness.campaign.targets import rate, share, target_figures, target_lines  # noqa: E402
 from harness.summary.scoring import EXPECTED_CLASS  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", "common_mode", None)
@@ -77,51 +76,17 @@ def _wall_time(runs: list[CampaignRun]) -> str:
             f"{max(wall):.0f} s, {sum(wall) / 3600.0:.2f} worker-hours in all.")
 
 
-def _onset_lines(faults: list[dict[str, Any]]) -> list[str]:
-    """Latency from onset against the targets, with the faults that began before their
-    observer's first judged window apart (main detector's rows)."""
-    early, late = [], []
-    for f in faults:
-        began_early = f.get("judgeable_s") is not None and f["judgeable_s"] > f["start_s"]
-        (early if began_early else late).append(f)
-    from_window = [{**f, "latency_s": f["latency_s"] - (f["judgeable_s"] - f["start_s"])}
-                   for f in early if f["latency_s"] is not None]
-    return ["", "## Latency from onset (main detector)", "",
-            "Median / p90 / max, s, of the isolated faults. A fault that began before its "
-            "observer's first judged window (images are judged from the end of its initial "
-            "slew plus `settle_s`) cannot be declared before that window closes.", "",
-            "| faults | count | from onset | from the first window that could judge them |",
-            "|---|---|---|---|",
-            f"| all | {len(faults)} | {latency_summary(faults)} | - |",
-            f"| began before their observer's first judged window | {len(early)} | "
-            f"{latency_summary(early)} | {latency_summary(from_window)} |",
-            f"| began later | {len(late)} | {latency_summary(late)} | - |"]
-
-
 def _cells(detector: str, st: dict[str, Any]) -> str:
     """The table cells after the row's labels: detected, isolated, identified (main only),
     latency median / p90 / max, false alarms per nominal cycle and per hour."""
-    ident = _pct(st["identified"], st["faults"]) if detector == "main" else "-"
-    return (f"{_pct(st['detected'], st['faults'])} | {_pct(st['isolated'], st['faults'])} | "
-            f"{ident} | {st['latency']} | {_rate(st['false_alarms'], st['nominal_cycles'])} | "
+    ident = share(st["identified"], st["faults"]) if detector == "main" else "-"
+    return (f"{share(st['detected'], st['faults'])} | {share(st['isolated'], st['faults'])} | "
+            f"{ident} | {st['latency']} | {rate(st['false_alarms'], st['nominal_cycles'])} | "
             f"{_fmt(st['false_alarms_per_hour'], '.3f')} |")
-
-
-def _rate(false_alarms: int, cycles: int) -> str:
-    """False alarms per nominal cycle, with the counts it comes from and its one-sided 95%
-    upper confidence bound (Clopper-Pearson)."""
-    if cycles == 0:
-        return "-"
-    return (f"{false_alarms / cycles:.4f} ({false_alarms}/{cycles}; 95% ≤ "
-            f"{false_alarm_bound(false_alarms, cycles):.2g})")
 
 
 def _fmt(v: float | None, f: str = ".0f") -> str:
     return "-" if v is None else format(v, f)
-
-
-def _pct(n: int, d: int) -> str:
-    return "-" if d == 0 else f"{100.0 * n / d:.0f}% ({n}/{d})"
 
 
 def _persistence_table(runs: list[CampaignRun]) -> list[str]:
@@ -136,16 +101,17 @@ def _persistence_table(runs: list[CampaignRun]) -> list[str]:
         label = f"{m} of {n}" + (" (as run)" if own == [(m, n)] else "")
         lat = [x.latency_s for x in f if x.isolated and x.latency_s is not None]
         lines.append(
-            f"| {label} | {_pct(sum(x.detected for x in f), len(f))} | "
-            f"{_pct(sum(x.isolated for x in f), len(f))} | {spread(lat)} | "
-            f"{_rate(r.false_alarms, r.nominal_cycles)} |")
+            f"| {label} | {share(sum(x.detected for x in f), len(f))} | "
+            f"{share(sum(x.isolated for x in f), len(f))} | {spread(lat)} | "
+            f"{rate(r.false_alarms, r.nominal_cycles)} |")
     return lines
 
 
 RESULT_FIELDS = ["run", "group", "seed", "status", "detector", "kind", "spacecraft", "start_s",
                  "magnitude", "detected", "isolated", "latency_s", "identified_class",
-                 "identification_latency_s", "expected_class", "judgeable_s", "false_alarms",
-                 "nominal_cycles"]
+                 "identification_latency_s", "expected_class", "judgeable_s", "unjudged",
+                 "window_latency_s", "declared_latency_s", "contact", "neighbours_latency_s",
+                 "first_latency_s", "false_alarms", "nominal_cycles"]
 """The columns of results.csv."""
 
 
@@ -161,6 +127,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     detectors = ["main"] + sorted({r["detector"] for r in rows} - {"main"})
     hours = {d: nominal_hours(runs, d) for d in detectors}
     lines = _head_lines(name, loaded, len(ids), hours["main"])
+    lines += target_lines(target_figures(rows, runs))
     lines += _side_by_side_lines(rows, detectors, hours)
     groups = list(dict.fromkeys(r.group for r in runs))
     lines += _group_lines(runs, rows, detectors, groups)
@@ -232,28 +199,31 @@ def _dimension_lines(out: Path, dimensions: list[Dimension]) -> list[str]:
     lines = ["", "## By drawn dimension", "",
              "Each setting the campaign drew per run, its runs in bins (a choice: by value; a "
              "range: four equal-width bins over its [min, max], an integer range of up to four "
-             "values by value); main detector. Latency from "
-             "onset of the isolated faults; false alarms per nominal observer-window and the "
+             "values by value); main detector. Faults no window could judge are counted apart "
+             "(unjudged); detected, identified and latencies are over the others: latency of "
+             "the isolated faults from the first judgeable window, and its median from onset "
+             "to the ground's declaration; false alarms per nominal observer-window and the "
              "neighbours' per nominal neighbour-window, with their 95% upper bounds. The worst "
              "bin (the largest share of failed runs, then the fewest isolated, identified, then "
-             "the highest "
-             "false-alarm bound, then the longest p90) is in bold "
+             "the highest false-alarm bound, then the longest p90) is in bold "
              "(harness/campaign/dimensions.py)."]
     for d in dimensions:
         lines += ["", f"### {d.name}", "",
-                  "| bin | runs | failed | faults | detected & isolated | identified | latency "
-                  "median / p90 (s) | false alarms per observer-window | neighbours' false "
-                  "alarms per neighbour-window |", "|---|---|---|---|---|---|---|---|---|"]
+                  "| bin | runs | failed | faults | unjudged | detected & isolated | identified | "
+                  "latency from the window, median / p90 (s) | from onset, median (s) | "
+                  "false alarms per observer-window | neighbours' false alarms per "
+                  "neighbour-window |", "|---|---|---|---|---|---|---|---|---|---|---|"]
         lines += [_bin_row(b) for b in d.bins]
     return lines
 
 
 def _bin_row(b: BinFigures) -> str:
     label = f"**{b.label}** (worst)" if b.worst else b.label
-    return (f"| {label} | {b.runs} | {b.failed} | {b.faults} | {_pct(b.isolated, b.faults)} | "
-            f"{_pct(b.identified, b.faults)} | {_fmt(b.latency_median_s)} / "
-            f"{_fmt(b.latency_p90_s)} | {_rate(b.false_alarms, b.windows)} | "
-            f"{_rate(b.neighbour_false_alarms, b.neighbour_windows)} |")
+    return (f"| {label} | {b.runs} | {b.failed} | {b.faults} | {b.unjudged} | "
+            f"{share(b.isolated, b.judgeable)} | {share(b.identified, b.judgeable)} | "
+            f"{_fmt(b.latency_median_s)} / {_fmt(b.latency_p90_s)} | "
+            f"{_fmt(b.onset_latency_median_s)} | {rate(b.false_alarms, b.windows)} | "
+            f"{rate(b.neighbour_false_alarms, b.neighbour_windows)} |")
 
 
 def _magnitude_lines(rows: list[dict[str, Any]], detectors: list[str],
@@ -268,9 +238,9 @@ def _magnitude_lines(rows: list[dict[str, Any]], detectors: list[str],
                    and (r["run"], r["fault_index"]) in members]
             st = detector_stats(sel, hours[d])
             lines.append(f"| {kind} | {label} | {d} | {st['faults']} | "
-                         f"{_pct(st['detected'], st['faults'])} | "
+                         f"{share(st['detected'], st['faults'])} | "
                          f"{st['faults'] - st['detected']} | "
-                         f"{_pct(st['isolated'], st['faults'])} | {st['latency']} |")
+                         f"{share(st['isolated'], st['faults'])} | {st['latency']} |")
     return lines
 
 
@@ -284,7 +254,7 @@ def _identification_lines(out: Path, rows: list[dict[str, Any]], main_hours: flo
              f"{main_stats['identification_latency']} s.", "",
              "![confusion](confusion.png)", ""]
     main_faults = [r for r in rows if r["detector"] == "main" and r["kind"] != "none"]
-    return lines + _confusion(out, main_faults) + _onset_lines(main_faults)
+    return lines + _confusion(out, main_faults)
 
 
 def _rescoring_lines(runs: list[CampaignRun]) -> list[str]:
@@ -416,7 +386,7 @@ def _margin_lines(margins: dict[str, np.ndarray]) -> list[str]:
              "|---|---|---|---|---|---|"]
     for kind, r in margins.items():
         lines.append(f"| {kind} | {len(r)} | {np.median(r):.3g} | {np.quantile(r, 0.99):.3g} | "
-                     f"{r.max():.3g} | {_pct(int(np.sum(r > 1.0)), len(r))} |")
+                     f"{r.max():.3g} | {share(int(np.sum(r > 1.0)), len(r))} |")
     return lines
 
 
@@ -452,14 +422,14 @@ def _threshold_lines(runs: list[CampaignRun]) -> list[str]:
         return []
     c = functools.reduce(operator.add, census)
     n = c.nominal_windows
-    by = ", ".join(f"{k} {_pct(v, n)}" for k, v in c.threshold_by)
+    by = ", ".join(f"{k} {share(v, n)}" for k, v in c.threshold_by)
     above, sampled = c.model_above_floor, c.sampled_above_floor
     failed = ", ".join(f"{k} {v}" for k, v in c.failed)
     zn = c.model_z.windows
-    z = ", ".join(f"|z| > {k}: {_pct(v, zn)}" for k, v in
+    z = ", ".join(f"|z| > {k}: {share(v, zn)}" for k, v in
                   ((2, c.model_z.over_2), (3, c.model_z.over_3), (4, c.model_z.over_4)))
     return ["", "## Thresholds (main detector, nominal windows)", "",
             f"{n} nominal windows decided.  Threshold in force: {by}.  The hardware model's "
-            f"threshold above the floor guard in {_pct(above, n)}; Eq. 11-12's sampled "
-            f"threshold in {_pct(sampled, n)}.  Tests failed: {failed}.  Nominal ratios in "
+            f"threshold above the floor guard in {share(above, n)}; Eq. 11-12's sampled "
+            f"threshold in {share(sampled, n)}.  Tests failed: {failed}.  Nominal ratios in "
             f"the hardware model (z = (x − μ)/σ; a Gaussian has 4.6%, 0.27%, 0.006%): {z}."]

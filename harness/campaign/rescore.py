@@ -8,7 +8,6 @@ m-of-n persistence: the ROC and the persistence table), without re-simulating.  
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -70,12 +69,21 @@ def load_runs(out: Path, ids: Sequence[str]) -> list[CampaignRun]:
 
 
 def fault_rows(runs: list[CampaignRun]) -> list[dict[str, Any]]:
-    """results.csv rows: per run, detector and fault (or one nominal row per detector)."""
+    """results.csv rows: per run, detector and fault (or one nominal row per detector).
+
+    Besides the scores of ``harness/summary/scoring.py``, each fault row says when a window of
+    the main detector could first judge it (``judgeable_s``; None: none could, ``unjudged``),
+    its latency from that window's start (``window_latency_s``), when the ground declared it
+    (``declared_latency_s``, from onset: with passes, once the data came down), where the
+    onset fell (``contact``: continuous, in_pass, between_passes), when the neighbours aboard
+    declared it (``neighbours_latency_s``, from onset) and the first of the two
+    (``first_latency_s``)."""
     rows = []
     for run in runs:
         s = run.summary
-        first = _first_judged(s)
+        windows = _judged_windows(s)
         detectors = {"main": _main_scores(s), **(s.baselines or {})}
+        neighbours = s.neighbours.scores.per_fault if s.neighbours is not None else []
         for name, sc in detectors.items():
             common = {"run": run.id, "group": run.group, "seed": s.seed, "status": s.status,
                       "detector": name, "false_alarms": sc.false_alarms if sc else 0,
@@ -94,26 +102,58 @@ def fault_rows(runs: list[CampaignRun]) -> list[dict[str, Any]]:
                              "identification_latency_s": f.identification_latency_s
                              if main else None,
                              "expected_class": f.expected_class,
-                             "judgeable_s": _judgeable_s(f, first)})
+                             **_timing(f, windows, _contact(s, f.start_s),
+                                       neighbours[i] if i < len(neighbours) else None)})
     return rows
 
 
-def _first_judged(summary: RunSummary) -> dict[int, float]:
-    """The start of each observer's first window the main detector judged, s (its
-    ``fdir_series``: the observer's initial slew and ``settle_s`` come before it)."""
-    first: dict[int, float] = {}
+def _judged_windows(summary: RunSummary) -> dict[int, list[tuple[float, float]]]:
+    """Each observer's windows the main detector judged, (start, end) s (its
+    ``fdir_series``)."""
+    out: dict[int, list[tuple[float, float]]] = {}
     for w in summary.fdir_series.main if summary.fdir_series else []:
-        first[w.spacecraft] = min(first.get(w.spacecraft, math.inf), w.t_start_s)
-    return first
+        out.setdefault(w.spacecraft, []).append((w.t_start_s, w.t_end_s))
+    return out
 
 
-def _judgeable_s(fault: FaultScore, first: dict[int, float]) -> float | None:
-    """When a fault could first be judged, s: its onset, or its observer's first judged
-    window's start when that is later (a common-mode fault, spacecraft 0: the first
-    observer's); None when its observer has no judged window."""
-    sc = fault.spacecraft
-    t0 = min(first.values(), default=None) if sc == 0 else first.get(sc)
-    return None if t0 is None else max(fault.start_s, t0)
+def _judgeable_s(fault: FaultScore, windows: dict[int, list[tuple[float, float]]]
+                 ) -> float | None:
+    """When a fault could first be judged, s: the start of the first judged window of its
+    observer (of any observer for a common-mode fault, spacecraft 0) that ends after the
+    onset, or the onset when that window began earlier; the onset for a fault declared without
+    one (a link fault is seen in the link, not in windows); None when no window after the onset
+    was judged (between passes: none came down in the run)."""
+    spans = [w for ws in windows.values() for w in ws] if fault.spacecraft == 0 \
+        else windows.get(fault.spacecraft, [])
+    t0 = min((a for a, b in spans if b > fault.start_s), default=None)
+    if t0 is None:
+        return fault.start_s if fault.detected else None
+    return max(fault.start_s, t0)
+
+
+def _contact(summary: RunSummary, t_s: float) -> str:
+    """Where ``t_s`` fell: ``continuous`` (the ground hears continuously), ``in_pass`` or
+    ``between_passes``."""
+    gc = summary.ground_contact
+    if gc is None:
+        return "continuous"
+    return "in_pass" if any(p.aos_s <= t_s < p.los_s for p in gc.passes) else "between_passes"
+
+
+def _timing(fault: FaultScore, windows: dict[int, list[tuple[float, float]]], contact: str,
+            neighbours: FaultScore | None) -> dict[str, Any]:
+    """A fault row's judgeability and latencies (:func:`fault_rows`)."""
+    judgeable = _judgeable_s(fault, windows)
+    isolated = fault.isolated and fault.latency_s is not None
+    declared = fault.declared_latency_s if isolated else None
+    aboard = neighbours.declared_latency_s if neighbours is not None and neighbours.isolated \
+        else None
+    firsts = [t for t in (declared, aboard) if t is not None]
+    return {"judgeable_s": judgeable, "unjudged": judgeable is None, "contact": contact,
+            "window_latency_s": fault.latency_s - (judgeable - fault.start_s)
+            if isolated and judgeable is not None else None,
+            "declared_latency_s": declared, "neighbours_latency_s": aboard,
+            "first_latency_s": min(firsts) if firsts else None}
 
 
 def latency_summary(faults: Sequence[dict[str, Any]], key: str = "latency_s") -> str:
@@ -136,7 +176,13 @@ def isolated_latencies(rows: Sequence[dict[str, Any]]) -> list[float]:
 
 
 def detector_stats(rows: Sequence[dict[str, Any]], hours: float) -> dict[str, Any]:
+    """A detector's counts over results.csv ``rows``: faults, detected, isolated, identified,
+    latencies (median / p90 / max), false alarms over nominal cycles (and per hour); and the
+    same over the faults a window could judge (``judgeable``: ``isolated_judgeable``,
+    ``identified_judgeable``, ``window_latency`` from the first such window), with the
+    ``unjudged`` apart."""
     faults = [r for r in rows if r["kind"] != "none"]
+    judgeable = [r for r in faults if not r.get("unjudged")]
     fa = sum(r["false_alarms"] for r in {(r["run"]): r for r in rows}.values())
     cycles = sum(r["nominal_cycles"] for r in {(r["run"]): r for r in rows}.values())
     return {
@@ -148,9 +194,21 @@ def detector_stats(rows: Sequence[dict[str, Any]], hours: float) -> dict[str, An
         "identification_latency": latency_summary(
             [f for f in faults if f.get("identified_class") == f["expected_class"]],
             "identification_latency_s"),
+        "judgeable": len(judgeable), "unjudged": len(faults) - len(judgeable),
+        "isolated_judgeable": sum(r["isolated"] for r in judgeable),
+        "identified_judgeable": sum(r.get("identified_class") == r["expected_class"]
+                                    for r in judgeable),
+        "window_latency": latency_summary(judgeable, "window_latency_s"),
         "false_alarms": fa, "nominal_cycles": cycles,
         "false_alarms_per_hour": fa / hours if hours > 0 else None,
     }
+
+
+def neighbour_false_alarms(runs: Sequence[CampaignRun]) -> tuple[int, int]:
+    """The neighbours' false alarms and nominal neighbour-windows over the runs that had them
+    on."""
+    nb = [r.summary.neighbours.scores for r in runs if r.summary.neighbours is not None]
+    return sum(s.false_alarms for s in nb), sum(s.nominal_cycles for s in nb)
 
 
 def detector_figures(out: Path, ids: Sequence[str], detector: str = "main") -> dict[str, Any]:

@@ -17,10 +17,12 @@ from harness.campaign.rescore import (
     CampaignRun,
     alarms_at,
     detector_figures,
+    fault_rows,
     load_runs,
     rescore,
     roc,
 )
+from harness.campaign.targets import target_figures
 from harness.summary import MainWindow, RunSummary, SummaryError
 
 
@@ -28,7 +30,8 @@ def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | No
            cls: str | None, expected: str) -> dict[str, object]:
     return {"spacecraft": sc, "kind": kind, "start_s": start, "detected": detected,
             "isolated": detected, "latency_s": latency, "identified_class": cls,
-            "expected_class": expected, "identified_correctly": cls == expected}
+            "expected_class": expected, "identified_correctly": cls == expected,
+            "declared_latency_s": latency}
 
 
 def _scores(per_fault: list[dict[str, object]], false_alarms: int, nominal_cycles: int
@@ -241,28 +244,54 @@ def test_a_replays_main_detector_is_scored_over_its_faithful_span(tmp_path: Path
     assert (figures["false_alarms"], figures["false_alarms_faithful"]) == (2, 0)
 
 
-def test_faults_before_the_first_judged_window_are_reported_apart(tmp_path: Path) -> None:
-    """A fault injected at 10 s on an observer whose first judged window opens at 150 s and
-    declared at 180 s: 170 s from onset, 30 s from the first window that could judge it; a
-    fault at 400 s on a judged observer counts among the later ones."""
+def test_faults_are_judged_from_the_first_window_that_could_judge_them(tmp_path: Path) -> None:
+    """One pass, 0-300 s.  sc2's fault at 10 s, in the pass, before sc2's first judged window
+    (150 s), declared at 180 s: 170 s from onset, 30 s from that window.  sc1's at 400 s,
+    between passes, has no window after it but is declared (40 s; the neighbours 30 s): judged
+    from onset.  sc3's at 500 s, between passes, missed, with no window at all: no window could
+    judge it, counted apart (the neighbours declared it at 50 s)."""
+    passes = {"passes": [{"station": "s", "aos_s": 0.0, "los_s": 300.0, "duration_s": 300.0,
+                          "tca_s": 150.0, "max_elevation_deg": 40.0}],
+              "longest_gap_s": 700.0, "downlink_bps": 5e7, "store_bytes": 8 << 30,
+              "stores": {}, "uplink_held": {}}
+    faults = [_fault(2, "pointing_actuator", 10.0, True, 170.0, "actuator", "actuator"),
+              _fault(1, "thruster_bias", 400.0, True, 40.0, "actuator", "actuator"),
+              _fault(3, "camera_degradation", 500.0, False, None, None, "camera")]
+    aboard = [_fault(2, "pointing_actuator", 10.0, False, None, None, "actuator"),
+              _fault(1, "thruster_bias", 400.0, True, 30.0, None, "actuator"),
+              _fault(3, "camera_degradation", 500.0, True, 50.0, None, "camera")]
     _write(tmp_path, "e", {
-        "injected_faults": [{"spacecraft": 2, "kind": "pointing_actuator", "start_s": 10.0,
-                             "end_s": None, "magnitude": 4.0},
-                            {"spacecraft": 1, "kind": "thruster_bias", "start_s": 400.0,
-                             "end_s": None, "magnitude": 0.3}],
-        "scores": _scores([_fault(2, "pointing_actuator", 10.0, True, 170.0, "actuator",
-                                  "actuator"),
-                           _fault(1, "thruster_bias", 400.0, True, 40.0, "actuator",
-                                  "actuator")], 0, 4),
+        "injected_faults": [{"spacecraft": f["spacecraft"], "kind": f["kind"],
+                             "start_s": f["start_s"], "magnitude": 0.5} for f in faults],
+        "scores": _scores(faults, 0, 4), "ground_contact": passes,
+        "neighbours": {"agree": 2, "scores": _scores(aboard, 0, 4000),
+                       "windows": {"neighbour_windows": 1, "judge_windows": 1,
+                                   "nominal_judge_windows": 1, "nominal_exceeded": 0},
+                       "disagreements": {"overruled": 0, "upheld": 0, "unruled": 0,
+                                         "ground_only": 0}},
         "fdir_series": {"main": [[1, 60, 90, 0.01, 0.05], [2, 150, 180, 0.5, 0.05],
                                  [2, 180, 210, 0.5, 0.05]]}})
+    rows = fault_rows(load_runs(tmp_path, ["e"]))
+    main = [r for r in rows if r["detector"] == "main"]
+    assert [(r["judgeable_s"], r["unjudged"], r["contact"]) for r in main] == [
+        (150.0, False, "in_pass"), (400.0, False, "between_passes"),
+        (None, True, "between_passes")]
+    assert [r["window_latency_s"] for r in main] == [30.0, 40.0, None]
+    assert [r["first_latency_s"] for r in main] == [170.0, 30.0, 50.0]
+    figures = {f.name.split(" (")[0]: f for f in target_figures(rows, load_runs(tmp_path, ["e"]))}
+    assert figures["faults"].value == "3 (1: 1 between passes)"
+    assert figures["detected and isolated, of the judgeable"].value == "100% (2/2)"
+    assert figures["detected and isolated, of the judgeable"].met is True
+    assert figures["identified as actuator"].value == "100% (2/2)"
+    assert "identified as camera" not in figures  # its only fault could not be judged
+    window = figures["latency from the first judgeable window, median / p90 / max"]
+    assert (window.value, window.met) == ("35 / 39 / 40", False)
+    between = figures["between passes, neighbours on"]
+    assert (between.value, between.met) == ("40 / 48 / 50", True)
+    assert figures["false alarms per nominal neighbour-window"].met is True  # 0/4000: ≤ 7.5e-4
+    assert figures["false alarms per nominal observer-window"].met is False  # 0/4: ≤ 0.53
     report = write_campaign_report(tmp_path, "x", ["e"]).read_text()
-    assert ("| began before their observer's first judged window | 1 | 170 / 170 / 170 | "
-            "30 / 30 / 30 |") in report
-    assert "| began later | 1 | 40 / 40 / 40 | - |" in report
-    main = [r for r in csv.DictReader(open(tmp_path / "results.csv"))
-            if r["detector"] == "main"]
-    assert [float(r["judgeable_s"]) for r in main] == [150.0, 400.0]
+    assert "| detected and isolated, of the judgeable | 100% (2/2) | ≥ 98% | met |" in report
 
 
 def test_a_malformed_summary_is_refused_naming_its_file_and_field(tmp_path: Path) -> None:

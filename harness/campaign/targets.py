@@ -1,0 +1,136 @@
+"""A campaign's figures against the detection targets (issue 39; docs/results.md), from
+results.csv's rows of the main detector and the runs' neighbours sections:
+
+* faults a window could judge (``rescore.fault_rows``: ``unjudged`` when none of its
+  observer's windows after the onset reached the ground in the run) and those none could,
+  apart, by where the onset fell (in contact, between passes);
+* of the judgeable: detected and isolated (≥ 98%), identified per expected class (≥ 95%
+  each), latency from the first judgeable window (median ≤ 30 s, p90 ≤ 60 s); from onset as
+  well, both stamped at the window's end and when the ground declared it (with passes, after
+  the data came down);
+* false alarms per nominal observer-window (the ground) and per nominal neighbour-window (the
+  neighbours aboard), 95% upper bound ≤ 1e-3;
+* faults between passes in runs with the neighbours on: the first declaration, by the
+  neighbours aboard or the ground, from onset (median ≤ 60 s).
+
+Each figure is a :class:`Figure`: what it is, its value as text, the target as text, and
+whether the target is met (None: nothing to judge it on).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from harness.campaign.rescore import CampaignRun, false_alarm_bound, neighbour_false_alarms, spread
+
+DETECTED_MIN = 0.98
+IDENTIFIED_MIN = 0.95
+WINDOW_MEDIAN_S, WINDOW_P90_S = 30.0, 60.0
+FALSE_ALARMS_MAX = 1e-3
+OUT_OF_CONTACT_MEDIAN_S = 60.0
+
+
+@dataclass(frozen=True)
+class Figure:
+    """One line of the table: a figure, its measured value, its target, met or not."""
+
+    name: str
+    value: str
+    target: str = ""
+    met: bool | None = None
+
+
+def share(n: int, d: int) -> str:
+    """"x% (n/d)", or "-" without a denominator."""
+    return "-" if d == 0 else f"{100.0 * n / d:.0f}% ({n}/{d})"
+
+
+def rate(n: int, d: int) -> str:
+    """False alarms per window with counts and the 95% upper bound, or "-"."""
+    return "-" if d == 0 else f"{n / d:.4f} ({n}/{d}; 95% ≤ {false_alarm_bound(n, d):.2g})"
+
+
+def _latencies(rows: Sequence[dict[str, Any]], key: str) -> list[float]:
+    return [r[key] for r in rows if r.get(key) is not None]
+
+
+def _quantiles_met(lat: Sequence[float], median_max: float, p90_max: float | None
+                   ) -> bool | None:
+    if not lat:
+        return None
+    return bool(np.median(lat) <= median_max
+                and (p90_max is None or np.quantile(lat, 0.9) <= p90_max))
+
+
+def _bound_met(n: int, d: int) -> bool | None:
+    return None if d == 0 else false_alarm_bound(n, d) <= FALSE_ALARMS_MAX
+
+
+def target_figures(rows: Sequence[dict[str, Any]], runs: Sequence[CampaignRun]
+                   ) -> list[Figure]:
+    """The figures (module docstring) of the main detector's results.csv ``rows`` and the
+    ``runs`` they come from."""
+    faults = [r for r in rows if r["detector"] == "main" and r["kind"] != "none"]
+    judged = [r for r in faults if not r["unjudged"]]
+    unjudged = [r for r in faults if r["unjudged"]]
+    isolated = sum(r["isolated"] for r in judged)
+    nominal = {r["run"]: r for r in rows if r["detector"] == "main"}.values()
+    fa, windows = sum(r["false_alarms"] for r in nominal), sum(r["nominal_cycles"]
+                                                                for r in nominal)
+    nfa, nwin = neighbour_false_alarms(runs)
+    window_lat = _latencies(judged, "window_latency_s")
+    with_neighbours = {r.id for r in runs if r.summary.neighbours is not None}
+    between = [r for r in faults if r["contact"] == "between_passes"
+               and r["run"] in with_neighbours]
+    first = _latencies(between, "first_latency_s")
+    out = [Figure("faults (no window could judge)",
+                  f"{len(faults)} ({len(unjudged)}: "
+                  f"{sum(r['contact'] == 'between_passes' for r in unjudged)} between passes)"),
+           Figure("detected and isolated, of the judgeable", share(isolated, len(judged)),
+                  f"≥ {DETECTED_MIN:.0%}",
+                  None if not judged else isolated >= DETECTED_MIN * len(judged))]
+    out += _identified_figures(judged)
+    out += [Figure("latency from the first judgeable window, median / p90 / max (s)",
+                   spread(window_lat), f"≤ {WINDOW_MEDIAN_S:g} / ≤ {WINDOW_P90_S:g}",
+                   _quantiles_met(window_lat, WINDOW_MEDIAN_S, WINDOW_P90_S)),
+            Figure("latency from onset, at the window's end (s)",
+                   spread(_latencies(judged, "latency_s"))),
+            Figure("latency from onset, when the ground declared it (s)",
+                   spread(_latencies(judged, "declared_latency_s"))),
+            Figure("false alarms per nominal observer-window (ground)", rate(fa, windows),
+                   f"95% bound ≤ {FALSE_ALARMS_MAX:g}", _bound_met(fa, windows)),
+            Figure("false alarms per nominal neighbour-window (neighbours)", rate(nfa, nwin),
+                   f"95% bound ≤ {FALSE_ALARMS_MAX:g}", _bound_met(nfa, nwin)),
+            Figure(f"between passes, neighbours on ({len(between)} faults, {len(first)} "
+                   "declared): first declaration from onset (s)", spread(first),
+                   f"median ≤ {OUT_OF_CONTACT_MEDIAN_S:g}",
+                   _quantiles_met(first, OUT_OF_CONTACT_MEDIAN_S, None))]
+    return out
+
+
+def _identified_figures(judged: Sequence[dict[str, Any]]) -> list[Figure]:
+    """Identified, of the judgeable faults, per expected class."""
+    out = []
+    for cls in sorted({r["expected_class"] for r in judged if r["expected_class"]}):
+        mine = [r for r in judged if r["expected_class"] == cls]
+        right = sum(r.get("identified_class") == cls for r in mine)
+        out.append(Figure(f"identified as {cls}", share(right, len(mine)),
+                          f"≥ {IDENTIFIED_MIN:.0%}", right >= IDENTIFIED_MIN * len(mine)))
+    return out
+
+
+def target_lines(figures: Sequence[Figure]) -> list[str]:
+    """The report's section."""
+    mark = {True: "met", False: "**not met**", None: "-"}
+    lines = ["", "## Against the targets (main detector)", "",
+             "A fault no window could judge (none of its observer's windows after the onset "
+             "reached the ground in the run: between passes with no pass after it in the run) "
+             "is counted apart; the rates and the latency from the first judgeable window are "
+             "over the others (harness/campaign/targets.py).", "",
+             "| figure | measured | target | |", "|---|---|---|---|"]
+    return lines + [f"| {f.name} | {f.value} | {f.target} | {mark[f.met] if f.target else ''} |"
+                    for f in figures]
