@@ -102,7 +102,7 @@ def fault_rows(runs: list[CampaignRun]) -> list[dict[str, Any]]:
                              "identification_latency_s": f.identification_latency_s
                              if main else None,
                              "expected_class": f.expected_class,
-                             **_timing(f, windows, _contact(s, f.start_s),
+                             **_timing(f, windows, s,
                                        neighbours[i] if i < len(neighbours) else None)})
     return rows
 
@@ -116,13 +116,17 @@ def _judged_windows(summary: RunSummary) -> dict[int, list[tuple[float, float]]]
     return out
 
 
-def _judgeable_s(fault: FaultScore, windows: dict[int, list[tuple[float, float]]]
-                 ) -> float | None:
-    """When a fault could first be judged, s: the start of the first judged window of its
-    observer (of any observer for a common-mode fault, spacecraft 0) that ends after the
-    onset, or the onset when that window began earlier; the onset for a fault declared without
-    one (a link fault is seen in the link, not in windows); None when no window after the onset
-    was judged (between passes: none came down in the run)."""
+def _judgeable_s(fault: FaultScore, windows: dict[int, list[tuple[float, float]]],
+                 summary: RunSummary) -> float | None:
+    """When a fault could first be judged, s (None: never in the run).  A link fault: once
+    the ground hears the constellation (at the onset, or at the next pass's acquisition: a
+    link is judged on what arrives, not in windows).  Any other: the start of the first judged
+    window of its observer (of any observer for a common-mode fault, spacecraft 0) that ends
+    after the onset, or the onset when that window began earlier; when no window after the
+    onset was judged (between passes: none came down in the run), the onset for a fault
+    declared all the same, else None."""
+    if fault.expected_class == "link":
+        return _heard_from_s(summary, fault.start_s)
     spans = [w for ws in windows.values() for w in ws] if fault.spacecraft == 0 \
         else windows.get(fault.spacecraft, [])
     t0 = min((a for a, b in spans if b > fault.start_s), default=None)
@@ -131,19 +135,29 @@ def _judgeable_s(fault: FaultScore, windows: dict[int, list[tuple[float, float]]
     return max(fault.start_s, t0)
 
 
+def _heard_from_s(summary: RunSummary, t_s: float) -> float | None:
+    """The first time at or after ``t_s`` the ground hears the constellation, s: ``t_s`` with
+    continuous contact or in a pass, else the next pass's acquisition (None: none in the
+    run)."""
+    gc = summary.ground_contact
+    if gc is None:
+        return t_s
+    return min((max(p.aos_s, t_s) for p in gc.passes if p.los_s > t_s), default=None)
+
+
 def _contact(summary: RunSummary, t_s: float) -> str:
     """Where ``t_s`` fell: ``continuous`` (the ground hears continuously), ``in_pass`` or
     ``between_passes``."""
-    gc = summary.ground_contact
-    if gc is None:
+    if summary.ground_contact is None:
         return "continuous"
-    return "in_pass" if any(p.aos_s <= t_s < p.los_s for p in gc.passes) else "between_passes"
+    return "in_pass" if _heard_from_s(summary, t_s) == t_s else "between_passes"
 
 
-def _timing(fault: FaultScore, windows: dict[int, list[tuple[float, float]]], contact: str,
-            neighbours: FaultScore | None) -> dict[str, Any]:
+def _timing(fault: FaultScore, windows: dict[int, list[tuple[float, float]]],
+            summary: RunSummary, neighbours: FaultScore | None) -> dict[str, Any]:
     """A fault row's judgeability and latencies (:func:`fault_rows`)."""
-    judgeable = _judgeable_s(fault, windows)
+    judgeable = _judgeable_s(fault, windows, summary)
+    contact = _contact(summary, fault.start_s)
     isolated = fault.isolated and fault.latency_s is not None
     declared = fault.declared_latency_s if isolated else None
     aboard = neighbours.declared_latency_s if neighbours is not None and neighbours.isolated \

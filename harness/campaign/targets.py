@@ -128,9 +128,10 @@ def target_lines(figures: Sequence[Figure]) -> list[str]:
     mark = {True: "met", False: "**not met**", None: "-"}
     lines = ["", "## Against the targets (main detector)", "",
              "A fault no window could judge (none of its observer's windows after the onset "
-             "reached the ground in the run: between passes with no pass after it in the run) "
-             "is counted apart; the rates and the latency from the first judgeable window are "
-             "over the others (harness/campaign/targets.py).", "",
+             "reached the ground in the run: between passes with no pass after it in the run; "
+             "a link fault: no pass after it) is counted apart; the rates and the latency from "
+             "the first judgeable window are over the others (harness/campaign/targets.py).",
+             "",
              "| figure | measured | target | |", "|---|---|---|---|"]
     return lines + [f"| {f.name} | {f.value} | {f.target} | {mark[f.met] if f.target else ''} |"
-                    for f in figures]
+                    for f in figures] + [""]
