@@ -4,7 +4,11 @@ that does not reach the ground is a link fault, never zero information gain.
 * **Loss**: more of a window's observations missing by sequence number (the observer numbers
   every message it publishes on its key) than the link's nominal loss allows
   (``observer.loss_limit``: ``comms.packet_loss`` plus ``fdir.loss_tol`` plus its spread),
-  for ``fdir.checks_persistence`` windows.
+  for ``fdir.checks_persistence`` windows; a window with a plan and no image counts as one
+  that lost everything.  One window decides alone when a healthy link would lose as many
+  with a probability (``observer.loss_tail``) below the window's false-alarm share of
+  ``fdir.false_alarms_per_observer_hour`` (a link losing 6 of 7 observations at a nominal
+  10%: 6e-6 against 8e-5 for 30 s windows and 0.01 per hour).
 * **Silence**: an observer with a plan that sends no image for ``fdir.silent_windows``
   windows in a row (once per episode).
 * **Store overflow** (ground passes): a window whose reports the observer's onboard store
@@ -15,7 +19,8 @@ from __future__ import annotations
 
 import logging
 
-from ground.fdir.observer import ObserverState, loss_limit
+from gnc.hardware_threshold import window_false_alarm
+from ground.fdir.observer import ObserverState, loss_limit, loss_tail
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, PoiObservations
 from interfaces.contracts.scenario import Scenario
@@ -31,6 +36,9 @@ class LinkChecks:
         self.node = node
         self.log = log
         self.loss = Persistence(self.cfg.checks_persistence)
+        self.alpha = window_false_alarm(self.cfg.false_alarms_per_observer_hour,
+                                        scenario.rates.fdi_period_s, 1)
+        """the false-alarm probability at which one window decides alone"""
 
     def judge(self, sc: int, obs: ObserverState, images: list[PoiObservations],
               planned: bool, b: float) -> tuple[int, list[FaultReport]]:
@@ -39,15 +47,27 @@ class LinkChecks:
         lost, reports = self._loss(sc, obs, images, b)
         if planned and not images:
             reports += self._silence(sc, obs, b)
+            if not obs.link_declared and self.loss.update(sc, True):  # all it sent was lost
+                self.loss.declare(sc)
+                reports.append(self._loss_report(sc, 1.0, self.limit(0), b))
         elif planned:
             obs.silent, obs.link_declared = 0, False
         obs.overflow_declared = False
         return lost, reports
 
+    @property
+    def burst(self) -> float:
+        """The links' mean burst length, packets (1: Bernoulli loss)."""
+        return self.comms.burst.mean_length_packets if self.comms.burst else 1.0
+
     def limit(self, sent: int) -> float:
         """The link's loss limit for ``sent`` observations (``observer.loss_limit``)."""
-        burst = self.comms.burst.mean_length_packets if self.comms.burst else 1.0
-        return loss_limit(self.comms.packet_loss, burst, self.cfg.loss_tol, sent)
+        return loss_limit(self.comms.packet_loss, self.burst, self.cfg.loss_tol, sent)
+
+    def decisive(self, lost: int, sent: int) -> bool:
+        """Whether a window losing ``lost`` of ``sent`` observations decides alone: a healthy
+        link loses as many with a probability below ``alpha`` (``observer.loss_tail``)."""
+        return loss_tail(lost, sent, self.comms.packet_loss, self.burst) <= self.alpha
 
     def _loss(self, sc: int, obs: ObserverState, images: list[PoiObservations], b: float
               ) -> tuple[int, list[FaultReport]]:
@@ -57,16 +77,24 @@ class LinkChecks:
         if obs.resync:  # the numbers the store lost were declared as its overflow
             obs.last_seq, obs.resync = max(obs.last_seq, seqs[0] - 1), False
         lost = obs.count_observations(seqs)
-        if obs.silent:  # the gap is the silence already judged (a link fault), not loss
+        if obs.link_declared:  # the gap is the silence already declared: count afresh
+            self.loss.update(sc, False)
             return 0, []
-        fraction = lost / (lost + len(seqs))
-        limit = self.limit(lost + len(seqs))
-        if not self.loss.update(sc, fraction > limit):
+        sent = lost + len(seqs)
+        fraction, limit = lost / sent, self.limit(sent)
+        declared = self.loss.declared(sc)
+        persisted = self.loss.update(sc, fraction > limit)
+        alone = fraction > limit and not declared and self.decisive(lost, sent)
+        if not (persisted or alone):
             return lost, []
+        self.loss.declare(sc)
+        return lost, [self._loss_report(sc, fraction, limit, b)]
+
+    def _loss_report(self, sc: int, fraction: float, limit: float, b: float) -> FaultReport:
         self.log.warning("FDIR: sc%d lost %.0f%% of its observations: link fault", sc,
                          100.0 * fraction)
-        return lost, [FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
-                                  metric=fraction, threshold=limit, window_end_s=b)]
+        return FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
+                           metric=fraction, threshold=limit, window_end_s=b)
 
     def overflow(self, sc: int, obs: ObserverState, b: float) -> list[FaultReport]:
         """A window whose reports the observer's onboard store lost to overflow (ground

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from itertools import pairwise
 
 import numpy as np
+from scipy.special import betainc
 
 from gnc.twin import FlightPlan, plans_in_force
 
@@ -216,6 +217,21 @@ def loss_limit(packet_loss: float, burst_packets: float, loss_tol: float, sent: 
     p = packet_loss
     spread = math.sqrt(p * (1.0 - p) * (2.0 * burst_packets - 1.0) / max(sent, 1))
     return min(1.0, p + loss_tol + 2.0 * spread)
+
+
+def loss_tail(lost: int, sent: int, packet_loss: float, burst_packets: float) -> float:
+    """The probability that a healthy link loses ``lost`` or more of ``sent`` observations:
+    the binomial tail P(X ≥ k), X ~ B(n, p), at the nominal loss p (``comms.packet_loss``),
+    with k and n divided by 2L − 1 for Gilbert-Elliott bursts of mean length L (the variance
+    inflation of :func:`loss_limit`: bursts make fewer independent draws), continued to
+    non-integer k and n as the regularized incomplete beta I_p(k, n − k + 1)."""
+    if lost <= 0:
+        return 1.0
+    if packet_loss <= 0.0:
+        return 0.0
+    inflation = max(2.0 * burst_packets - 1.0, 1.0)
+    k, n = lost / inflation, sent / inflation
+    return float(betainc(k, n - k + 1.0, min(packet_loss, 1.0)))
 
 
 MAX_JUDGED_LOSS = 0.9

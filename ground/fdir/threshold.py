@@ -76,6 +76,11 @@ class Persistence:
         """Whether a fault of ``spacecraft`` is declared and its episode still going on."""
         return spacecraft in self._declared
 
+    def declare(self, spacecraft: int) -> None:
+        """A fault of ``spacecraft`` declared on other grounds (one decisive window): its
+        episode goes on while its windows keep exceeding, without another declaration."""
+        self._declared.add(spacecraft)
+
     def update(self, spacecraft: int, exceeded: bool | None) -> bool:
         if exceeded is None:
             return False

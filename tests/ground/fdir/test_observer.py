@@ -13,7 +13,7 @@ from gnc.infocost import Camera
 from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
 from gnc.twin import TwinModel, centre_boresights, planned_boresights
-from ground.fdir.observer import ObserverState, TimeSeries, loss_limit
+from ground.fdir.observer import ObserverState, TimeSeries, loss_limit, loss_tail
 from ground.fdir.threshold import sampled_threshold
 
 
@@ -33,6 +33,16 @@ def test_loss_limit_is_the_nominal_loss_plus_tolerance_and_two_sigma() -> None:
     assert loss_limit(0.1, 5.0, 0.05, 100) == pytest.approx(0.15 + 2 * math.sqrt(0.81 / 100))
     assert loss_limit(0.0, 1.0, 0.05, 0) == pytest.approx(0.05)
     assert loss_limit(0.9, 1.0, 0.5, 1) == 1.0
+
+
+def test_loss_tail_is_the_binomial_tail_with_bursts_thinning_the_draws() -> None:
+    from scipy.stats import binom
+
+    assert loss_tail(5, 15, 0.05, 1.0) == pytest.approx(binom.sf(4, 15, 0.05))
+    assert loss_tail(12, 22, 0.05, 1.0) == pytest.approx(binom.sf(11, 22, 0.05))
+    # bursts of mean length 3: a fifth of the draws (2L - 1 = 5)
+    assert loss_tail(10, 50, 0.1, 3.0) == pytest.approx(binom.sf(1, 10, 0.1))
+    assert loss_tail(0, 10, 0.1, 1.0) == 1.0 and loss_tail(1, 10, 0.0, 1.0) == 0.0
 
 
 def test_a_series_is_nan_where_it_is_stale_and_none_where_any_is() -> None:

@@ -56,21 +56,51 @@ def test_silence_is_a_link_fault_once_per_episode() -> None:
     assert links.judge(2, ObserverState(), [], False, 10.0) == (0, [])  # no plan: no silence
 
 
-def test_loss_beyond_the_links_limit_for_two_windows_is_a_link_fault() -> None:
-    scenario = small_scenario(comms={"packet_loss": 0.0}, fdir={"loss_tol": 0.1,
-                                                                "checks_persistence": 2})
-    links = LinkChecks(scenario, "ground", LOG)
-    assert links.limit(15) == pytest.approx(0.1)  # no nominal loss: no spread either
+def _lossy_windows(links: LinkChecks, missing: list[int], received: int = 10
+                  ) -> list[tuple[int, list[FaultReport]]]:
+    """Windows of ``received`` observations after ``missing[k]`` lost ones (none received when
+    ``received`` is 0 and the window has a plan)."""
     obs, seq, out = ObserverState(), 0, []
-    for k in range(3):  # 10 received, 5 missing before them, each window
-        seq += 5
-        images = [_obs(1, 10.0 * k + i, seq + i + 1) for i in range(10)]
-        seq += 10
+    for k, m in enumerate(missing):
+        seq += m
+        images = [_obs(1, 10.0 * k + i, seq + i + 1) for i in range(received)]
+        seq += received
         out.append(links.judge(1, obs, images, True, 10.0 * (k + 1)))
+    return out
+
+
+def test_loss_beyond_the_links_limit_for_two_windows_is_a_link_fault() -> None:
+    """5 of 15 missing at a nominal 5%: beyond the limit (0.1 + 0.05 + 2σ), but a healthy link
+    does it with probability 6e-3, above the window's one-window share (8.3e-5): two windows."""
+    scenario = small_scenario(comms={"packet_loss": 0.05}, fdir={"loss_tol": 0.1,
+                                                                 "checks_persistence": 2})
+    links = LinkChecks(scenario, "ground", LOG)
+    assert links.limit(15) == pytest.approx(0.15 + 2 * (0.05 * 0.95 / 15) ** 0.5)
+    assert not links.decisive(5, 15)
+    out = _lossy_windows(links, [5, 5, 5])
     assert [lost for lost, _ in out] == [5, 5, 5]
     assert [len(r) for _, r in out] == [0, 1, 0]
     assert out[1][1][0].metric == pytest.approx(5 / 15)
-    assert out[1][1][0].threshold == pytest.approx(0.1)
+
+
+def test_one_window_decides_when_a_healthy_link_could_hardly_lose_as_much() -> None:
+    """12 of 22 missing at a nominal 5% (probability 1e-11): declared on that window, once per
+    episode; with no nominal loss any loss beyond the limit decides; a window with a plan and
+    no image counts as one that lost everything for the persistence."""
+    scenario = small_scenario(comms={"packet_loss": 0.05}, fdir={"loss_tol": 0.1,
+                                                                 "checks_persistence": 2})
+    links = LinkChecks(scenario, "ground", LOG)
+    assert links.alpha == pytest.approx(0.01 * 30.0 / 3600.0)
+    assert links.decisive(12, 22)
+    assert [len(r) for _, r in _lossy_windows(links, [12, 12, 12])] == [1, 0, 0]
+    lossless = LinkChecks(small_scenario(comms={"packet_loss": 0.0}, fdir={"loss_tol": 0.1}),
+                          "ground", LOG)
+    assert [len(r) for _, r in _lossy_windows(lossless, [5, 5])] == [1, 0]
+    # 5 of 15 (not decisive), then a silent window: declared on the second
+    links, obs = LinkChecks(scenario, "ground", LOG), ObserverState()
+    images = [_obs(1, float(i), 5 + i + 1) for i in range(10)]
+    assert len(links.judge(1, obs, images, True, 10.0)[1]) == 0
+    assert [r.fault_class for r in links.judge(1, obs, [], True, 20.0)[1]] == ["link"]
 
 
 def test_window_context_judges_tracked_images_under_a_plan() -> None:
