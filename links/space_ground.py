@@ -10,7 +10,9 @@ node's channel stage (``links.channel``) that holds what crosses them.
 * **Uplink** (from the ground): a message sent in contact is judged by the channel as any
   other; one sent out of contact waits on the ground until the next acquisition and is judged
   then (cut, range, loss at that time), the link's delay later.  Nothing leaves a ground that
-  hears no station: it stays, counted as held.
+  hears no station: it stays, counted as held.  What the ground sends at the run's start
+  (t = 0: the initial assignments) was loaded aboard in a pass before the run: it is judged
+  by the channel at once, as in contact.
 
 Both are simulated in send time, so what is delivered when does not depend on when the Bus
 asks (``released``), only on the messages.
@@ -111,7 +113,7 @@ class SpaceGroundLink:
             self._store(src).offer(env, msg, _topic(key), catalogue.downlink_priority(key))
             env.msg = Aboard.of(msg)  # until it comes down (``released``)
             return True
-        if src == GROUND and not self.plan.in_contact(msg.t_sim):
+        if src == GROUND and msg.t_sim > TIME_TOL_S and not self.plan.in_contact(msg.t_sim):
             bisect.insort(self.uplink, (self.plan.next_contact(msg.t_sim),
                                         (msg.t_sim, key, msg.seq), env), key=lambda u: u[:2])
             self.held += 1

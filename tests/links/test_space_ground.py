@@ -1,6 +1,7 @@
 """The space-ground links with ground passes (links/space_ground.py, through the
 channel stage that owns them): a downlink waits in the store for the pass and comes down at
-the stated rate, an uplink sent out of contact waits on the ground for the acquisition, and a
+the stated rate, an uplink sent out of contact waits on the ground for the acquisition (but
+what is sent at the start was loaded before the run), and a
 link cut for a whole pass keeps everything aboard for the next one, accounted for."""
 
 from __future__ import annotations
@@ -65,6 +66,17 @@ def test_an_uplink_out_of_contact_waits_for_the_acquisition() -> None:
     assert ch.transmit("ground", env.key, in_pass, env) == "deliver"  # judged at once
     (c,) = ch.counters()
     assert (c.held, c.sent, c.delivered) == (1, 2, 2)
+
+
+def test_what_the_ground_sends_at_the_start_was_loaded_before_the_run() -> None:
+    """The initial assignments (t = 0, out of contact here: the first pass is at 100 s) are
+    aboard from the start, not held for the first pass."""
+    ch = _channel("sc1")
+    cmd = ProAssignments(sender="ground", seq=1, t_sim=0.0, assignments=[])
+    env = Envelope(cmd, "insp/m/ground/planner/assignments", "ground", False, [])
+    assert ch.transmit("ground", env.key, cmd, env) == "deliver"
+    (c,) = ch.counters()
+    assert c.held == 0
 
 
 def test_a_link_cut_for_a_whole_pass_keeps_the_data_for_the_next() -> None:
