@@ -87,7 +87,8 @@ class FdirPipeline:
         self.information = InformationTest(sc, self.twin)
         self.global_check = GlobalCheck(cfg, self.information.q_window, node, log)
         self.declarer = Declarer(cfg, node, log)
-        self.integrity = IntegrityCheck(cfg, node, log, sc.rates.fdi_period_s)
+        self.integrity = IntegrityCheck(cfg, node, log, sc.rates.fdi_period_s,
+                                        sc.comms.packet_loss)
         self.rulings = NeighbourRulings(node, log)
         self.next_window = 0
         """the next FDI window to judge (``interfaces.contracts.fdi_schedule``)"""

@@ -172,12 +172,13 @@ def test_a_class_found_on_a_later_window_and_common_mode_not_held_against_one() 
     assert out[0].exceeded is False and len(out) == 1
 
 
-def _integrity_over_two_boundaries(observers: dict[int, ObserverState]
+def _integrity_over_two_boundaries(observers: dict[int, ObserverState],
+                                   crosslink_loss: float = 0.0
                                    ) -> list[tuple[list[FaultReport], dict[int, str]]]:
     """The data-integrity check at boundaries 1 and 2 (10 s, 20 s) of two observers whose map
     the ground holds, sc1 reporting its H_i 1.5 times what its observations give."""
     cfg = small_scenario(fdir={"checks_persistence": 2, "integrity_tol": 0.2}).fdir
-    check = IntegrityCheck(cfg, "ground", LOG)
+    check = IntegrityCheck(cfg, "ground", LOG, crosslink_loss=crosslink_loss)
     settled = PoiMap.uniform(10, 1.0, 2)
     settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
     settled.add(2, np.array([2, 3]), np.array([0.5, 0.5]))
@@ -214,6 +215,16 @@ def test_no_integrity_verdict_rests_on_observations_lost_to_a_stores_overflow() 
     out = _integrity_over_two_boundaries(observers)
     assert [r for r, _ in out] == [[], []]
     assert [u for _, u in out] == [{1: "lost", 2: "lost"}] * 2
+
+
+def test_no_integrity_verdict_when_the_crosslinks_lose_more_than_it_allows() -> None:
+    """The crosslinks' nominal loss of 15% (above integrity_max_loss, 10%): every observer
+    fused its neighbours' images less what they lost, which the ground cannot rebuild."""
+    out = _integrity_over_two_boundaries({1: ObserverState(), 2: ObserverState()}, 0.15)
+    assert [r for r, _ in out] == [[], []]
+    assert [u for _, u in out] == [{1: "lost", 2: "lost"}] * 2
+    assert [len(r) for r, _ in _integrity_over_two_boundaries(
+        {1: ObserverState(), 2: ObserverState()}, 0.05)] == [0, 1]
 
 
 def test_no_integrity_verdict_while_reports_before_the_boundary_are_still_aboard() -> None:
