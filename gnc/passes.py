@@ -37,6 +37,7 @@ from scipy.optimize import brentq, minimize_scalar
 from gnc.constants import J2_EARTH, MU_EARTH_M3_S2, R_EARTH_M
 from gnc.frames import orbit_plane_axes
 from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.timing import TIME_TOL_S
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -251,6 +252,12 @@ class ContactPlan:
             return t_s
         i = self.pass_index(t_s) + 1
         return self.windows[i][0] if i < len(self.windows) else math.inf
+
+    def uplinked_s(self, t_send_s: float) -> float:
+        """When the ground's message sent at ``t_send_s`` (s) leaves for the spacecraft: at
+        once in contact, and at the run's start (t = 0: loaded aboard in a pass before the
+        run); else at the next acquisition (inf if none follows)."""
+        return t_send_s if t_send_s <= TIME_TOL_S else self.next_contact(t_send_s)
 
     def contact_end(self, t_s: float) -> float:
         """The loss of signal that ends the contact at or after ``t_s`` (s); inf if none."""

@@ -113,9 +113,10 @@ class SpaceGroundLink:
             self._store(src).offer(env, msg, _topic(key), catalogue.downlink_priority(key))
             env.msg = Aboard.of(msg)  # until it comes down (``released``)
             return True
-        if src == GROUND and msg.t_sim > TIME_TOL_S and not self.plan.in_contact(msg.t_sim):
-            bisect.insort(self.uplink, (self.plan.next_contact(msg.t_sim),
-                                        (msg.t_sim, key, msg.seq), env), key=lambda u: u[:2])
+        t_go = self.plan.uplinked_s(msg.t_sim)
+        if src == GROUND and t_go > msg.t_sim:
+            bisect.insort(self.uplink, (t_go, (msg.t_sim, key, msg.seq), env),
+                          key=lambda u: u[:2])
             self.held += 1
             return True
         return False

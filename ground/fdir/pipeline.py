@@ -126,10 +126,11 @@ class FdirPipeline:
 
     def assignments(self, msg: ProAssignments) -> None:
         """The ground's own assignments.  With ground passes one sent out of contact waits for
-        the next pass, so the plan is in force from then at the earliest; of those held for
+        the next pass (``ContactPlan.uplinked_s``: not one sent at the start, loaded before the
+        run), so the plan is in force from then at the earliest; of those held for
         the same pass an observer flies only the newest, so an older plan that would start no
         earlier than a newer one is dropped (superseded before it started)."""
-        reach = self.contact.next_contact(msg.t_sim) if self.contact is not None else 0.0
+        reach = self.contact.uplinked_s(msg.t_sim) if self.contact is not None else 0.0
         for a in msg.assignments:
             obs = self.observers.get(a.spacecraft)
             if obs is None or a.assignment_id in obs.plans:

@@ -76,7 +76,8 @@ def test_observations_missing_by_sequence_make_a_link_fault() -> None:
     windows = [m for m in sent if isinstance(m, FdirWindow) and m.spacecraft == 2]
     assert [w.lost for w in windows] == [0, 6, 6, 6]
     reports = [m for m in sent if isinstance(m, FaultReport)]
-    assert [(r.spacecraft, r.fault_class, r.t_sim) for r in reports] == [(2, "link", 30.0)]
+    # 6 of 10 lost where the link loses none nominally: the first such window decides alone
+    assert [(r.spacecraft, r.fault_class, r.t_sim) for r in reports] == [(2, "link", 20.0)]
     assert reports[0].metric == pytest.approx(0.6)
     assert app.pipeline.observers[2].lost_fraction() == pytest.approx(18 / 40)
 
