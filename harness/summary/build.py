@@ -103,28 +103,6 @@ def build_summary(digest: RunDigest, scenario: Scenario, mission: str,
     return summary
 
 
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
-
 def _last_of(digest: RunDigest, model: type[M]) -> dict[str, M]:
     """The last ``model`` message of each key, by node (cumulative counters)."""
     msgs = [rec.decode(model) for (_, type_name), rec in digest.counters.last.items()
