@@ -124,24 +124,23 @@ def draw_onset(scenario: Scenario, phases: Sequence[OnsetPhase], rng: np.random.
 
 
 def heard_by_s(scenario: Scenario, onsets_s: Sequence[float], max_extension_s: float) -> float:
-    """How long a run with ground passes must last (s) for the ground to hear the
-    ``WINDOWS_AFTER`` FDI windows after each of ``onsets_s``: for each onset, the first pass
-    that lasts that long past it; when it does not begin ``WINDOWS_AFTER`` windows before the
-    run's end, the run must last until its loss of signal plus ``WINDOWS_AFTER`` windows (its
-    dump judged).  The run's own duration when it is long enough, when the ground hears
-    continuously, or when that would lengthen it by more than ``max_extension_s`` (the fault is
-    then counted as one no window could judge)."""
+    """How long a run with ground passes must last (s) for the ground to hear what followed
+    each of ``onsets_s``: until the loss of signal of the first pass that lasts
+    ``WINDOWS_AFTER`` FDI windows past the onset, plus ``WINDOWS_AFTER`` windows (its dump
+    judged; a silence is known only once the pass is over).  The run's own duration when it
+    is long enough or the ground hears continuously; an onset that would lengthen the run by
+    more than ``max_extension_s`` is left out (its fault is then one no window could judge)."""
     base = scenario.duration_s
     plan = ContactPlan.of(scenario.model_copy(update={"duration_s": base + max_extension_s}))
-    if plan is None or not onsets_s:
+    if plan is None:
         return base
     margin = WINDOWS_AFTER * scenario.rates.fdi_period_s
-    need = base
+    need = [base]
     for onset in onsets_s:
-        after = [(aos, los) for aos, los in plan.windows if los > onset + margin]
-        if after and after[0][0] + margin > base:
-            need = max(need, after[0][1] + margin)
-    return need if need - base <= max_extension_s else base
+        los = [b for _, b in plan.windows if b > onset + margin]
+        if los and los[0] + margin - base <= max_extension_s:
+            need.append(los[0] + margin)
+    return max(need)
 
 
 def _uniform_in(spans: Sequence[Span], rng: np.random.Generator) -> float:

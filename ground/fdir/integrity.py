@@ -110,13 +110,20 @@ class IntegrityCheck:
             return "aboard"
         if any(o.heard_s < b - period_s for o in observers.values()):
             return "lost"
-        worst = max(float(lost.max(initial=0.0)), self.crosslink_loss)
-        return "lost" if worst > self.cfg.integrity_max_loss else None
+        if self.crosslink_loss > self.cfg.integrity_max_loss:
+            return "crosslink_loss"
+        return "lost" if float(lost.max(initial=0.0)) > self.cfg.integrity_max_loss else None
 
     def _unjudged(self, sc: int, reason: Unjudged, lost: np.ndarray) -> None:
         self.unjudged[reason] = self.unjudged.get(reason, 0) + 1
         count = sum(self.unjudged.values())
-        if count == 1 or count % 100 == 0:
+        if not (count == 1 or count % 100 == 0):
+            return
+        if reason == "crosslink_loss":
+            self.log.info("FDIR: sc%d's H_i report not judged: the crosslinks lose %.0f%% "
+                          "(data integrity needs at most %.0f%%; %d unjudged so far)", sc,
+                          100 * self.crosslink_loss, 100 * self.cfg.integrity_max_loss, count)
+        else:
             self.log.info("FDIR: sc%d's H_i report not judged (%s): %.0f%% of sc%d's "
                           "observations lost (data integrity needs at most %.0f%%; %d unjudged "
                           "so far)", sc, reason, 100 * lost.max(initial=0.0),

@@ -4,13 +4,14 @@ that does not reach the ground is a link fault, never zero information gain.
 * **Loss**: more of a window's observations missing by sequence number (the observer numbers
   every message it publishes on its key) than the link's nominal loss allows
   (``observer.loss_limit``: ``comms.packet_loss`` plus ``fdir.loss_tol`` plus its spread),
-  for ``fdir.checks_persistence`` windows; a window with a plan and no image counts as one
-  that lost everything.  One window decides alone when a healthy link would lose as many
+  for ``fdir.checks_persistence`` windows; the window after a silence counts the silence's
+  missing observations too.  One window decides alone when a healthy link would lose as many
   with a probability (``observer.loss_tail``) below the window's false-alarm share of
   ``fdir.false_alarms_per_observer_hour`` (a link losing 6 of 7 observations at a nominal
   10%: 6e-6 against 8e-5 for 30 s windows and 0.01 per hour).
 * **Silence**: an observer with a plan that sends no image for ``fdir.silent_windows``
-  windows in a row (once per episode).
+  windows in a row (once per episode, and not when its loss was declared already: one link
+  fault, declared once).
 * **Store overflow** (ground passes): a window whose reports the observer's onboard store
   lost is a link fault of known cause (once per episode), never judged for information.
 """
@@ -47,9 +48,6 @@ class LinkChecks:
         lost, reports = self._loss(sc, obs, images, b)
         if planned and not images:
             reports += self._silence(sc, obs, b)
-            if not obs.link_declared and self.loss.update(sc, True):  # all it sent was lost
-                self.loss.declare(sc)
-                reports.append(self._loss_report(sc, 1.0, self.limit(0), b))
         elif planned:
             obs.silent, obs.link_declared = 0, False
         obs.overflow_declared = False
@@ -111,6 +109,8 @@ class LinkChecks:
 
     def _silence(self, sc: int, obs: ObserverState, b: float) -> list[FaultReport]:
         obs.silent += 1
+        if self.loss.declared(sc):  # the loss that went silent is the link fault declared
+            obs.link_declared = True
         if obs.silent < self.cfg.silent_windows or obs.link_declared:
             return []
         obs.link_declared = True

@@ -80,6 +80,7 @@ class Persistence:
         """A fault of ``spacecraft`` declared on other grounds (one decisive window): its
         episode goes on while its windows keep exceeding, without another declaration."""
         self._declared.add(spacecraft)
+        self._hits[spacecraft] = [True] * (self.window or self.count)
 
     def update(self, spacecraft: int, exceeded: bool | None) -> bool:
         if exceeded is None:

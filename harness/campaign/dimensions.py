@@ -39,6 +39,7 @@ from harness.campaign.rescore import (
     detector_stats,
     false_alarm_bound,
     neighbour_false_alarms,
+    values,
 )
 
 
@@ -203,14 +204,11 @@ def _bin_figures(label: str, mine: Sequence[CampaignRun], failed: int,
     return BinFigures(
         label, runs=len(mine), failed=failed, faults=st["faults"], unjudged=st["unjudged"],
         isolated=st["isolated_judgeable"], identified=st["identified_judgeable"],
-        latencies_s=_values(judged, "window_latency_s"),
-        onset_latencies_s=_values(judged, "declared_latency_s"),
+        latencies_s=tuple(values(judged, "window_latency_s")),
+        onset_latencies_s=tuple(values(judged, "declared_latency_s")),
         false_alarms=st["false_alarms"], windows=st["nominal_cycles"],
         neighbour_false_alarms=nfa, neighbour_windows=nwin)
 
-
-def _values(rows: Sequence[dict[str, Any]], key: str) -> tuple[float, ...]:
-    return tuple(r[key] for r in rows if r.get(key) is not None)
 
 
 def _badness(b: BinFigures) -> tuple[float, ...]:

@@ -8,6 +8,7 @@ m-of-n persistence: the ROC and the persistence table), without re-simulating.  
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -102,7 +103,7 @@ def fault_rows(runs: list[CampaignRun]) -> list[dict[str, Any]]:
                              "identification_latency_s": f.identification_latency_s
                              if main else None,
                              "expected_class": f.expected_class,
-                             **_timing(f, windows, s,
+                             **_timing(f, s.injected_faults[i].end_s, windows, run,
                                        neighbours[i] if i < len(neighbours) else None)})
     return rows
 
@@ -116,58 +117,91 @@ def _judged_windows(summary: RunSummary) -> dict[int, list[tuple[float, float]]]
     return out
 
 
-def _judgeable_s(fault: FaultScore, windows: dict[int, list[tuple[float, float]]],
-                 summary: RunSummary) -> float | None:
-    """When a fault could first be judged, s (None: never in the run).  A link fault: once
-    the ground hears the constellation (at the onset, or at the next pass's acquisition: a
-    link is judged on what arrives, not in windows).  Any other: the start of the first judged
-    window of its observer (of any observer for a common-mode fault, spacecraft 0) that ends
-    after the onset, or the onset when that window began earlier; when no window after the
-    onset was judged (between passes: none came down in the run), the onset for a fault
-    declared all the same, else None."""
+def _judgeable_s(fault: FaultScore, end_s: float | None,
+                 windows: dict[int, list[tuple[float, float]]], summary: RunSummary,
+                 integrity_blind: bool) -> float | None:
+    """When a fault could first be judged, s (None: never in the run).
+
+    * A link fault: once the ground hears the constellation after the onset (at once, or at
+      the next pass's acquisition: a link is judged on what arrives, not in windows), if the
+      run lasts until that contact's end and a window more (a silence is known only when the
+      pass is over).
+    * A data-integrity fault in a run whose integrity check never judged (``integrity_blind``:
+      the crosslinks lose more than ``fdir.integrity_max_loss``): never.
+    * Any other: the start of the first judged window of its observer (of any observer for a
+      common-mode fault, spacecraft 0) that ends after the onset and begins while the fault is
+      on (before ``end_s`` and a window), or the onset when that window began earlier; with
+      none (between passes: none came down in the run), the onset for a fault isolated all the
+      same, else None."""
     if fault.expected_class == "link":
         return _heard_from_s(summary, fault.start_s)
+    if fault.expected_class == "data_integrity" and integrity_blind:
+        return None
     spans = [w for ws in windows.values() for w in ws] if fault.spacecraft == 0 \
         else windows.get(fault.spacecraft, [])
-    t0 = min((a for a, b in spans if b > fault.start_s), default=None)
+    until = math.inf if end_s is None else end_s + summary.fdir_settings.fdi_period_s
+    t0 = min((a for a, b in spans if b > fault.start_s and a < until), default=None)
     if t0 is None:
-        return fault.start_s if fault.detected else None
+        return fault.start_s if fault.isolated else None
     return max(fault.start_s, t0)
 
 
 def _heard_from_s(summary: RunSummary, t_s: float) -> float | None:
     """The first time at or after ``t_s`` the ground hears the constellation, s: ``t_s`` with
-    continuous contact or in a pass, else the next pass's acquisition (None: none in the
-    run)."""
+    continuous contact or in a pass, else the next pass's acquisition; None when the run ends
+    before that contact does, plus a window."""
     gc = summary.ground_contact
     if gc is None:
         return t_s
-    return min((max(p.aos_s, t_s) for p in gc.passes if p.los_s > t_s), default=None)
+    end = (summary.duration_s or math.inf) - summary.fdir_settings.fdi_period_s
+    return min((max(p.aos_s, t_s) for p in gc.passes if p.los_s > t_s and p.los_s <= end),
+               default=None)
 
 
 def _contact(summary: RunSummary, t_s: float) -> str:
     """Where ``t_s`` fell: ``continuous`` (the ground hears continuously), ``in_pass`` or
     ``between_passes``."""
-    if summary.ground_contact is None:
+    gc = summary.ground_contact
+    if gc is None:
         return "continuous"
-    return "in_pass" if _heard_from_s(summary, t_s) == t_s else "between_passes"
+    return "in_pass" if any(p.aos_s <= t_s < p.los_s for p in gc.passes) else "between_passes"
 
 
-def _timing(fault: FaultScore, windows: dict[int, list[tuple[float, float]]],
-            summary: RunSummary, neighbours: FaultScore | None) -> dict[str, Any]:
-    """A fault row's judgeability and latencies (:func:`fault_rows`)."""
-    judgeable = _judgeable_s(fault, windows, summary)
-    contact = _contact(summary, fault.start_s)
+def integrity_blind(run: CampaignRun) -> bool:
+    """Whether the run's data-integrity check could judge nothing: the crosslinks' nominal
+    loss above ``fdir.integrity_max_loss`` (``crosslink_loss`` among its unjudged reports; in
+    summaries before that reason, the drawn ``comms.packet_loss``)."""
+    census = run.summary.fdir_thresholds
+    if census is not None and census.integrity_unjudged.crosslink_loss > 0:
+        return True
+    loss = run.drawn.get("comms.packet_loss")
+    return isinstance(loss, int | float) and loss > run.summary.fdir_settings.integrity_max_loss
+
+
+def _timing(fault: FaultScore, end_s: float | None, windows: dict[int, list[tuple[float, float]]],
+            run: CampaignRun, neighbours: FaultScore | None) -> dict[str, Any]:
+    """A fault row's judgeability and latencies (:func:`fault_rows`).  From the first
+    judgeable window: to the declaring window's end, or for a link fault (whose window may
+    end before the contact that brings it) to its declaration."""
+    summary = run.summary
+    judgeable = _judgeable_s(fault, end_s, windows, summary, integrity_blind(run))
     isolated = fault.isolated and fault.latency_s is not None
     declared = fault.declared_latency_s if isolated else None
     aboard = neighbours.declared_latency_s if neighbours is not None and neighbours.isolated \
         else None
     firsts = [t for t in (declared, aboard) if t is not None]
-    return {"judgeable_s": judgeable, "unjudged": judgeable is None, "contact": contact,
-            "window_latency_s": fault.latency_s - (judgeable - fault.start_s)
-            if isolated and judgeable is not None else None,
+    since = fault.latency_s if fault.expected_class != "link" else declared
+    window = None if not isolated or judgeable is None or since is None \
+        else max(since - (judgeable - fault.start_s), 0.0)
+    return {"judgeable_s": judgeable, "unjudged": judgeable is None,
+            "contact": _contact(summary, fault.start_s), "window_latency_s": window,
             "declared_latency_s": declared, "neighbours_latency_s": aboard,
             "first_latency_s": min(firsts) if firsts else None}
+
+
+def values(rows: Sequence[dict[str, Any]], key: str) -> list[float]:
+    """The values of ``key`` in results.csv ``rows`` that have one."""
+    return [r[key] for r in rows if r.get(key) is not None]
 
 
 def latency_summary(faults: Sequence[dict[str, Any]], key: str = "latency_s") -> str:
@@ -192,9 +226,8 @@ def isolated_latencies(rows: Sequence[dict[str, Any]]) -> list[float]:
 def detector_stats(rows: Sequence[dict[str, Any]], hours: float) -> dict[str, Any]:
     """A detector's counts over results.csv ``rows``: faults, detected, isolated, identified,
     latencies (median / p90 / max), false alarms over nominal cycles (and per hour); and the
-    same over the faults a window could judge (``judgeable``: ``isolated_judgeable``,
-    ``identified_judgeable``, ``window_latency`` from the first such window), with the
-    ``unjudged`` apart."""
+    same over the faults a window could judge (``isolated_judgeable``,
+    ``identified_judgeable``), with the ``unjudged`` apart."""
     faults = [r for r in rows if r["kind"] != "none"]
     judgeable = [r for r in faults if not r.get("unjudged")]
     fa = sum(r["false_alarms"] for r in {(r["run"]): r for r in rows}.values())
@@ -208,11 +241,10 @@ def detector_stats(rows: Sequence[dict[str, Any]], hours: float) -> dict[str, An
         "identification_latency": latency_summary(
             [f for f in faults if f.get("identified_class") == f["expected_class"]],
             "identification_latency_s"),
-        "judgeable": len(judgeable), "unjudged": len(faults) - len(judgeable),
+        "unjudged": len(faults) - len(judgeable),
         "isolated_judgeable": sum(r["isolated"] for r in judgeable),
         "identified_judgeable": sum(r.get("identified_class") == r["expected_class"]
                                     for r in judgeable),
-        "window_latency": latency_summary(judgeable, "window_latency_s"),
         "false_alarms": fa, "nominal_cycles": cycles,
         "false_alarms_per_hour": fa / hours if hours > 0 else None,
     }

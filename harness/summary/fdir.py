@@ -104,6 +104,7 @@ class UnjudgedCounts(Counts):
     store_overflow: int = 0
     aboard: int = 0
     lost: int = 0
+    crosslink_loss: int = 0
     no_plan: int = 0
     camera_off: int = 0
     no_images: int = 0

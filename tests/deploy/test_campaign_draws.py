@@ -245,14 +245,18 @@ def test_onset_phases_of_the_shipped_scenarios() -> None:
 
 def test_a_passes_run_lasts_until_the_ground_hears_its_fault() -> None:
     """passes.toml's passes: 29-498 s and 5,963-6,367 s.  An onset in the first pass is heard
-    in it; one after its loss of signal needs the second pass, until its loss of signal plus
-    three FDI windows (90 s), unless that lengthens the run by more than allowed."""
+    in it, until its loss of signal plus three FDI windows (90 s); one after that needs the
+    second pass, unless that lengthens the run by more than allowed (then that onset alone is
+    left out)."""
     passes = load_scenario(SCENARIOS / "passes.toml")
     short = passes.model_copy(update={"duration_s": 1200.0})
     assert heard_by_s(short, [300.0], 6000.0) == 1200.0
     assert heard_by_s(short, [450.0], 6000.0) == pytest.approx(6367.09 + 90.0, abs=0.5)
     assert heard_by_s(short, [300.0, 600.0], 6000.0) == pytest.approx(6457.1, abs=0.5)
     assert heard_by_s(short, [600.0], 5000.0) == 1200.0  # beyond the allowance
+    shorter = passes.model_copy(update={"duration_s": 450.0})  # ends in the first pass
+    assert heard_by_s(shorter, [300.0], 6000.0) == pytest.approx(497.99 + 90.0, abs=0.5)
+    assert heard_by_s(shorter, [300.0, 600.0], 5000.0) == pytest.approx(588.0, abs=0.5)
     continuous = short.model_copy(update={"ground": short.ground.model_copy(
         update={"contact": "continuous"})})
     assert heard_by_s(continuous, [600.0], 6000.0) == 1200.0

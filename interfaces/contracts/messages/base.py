@@ -184,8 +184,8 @@ class PoiPrecisions(Message):
         self.__pydantic_private__["_arrays"] = (self.poi, idx, prec)  # type: ignore[index]
 
 
-Unjudged = Literal["store_overflow", "aboard", "lost", "no_plan", "camera_off", "no_images",
-                   "not_tracking", "plan_unknown", "transfer", "excluded"]
+Unjudged = Literal["store_overflow", "aboard", "lost", "crosslink_loss", "no_plan", "camera_off",
+                   "no_images", "not_tracking", "plan_unknown", "transfer", "excluded"]
 """Why a window, or the H_i report at its end, has no decision (docs/fdir.md, "Lost is not
 corrupt"): its reports lost to the store's overflow (``store_overflow``) or still aboard
 (``aboard``); too many of the observers' observations lost for the report's recomputation

@@ -43,6 +43,10 @@ def test_loss_tail_is_the_binomial_tail_with_bursts_thinning_the_draws() -> None
     # bursts of mean length 3: a fifth of the draws (2L - 1 = 5)
     assert loss_tail(10, 50, 0.1, 3.0) == pytest.approx(binom.sf(1, 10, 0.1))
     assert loss_tail(0, 10, 0.1, 1.0) == 1.0 and loss_tail(1, 10, 0.0, 1.0) == 0.0
+    assert loss_tail(10, 10, 0.1, 1.0) == pytest.approx(1e-10)  # all lost: p^n
+    # k = 0.4 of n = 4 after thinning: more likely than losing one whole draw of four
+    assert 1.0 - 0.9**4 < loss_tail(2, 20, 0.1, 3.0) < 1.0
+    assert loss_tail(5, 5, 1.0, 1.0) == 1.0  # a link that loses everything nominally
 
 
 def test_a_series_is_nan_where_it_is_stale_and_none_where_any_is() -> None:

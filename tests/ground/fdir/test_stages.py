@@ -85,22 +85,34 @@ def test_loss_beyond_the_links_limit_for_two_windows_is_a_link_fault() -> None:
 
 def test_one_window_decides_when_a_healthy_link_could_hardly_lose_as_much() -> None:
     """12 of 22 missing at a nominal 5% (probability 1e-11): declared on that window, once per
-    episode; with no nominal loss any loss beyond the limit decides; a window with a plan and
-    no image counts as one that lost everything for the persistence."""
+    episode however long it lasts (3 windows in a row to declare otherwise); with no nominal
+    loss any loss beyond the limit decides; a loss declared, then silence, is one link fault."""
     scenario = small_scenario(comms={"packet_loss": 0.05}, fdir={"loss_tol": 0.1,
-                                                                 "checks_persistence": 2})
+                                                                 "checks_persistence": 3})
     links = LinkChecks(scenario, "ground", LOG)
     assert links.alpha == pytest.approx(0.01 * 30.0 / 3600.0)
     assert links.decisive(12, 22)
-    assert [len(r) for _, r in _lossy_windows(links, [12, 12, 12])] == [1, 0, 0]
+    assert [len(r) for _, r in _lossy_windows(links, [12] * 5)] == [1, 0, 0, 0, 0]
     lossless = LinkChecks(small_scenario(comms={"packet_loss": 0.0}, fdir={"loss_tol": 0.1}),
                           "ground", LOG)
     assert [len(r) for _, r in _lossy_windows(lossless, [5, 5])] == [1, 0]
-    # 5 of 15 (not decisive), then a silent window: declared on the second
     links, obs = LinkChecks(scenario, "ground", LOG), ObserverState()
-    images = [_obs(1, float(i), 5 + i + 1) for i in range(10)]
-    assert len(links.judge(1, obs, images, True, 10.0)[1]) == 0
-    assert [r.fault_class for r in links.judge(1, obs, [], True, 20.0)[1]] == ["link"]
+    images = [_obs(1, float(i), 12 + i + 1) for i in range(10)]
+    assert len(links.judge(1, obs, images, True, 10.0)[1]) == 1
+    assert [len(links.judge(1, obs, [], True, b)[1]) for b in (20.0, 30.0, 40.0)] == [0, 0, 0]
+
+
+def test_the_window_after_a_silence_counts_its_missing_observations() -> None:
+    """One silent window (not yet a link fault), then 2 received after 18 missing: 90% of 20
+    lost at a nominal 5% decides alone."""
+    links = LinkChecks(small_scenario(comms={"packet_loss": 0.05}), "ground", LOG)
+    obs = ObserverState()
+    first = [_obs(1, float(i), i + 1) for i in range(10)]
+    assert links.judge(1, obs, first, True, 10.0) == (0, [])
+    assert links.judge(1, obs, [], True, 20.0) == (0, [])
+    lost, reports = links.judge(1, obs, [_obs(1, 21.0, 29), _obs(1, 22.0, 30)], True, 30.0)
+    assert lost == 18 and [r.fault_class for r in reports] == ["link"]
+    assert reports[0].metric == pytest.approx(0.9)
 
 
 def test_window_context_judges_tracked_images_under_a_plan() -> None:
@@ -222,7 +234,7 @@ def test_no_integrity_verdict_when_the_crosslinks_lose_more_than_it_allows() -> 
     fused its neighbours' images less what they lost, which the ground cannot rebuild."""
     out = _integrity_over_two_boundaries({1: ObserverState(), 2: ObserverState()}, 0.15)
     assert [r for r, _ in out] == [[], []]
-    assert [u for _, u in out] == [{1: "lost", 2: "lost"}] * 2
+    assert [u for _, u in out] == [{1: "crosslink_loss", 2: "crosslink_loss"}] * 2
     assert [len(r) for r, _ in _integrity_over_two_boundaries(
         {1: ObserverState(), 2: ObserverState()}, 0.05)] == [0, 1]
 

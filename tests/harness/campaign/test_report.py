@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import json
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -24,6 +25,7 @@ from harness.campaign.rescore import (
 )
 from harness.campaign.targets import target_figures
 from harness.summary import MainWindow, RunSummary, SummaryError
+from harness.summary.fdir import UnjudgedCounts
 
 
 def _fault(sc: int, kind: str, start: float, detected: bool, latency: float | None,
@@ -292,6 +294,62 @@ def test_faults_are_judged_from_the_first_window_that_could_judge_them(tmp_path:
     assert figures["false alarms per nominal observer-window"].met is False  # 0/4: ≤ 0.53
     report = write_campaign_report(tmp_path, "x", ["e"]).read_text()
     assert "| detected and isolated, of the judgeable | 100% (2/2) | ≥ 98% | met |" in report
+
+
+def _passes(*spans: tuple[float, float]) -> dict[str, Any]:
+    return {"passes": [{"station": "s", "aos_s": a, "los_s": b, "duration_s": b - a,
+                        "tca_s": (a + b) / 2, "max_elevation_deg": 40.0} for a, b in spans],
+            "longest_gap_s": 700.0, "downlink_bps": 5e7, "store_bytes": 8 << 30,
+            "stores": {}, "uplink_held": {}}
+
+
+@pytest.mark.parametrize("duration", [1400.0, 1350.0])
+def test_a_link_fault_between_passes_is_judged_from_the_next_pass(duration: float) -> None:
+    """Passes 0-300 s and 1,000-1,300 s, FDI windows of 100 s.  A link cut at 400 s, stamped
+    at 500 s and declared at 1,350 s (the silence known once the pass is over): judgeable from
+    the acquisition at 1,000 s, 350 s later; in a run that ends before that pass's end and a
+    window (1,350 s), no window could judge it.  Never a latency below zero."""
+    fault = {**_fault(2, "link_loss", 400.0, True, 100.0, "link", "link"),
+             "declared_latency_s": 950.0}
+    run = _run({"injected_faults": [{"spacecraft": 2, "kind": "link_loss", "start_s": 400.0}],
+                "scores": _scores([fault], 0, 4), "ground_contact": _passes((0, 300),
+                                                                           (1000, 1300)),
+                "duration_s": duration, "fdir_series": {"main": [[2, 0, 100, 0.01, 0.05]]}})
+    (row,) = [r for r in fault_rows([run]) if r["detector"] == "main"]
+    assert row["contact"] == "between_passes"
+    if duration == 1400.0:
+        assert (row["judgeable_s"], row["window_latency_s"]) == (1000.0, 350.0)
+    else:
+        assert row["unjudged"] and row["window_latency_s"] is None
+
+
+def test_data_integrity_is_unjudgeable_where_the_crosslinks_lose_too_much() -> None:
+    """A faulty-data fault in a run whose crosslinks lose 15% (integrity_max_loss 10%: the
+    check judged nothing) is not a miss; at 5% it is."""
+    fault = _fault(1, "faulty_data", 100.0, False, None, None, "data_integrity")
+    sections = {"injected_faults": [{"spacecraft": 1, "kind": "faulty_data", "start_s": 100.0,
+                                     "magnitude": 2.0}],
+                "scores": _scores([fault], 0, 4),
+                "fdir_series": {"main": [[1, 100, 200, 0.01, 0.05]]}}
+    for loss, unjudged in ((0.15, True), (0.05, False)):
+        run = CampaignRun("r", "r", "-", _summary("r", sections), {"comms.packet_loss": loss})
+        (row,) = [r for r in fault_rows([run]) if r["detector"] == "main"]
+        assert row["unjudged"] is unjudged, loss
+    census = SimpleNamespace(integrity_unjudged=UnjudgedCounts(crosslink_loss=3))
+    run = CampaignRun("r", "r", "-", _summary("r", sections).model_copy(
+        update={"fdir_thresholds": census}))  # its census: the check's reason, not drawn
+    assert [r["unjudged"] for r in fault_rows([run]) if r["detector"] == "main"] == [True]
+
+
+def test_a_fault_gone_before_its_observers_next_window_could_not_be_judged() -> None:
+    """A fault on from 150 s to 160 s, its observer's windows 0-100 s and 400-500 s (none
+    came down between): no window while it was on (or a window after)."""
+    fault = _fault(1, "pointing_actuator", 150.0, False, None, None, "actuator")
+    run = _run({"injected_faults": [{"spacecraft": 1, "kind": "pointing_actuator",
+                                     "start_s": 150.0, "end_s": 160.0, "magnitude": 3.0}],
+                "scores": _scores([fault], 0, 4),
+                "fdir_series": {"main": [[1, 0, 100, 0.01, 0.05], [1, 400, 500, 0.01, 0.05]]}})
+    assert [r["unjudged"] for r in fault_rows([run]) if r["detector"] == "main"] == [True]
 
 
 def test_a_malformed_summary_is_refused_naming_its_file_and_field(tmp_path: Path) -> None:
