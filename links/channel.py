@@ -164,8 +164,14 @@ class ChannelModel:
                  envelope: object) -> Literal["deliver", "drop", "wait"]:
         """One message from ``src`` on ``key`` (the runtime's link stage): with ground passes
         one that must wait on a space-ground link (stored onboard, or held on the ground until
-        a pass) is taken, to come back from ``released``; any other is judged now
-        (``decide``, counted)."""
+        a pass) is taken, to come back from ``released``, and what the ground loaded before the
+        run is delivered (``SpaceGroundLink.preloaded``); any other is judged now (``decide``,
+        counted)."""
+        if self.passes is not None and self.passes.preloaded(src, msg):
+            link = self._link(src)
+            link.counter.sent += 1
+            link.counter.delivered += 1
+            return "deliver"
         if self.passes is not None and self.passes.takes(src, key, msg, envelope):
             return "wait"
         return "deliver" if self.delivers(src, msg.t_sim) else "drop"

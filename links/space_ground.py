@@ -11,8 +11,8 @@ node's channel stage (``links.channel``) that holds what crosses them.
   other; one sent out of contact waits on the ground until the next acquisition and is judged
   then (cut, range, loss at that time), the link's delay later.  Nothing leaves a ground that
   hears no station: it stays, counted as held.  What the ground sends at the run's start
-  (t = 0: the initial assignments) was loaded aboard in a pass before the run: it is judged
-  by the channel at once, as in contact.
+  (t = 0: the initial assignments) was loaded aboard in a pass before the run: it is
+  delivered at once, neither cut nor lost (``preloaded``; counted sent and delivered).
 
 Both are simulated in send time, so what is delivered when does not depend on when the Bus
 asks (``released``), only on the messages.
@@ -120,6 +120,11 @@ class SpaceGroundLink:
             self.held += 1
             return True
         return False
+
+    def preloaded(self, src: str, msg: Message) -> bool:
+        """Whether ``msg`` from ``src`` was loaded aboard before the run: the ground's, sent
+        at its start (``ContactPlan.uplinked_s``)."""
+        return src == GROUND and self.receiver != GROUND and msg.t_sim <= TIME_TOL_S
 
     def released(self, t_now: float, radio: Radio) -> list[Any]:
         """The envelopes that reach the receiver by ``t_now`` (s): dumped ones in the order

@@ -1,7 +1,10 @@
 """The central agent's mission plan: which PRO each observer flies, and when (Fig. 7 phases,
 hierarchical planner of Sec. II.C).
 
-Scenario phases (``assign = "scenario"``) give their PROs directly.  Information phases
+Scenario phases (``assign = "scenario"``) give their PROs directly.  A phase is uplinked
+``UPLINK_LEAD_S`` before it starts; with ground passes and observers released from the target,
+the first phase is issued at the start, loaded aboard before the run, when no pass comes before
+its uplink time (the later ones wait for a pass, as the ground's plan depends on what it saw).  Information phases
 (``assign = "information"``) are decided when they are uplinked, from the ground's fused view of
 the POIs at that moment: the greedy set of
 :func:`ground.planning.orbit_assignment.greedy_assignment`, matched to the observers by
@@ -35,6 +38,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from gnc.mission import MissionConstants
+from gnc.passes import ContactPlan
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro, min_distance_to_origin
 from ground.planning.orbit_assignment import gain_saturated
@@ -125,6 +129,7 @@ class MissionPlan:
         self._info_phase = ""
         self._reassignments = 0
         self._recoveries = 0
+        self._contact = ContactPlan.of(sc)
         self.dropped: set[int] = set()  # observers untasked (failed camera)
         self.impaired: dict[int, float] = {}  # observer -> keep-out it needs (actuator), m
         if sc.observers.start == "pro":
@@ -147,12 +152,23 @@ class MissionPlan:
         set for saturation.  ``fused``: the ground's fused POI map at ``t``."""
         phases = self.scenario.phases
         while (self._next_phase < len(phases)
-               and phases[self._next_phase].start_s - UPLINK_LEAD_S <= t + TIME_TOL_S):
+               and (phases[self._next_phase].start_s - UPLINK_LEAD_S <= t + TIME_TOL_S
+                    or self._preloads(t))):
             self._start_phase(phases[self._next_phase], t, fused)
             self._next_phase += 1
         self._check_saturation(t, fused)
 
     # ------------------------------------------------------------------------- internals
+
+    def _preloads(self, t: float) -> bool:
+        """Whether the first phase is loaded aboard before the run (issued at t = 0): with
+        ground passes, when no pass comes before its uplink time and nothing else is issued
+        at the start (a spacecraft holds one assignment pending; ``ContactPlan.uplinked_s``:
+        what is sent at t = 0 is aboard from the start)."""
+        if t > TIME_TOL_S or self._next_phase or self.issued or self._contact is None:
+            return False
+        uplink = self.scenario.phases[0].start_s - UPLINK_LEAD_S
+        return self._contact.uplinked_s(max(uplink, TIME_TOL_S * 2)) > uplink + TIME_TOL_S
 
     def _issue(self, phase: str, pros: dict[int, ProElements], t_depart: float,
                t_arrive: float) -> None:

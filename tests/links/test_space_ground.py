@@ -70,13 +70,16 @@ def test_an_uplink_out_of_contact_waits_for_the_acquisition() -> None:
 
 def test_what_the_ground_sends_at_the_start_was_loaded_before_the_run() -> None:
     """The initial assignments (t = 0, out of contact here: the first pass is at 100 s) are
-    aboard from the start, not held for the first pass."""
-    ch = _channel("sc1")
+    aboard from the start, not held for the first pass, nor cut, nor lost; what follows at
+    1 s waits for the pass."""
+    ch = _channel("sc1", cuts=[LinkCut(a="sc1", b="ground", start_s=0.0, end_s=50.0)])
     cmd = ProAssignments(sender="ground", seq=1, t_sim=0.0, assignments=[])
     env = Envelope(cmd, "insp/m/ground/planner/assignments", "ground", False, [])
     assert ch.transmit("ground", env.key, cmd, env) == "deliver"
+    later = cmd.model_copy(update={"t_sim": 1.0, "seq": 2})
+    assert ch.transmit("ground", env.key, later, env) == "wait"
     (c,) = ch.counters()
-    assert c.held == 0
+    assert (c.held, c.sent, c.delivered, c.dropped_cut) == (1, 1, 1, 0)
 
 
 def test_a_link_cut_for_a_whole_pass_keeps_the_data_for_the_next() -> None:

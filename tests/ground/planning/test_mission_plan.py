@@ -72,6 +72,34 @@ def test_scenario_phases_are_issued_at_their_uplink_time() -> None:
     assert plan.decisions == []
 
 
+@pytest.mark.parametrize("contact", ["continuous", "passes"])
+def test_with_passes_the_first_phase_is_loaded_before_the_run(contact: str) -> None:
+    """Observers released from the target (no initial assignment), the first phase at 500 s:
+    under passes.toml's station, whose passes come at 29-498 s and 5,963-6,367 s, its uplink
+    time (440 s) is in contact and it waits for it; under a station whose first pass comes
+    later, it is issued at t = 0, to be aboard before the run; with continuous contact, at its
+    uplink time."""
+    base = _scenario([{"name": "a", "start_s": 500.0, "transfer_s": 300.0, "rho_x_m": 12.0}])
+    station = {"name": "mid", "latitude_deg": 48.08, "longitude_deg": 11.28}
+    data = base.model_dump()
+    data["observers"]["start"] = "deploy"
+    sc = Scenario.model_validate({**data, "orbit": {"raan_deg": 255.0,
+                                                               "arg_latitude_deg": 90.0},
+                                  "ground": {"contact": contact, "stations": [station]}})
+    late = Scenario.model_validate({**sc.model_dump(), "phases": [
+        {"name": "a", "start_s": 1500.0, "transfer_s": 300.0, "rho_x_m": 12.0}]})
+    fused = PoiMap.uniform(400, 1.0, 3)
+    for scenario, preloaded in ((sc, False), (late, contact == "passes")):
+        plan = MissionPlan(scenario, MissionConstants.of(scenario))
+        assert plan.current is None
+        plan.update(0.0, fused)
+        assert (plan.current is not None) is preloaded
+        start = scenario.phases[0].start_s
+        plan.update(start - UPLINK_LEAD_S, fused)
+        assert plan.current is not None and plan.current.t_depart_s == start
+        assert len(plan.issued) == 1
+
+
 def test_information_phase_takes_the_greedy_set_matched_to_the_observers() -> None:
     sc = _scenario([{"name": "insp", "start_s": 600.0, "transfer_s": 500.0,
                      "assign": "information"}])
