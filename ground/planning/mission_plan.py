@@ -5,8 +5,8 @@ Scenario phases (``assign = "scenario"``) give their PROs directly.  A phase is 
 ``UPLINK_LEAD_S`` before it starts; with ground passes and observers released from the target,
 the first phase is issued at the start, loaded aboard before the run, when no pass comes before
 its uplink time (the later ones wait for a pass, as the ground's plan depends on what it saw).
-Information phases (``assign = "information"``) are decided when they are uplinked, from the ground's fused view of
-the POIs at that moment: the greedy set of
+Information phases (``assign = "information"``) are decided when they are uplinked, from the
+ground's fused view of the POIs at that moment: the greedy set of
 :func:`ground.planning.orbit_assignment.greedy_assignment`, matched to the observers by
 :func:`ground.planning.orbit_assignment.match_to_observers`.  While an
 information phase is the latest one, the plan measures how much the fused cost H falls in each
