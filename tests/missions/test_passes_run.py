@@ -140,8 +140,8 @@ def test_uplinks_wait_for_a_pass(orbit: tuple[Scenario, Path]) -> None:
     assert len(flown) >= 3  # both first plans, and the re-plan after the declaration
     for k in flown:  # what is sent at the start was loaded before the run
         assert first_seen[k] >= plan.uplinked_s(sent[k]), k
-    assert sent[(2, 1)] == 0.0 and first_seen[(2, 1)] < plan.windows[0][0]  # flown at once
-    assert (1, 1) in flown and first_seen[(1, 1)] >= CUT_END_S  # not heard in the first pass
+    for sc in (1, 2):  # loaded before the run: flown at once, sc1's link cut from 0 s or not
+        assert sent[(sc, 1)] == 0.0 and first_seen[(sc, 1)] < plan.windows[0][0]
     held = RunSummary.read(run / "summary.json").ground_contact.uplink_held  # type: ignore[union-attr]
     assert held["sc1"] > 0 and held["sc2"] > 0
 
