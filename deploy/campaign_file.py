@@ -21,6 +21,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from deploy.draws import Record
 from deploy.onsets import OnsetPhase, draw_onset
 from interfaces.contracts.scenario import COMMON_MODE_KINDS, FaultKind, Scenario
+from interfaces.contracts.scenario.faults import NO_MAGNITUDE
 
 
 class Strict(BaseModel):
@@ -61,9 +62,6 @@ class PerKind(Strict):
 
     per_kind: dict[FaultKind, float | Range]
 
-
-NO_MAGNITUDE = frozenset({"link_loss"})
-"""Fault kinds that take no magnitude."""
 
 Number = float | list[float] | Range
 

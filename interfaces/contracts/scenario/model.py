@@ -59,6 +59,9 @@ class Scenario(Section):
         for f in self.faults:
             if f.spacecraft > n:
                 raise ValueError(f"fault on spacecraft {f.spacecraft} but observers.count = {n}")
+            if f.start_s >= self.duration_s:
+                raise ValueError(f"a {f.kind} fault starts at {f.start_s:g} s, not before the "
+                                 f"end of the run (duration_s = {self.duration_s:g})")
         for where, formation in [("observers", self.observers)] + [
                 (f"phase {p.name!r}", p) for p in self.phases]:
             for o in formation.overrides:
@@ -84,13 +87,14 @@ class Scenario(Section):
         return int(math.floor(self.duration_s * self.rates.high_hz + 1e-9)) + 1
 
     def with_overrides(self, seed: int | None = None, duration_s: float | None = None) -> Scenario:
-        """A copy with the command-line overrides applied (and validated)."""
+        """A copy with the command-line overrides applied, validated as a file is (a
+        ScenarioError naming the key, e.g. ``duration_s``)."""
         data = self.model_dump()
         if seed is not None:
             data["seed"] = seed
         if duration_s is not None:
             data["duration_s"] = duration_s
-        return Scenario.model_validate(data)
+        return validated(data, "the command line")
 
 
 class ScenarioError(ValueError):
@@ -105,6 +109,9 @@ def load_scenario(path: str | Path) -> Scenario:
         text = p.read_text(encoding="utf-8")
     except OSError as e:
         raise ScenarioError(f"cannot read scenario {p}: {e.strerror}") from e
+    except UnicodeDecodeError as e:
+        raise ScenarioError(f"{p}: not UTF-8 text (byte {e.start}: {e.reason}); a scenario is "
+                            "a TOML file") from None
     if p.suffix == ".json":
         try:
             return Scenario.model_validate_json(text)
@@ -119,6 +126,11 @@ def parse_scenario(text: str, source: str = "<string>") -> Scenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ScenarioError(f"{source}: not valid TOML: {e}") from e
+    return validated(data, source)
+
+
+def validated(data: dict[str, object], source: str) -> Scenario:
+    """``data`` as a Scenario; ScenarioError naming each invalid key, from ``source``."""
     try:
         return Scenario.model_validate(data)
     except ValidationError as e:

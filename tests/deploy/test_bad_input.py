@@ -1,0 +1,67 @@
+"""Bad input to the commands, as a table (issue 40): each case drives ``insp-fdir`` in this
+process with one bad value and asserts the exit code, that the message names the problem,
+that no traceback is printed, and that no output folder was made."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from deploy.cli import main
+
+REPO = Path(__file__).resolve().parents[2]
+NOMINAL = REPO / "deploy" / "scenarios" / "nominal.toml"
+
+FAULT = "[[faults]]\nspacecraft = 1\nkind = \"{kind}\"\nstart_s = {start}\n{extra}\n"
+"""A fault appended to the paper's scenario (1,200 s, 5 observers)."""
+
+
+def _scenario(tmp: Path, kind: str, extra: str, start: float = 100.0) -> Path:
+    path = tmp / "bad.toml"
+    path.write_text(NOMINAL.read_text() + "\n" + FAULT.format(kind=kind, start=start,
+                                                                extra=extra))
+    return path
+
+
+# (id, command line after `insp-fdir`, with {scenario}/{out}, the scenario's fault or raw
+#  bytes, what the message must name)
+CASES = [
+    ("duration negative", ["run", "--duration", "-5"], None, "duration_s"),
+    ("duration zero", ["run", "--duration", "0"], None, "duration_s"),
+    ("duration nan", ["run", "--duration", "nan"], None, "duration_s"),
+    ("duration inf", ["run", "--duration", "inf"], None, "duration_s"),
+    ("seed negative", ["run", "--seed", "-1"], None, "seed"),
+    ("thruster leak of a million", ["run"], ("thruster_bias", "magnitude = 1e6"),
+     "thruster_bias magnitude must be in (0, 1]"),
+    ("negative leak", ["run"], ("thruster_bias", "magnitude = -0.4"), "thruster_bias magnitude"),
+    ("negative pointing", ["run"], ("pointing_actuator", "magnitude = -5"),
+     "pointing_actuator magnitude"),
+    ("negative nav bias", ["run"], ("nav_sensor_bias", "magnitude = -5"),
+     "nav_sensor_bias magnitude"),
+    ("negative faulty data", ["run"], ("faulty_data", "magnitude = -2"), "faulty_data magnitude"),
+    ("faulty data of one", ["run"], ("faulty_data", "magnitude = 1.0"), "not 1"),
+    ("link loss with a magnitude", ["run"], ("link_loss", "magnitude = 0.5"),
+     "takes no magnitude"),
+    ("fault after the end", ["run"], ("camera_degradation", "magnitude = 0.5", 1300.0),
+     "not before the end of the run"),
+    ("scenario not UTF-8", ["run"], b"name = \"x\"\n\xff\xfe\n", "not UTF-8"),
+]
+
+
+@pytest.mark.parametrize("argv, fault, says", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_bad_input_is_refused_cleanly(tmp_path: Path, capsys: pytest.CaptureFixture[str],
+                                      argv: list[str], fault: tuple | bytes | None,
+                                      says: str) -> None:
+    if isinstance(fault, bytes):
+        scenario = tmp_path / "bad.toml"
+        scenario.write_bytes(fault)
+    else:
+        scenario = _scenario(tmp_path, *fault) if fault else NOMINAL
+    out = tmp_path / "out"
+    code = main([*argv, "--scenario", str(scenario), "--out", str(out),
+                 "--transport", "inproc"])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert says in err and "Traceback" not in err
+    assert not out.exists()
