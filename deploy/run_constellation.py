@@ -52,6 +52,8 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
+from deploy.out_folder import OutFolderError  # noqa: E402
+from deploy.out_folder import prepare as prepare_out  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
@@ -83,7 +85,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO, help="scenario TOML")
-    p.add_argument("--out", type=Path, help="output directory (default runs/<scenario>-<time>)")
+    p.add_argument("--out", type=Path, help="output directory, refused when it holds anything "
+                                            "(default runs/<scenario>-<time>)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="remove the run already in --out wholly before this one is written")
     p.add_argument("--transport", choices=("zenoh", "inproc"), default="zenoh")
     p.add_argument("--seed", type=int, help="override the scenario seed")
     p.add_argument("--duration", type=float, help="override duration_s (s)")
@@ -150,8 +155,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: --external takes nodes of a Zenoh run ({', '.join(sorted(known))}), not "
               f"{', '.join(args.external)}", file=sys.stderr)
         return 2
-    out = args.out or REPO / "runs" / f"{scenario.name}-{time.strftime('%Y%m%d-%H%M%S')}"
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out = prepare_out(args.out, REPO / "runs" / f"{scenario.name}-"
+                          f"{time.strftime('%Y%m%d-%H%M%S')}", args.overwrite)
+    except OutFolderError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     mission = args.mission or scenario.name
     scenario_text = args.scenario.read_text(encoding="utf-8")
     wall0 = time.monotonic()

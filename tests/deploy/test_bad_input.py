@@ -1,6 +1,7 @@
 """Bad input to the commands, as a table (issue 40): each case drives ``insp-fdir`` in this
 process with one bad value and asserts the exit code, that the message names the problem,
-that no traceback is printed, and that no output folder was made."""
+that no traceback is printed, and that the output folder was not made, or that nothing in it
+changed."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from deploy.cli import main
+from deploy.out_folder import OutFolderError, prepare
 
 REPO = Path(__file__).resolve().parents[2]
 NOMINAL = REPO / "deploy" / "scenarios" / "nominal.toml"
@@ -48,6 +50,14 @@ CASES = [
     ("scenario not UTF-8", ["run"], b"name = \"x\"\n\xff\xfe\n", "not UTF-8"),
 ]
 
+RUN = {"run.mcap": b"\x89MCAP0\r\nold", "summary.json": b"{}", "report.md": b"# old"}
+OUT_CASES = [
+    ("out holds a run", [], RUN, "already holds report.md, run.mcap, summary.json"),
+    ("overwrite a folder that is no run's", ["--overwrite"], {"thesis.tex": b"%"},
+     "not a run's files"),
+    ("out is a file", [], None, "a file, not a folder"),
+]
+
 
 @pytest.mark.parametrize("argv, fault, says", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
 def test_bad_input_is_refused_cleanly(tmp_path: Path, capsys: pytest.CaptureFixture[str],
@@ -65,3 +75,47 @@ def test_bad_input_is_refused_cleanly(tmp_path: Path, capsys: pytest.CaptureFixt
     assert code == 2, err
     assert says in err and "Traceback" not in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("argv, held, says", [c[1:] for c in OUT_CASES],
+                         ids=[c[0] for c in OUT_CASES])
+def test_an_output_folder_in_use_is_left_as_it_was(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str],
+        held: dict[str, bytes] | None, says: str) -> None:
+    out = tmp_path / "out"
+    if held is None:
+        out.write_text("notes")
+    else:
+        out.mkdir()
+        for name, data in held.items():
+            (out / name).write_bytes(data)
+    before = _snapshot(out)
+    code = main(["run", "--scenario", str(NOMINAL), "--out", str(out), "--transport", "inproc",
+                 *argv])
+    err = capsys.readouterr().err
+    assert code == 2 and says in err and "Traceback" not in err, err
+    assert _snapshot(out) == before
+
+
+def _snapshot(path: Path) -> dict[str, bytes]:
+    if path.is_file():
+        return {path.name: path.read_bytes()}
+    return {p.name: p.read_bytes() for p in sorted(path.iterdir())}
+
+
+def test_overwrite_removes_the_old_run_wholly_and_the_default_name_is_unique(
+        tmp_path: Path) -> None:
+    """No file of the old run is left to mix with the new one (a second segment
+    ``run-1.mcap`` included); two runs named in the same second get ``-2``."""
+    out = tmp_path / "old"
+    out.mkdir()
+    for name in ("run.mcap", "run-1.mcap", "report.md"):
+        (out / name).write_text("old")
+    assert prepare(out, tmp_path / "unused", overwrite=True) == out
+    assert list(out.iterdir()) == []
+    default = tmp_path / "runs" / "nominal-20261205-120000"
+    first = prepare(None, default, overwrite=False)
+    (first / "run.mcap").write_text("x")
+    assert prepare(None, default, overwrite=False) == default.with_name(default.name + "-2")
+    with pytest.raises(OutFolderError, match="already holds"):
+        prepare(first, default, overwrite=False)

@@ -1,0 +1,52 @@
+"""A run's output folder (``--out``): never silently reused (issue 40).
+
+A folder that holds anything is refused unless the user says ``--overwrite``, which removes it
+wholly first, so two runs never mix in one folder; and ``--overwrite`` removes only a run's
+folder (one holding a run's files), never another folder given by mistake.  The default name,
+``runs/<scenario>-<time>``, is made unique with a counter.  Errors name the folder and what is
+in it (``OutFolderError``), for the command to print with exit 2.
+"""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+RUN_FILES = ("run.mcap", "summary.json", "run.log", "report.md", "run.foxglove.json")
+"""Files only a run writes: a folder holding one of them is a run's."""
+
+
+class OutFolderError(ValueError):
+    """An output folder that cannot be used; the message says why and what to do."""
+
+
+def _contents(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.iterdir())
+
+
+def prepare(out: Path | None, default: Path, overwrite: bool) -> Path:
+    """The run's folder, made and empty: ``out`` (refused when it holds anything, unless
+    ``overwrite`` and it is a run's folder, which is then removed first), or ``default``
+    (with ``-2``, ``-3``... when taken).  Raises OutFolderError."""
+    if out is None:
+        out, k = default, 1
+        while out.exists():
+            k += 1
+            out = default.with_name(f"{default.name}-{k}")
+    elif out.exists() and not out.is_dir():
+        raise OutFolderError(f"--out {out}: a file, not a folder")
+    elif out.exists() and any(out.iterdir()):
+        held = _contents(out)
+        listed = ", ".join(held[:6]) + (" ..." if len(held) > 6 else "")
+        if not overwrite:
+            raise OutFolderError(f"--out {out} already holds {listed}: give another --out, or "
+                                 "--overwrite to remove that run wholly first")
+        if not any(name.startswith(RUN_FILES) for name in held):
+            raise OutFolderError(f"--out {out} holds {listed}, not a run's files: "
+                                 "--overwrite removes only a run's folder")
+        shutil.rmtree(out)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise OutFolderError(f"--out {out}: cannot make the folder: {e.strerror or e}") from None
+    return out
