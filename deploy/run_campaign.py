@@ -69,6 +69,7 @@ from harness.campaign.report import write_campaign_report  # noqa: E402
 from harness.replay import parse_settings, scenario_with  # noqa: E402
 from harness.summary import RunSummary  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
+from interfaces.runtime.arguments import positive_int  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
 
@@ -79,9 +80,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--campaign", type=Path,
                    help="campaign TOML (not needed with --report-only on an existing --out)")
     p.add_argument("--out", type=Path, required=True, help="campaign directory")
-    p.add_argument("--workers", type=int, default=os.cpu_count() or 1,
-                   help="local worker processes (default: one per core)")
-    p.add_argument("--limit", type=int, help="run only the first N runs of the list")
+    p.add_argument("--workers", type=positive_int, default=os.cpu_count() or 1,
+                   help="local worker processes, at least 1 (default: one per core)")
+    p.add_argument("--limit", type=positive_int, help="run only the first N runs of the list")
     p.add_argument("--cluster", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786")
     p.add_argument("--transport", choices=("inproc", "zenoh"), default="inproc",
                    help="each run in one process (default), or multi-process over Zenoh on "
@@ -223,7 +224,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 2
     if args.limit is not None:
-        runs = runs[:max(args.limit, 0)]
+        runs = runs[:args.limit]
     args.out.mkdir(parents=True, exist_ok=True)
     if args.campaign.resolve() != (args.out / "campaign.toml").resolve():
         shutil.copyfile(args.campaign, args.out / "campaign.toml")

@@ -69,6 +69,7 @@ from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
 from interfaces.contracts.topology import RECORDER, ROUTER, SIM, topology  # noqa: E402
+from interfaces.runtime.arguments import add_log_level  # noqa: E402
 from interfaces.runtime.cds import read_starts, write_run_key  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
@@ -84,12 +85,15 @@ log = logging.getLogger("insp.launcher")
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO, help="scenario TOML")
+    p.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO,
+                   help="scenario TOML (default %(default)s)")
     p.add_argument("--out", type=Path, help="output directory, refused when it holds anything "
                                             "(default runs/<scenario>-<time>)")
     p.add_argument("--overwrite", action="store_true",
                    help="remove the run already in --out wholly before this one is written")
-    p.add_argument("--transport", choices=("zenoh", "inproc"), default="zenoh")
+    p.add_argument("--transport", choices=("zenoh", "inproc"), default="zenoh",
+                   help="zenoh: one process per node over a Zenoh router (default); inproc: "
+                        "every node in this process, same results")
     p.add_argument("--seed", type=int, help="override the scenario seed")
     p.add_argument("--duration", type=float, help="override duration_s (s)")
     p.add_argument("--realtime", type=float, metavar="SPEED",
@@ -124,7 +128,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--compare-recovery", action="store_true",
                    help="also run the scenario with [fdir] recovery flipped (in-process) and "
                         "compare final H in summary.json")
-    p.add_argument("--log-level", default="INFO")
+    add_log_level(p)
     return p.parse_args(argv)
 
 
@@ -136,7 +140,7 @@ def _interrupt(signum: int, _frame: object) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
-    logging.basicConfig(level=getattr(logging, args.log_level.upper(), logging.INFO),
+    logging.basicConfig(level=getattr(logging, args.log_level),
                         format="%(asctime)s launcher %(levelname)s %(message)s", datefmt="%H:%M:%S")
     try:
         scenario = load_scenario(args.scenario).with_overrides(args.seed, args.duration)

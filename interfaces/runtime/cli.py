@@ -13,6 +13,7 @@ from pathlib import Path
 from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.contracts.topology import topology
+from interfaces.runtime.arguments import add_log_level
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore
 from interfaces.runtime.executive import Executive, TickClient
@@ -30,7 +31,7 @@ def add_node_args(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--connect", default=DEFAULT_ENDPOINT,
                         help=f"Zenoh endpoint to join (default {DEFAULT_ENDPOINT})")
     parser.add_argument("--zenoh-config", help="Zenoh JSON5 config file (overrides --connect)")
-    parser.add_argument("--log-level", default="INFO")
+    add_log_level(parser)
     parser.add_argument("--cds", type=Path, metavar="DIR",
                         help="keep this node's critical-data store in DIR (made by the launcher "
                              "with the run's key) and restore from it when started again "

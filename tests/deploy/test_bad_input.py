@@ -103,6 +103,26 @@ def _snapshot(path: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in sorted(path.iterdir())}
 
 
+PARSER_CASES = [
+    ("log level bogus", ["run", "--log-level", "bogus"], "--log-level: 'bogus': one of DEBUG"),
+    ("workers zero", ["campaign", "--workers", "0"], "--workers: 0: at least 1"),
+    ("limit negative", ["campaign", "--limit", "-1"], "--limit: -1: at least 1"),
+    ("limit zero", ["campaign", "--limit", "0"], "--limit: 0: at least 1"),
+]
+
+
+@pytest.mark.parametrize("argv, says", [c[1:] for c in PARSER_CASES],
+                         ids=[c[0] for c in PARSER_CASES])
+def test_impossible_option_values_are_refused_by_the_parser(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], says: str) -> None:
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as stop:
+        main([*argv, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and says in err and "Traceback" not in err, err
+    assert not out.exists()
+
+
 def test_overwrite_removes_the_old_run_wholly_and_the_default_name_is_unique(
         tmp_path: Path) -> None:
     """No file of the old run is left to mix with the new one (a second segment
