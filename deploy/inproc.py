@@ -10,6 +10,7 @@ node's channel stage, no barrier wait (every announced message was delivered bef
 from __future__ import annotations
 
 import logging
+import threading
 
 from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario
@@ -29,11 +30,13 @@ def run_inproc(
     tap: RawHandler | None = None,
     ground: bool = True,
     sample_tap: SampleHandler | None = None,
+    stop: threading.Event | None = None,
 ) -> tuple[SimNode, dict[str, Executive]]:
     """Run ``scenario`` to the end in this process.  ``tap`` receives every message raw (key,
     type, payload), as the recorder does; ``sample_tap`` every message as a Sample (the
     message object with its JSON bytes encoded on demand, once: the recorder's fast path).
-    Returns the sim and the executives by node."""
+    ``stop``, set, stops the run at the next tick boundary (``SimNode.completed`` stays
+    False).  Returns the sim and the executives by node."""
     mission = mission or scenario.name
     net = InprocNetwork()
     if tap is not None:
@@ -49,6 +52,6 @@ def run_inproc(
         executives[node.name] = executive_of(node, bus, scenario)
         TickClient(executives[node.name], synchronous=True)
     sim = SimNode(Bus(topics.SIM, mission, net.endpoint()), scenario, topo.participants,
-                  log=logging.getLogger("insp.sim"))
+                  log=logging.getLogger("insp.sim"), stop=stop or threading.Event())
     sim.run()
     return sim, executives

@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import signal
 import sys
 import threading
 import time
@@ -52,6 +51,7 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
+from deploy.interrupts import Interrupts, raise_keyboard_interrupt  # noqa: E402
 from deploy.out_folder import OutFolderError  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor  # noqa: E402
@@ -79,6 +79,8 @@ if TYPE_CHECKING:
     from ground.tools.live import LiveView
 
 DEFAULT_SCENARIO = REPO / "deploy" / "scenarios" / "default.toml"
+INTERRUPTED = "interrupted by the user (SIGINT or SIGTERM)"
+"""The error of a run stopped by a signal before its sim finished (status ``interrupted``)."""
 log = logging.getLogger("insp.launcher")
 
 
@@ -132,12 +134,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     return p.parse_args(argv)
 
 
-def _interrupt(signum: int, _frame: object) -> None:
-    """SIGTERM (e.g. a job scheduler or ``kill``) stops the run like Ctrl-C: the children are
-    stopped and the archive and summary are written."""
-    raise KeyboardInterrupt(f"signal {signum}")
-
-
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     logging.basicConfig(level=getattr(logging, args.log_level),
@@ -170,15 +166,13 @@ def main(argv: list[str] | None = None) -> int:
     wall0 = time.monotonic()
     digest: RunDigest | None = None
     if args.transport == "inproc":
-        status, error, digest = _run_inproc(scenario, mission, out, scenario_text, args)
-    else:
-        main_thread = threading.current_thread() is threading.main_thread()
-        previous = signal.signal(signal.SIGTERM, _interrupt) if main_thread else None
-        try:
+        stop = threading.Event()
+        with Interrupts(lambda signum: _stopping(stop, signum)) as caught:
+            status, error, digest = _run_inproc(scenario, mission, out, scenario_text, args,
+                                                stop)
+    else:  # SIGINT or SIGTERM: the children are stopped and the archive and summary written
+        with Interrupts(raise_keyboard_interrupt) as caught:
             status, error = _run_zenoh(scenario, mission, out, args)
-        finally:
-            if main_thread:
-                signal.signal(signal.SIGTERM, previous)
     wall_s = time.monotonic() - wall0
     digest = digest or _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
@@ -190,8 +184,9 @@ def main(argv: list[str] | None = None) -> int:
     if not args.no_report:
         write_report(out, scenario, mission, digest=digest)
     rtf = summary.real_time_factor
+    reached = "" if status == "completed" else f"{summary.t_sim_final_s or 0.0:.0f} of "
     print(f"{status}: {scenario.name} seed {scenario.seed}, "
-          f"{scenario.duration_s:.0f} s simulated in "
+          f"{reached}{scenario.duration_s:.0f} s simulated in "
           f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time" if rtf else "")
           + (f", at most {args.realtime:g}x" if rtf and args.realtime else "")
           + (")" if rtf else "")
@@ -199,7 +194,16 @@ def main(argv: list[str] | None = None) -> int:
           f"\n  {out}/summary.json" + ("" if args.no_report else f"\n  {out}/report.md"))
     if error:
         print(f"error: {error}", file=sys.stderr)
+    if status == "interrupted":
+        return caught.exit_status or 130
     return 0 if status == "completed" else 1
+
+
+def _stopping(stop: threading.Event, signum: int) -> None:
+    """The in-process run's reaction to SIGINT or SIGTERM: its sim stops at the next tick."""
+    log.warning("signal %d: stopping at the next tick; the archive and summary are written",
+                signum)
+    stop.set()
 
 
 def _read_archive(out: Path, scenario: Scenario, mission: str) -> RunDigest | None:
@@ -212,9 +216,11 @@ def _read_archive(out: Path, scenario: Scenario, mission: str) -> RunDigest | No
 
 
 def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
-                args: argparse.Namespace) -> tuple[str, str | None, RunDigest]:
+                args: argparse.Namespace, stop: threading.Event
+                ) -> tuple[str, str | None, RunDigest]:
     """Run in this process, recording into ``<out>/run.mcap`` (the recorder in a child
-    process) and digesting the run for its summary as it goes."""
+    process) and digesting the run for its summary as it goes; ``stop`` set stops it at the
+    next tick boundary (``interrupted``)."""
     from deploy.inproc import run_inproc
 
     if args.realtime:
@@ -232,10 +238,12 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
                 live.forward(sample.key, sample.type_name, sample.payload)
 
         try:
-            run_inproc(scenario, mission, sample_tap=tap)
+            sim, _ = run_inproc(scenario, mission, sample_tap=tap, stop=stop)
         finally:
             if live is not None:
                 live.close()
+    if not sim.completed:
+        return "interrupted", INTERRUPTED, digest.finish()
     return "completed", None, digest.finish()
 
 
@@ -401,6 +409,8 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         recorder.stop(timeout_s=10.0)
         if recorder.returncode != 0 and error is None:
             error = f"recorder {recorder.describe_exit()}:\n{recorder.log_tail()}"
+    if error == INTERRUPTED:
+        return "interrupted", error
     if error:
         return "failed", error
     lost = progress.lost_participants()
@@ -494,8 +504,8 @@ class _Watch:
                                 + ", ".join(running))
                 time.sleep(0.1)
                 self.progress.report()
-        except KeyboardInterrupt:
-            return "interrupted by the user"
+        except KeyboardInterrupt:  # a run whose sim had finished is complete
+            return None if self.progress.finished.is_set() else INTERRUPTED
 
     def read_restores(self, directory: Path) -> None:
         """Name in each restart's incident how the process came back (restored from its

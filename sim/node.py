@@ -96,6 +96,8 @@ class SimNode:
     """how long a lost participant is waited for before the next tick (its restart), wall s"""
     log: logging.Logger = field(default_factory=lambda: logging.getLogger("insp.sim"))
     stop: threading.Event = field(default_factory=threading.Event)
+    completed: bool = field(default=False, init=False)
+    """whether every tick ran (False: stopped by ``stop`` before the end)"""
 
     def __post_init__(self) -> None:
         sc = self.scenario
@@ -240,6 +242,7 @@ class SimNode:
                 self.log.info("tick %d/%d  t=%.1f s  %.0f ticks/s", k, n_ticks, t, rate)
         self._status("finished", n_ticks - 1)
         self.lockstep.await_departure(timeout_s=10.0)
+        self.completed = True
         return True
 
     def _commands_in(self, expect: dict[str, int], deadline: float) -> None:

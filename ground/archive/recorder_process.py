@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import multiprocessing
 import pickle
+import signal
 from multiprocessing.connection import Connection
 from pathlib import Path
 from types import TracebackType
@@ -37,7 +38,9 @@ class RecorderDied(RuntimeError):
 
 def _serve(conn: Connection, path: str, metadata: dict[str, dict[str, str]] | None,
            chunk_size: int) -> None:
-    """The child: write every batch until the end-of-run sentinel or the end of the pipe."""
+    """The child: write every batch until the end-of-run sentinel or the end of the pipe.  It
+    ignores SIGINT (Ctrl-C reaches the whole process group): the run decides when it ends."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     with McapRecorder(path, metadata, chunk_size=chunk_size) as rec:
         while True:
             try:

@@ -51,7 +51,7 @@ class RunOutcome:
 
     transport: Literal["inproc", "zenoh"]
     wall_s: float
-    status: Literal["completed", "degraded", "failed"]
+    status: Literal["completed", "degraded", "failed", "interrupted"]
     error: str | None = None
 
 
@@ -111,7 +111,7 @@ def _last_of(digest: RunDigest, model: type[M]) -> dict[str, M]:
 
 
 def write_summary(out: Path, scenario: Scenario, transport: Literal["inproc", "zenoh"],
-                  wall_s: float, status: Literal["completed", "degraded", "failed"],
+                  wall_s: float, status: Literal["completed", "degraded", "failed", "interrupted"],
                   error: str | None = None, mission: str | None = None,
                   digest: RunDigest | None = None,
                   access: AccessAudit | None = None) -> RunSummary:

@@ -52,7 +52,7 @@ class RunSummary(SummaryRecord):
     transport: Literal["inproc", "zenoh"] | None = None
     duration_s: float | None = Field(default=None, description="scenario duration, sim s")
     wall_s: float | None = Field(default=None, description="the run's wall time, s")
-    status: Literal["completed", "degraded", "failed"]
+    status: Literal["completed", "degraded", "failed", "interrupted"]
     error: str | None
     injected_faults: list[Fault] = Field(description="as in the scenario")
     archive: ArchiveInfo | None = None
