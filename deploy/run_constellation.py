@@ -69,7 +69,7 @@ from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
 from interfaces.contracts.topology import RECORDER, ROUTER, SIM, topology  # noqa: E402
-from interfaces.runtime.arguments import add_log_level  # noqa: E402
+from interfaces.runtime.arguments import add_log_level, mission_name  # noqa: E402
 from interfaces.runtime.cds import read_starts, write_run_key  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
@@ -123,7 +123,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--audit-access", action="store_true",
                    help="count the router's refusals into logs/access.json and the summary "
                         "(traces every routed message: slower)")
-    p.add_argument("--mission", help="key-space name (default: scenario name)")
+    p.add_argument("--mission", type=mission_name,
+                   help="key-space name: letters, digits, '_' or '-' (default: scenario name)")
     p.add_argument("--no-report", action="store_true", help="skip report.md and plots")
     p.add_argument("--live", type=int, metavar="PORT", default=0,
                    help="stream the run to Foxglove on ws://127.0.0.1:PORT (off by default)")
@@ -146,6 +147,11 @@ def main(argv: list[str] | None = None) -> int:
     data_budget = budget(scenario)
     for warning in data_budget.warnings() if data_budget is not None else []:
         log.warning("%s", warning)
+    zenoh_only = _zenoh_only(args)
+    if args.transport == "inproc" and zenoh_only:
+        print(f"error: {', '.join(zenoh_only)} apply only to --transport zenoh",
+              file=sys.stderr)
+        return 2
     if args.realtime is not None and not args.realtime > 0.0:
         print(f"error: --realtime takes a positive speed (times real time), not {args.realtime}",
               file=sys.stderr)
@@ -197,6 +203,14 @@ def main(argv: list[str] | None = None) -> int:
     if status == "interrupted":
         return caught.exit_status or 130
     return 0 if status == "completed" else 1
+
+
+def _zenoh_only(args: argparse.Namespace) -> list[str]:
+    """The options given that only a Zenoh run uses."""
+    given = {"--endpoint": args.endpoint != DEFAULT_ENDPOINT, "--advertise": args.advertise,
+             "--tls-host": args.tls_host, "--restart-on-crash": args.restart_on_crash,
+             "--audit-access": args.audit_access}
+    return [name for name, on in given.items() if on]
 
 
 def _stopping(stop: threading.Event, signum: int) -> None:

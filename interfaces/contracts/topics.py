@@ -107,6 +107,12 @@ def _match(pat: list[str], key_parts: list[str]) -> bool:
     return False
 
 
+def is_segment(s: str) -> bool:
+    """Whether ``s`` may be one segment of a key (a mission's name): letters, digits, '_'
+    or '-'."""
+    return bool(_SEGMENT.match(s))
+
+
 def _check_segment(s: str) -> None:
     if not _SEGMENT.match(s):
         raise ValueError(f"invalid key segment {s!r}: use letters, digits, '_' or '-'")

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import argparse
 
+from interfaces.contracts.topics import is_segment
+
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR")
 
 
@@ -26,6 +28,14 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"{value}: at least 1")
     return value
+
+
+def mission_name(text: str) -> str:
+    """A key-space name (one key segment: letters, digits, '_' or '-')."""
+    if not is_segment(text):
+        raise argparse.ArgumentTypeError(f"{text!r}: letters, digits, '_' or '-' only (one "
+                                         "segment of the bus's keys)")
+    return text
 
 
 def add_log_level(parser: argparse.ArgumentParser) -> None:

@@ -13,7 +13,7 @@ from pathlib import Path
 from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.contracts.topology import topology
-from interfaces.runtime.arguments import add_log_level
+from interfaces.runtime.arguments import add_log_level, mission_name
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore
 from interfaces.runtime.executive import Executive, TickClient
@@ -25,7 +25,8 @@ from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, 
 
 def add_node_args(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scenario", required=True, help="scenario TOML file")
-    parser.add_argument("--mission", help="key-space name (default: the scenario name)")
+    parser.add_argument("--mission", type=mission_name,
+                        help="key-space name (default: the scenario name)")
     parser.add_argument("--seed", type=int, help="override the scenario seed")
     parser.add_argument("--duration", type=float, help="override duration_s (s)")
     parser.add_argument("--connect", default=DEFAULT_ENDPOINT,

@@ -48,6 +48,10 @@ CASES = [
     ("fault after the end", ["run"], ("camera_degradation", "magnitude = 0.5", 1300.0),
      "not before the end of the run"),
     ("scenario not UTF-8", ["run"], b"name = \"x\"\n\xff\xfe\n", "not UTF-8"),
+    ("endpoint in process", ["run", "--endpoint", "garbage"], None,
+     "--endpoint apply only to --transport zenoh"),
+    ("restarts in process", ["run", "--restart-on-crash", "--audit-access"], None,
+     "--restart-on-crash, --audit-access apply only"),
 ]
 
 RUN = {"run.mcap": b"\x89MCAP0\r\nold", "summary.json": b"{}", "report.md": b"# old"}
@@ -104,6 +108,7 @@ def _snapshot(path: Path) -> dict[str, bytes]:
 
 
 PARSER_CASES = [
+    ("mission with a slash", ["run", "--mission", "a/b"], "--mission: 'a/b': letters"),
     ("log level bogus", ["run", "--log-level", "bogus"], "--log-level: 'bogus': one of DEBUG"),
     ("workers zero", ["campaign", "--workers", "0"], "--workers: 0: at least 1"),
     ("limit negative", ["campaign", "--limit", "-1"], "--limit: -1: at least 1"),

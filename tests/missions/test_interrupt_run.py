@@ -30,9 +30,10 @@ def test_an_interrupted_run_is_written_as_one(tmp_path: Path, free_port: int, tr
     out = tmp_path / "run"
     env = {**os.environ, "PYTHONPATH": str(REPO)}
     port = free_port
+    endpoint = ["--endpoint", f"tcp/127.0.0.1:{port}"] if transport == "zenoh" else []
     proc = subprocess.Popen(
         [sys.executable, "-m", "deploy.cli", "run", "--scenario", str(NOMINAL), "--transport",
-         transport, "--endpoint", f"tcp/127.0.0.1:{port}", "--no-report", "--out", str(out)],
+         transport, *endpoint, "--no-report", "--out", str(out)],
         cwd=REPO, env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     assert proc.stderr is not None
     seen = []
