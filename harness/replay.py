@@ -67,6 +67,7 @@ from interfaces.contracts.messages import (
 )
 from interfaces.contracts.scenario import Scenario, ScenarioError
 from interfaces.contracts.topology import topology
+from interfaces.runtime.arguments import prog_name
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import TickClient
@@ -304,7 +305,7 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m harness.replay", description=__doc__,
+    p = argparse.ArgumentParser(prog=prog_name("python -m harness.replay"), description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("runs", nargs="+", type=Path, help="run directories or run.mcap files")
     p.add_argument("--set", dest="settings", action="append", default=[],

@@ -18,6 +18,7 @@ import threading
 import time
 from dataclasses import dataclass
 
+from interfaces.runtime.arguments import prog_name
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
 
 SKIP_FIELDS = {"sender", "seq", "t_sim", "t_wall"}
@@ -79,7 +80,7 @@ def table(rows: dict[str, _Row]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m ground.tools.tlm", description=__doc__,
+    p = argparse.ArgumentParser(prog=prog_name("python -m ground.tools.tlm"), description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--filter", default="insp/**", help="Zenoh key expression (default insp/**)")
     p.add_argument("--connect", default=DEFAULT_ENDPOINT,

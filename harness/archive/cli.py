@@ -37,6 +37,7 @@ from harness.archive.locate import ArchivePathError, archive_file
 from harness.archive.reader import ArchiveError, RunArchive, load_run
 from harness.archive.sequences import by_topic
 from harness.archive.span import cut_of, seconds
+from interfaces.runtime.arguments import prog_name
 
 PARQUET_SUFFIXES = (".parquet", ".pq")
 """``export --out`` file suffixes that choose Parquet over CSV."""
@@ -125,22 +126,24 @@ def export_csv(archive: RunArchive, key_expr: str, out: TextIO) -> int:
     return len(rows)
 
 
-def export(run: Path, key_expr: str, out: Path | None) -> int:
+def export(run: Path, key_expr: str, out: Path | None) -> tuple[int, str | None]:
     """Export the messages of ``key_expr``: Parquet if ``out`` has a Parquet suffix, else CSV
-    to ``out`` or stdout; returns the number of rows (a Parquet export of nothing raises)."""
-    if out is not None and out.suffix.lower() in PARQUET_SUFFIXES:
-        frame = topic_frame(run, key_expr)
-        frame.to_parquet(out)
-        return len(frame)
+    to ``out`` or stdout; returns the number of rows (a Parquet export of nothing raises) and,
+    for an archive cut short, where it was cut (``span.cut_of``: the export ends there)."""
     archive = load_run(run)
+    cut = cut_of(archive)
+    if out is not None and out.suffix.lower() in PARQUET_SUFFIXES:
+        frame = topic_frame(archive, key_expr)
+        frame.to_parquet(out)
+        return len(frame), cut
     if out is None:
-        return export_csv(archive, key_expr, sys.stdout)
+        return export_csv(archive, key_expr, sys.stdout), cut
     with open(out, "w", newline="") as f:
-        return export_csv(archive, key_expr, f)
+        return export_csv(archive, key_expr, f), cut
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m harness.archive", description=__doc__,
+    p = argparse.ArgumentParser(prog=prog_name("python -m harness.archive"), description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     run_help = "a run folder (holding run.mcap) or an archive file"
@@ -166,8 +169,11 @@ def main(argv: list[str] | None = None) -> int:
         elif args.command == "summary":
             summarize(load_run(runs[0]), sys.stdout)
         else:
-            n = export(runs[0], args.topic, args.out)
+            n, cut = export(runs[0], args.topic, args.out)
             print(f"{n} messages exported", file=sys.stderr)
+            if cut is not None:
+                print(f"warning: the archive is truncated ({cut}): the export ends where it "
+                      "does", file=sys.stderr)
             if n == 0:
                 print(f"warning: no message matches {args.topic!r}; `list` shows the keys",
                       file=sys.stderr)

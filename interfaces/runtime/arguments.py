@@ -5,6 +5,7 @@ refused by the parser with exit 2 and a line naming the option, never a tracebac
 from __future__ import annotations
 
 import argparse
+import sys
 
 from interfaces.contracts.topics import is_segment
 
@@ -36,6 +37,12 @@ def mission_name(text: str) -> str:
         raise argparse.ArgumentTypeError(f"{text!r}: letters, digits, '_' or '-' only (one "
                                          "segment of the bus's keys)")
     return text
+
+
+def prog_name(own: str) -> str:
+    """The name a tool's help and errors go under: ``insp-fdir <subcommand>`` when run as one
+    (``deploy/cli.py`` names it in ``sys.argv[0]``), else its own (``python -m ...``)."""
+    return sys.argv[0] if sys.argv[0].startswith("insp-fdir ") else own
 
 
 def add_log_level(parser: argparse.ArgumentParser) -> None:

@@ -37,11 +37,12 @@ def test_help_lists_the_subcommands_one_line_each() -> None:
         assert cli.COMMANDS[name].help in line
 
 
-def test_a_subcommands_help_is_the_tools_own() -> None:
-    done = _cli("run", "--help")
+@pytest.mark.parametrize("name", SUBCOMMANDS)
+def test_a_subcommands_help_is_the_tools_own_under_its_insp_fdir_name(name: str) -> None:
+    done = _cli(name, "--help")
     assert done.returncode == 0, done.stderr
-    assert done.stdout.startswith("usage: insp-fdir run")
-    doc = importlib.import_module(cli.COMMANDS["run"].module).__doc__
+    assert done.stdout.startswith(f"usage: insp-fdir {name}")
+    doc = importlib.import_module(cli.COMMANDS[name].module).__doc__
     assert doc is not None and doc.splitlines()[0] in done.stdout
 
 
