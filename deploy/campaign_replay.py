@@ -25,6 +25,7 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
+from deploy.cluster import dask_client
 from harness.archive.reader import ArchiveError
 from harness.archive.run_scenario import archived_scenario
 from harness.campaign.report import write_campaign_report
@@ -75,10 +76,9 @@ def _local(jobs: list[tuple[str, dict[str, str], str]], workers: int
 
 def _dask(jobs: list[tuple[str, dict[str, str], str]], address: str
           ) -> Iterator[dict[str, Any]]:
-    from distributed import Client
     from distributed import as_completed as dask_completed
 
-    with Client(address, timeout="30s") as client:
+    with dask_client(address) as client:
         futures = [client.submit(replay_job, *job, pure=False) for job in jobs]
         for f in dask_completed(futures):
             yield f.result()

@@ -63,6 +63,7 @@ from deploy.campaign import (  # noqa: E402
     record_failure,
 )
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
+from deploy.cluster import CONNECT_TIMEOUT_S, ClusterError, dask_client  # noqa: E402
 from harness.campaign.formation_study import write_formation_study  # noqa: E402
 from harness.campaign.neighbours_study import write_neighbours_study  # noqa: E402
 from harness.campaign.report import write_campaign_report  # noqa: E402
@@ -83,7 +84,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--workers", type=positive_int, default=os.cpu_count() or 1,
                    help="local worker processes, at least 1 (default: one per core)")
     p.add_argument("--limit", type=positive_int, help="run only the first N runs of the list")
-    p.add_argument("--cluster", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786")
+    p.add_argument("--cluster", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786 (an "
+                                     f"error if none answers within {CONNECT_TIMEOUT_S:g} s)")
     p.add_argument("--transport", choices=("inproc", "zenoh"), default="inproc",
                    help="each run in one process (default), or multi-process over Zenoh on "
                         "its own loopback port and key space")
@@ -184,10 +186,10 @@ def one_blas_thread() -> None:
 
 def _dask(todo: list[RunSpec], out: Path, address: str, transport: str
           ) -> Iterator[dict[str, Any]]:
-    from distributed import Client, as_completed
+    from distributed import as_completed
 
     tag = hashlib.sha256(str(out.resolve()).encode()).hexdigest()[:8]
-    with Client(address, timeout="30s") as client:
+    with dask_client(address) as client:
         futures = {client.submit(execute_run, spec, str(out), transport,
                                  key=f"run-{tag}-{spec.id}", pure=False): spec for spec in todo}
         try:
@@ -273,7 +275,7 @@ def _replay(args: argparse.Namespace) -> int:
         kw = {"workers": args.workers, "cluster": args.cluster, "progress": print_progress}
         path = (sweep(args.out, name, values, dest, settings, **kw) if args.sweep
                 else rejudge(args.out, settings, dest, **kw))
-    except ScenarioError as e:
+    except (ScenarioError, ClusterError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     print(f"report: {path}", file=sys.stderr)
@@ -322,6 +324,9 @@ def _run_locked(runs: list[RunSpec], args: argparse.Namespace, runs_dir: Path) -
             _local(todo, args.out, args.workers, args.transport)
         for result in results:
             progress.update(result)
+    except ClusterError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("", file=sys.stderr)
         log.warning("interrupted: %d runs finished this time; start again with the same --out "

@@ -34,6 +34,7 @@ CASES = [
     ("duration nan", ["run", "--duration", "nan"], None, "duration_s"),
     ("duration inf", ["run", "--duration", "inf"], None, "duration_s"),
     ("seed negative", ["run", "--seed", "-1"], None, "seed"),
+    ("duration under a tick", ["run", "--duration", "1e-9"], None, "shorter than one tick"),
     ("thruster leak of a million", ["run"], ("thruster_bias", "magnitude = 1e6"),
      "thruster_bias magnitude must be in (0, 1]"),
     ("negative leak", ["run"], ("thruster_bias", "magnitude = -0.4"), "thruster_bias magnitude"),
@@ -144,3 +145,17 @@ def test_overwrite_removes_the_old_run_wholly_and_the_default_name_is_unique(
     assert prepare(None, default, overwrite=False) == default.with_name(default.name + "-2")
     with pytest.raises(OutFolderError, match="already holds"):
         prepare(first, default, overwrite=False)
+
+
+def test_an_unreachable_cluster_is_named_within_the_stated_time(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch,
+        free_port: int) -> None:
+    import deploy.cluster
+
+    monkeypatch.setattr(deploy.cluster, "CONNECT_TIMEOUT_S", 1.0)
+    campaign = REPO / "deploy" / "campaigns" / "paper.toml"
+    code = main(["campaign", "--campaign", str(campaign), "--out", str(tmp_path / "c"),
+                 "--limit", "1", "--cluster", f"tcp://127.0.0.1:{free_port}"])
+    err = capsys.readouterr().err
+    assert code == 2 and "no Dask scheduler answered within 1 s" in err, err
+    assert "Traceback" not in err

@@ -55,6 +55,9 @@ class Scenario(Section):
 
     @model_validator(mode="after")
     def _consistency(self) -> Scenario:
+        if self.duration_s < self.rates.dt_s:
+            raise ValueError(f"duration_s = {self.duration_s:g} s is shorter than one tick "
+                             f"({self.rates.dt_s:g} s at rates.high_hz)")
         n = self.observers.count
         for f in self.faults:
             if f.spacecraft > n:
