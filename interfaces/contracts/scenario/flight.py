@@ -32,9 +32,11 @@ class Guidance(Section):
 class Attitude(Section):
     """Attitude guidance and control (ω_high): slews planned by SCP, nonlinear tracking."""
 
-    settling_time_s: float = Field(default=30.0, gt=0.0)
-    slew_rate_max_dps: float = Field(default=2.0, gt=0.0)
-    slew_threshold_deg: float = Field(default=10.0, gt=0.0,
+    settling_time_s: float = Field(default=30.0, ge=1.0, le=3600.0,
+                                   description="attitude loop settling time, s (1 to 3,600)")
+    slew_rate_max_dps: float = Field(default=2.0, gt=0.0, le=30.0,
+                                     description="slew rate limit, deg/s (at most 30)")
+    slew_threshold_deg: float = Field(default=10.0, gt=0.0, le=180.0,
                                       description="errors above this are slewed on a plan")
     boresight_body: tuple[float, float, float] = (0.0, 0.0, 1.0)
 
@@ -46,17 +48,24 @@ class Attitude(Section):
 
 
 class Sensors(Section):
-    relnav_sigma_r_m: float = Field(default=0.1, gt=0.0, description="1σ position noise, m")
-    relnav_sigma_v_mps: float = Field(default=0.002, gt=0.0, description="1σ velocity noise, m/s")
-    gyro_arw_rad_rts: float = Field(default=4.4e-5, ge=0.0,
-                                    description="angle random walk σv, rad/√s (0.15°/√h)")
-    gyro_bias_rw_rad_s15: float = Field(default=3e-7, ge=0.0,
-                                        description="bias random walk σu, rad/s^1.5")
-    gyro_bias_sigma_radps: float = Field(default=1e-4, gt=0.0,
-                                         description="1σ initial gyro bias, rad/s")
+    relnav_sigma_r_m: float = Field(default=0.1, gt=0.0, le=100.0,
+                                    description="1σ position noise, m (at most 100)")
+    relnav_sigma_v_mps: float = Field(default=0.002, gt=0.0, le=10.0,
+                                      description="1σ velocity noise, m/s (at most 10: a draw "
+                                                  "stays within the measurement's 1,000 m/s)")
+    gyro_arw_rad_rts: float = Field(default=4.4e-5, ge=0.0, le=0.01,
+                                    description="angle random walk σv, rad/√s (0.15°/√h; at "
+                                                "most 0.01)")
+    gyro_bias_rw_rad_s15: float = Field(default=3e-7, ge=0.0, le=1e-3,
+                                        description="bias random walk σu, rad/s^1.5 (at most "
+                                                    "1e-3)")
+    gyro_bias_sigma_radps: float = Field(default=1e-4, gt=0.0, le=0.1,
+                                         description="1σ initial gyro bias, rad/s (at most 0.1)")
     star_tracker_hz: float = Field(default=1.0, gt=0.0)
-    star_tracker_cross_arcsec: float = Field(default=10.0, gt=0.0, description="1σ")
-    star_tracker_roll_arcsec: float = Field(default=60.0, gt=0.0, description="1σ, about boresight")
+    star_tracker_cross_arcsec: float = Field(default=10.0, gt=0.0, le=3600.0,
+                                             description="1σ, at most 1°")
+    star_tracker_roll_arcsec: float = Field(default=60.0, gt=0.0, le=3600.0,
+                                            description="1σ, about boresight, at most 1°")
 
 
 class Nav(Section):

@@ -4,20 +4,28 @@ mission's phases (formations the ground assigns in turn)."""
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
 from interfaces.contracts.scenario.base import Section
 
+MAX_PRO_M = 10_000.0
+"""The largest PRO size, m: an inspection flies tens of metres, and the relative navigation
+measures within 100 km (ρy + 2ρx at most 30 km)."""
+Size = Annotated[float, Field(ge=0.0, le=MAX_PRO_M)]
+Offset = Annotated[float, Field(ge=-MAX_PRO_M, le=MAX_PRO_M)]
+Angle = Annotated[float, Field(ge=-360.0, le=360.0)]
+"""A PRO phase, deg."""
+
 
 class ObserverOverride(Section):
     spacecraft: int = Field(ge=1)
-    rho_x_m: float | None = None
-    alpha_x_deg: float | None = None
-    rho_y_m: float | None = None
-    rho_z_m: float | None = None
-    alpha_z_deg: float | None = None
+    rho_x_m: Size | None = None
+    alpha_x_deg: Angle | None = None
+    rho_y_m: Offset | None = None
+    rho_z_m: Size | None = None
+    alpha_z_deg: Angle | None = None
 
 
 class _ProFormation(Section):
@@ -26,10 +34,10 @@ class _ProFormation(Section):
     By default spacecraft i of N has αx = αz = phase0_deg + 360°·(i-1)/N; ``overrides`` set any
     parameter of one spacecraft."""
 
-    rho_x_m: float = Field(default=20.0, ge=0.0)
-    rho_y_m: float = 0.0
-    rho_z_m: float = Field(default=20.0, ge=0.0)
-    phase0_deg: float = 0.0
+    rho_x_m: Size = 20.0
+    rho_y_m: Offset = 0.0
+    rho_z_m: Size = 20.0
+    phase0_deg: Angle = 0.0
     overrides: list[ObserverOverride] = Field(default_factory=list)
 
     def pro_of(self, spacecraft: int, count: int) -> tuple[float, float, float, float, float]:
@@ -61,7 +69,10 @@ class Observers(_ProFormation):
     deploy_radius_m: float = Field(default=5.0, gt=0.0)
     deploy_speed_mps: float = Field(default=0.05, ge=0.0)
     initial_attitude: Literal["random", "lvlh"] = "random"
-    tumble_rate_dps: float = Field(default=0.2, ge=0.0, description="1σ initial rate per axis")
+    tumble_rate_dps: float = Field(
+        default=0.2, ge=0.0, le=90.0,
+        description="1σ initial rate per axis, deg/s (at most 90: a draw stays within the truth "
+                    "state's 10 rad/s bound to 6σ)")
 
     @model_validator(mode="after")
     def _inertia(self) -> Observers:

@@ -11,10 +11,10 @@ class Rates(Section):
     """Rate groups ω_high / ω_mid / ω_low (Hz) and the FDI period (s), a whole number of ω_mid
     periods (``interfaces.contracts.fdi_schedule``)."""
 
-    high_hz: float = Field(default=10.0, gt=0.0)
-    mid_hz: float = Field(default=1.0, gt=0.0)
-    low_hz: float = Field(default=0.1, gt=0.0)
-    fdi_period_s: float = Field(default=30.0, gt=0.0)
+    high_hz: float = Field(default=10.0, gt=0.0, le=1000.0)
+    mid_hz: float = Field(default=1.0, ge=0.01)
+    low_hz: float = Field(default=0.1, ge=0.001, description="at least once in 1,000 s")
+    fdi_period_s: float = Field(default=30.0, gt=0.0, le=3600.0)
 
     @model_validator(mode="after")
     def _integer_ratios(self) -> Rates:
