@@ -50,6 +50,15 @@ class Alarm:
     declared_s: float | None = None
     """when it was declared (s; None: not known)"""
 
+    @property
+    def at_s(self) -> float:
+        """When the alarm counts, s: its window's end, but for a link fault when it was
+        declared (with ground passes a silence is declared in the pass after it, and may be a
+        window's end before the cut that kept that window's data aboard)."""
+        if self.fault_class == "link" and self.declared_s is not None:
+            return self.declared_s
+        return self.t_s
+
 
 @dataclass(frozen=True)
 class Judged:
@@ -77,7 +86,7 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
     """The ``scores`` section: ``per_fault`` (in scenario order) and the false-alarm figures."""
     per_fault = []
     for f in faults:
-        during = sorted((a for a in alarms if _active(f, a.t_s, grace_s)), key=lambda a: a.t_s)
+        during = sorted((a for a in alarms if _active(f, a.at_s, grace_s)), key=lambda a: a.at_s)
         on_it = [a for a in during if a.spacecraft == f.spacecraft]
         first = on_it[0] if on_it else (during[0] if during else None)
         classed = [a for a in on_it if a.fault_class is not None]
@@ -85,10 +94,10 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
         per_fault.append(FaultScore(
             spacecraft=f.spacecraft, kind=f.kind, start_s=f.start_s,
             detected=bool(during), isolated=bool(on_it),
-            latency_s=None if first is None else first.t_s - f.start_s,
+            latency_s=None if first is None else first.at_s - f.start_s,
             identified_class=identified, expected_class=EXPECTED_CLASS[f.kind],
             identified_correctly=identified == EXPECTED_CLASS[f.kind],
-            identification_latency_s=classed[0].t_s - f.start_s if classed else None,
+            identification_latency_s=classed[0].at_s - f.start_s if classed else None,
             declared_latency_s=(first.declared_s - f.start_s
                                 if first is not None and first.declared_s is not None else None),
         ))
@@ -99,7 +108,7 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
     def overlaps(j: Judged) -> bool:
         return overlaps_fault(faults, j.spacecraft, j.t_start_s, j.t_end_s)
 
-    false_alarms = [a for a in alarms if not faulty(a.spacecraft, a.t_s)]
+    false_alarms = [a for a in alarms if not faulty(a.spacecraft, a.at_s)]
     nominal = [j for j in judged if not overlaps(j)]
     hours = sum(j.t_end_s - j.t_start_s for j in nominal) / 3600.0
     return Scores(

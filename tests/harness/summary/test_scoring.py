@@ -43,3 +43,14 @@ def test_detected_but_not_isolated_uses_the_first_alarm() -> None:
     assert f.detected and not f.isolated and f.latency_s == 80.0
     assert f.identified_class is None and not f.identified_correctly
     assert s.nominal_cycles == 0 and s.false_alarm_rate is None
+
+
+def test_a_link_alarm_counts_when_it_was_declared() -> None:
+    """A cut at 300 s kept the data of the window ending 250 s aboard; the ground declared the
+    silence at 380 s, in the pass after it: the fault's detection at 80 s, not a false alarm
+    before it.  Any other class counts at its window's end."""
+    fault = [Fault(spacecraft=4, kind="link_loss", start_s=300.0)]
+    s = score(fault, [Alarm(4, 250.0, "link", declared_s=380.0)], [], grace_s=50.0)
+    assert (s.per_fault[0].isolated, s.per_fault[0].latency_s, s.false_alarms) == (True, 80.0, 0)
+    s = score(fault, [Alarm(4, 250.0, "actuator", declared_s=380.0)], [], grace_s=50.0)
+    assert (s.per_fault[0].isolated, s.false_alarms) == (False, 1)
