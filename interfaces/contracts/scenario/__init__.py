@@ -15,6 +15,7 @@ from interfaces.contracts.scenario.model import (
     ScenarioError,
     load_scenario,
     parse_scenario,
+    validated,
 )
 from interfaces.contracts.scenario.neighbours import Neighbours
 from interfaces.contracts.scenario.observers import ObserverOverride, Observers, Phase
@@ -34,5 +35,5 @@ __all__ = [
     "LinkCut", "Nav", "Neighbours", "ObserverOverride", "Observers", "OnboardFdir", "Orbit",
     "Phase", "Rates",
     "Scenario", "ScenarioError", "Section", "Sensors", "SequenceName", "SimSettings", "Station",
-    "Target", "Watchpoint", "load_scenario", "parse_scenario",
+    "Target", "Watchpoint", "load_scenario", "parse_scenario", "validated",
 ]

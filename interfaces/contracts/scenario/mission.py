@@ -28,7 +28,9 @@ class Target(Section):
 
     shape: Literal["sphere"] = "sphere"
     radius_m: float = Field(default=5.0, gt=0.0)
-    pois: int = Field(default=5000, ge=1)
+    pois: int = Field(default=5000, ge=1, le=200_000,
+                      description="points of interest on the target (at most 200,000: four "
+                                  "times the 50,000 of the scaling target)")
     prior_variance: float = Field(default=1.0, gt=0.0, description="w, per POI")
 
 
