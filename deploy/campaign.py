@@ -89,6 +89,7 @@ import hashlib
 import itertools
 import json
 import logging
+import shutil
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -474,16 +475,21 @@ def _zenoh_run(spec: RunSpec, out: Path) -> RunSummary:
     from deploy.processes import die_with_parent
     from harness.summary.build import write_summary
 
-    scenario = out / "scenario.json"
+    launch = out.with_name(out.name + ".launch")  # beside: the launcher's --out stays empty
+    launch.mkdir(exist_ok=True)
+    scenario = launch / "scenario.json"
     scenario.write_text(spec.scenario.model_dump_json(indent=1))
-    for _attempt in range(3):  # a free port can be taken before the launcher binds it
+    for attempt in range(3):  # a free port can be taken before the launcher binds it
+        if attempt:  # what the refused launcher left: the next one starts from an empty --out
+            shutil.rmtree(out)
+            out.mkdir()
         with socket.socket() as s:
             s.bind(("127.0.0.1", 0))
             port = s.getsockname()[1]
         cmd = [sys.executable, str(Path(__file__).resolve().parent / "run_constellation.py"),
                "--scenario", str(scenario), "--out", str(out), "--no-report",
                "--endpoint", f"tcp/127.0.0.1:{port}", "--mission", f"{spec.scenario.name}-{port}"]
-        with open(out / "launcher.log", "w") as log_file:
+        with open(launch / "launcher.log", "w") as log_file:
             try:
                 subprocess.run(cmd, stdout=log_file, stderr=subprocess.STDOUT, check=False,
                                timeout=max(600.0, 5.0 * spec.scenario.duration_s),
@@ -491,8 +497,11 @@ def _zenoh_run(spec: RunSpec, out: Path) -> RunSummary:
                                else None)  # a killed worker takes its run down with it
             except subprocess.TimeoutExpired:
                 pass  # recorded below from what the launcher left
-        if "cannot listen on" not in (out / "launcher.log").read_text(errors="replace"):
+        if "cannot listen on" not in (launch / "launcher.log").read_text(errors="replace"):
             break
+    for name in ("scenario.json", "launcher.log"):  # into the run's folder, as before
+        (launch / name).replace(out / name)
+    launch.rmdir()
     summary_path = out / "summary.json"
     if summary_path.exists():
         return RunSummary.read(summary_path)

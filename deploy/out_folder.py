@@ -20,12 +20,16 @@ class OutFolderError(ValueError):
     """An output folder that cannot be used; the message says why and what to do."""
 
 
-def _contents(folder: Path) -> list[str]:
-    return sorted(p.name for p in folder.iterdir())
+def _contents(folder: Path, inputs: tuple[Path, ...] = ()) -> list[str]:
+    """The names in ``folder``, but the run's own ``inputs``."""
+    own = {i.resolve() for i in inputs}
+    return sorted(p.name for p in folder.iterdir() if p.resolve() not in own)
 
 
-def prepare(out: Path | None, default: Path, overwrite: bool) -> Path:
-    """The run's folder, made and empty: ``out`` (refused when it holds anything, unless
+def prepare(out: Path | None, default: Path, overwrite: bool,
+            inputs: tuple[Path, ...] = ()) -> Path:
+    """The run's folder, made and empty but for the run's own ``inputs`` (its scenario file,
+    which a campaign writes there): ``out`` (refused when it holds anything else, unless
     ``overwrite`` and it is a run's folder, which is then removed first), or ``default``
     (with ``-2``, ``-3``... when taken).  Raises OutFolderError."""
     if out is None:
@@ -35,8 +39,8 @@ def prepare(out: Path | None, default: Path, overwrite: bool) -> Path:
             out = default.with_name(f"{default.name}-{k}")
     elif out.exists() and not out.is_dir():
         raise OutFolderError(f"--out {out}: a file, not a folder")
-    elif out.exists() and any(out.iterdir()):
-        held = _contents(out)
+    elif out.exists() and _contents(out, inputs):
+        held = _contents(out, inputs)
         listed = ", ".join(held[:6]) + (" ..." if len(held) > 6 else "")
         if not overwrite:
             raise OutFolderError(f"--out {out} already holds {listed}: give another --out, or "

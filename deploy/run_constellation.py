@@ -163,7 +163,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         out = prepare_out(args.out, REPO / "runs" / f"{scenario.name}-"
-                          f"{time.strftime('%Y%m%d-%H%M%S')}", args.overwrite)
+                          f"{time.strftime('%Y%m%d-%H%M%S')}", args.overwrite,
+                          inputs=(args.scenario,))
     except OutFolderError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
