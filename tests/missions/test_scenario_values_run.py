@@ -39,7 +39,7 @@ VALUES = st.one_of(
     st.sampled_from([0, -1, 1e-12, 1e12, math.nan, math.inf]))
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(where=st.sampled_from(SETTINGS), value=VALUES)
 def test_a_value_is_refused_by_name_or_flies(where: tuple[str, str], value: Any) -> None:
     section, key = where
