@@ -108,8 +108,9 @@ def _sizes(p: psutil.Process) -> tuple[int, int]:
 def constellation(scenario: Path, out: Path, transport: str, duration: float,
                   report: bool = False) -> Measured:
     cmd = [sys.executable, "deploy/run_constellation.py", "--scenario", str(scenario),
-           "--out", str(out), "--transport", transport, "--duration", str(duration),
-           "--endpoint", f"tcp/127.0.0.1:{free_port()}"]
+           "--out", str(out), "--transport", transport, "--duration", str(duration)]
+    if transport == "zenoh":  # an in-process run refuses Zenoh-only options
+        cmd += ["--endpoint", f"tcp/127.0.0.1:{free_port()}"]
     if not report:
         cmd.append("--no-report")
     wall, rss, pss = run_tree(cmd)
