@@ -174,14 +174,18 @@ class GuidanceApp(App):
 
     def _plan(self, t: float, x: np.ndarray, a: ProAssignment) -> None:
         """Plan the transfer to the assigned PRO.  If no safe plan exists, the assignment is
-        refused and the previous orbit kept (the MPC alone has no keep-out constraint); an
-        assignment already due with the spacecraft near its PRO is held directly."""
+        refused and the previous orbit kept (the MPC alone has no keep-out constraint), and
+        the refusal published (a plan not solved); an assignment already due with the
+        spacecraft near its PRO is held directly.  One received more than a cycle after its
+        departure (held for a pass) takes the transfer time it asked for from now."""
         self.planned_id = a.assignment_id
         self.plan = None
         self.mpc.reset()
         duration = a.t_arrive_s - t
         if duration <= 0.0 and a.t_depart_s >= a.t_arrive_s:
             return  # a hold from the start (no transfer in the command)
+        if t - a.t_depart_s > self.dt and a.t_arrive_s > a.t_depart_s:
+            duration = max(duration, a.t_arrive_s - a.t_depart_s)  # late: the time asked
         duration = max(duration, MIN_TRANSFER_S)
         d_min = min(self.cfg.keep_out_m + KEEP_OUT_MARGIN_M, 0.9 * float(np.linalg.norm(x[:3])))
         # Too short for the planning thrust: use the full limit, then take longer.
@@ -192,6 +196,10 @@ class GuidanceApp(App):
                 plan = self._solve_transfer(t, x, duration, u_max, d_min)
             except ValueError as e:
                 self.log.error("assignment %d refused: %s", a.assignment_id, e)
+                self.publish("plan", TransferPlanMsg(
+                    sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id,
+                    assignment_id=a.assignment_id, t_s=[], x=[], u_mps2=[], dv_mps=0.0,
+                    status="refused", iterations=0, min_range_m=0.0, solve_ms=0.0))
                 self._revert()
                 return
             if plan.status != "infeasible_thrust_limit":

@@ -55,15 +55,42 @@ class FusedViews:
             self.fused[np.ix_(np.flatnonzero(rows), idx)] += prec
             self.images[rows, m.spacecraft - 1] += 1
 
-    def contributions(self, settled: PoiMap, lost: np.ndarray) -> np.ndarray:
+    def contributions(self, settled: PoiMap, lost: np.ndarray,
+                      shared: np.ndarray | None = None) -> np.ndarray:
         """Each observer's H_i (N,) on its own view: ψ from what it fused, every observer's
         precision scaled up by the share of its observations lost on the way to the ground
         (``lost``, capped at ``MAX_JUDGED_LOSS``: such an observer is not judged), in each
-        view by the share of its images that view holds."""
+        view by the share of its images that view holds.  With ``shared`` (N,), the
+        neighbours' images each observer says it fused (``InfoCostTelemetry.shared_received``;
+        NaN: not known), the neighbours' part of its view is thinned to that count
+        (:func:`thinned`): what the crosslinks lost into it."""
         extra = 1.0 / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS)) - 1.0
         held = np.divide(self.images, np.diag(self.images)[None, :],
                          out=np.zeros_like(self.images), where=np.diag(self.images) > 0)
         view = self.fused + (held * extra[None, :]) @ settled.F
+        if shared is not None:
+            view = thinned(view, settled.F * (1.0 + extra)[:, None],
+                           self.images * (1.0 + extra)[None, :], shared)
         psi = 1.0 / (settled.w_inv[None, :] + view) ** 2
         own = settled.F * (1.0 + extra)[:, None]
         return np.einsum("im,im->i", own, psi * settled.phi[None, :])
+
+
+MAX_THINNING = 2.0
+"""The largest factor :func:`thinned` applies (an observer that fused more of its neighbours'
+images than the ground counts in range: the range's edge, by the nav positions)."""
+
+
+def thinned(view: np.ndarray, own: np.ndarray, counted: np.ndarray,
+            shared: np.ndarray) -> np.ndarray:
+    """Each observer's view (N, M) with its neighbours' part scaled by the share of their
+    images it says it fused: ``shared[i]`` (NaN: unknown, unscaled) over the ground's count
+    of their images in its range (``counted[i, j]``, j ≠ i, lost ones included); ``own``
+    (N, M) is each observer's own part of its view.  The crosslinks lose images uniformly
+    over time and POIs, so the scaling rebuilds the view the observer fused (at 15% loss,
+    an observer lacks 15% of every neighbour's precision)."""
+    expected = counted.sum(axis=1) - np.diag(counted)
+    known = np.isfinite(shared) & (expected > 0)
+    ratio = np.ones(len(view))
+    ratio[known] = np.clip(shared[known] / expected[known], 0.0, MAX_THINNING)
+    return own + ratio[:, None] * (view - own)

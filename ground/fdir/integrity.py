@@ -6,16 +6,21 @@ The ground's map then holds every image before the boundary that came down.  Eac
 report is recomputed on the view it fused (``fused_views.py``: its own images and those of
 the observers in crosslink range when they were taken), every observer's precision scaled up
 by the share of its observations lost on the way (sequence gaps, and its store's overflow),
+and the neighbours' part of each view thinned to the count of their images the observer says
+it fused (``shared_received``: what the crosslinks lost into it, ``fused_views.thinned``),
 so ψ is as consistent as the ground can make it: the observer's H_i holds all of its images.
-The two then differ only by the crosslinks' loss, so a relative difference above
-``fdir.integrity_tol`` is an
-inconsistent report, and ``fdir.checks_persistence`` of them in a row a data-integrity fault.
+Without the thinning a packet-loss fault on an observer's links, which starves its view of
+its neighbours' images, read as a corrupt report (space campaign, faults 0038 and 0098).
+The two then differ only by what the scalings miss, so a relative difference above
+``fdir.integrity_tol`` is an inconsistent report, and ``fdir.checks_persistence`` of them in a row a data-integrity fault.
 
 The recomputation holds only while the ground has nearly every observation: ψ depends on every
 observer's images, and lost ones are lost in bursts, from particular views, which no uniform
 rescaling restores (at 30% loss in bursts of 50 packets a healthy report differed from it by a
 median 11%, up to 55%).  While more than ``fdir.integrity_max_loss`` of any observer's
-observations are missing, no report is judged (counted in ``unjudged``, logged).  The same
+observations are missing, or any observer's latest window lost more than its link's nominal
+loss explains (``link_checks.LOSSY_TAIL``: a link fault loses its share there long before the
+run's total shows it), no report is judged (counted in ``unjudged``, logged).  The same
 holds for the crosslinks: each observer fused its neighbours' images less the crosslinks'
 nominal loss (``comms.packet_loss``), which the ground cannot tell image by image; above
 ``fdir.integrity_max_loss`` no report is judged either (at 13% on the paper's set-up under
@@ -54,11 +59,13 @@ class IntegrityCheck:
         self.persistence = Persistence(cfg.checks_persistence)
         self.unjudged: dict[Unjudged, int] = {}
         """reports not judged, by reason"""
-        self._reported: dict[tuple[int, int], float] = {}  # (observer, boundary) -> H_i
+        self._reported: dict[tuple[int, int], tuple[float, int]] = {}
+        """(observer, boundary) -> its H_i and the neighbours' images it fused"""
 
     def reported(self, msg: InfoCostTelemetry, boundary: int) -> None:
-        """Keep the H_i ``msg`` reports at window boundary ``boundary``."""
-        self._reported[(msg.spacecraft, boundary)] = msg.h_i
+        """Keep the H_i ``msg`` reports at window boundary ``boundary``, with the count of
+        its neighbours' images it fused."""
+        self._reported[(msg.spacecraft, boundary)] = (msg.h_i, msg.shared_received)
 
     def check(self, j: int, b: float, settled: PoiMap, views: FusedViews,
               observers: dict[int, ObserverState],
@@ -71,12 +78,14 @@ class IntegrityCheck:
         report is judged while any observer's reports before b are still aboard (the map
         lacks them), or more of any observer's observations are lost than
         ``fdir.integrity_max_loss`` (on the link or to its store's overflow, or the
-        crosslinks' nominal loss is more); nor is the
+        crosslinks' nominal loss is more), or any observer's latest window lost more than its
+        link's nominal loss explains (``ObserverState.lossy``); nor is the
         report of an observer that ``excludes`` a neighbour its neighbours declared (it fuses
         less than the ground)."""
         lost = np.array([o.lost_fraction() for o in observers.values()])
         reports = {sc: self._reported.pop((sc, j), None) for sc in observers}
-        ground = views.contributions(settled, lost)
+        shared = np.array([math.nan if r is None else float(r[1]) for r in reports.values()])
+        ground = views.contributions(settled, lost, shared)
         why = self._blocked(b, self.period_s, lost, observers)
         out: list[FaultReport] = []
         unjudged: dict[int, Unjudged] = {}
@@ -84,7 +93,7 @@ class IntegrityCheck:
             mine = float(ground[sc - 1])
             if report is None or mine <= 0.0:
                 continue
-            reported = report
+            reported = report[0]
             reason = why or ("excluded" if excludes(sc) else None)
             if reason is not None:
                 unjudged[sc] = reason
@@ -112,6 +121,8 @@ class IntegrityCheck:
             return "lost"
         if self.crosslink_loss > self.cfg.integrity_max_loss:
             return "crosslink_loss"
+        if any(o.lossy for o in observers.values()):
+            return "lost"
         return "lost" if float(lost.max(initial=0.0)) > self.cfg.integrity_max_loss else None
 
     def _unjudged(self, sc: int, reason: Unjudged, lost: np.ndarray) -> None:

@@ -11,7 +11,21 @@ that does not reach the ground is a link fault, never zero information gain.
   10%: 6e-6 against 8e-5 for 30 s windows and 0.01 per hour).
 * **Silence**: an observer with a plan that sends no image for ``fdir.silent_windows``
   windows in a row (once per episode, and not when its loss was declared already: one link
-  fault, declared once).
+  fault, declared once).  One silent window decides alone when a healthy link would lose all
+  of a window's images (one per ω_mid period) with a probability below the window's share,
+  as for loss (30 images at a nominal 15%: 2e-25; in bursts of 50 packets: 0.57, and the
+  silence waits for ``fdir.silent_windows``).
+* **Lossy windows**: a window whose loss a healthy link would reach with a probability below
+  ``LOSSY_TAIL``, or a silent one, marks its observer ``lossy`` (``ObserverState.lossy``):
+  the data-integrity check judges no report while one is (its loss is not spread over the
+  run, so no rescaling of the ground's map rebuilds what the observers fused).
+* **Dump loss** (ground passes): the store sends a lost message again, so nothing is missing
+  by sequence number; the loss shows in the store's accounting (sent again vs dumped) as it
+  comes down with the ground's link counters.  Counted over ``rates.fdi_period_s`` of dump,
+  a loss beyond the link's limit that a healthy link would reach with a probability below the
+  window's share (``decisive``) is a link fault, declared once per episode (a dump window
+  within the limit ends it).  Without it a packet-loss fault that began between passes was
+  invisible to the ground (space campaign, fault-0028: 86% on a 15% link, every image in).
 * **Store overflow** (ground passes): a window whose reports the observer's onboard store
   lost is a link fault of known cause (once per episode), never judged for information.
 """
@@ -23,8 +37,13 @@ import logging
 from gnc.hardware_threshold import window_false_alarm
 from ground.fdir.observer import ObserverState, loss_limit, loss_tail
 from ground.fdir.threshold import Persistence
-from interfaces.contracts.messages import FaultReport, PoiObservations
+from interfaces.contracts.messages import FaultReport, PoiObservations, StoreCounter
+from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.contracts.scenario import Scenario
+
+LOSSY_TAIL = 0.05
+"""A window losing as many observations as a healthy link would with at most this probability
+is lossy (one healthy window in twenty at most)."""
 
 
 class LinkChecks:
@@ -40,12 +59,18 @@ class LinkChecks:
         self.alpha = window_false_alarm(self.cfg.false_alarms_per_observer_hour,
                                         scenario.rates.fdi_period_s, 1)
         """the false-alarm probability at which one window decides alone"""
+        self.period_s = scenario.rates.fdi_period_s
+        self.images_per_window = max(round(scenario.rates.fdi_period_s
+                                           * scenario.rates.mid_hz), 1)
+        """the images an observer takes in a window (one per ω_mid period)"""
 
     def judge(self, sc: int, obs: ObserverState, images: list[PoiObservations],
               planned: bool, b: float) -> tuple[int, list[FaultReport]]:
         """One observer's window ending at b (s): its received ``images`` and whether a plan
         is in force.  Returns the observations lost and the link faults declared."""
         lost, reports = self._loss(sc, obs, images, b)
+        obs.lossy = (loss_tail(lost, lost + len(images), self.comms.packet_loss, self.burst)
+                     < LOSSY_TAIL) if images else planned
         if planned and not images:
             reports += self._silence(sc, obs, b)
         elif planned:
@@ -94,6 +119,34 @@ class LinkChecks:
         return FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
                            metric=fraction, threshold=limit, window_end_s=b)
 
+    def dump(self, sc: int, obs: ObserverState, store: StoreCounter, t: float
+             ) -> list[FaultReport]:
+        """Observer ``sc``'s ``store`` accounting as it came down at ``t`` (s): once a dump
+        window of ``rates.fdi_period_s`` is over, the share of its transmissions lost (sent
+        again) against the link's limit; returns the link fault declared (module docstring)."""
+        start = obs.dump_start
+        if start is None or store.dumped < start[1]:
+            obs.dump_start = (t, store.dumped, store.retransmitted)
+            return []
+        if t - start[0] < self.period_s - TIME_TOL_S:
+            return []
+        obs.dump_start = (t, store.dumped, store.retransmitted)
+        lost = store.retransmitted - start[2]
+        sent = lost + store.dumped - start[1]
+        if sent <= 0:
+            return []
+        fraction, limit = lost / sent, self.limit(sent)
+        if fraction <= limit:
+            obs.dump_declared = False
+            return []
+        if obs.dump_declared or not self.decisive(lost, sent):
+            return []
+        obs.dump_declared = True
+        self.log.warning("FDIR: sc%d's dump lost %.0f%% of %d transmissions: link fault", sc,
+                         100.0 * fraction, sent)
+        return [FaultReport(sender=self.node, t_sim=t, spacecraft=sc, fault_class="link",
+                            metric=fraction, threshold=limit, window_end_s=t)]
+
     def overflow(self, sc: int, obs: ObserverState, b: float) -> list[FaultReport]:
         """A window whose reports the observer's onboard store lost to overflow (ground
         passes): a link fault of known cause, declared once per episode; the window is judged
@@ -111,7 +164,9 @@ class LinkChecks:
         obs.silent += 1
         if self.loss.declared(sc):  # the loss that went silent is the link fault declared
             obs.link_declared = True
-        if obs.silent < self.cfg.silent_windows or obs.link_declared:
+        n = self.images_per_window
+        if obs.link_declared or (obs.silent < self.cfg.silent_windows
+                                 and not self.decisive(n, n)):
             return []
         obs.link_declared = True
         self.log.warning("FDIR: sc%d silent for %d windows: link fault", sc, obs.silent)

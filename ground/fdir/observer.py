@@ -65,6 +65,8 @@ class ObserverState:
     attitude mode changed (as reported), and its silence count."""
 
     plans: dict[int, FlightPlan] = field(default_factory=dict)
+    refused: set[int] = field(default_factory=set)
+    """assignments it refused (``TransferPlanMsg.refused``): it keeps the plan before"""
     modes: list[tuple[float, str]] = field(default_factory=list)
     nav: TimeSeries = field(default_factory=TimeSeries)
     """reported position (nav estimate), LVLH m"""
@@ -107,6 +109,14 @@ class ObserverState:
     received: int = 0
     lost: int = 0
     """observations received and missing (sequence gaps) since the start"""
+    dump_start: tuple[float, int, int] | None = None
+    """(time s, messages dumped, sent again) of its store when the dump window being counted
+    began (ground passes; None: not yet seen)"""
+    dump_declared: bool = False
+    """its dump's loss was declared a link fault, and no healthy dump window came since"""
+    lossy: bool = False
+    """its latest judged window lost more of its observations than its link's nominal loss
+    explains (``link_checks.LOSSY_TAIL``), or all of them: the loss is not spread over the run"""
 
     def overflowed(self, a: float, b: float) -> bool:
         """Whether its store lost FDIR reports sent in the window [a, b) (s)."""

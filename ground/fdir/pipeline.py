@@ -94,6 +94,8 @@ class FdirPipeline:
         """the next FDI window to judge (``interfaces.contracts.fdi_schedule``)"""
         self.rejected = 0
         self._transfers: dict[tuple[int, int], Transfer] = {}
+        self._dump_reports: list[FaultReport] = []
+        """link faults the dumps' accounting declared, out with the next ``due``"""
 
     # --- what the observers report ---------------------------------------------------------
 
@@ -114,11 +116,20 @@ class FdirPipeline:
             self.views.add([msg], self.observers)
 
     def transfer(self, msg: TransferPlanMsg) -> None:
-        if msg.spacecraft not in self.observers or len(msg.t_s) < 2:
+        """A transfer an observer planned, the path it flies to its assignment's PRO; or its
+        refusal of the assignment (it keeps the plan before, which its windows are then
+        judged against)."""
+        obs = self.observers.get(msg.spacecraft)
+        if obs is not None and msg.refused:
+            obs.refused.add(msg.assignment_id)
+            if obs.plans.pop(msg.assignment_id, None) is not None:
+                self.log.warning("FDIR: sc%d refused assignment %d (%s): judged on the plan it "
+                                 "keeps", msg.spacecraft, msg.assignment_id, msg.status)
+            return
+        if obs is None or len(msg.t_s) < 2:
             return
         tr = Transfer(np.array(msg.t_s), np.array(msg.x), np.array(msg.u_mps2))
         self._transfers[(msg.spacecraft, msg.assignment_id)] = tr
-        obs = self.observers[msg.spacecraft]
         plan = obs.plans.get(msg.assignment_id)
         if plan is not None:
             obs.plans[msg.assignment_id] = FlightPlan(plan.t_from_s, plan.pro, tr,
@@ -133,7 +144,7 @@ class FdirPipeline:
         reach = self.contact.uplinked_s(msg.t_sim) if self.contact is not None else 0.0
         for a in msg.assignments:
             obs = self.observers.get(a.spacecraft)
-            if obs is None or a.assignment_id in obs.plans:
+            if obs is None or a.assignment_id in obs.plans or a.assignment_id in obs.refused:
                 continue
             plan = FlightPlan.of(a, max(a.t_depart_s, reach),
                                  self._transfers.get((a.spacecraft, a.assignment_id)))
@@ -186,11 +197,13 @@ class FdirPipeline:
         """The ground's own channel counters: with ground passes, each observer's onboard store
         as its housekeeping reports it in a pass (docs/fdir.md, "Ground passes"): the FDIR
         topics' overflow runs, the observations lost to overflow, and the oldest report the
-        FDIR judges still aboard."""
+        FDIR judges still aboard; and the dump's loss (``LinkChecks.dump``)."""
         for c in msg.links:
-            obs = self.observers.get(spacecraft_of(c.src) or 0)
+            sc = spacecraft_of(c.src) or 0
+            obs = self.observers.get(sc)
             if obs is None or c.dst != self.node or c.store is None:
                 continue
+            self._dump_reports += self.links.dump(sc, obs, c.store, msg.t_sim)
             runs = c.store.overflow_runs
             obs.overflow = [(r.first_s, r.last_s) for r in runs if r.topic in FDIR_DOWNLINK_TOPICS]
             obs.overflow_observations = sum(r.count for r in runs if r.topic == OBSERVATIONS.path)
@@ -212,8 +225,10 @@ class FdirPipeline:
         return self.schedule.start(self.next_window)
 
     def due(self, t: float) -> list[Message]:
-        """Judge every window due by time t (s): ``fdir.latency_s`` after it closed."""
-        out: list[Message] = []
+        """Judge every window due by time t (s): ``fdir.latency_s`` after it closed; with the
+        link faults the dumps' accounting declared since the last call."""
+        out: list[Message] = [*self._dump_reports]
+        self._dump_reports = []
         if self.contact is not None:
             now = self.contact.pass_index(t)
             for o in self.observers.values():

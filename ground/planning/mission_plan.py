@@ -5,6 +5,9 @@ Scenario phases (``assign = "scenario"``) give their PROs directly.  A phase is 
 ``UPLINK_LEAD_S`` before it starts; with ground passes and observers released from the target,
 the first phase is issued at the start, loaded aboard before the run, when no pass comes before
 its uplink time (the later ones wait for a pass, as the ground's plan depends on what it saw).
+With ground passes no assignment departs before ``UPLINK_LEAD_S`` after its uplink reaches the
+spacecraft: one held for a pass, a phase's or a re-plan's, leaves after that pass (its transfer
+as long as asked), so no observer is asked to fly a transfer already under way.
 Information phases (``assign = "information"``) are decided when they are uplinked, from the
 ground's fused view of the POIs at that moment: the greedy set of
 :func:`ground.planning.orbit_assignment.greedy_assignment`, matched to the observers by
@@ -170,6 +173,17 @@ class MissionPlan:
         uplink = self.scenario.phases[0].start_s - UPLINK_LEAD_S
         return self._contact.uplinked_s(max(uplink, TIME_TOL_S * 2)) > uplink + TIME_TOL_S
 
+    def _departure(self, t: float, t_depart: float) -> float:
+        """The departure (s) of an assignment issued at ``t`` (s) that asks for ``t_depart``:
+        with ground passes, one held for a pass (``ContactPlan.uplinked_s``) leaves
+        ``UPLINK_LEAD_S`` after that pass's acquisition at the earliest, with the whole
+        transfer time it asks for; one sent at once keeps its time, as does one with no pass
+        to follow (it never arrives)."""
+        reach = self._contact.uplinked_s(t) if self._contact is not None else t
+        if reach <= t + TIME_TOL_S or not math.isfinite(reach):
+            return t_depart
+        return max(t_depart, reach + UPLINK_LEAD_S)
+
     def _issue(self, phase: str, pros: dict[int, ProElements], t_depart: float,
                t_arrive: float) -> None:
         self.issued.append(PlannedAssignment(len(self.issued) + 1, phase, pros, t_depart,
@@ -177,7 +191,7 @@ class MissionPlan:
         self._gains, self._last_check = [], None
 
     def _start_phase(self, phase: Phase, t: float, fused: PoiMap) -> None:
-        t_depart = phase.start_s  # a late uplink is the guidance's to absorb
+        t_depart = self._departure(t, phase.start_s)
         if phase.assign == "scenario":
             self._issue(phase.name, _scenario_pros(phase, self.count), t_depart,
                         t_depart + phase.transfer_s)
@@ -202,7 +216,7 @@ class MissionPlan:
         self._last_check = (t, h)
         if not gain_saturated(self._gains, a.saturation_fraction):
             return
-        t_depart = t + UPLINK_LEAD_S
+        t_depart = self._departure(t, t + UPLINK_LEAD_S)
         upcoming = self.scenario.phases[self._next_phase:]
         if upcoming and upcoming[0].start_s < t_depart + a.transfer_s:
             return  # the next phase comes first
@@ -256,7 +270,7 @@ class MissionPlan:
         if (dropped, impaired) == (self.dropped, self.impaired) or len(dropped) >= self.count:
             return False
         a = self.scenario.assignment
-        t_depart = t + UPLINK_LEAD_S
+        t_depart = self._departure(t, t + UPLINK_LEAD_S)
         t_arrive = t_depart + a.transfer_s
         w, phi = self.sets.weights(t_arrive, fused, dropped, self._current_pros)
         pros, per_observer, gain, bound = self.sets.plan_set(t_depart, t_arrive, w, phi, dropped,
@@ -279,7 +293,7 @@ class MissionPlan:
         cur = self.current
         if cur is None:
             return False
-        t_depart = t + UPLINK_LEAD_S
+        t_depart = self._departure(t, t + UPLINK_LEAD_S)
         self._issue(cur.phase, dict(cur.pros), t_depart,
                     t_depart + self.scenario.assignment.transfer_s)
         return True

@@ -77,7 +77,8 @@ class StateEstimate(Message):
 
 class TransferPlanMsg(Message):
     """A planned transfer (SCP, L1 fuel): node times (s, mission time), LVLH states (m, m/s) and
-    ZOH accelerations (m/s², one per interval) — the nominal plan the ground's twin replays."""
+    ZOH accelerations (m/s², one per interval) — the nominal plan the ground's twin replays;
+    or, when not solved (``refused``), the spacecraft's refusal of the assignment."""
 
     WALL_CLOCK_FIELDS: ClassVar[frozenset[str]] = frozenset({"t_wall", "solve_ms"})
 
@@ -91,6 +92,13 @@ class TransferPlanMsg(Message):
     iterations: int = Field(ge=0)
     min_range_m: float = Field(ge=0.0)
     solve_ms: float = Field(ge=0.0)
+
+    @property
+    def refused(self) -> bool:
+        """The spacecraft found no plan meeting every constraint (``status`` other than
+        ``"solved"``; no nodes when it could not plan at all): it refused the assignment and
+        keeps flying its previous one."""
+        return self.status != "solved"
 
 
 class GuidanceStatus(Message):

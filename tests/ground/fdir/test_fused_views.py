@@ -10,7 +10,7 @@ import pytest
 
 from gnc.infocost import agent_contributions
 from gnc.poi_map import PoiMap
-from ground.fdir.fused_views import FusedViews
+from ground.fdir.fused_views import MAX_THINNING, FusedViews
 from ground.fdir.observer import MAX_JUDGED_LOSS, ObserverState
 from interfaces.contracts.messages import PoiObservations
 
@@ -83,3 +83,25 @@ def test_what_was_lost_on_the_way_is_scaled_up_on_each_view() -> None:
         scaled[0] *= scale
         assert views.contributions(m, np.array([lost, 0.0, 0.0])) == pytest.approx(
             agent_contributions(m.phi, m.w_inv, scaled))
+
+
+def test_a_view_is_thinned_to_the_neighbours_images_its_observer_fused() -> None:
+    """Three observers, each with 10 images every view holds; sc1 says it fused 5 of its
+    neighbours' 20 (a crosslink losing 75% into it): its H_i is Eq. 8 on its own precision
+    plus a quarter of its neighbours'; sc2 and sc3, who fused all 20 (or said nothing), keep
+    the full view; one who fused more than the ground counts is scaled up, at most by
+    MAX_THINNING."""
+    rng = np.random.default_rng(5)
+    m = PoiMap.uniform(40, 3.0, 3)
+    for agent in range(1, 4):
+        m.add(agent, rng.choice(40, 15, replace=False), rng.uniform(0.5, 2.0, 15))
+    views = FusedViews(80.0, np.tile(m.F.sum(axis=0), (3, 1)), np.full((3, 3), 10.0))
+    got = views.contributions(m, np.zeros(3), np.array([5.0, 20.0, np.nan]))
+    full = agent_contributions(m.phi, m.w_inv, m.F)
+    view1 = m.F[0] + 0.25 * (m.F[1] + m.F[2])
+    h1 = float(np.sum(m.phi * m.F[0] / (m.w_inv + view1) ** 2))
+    assert got == pytest.approx([h1, full[1], full[2]])
+    assert got[0] / full[0] - 1.0 > 0.2  # unthinned, its honest report would read as corrupt
+    doubled = m.F[0] + MAX_THINNING * (m.F[1] + m.F[2])
+    assert views.contributions(m, np.zeros(3), np.array([100.0, 20.0, 20.0]))[0] == \
+        pytest.approx(float(np.sum(m.phi * m.F[0] / (m.w_inv + doubled) ** 2)))

@@ -33,6 +33,7 @@ from interfaces.contracts.messages import (
     FdirWindow,
     InfoCostTelemetry,
     PoiObservations,
+    StoreCounter,
 )
 from tests.conftest import small_scenario
 
@@ -44,8 +45,15 @@ def _obs(sc: int, t: float, seq: int) -> PoiObservations:
                            poi=[1, 2], precision=[0.01, 0.02])
 
 
+BURSTY = {"packet_loss": 0.3, "burst": {"mean_length_packets": 50.0}}
+"""A link whose healthy loss can empty a window: 30% in bursts of 50 packets."""
+
+
 def test_silence_is_a_link_fault_once_per_episode() -> None:
-    links = LinkChecks(small_scenario(fdir={"silent_windows": 2}), "ground", LOG)
+    """On a bursty link one silent window is no proof (a healthy one empties a window of 30
+    images with probability 0.3^(30/99) = 0.69): ``silent_windows`` of them are."""
+    links = LinkChecks(small_scenario(comms=BURSTY, fdir={"silent_windows": 2}), "ground", LOG)
+    assert links.images_per_window == 30 and not links.decisive(30, 30)
     obs = ObserverState()
     reports = [links.judge(1, obs, [], True, b)[1] for b in (10.0, 20.0, 30.0)]
     assert [len(r) for r in reports] == [0, 1, 0]
@@ -54,6 +62,54 @@ def test_silence_is_a_link_fault_once_per_episode() -> None:
     assert obs.silent == 0 and not obs.link_declared
     assert [len(links.judge(1, obs, [], True, b)[1]) for b in (50.0, 60.0)] == [0, 1]
     assert links.judge(2, ObserverState(), [], False, 10.0) == (0, [])  # no plan: no silence
+
+
+@pytest.mark.parametrize("loss", [0.0, 0.15])
+def test_one_silent_window_decides_when_a_healthy_link_could_hardly_empty_it(loss: float
+                                                                          ) -> None:
+    """No image of the 30 a window holds at a nominal loss of 0 or 15% (0.15^30 = 2e-25,
+    against the window's share 8e-5): a link fault on the first silent window, once."""
+    links = LinkChecks(small_scenario(comms={"packet_loss": loss},
+                                      fdir={"silent_windows": 3}), "ground", LOG)
+    assert links.decisive(30, 30)
+    obs = ObserverState()
+    reports = [links.judge(1, obs, [], True, b)[1] for b in (30.0, 60.0, 90.0)]
+    assert [len(r) for r in reports] == [1, 0, 0]
+    assert reports[0][0].fault_class == "link" and reports[0][0].window_end_s == 30.0
+
+
+def test_a_window_losing_more_than_its_link_explains_is_lossy() -> None:
+    """At a nominal 5%: 1 of 10 lost is healthy (P = 0.40), 4 of 10 is not (P = 1e-3), and a
+    silent window with a plan is (without one it says nothing)."""
+    links = LinkChecks(small_scenario(comms={"packet_loss": 0.05}), "ground", LOG)
+    obs = ObserverState()
+    flags = []
+    for k, (missing, received) in enumerate([(0, 10), (1, 9), (4, 6), (0, 10)]):
+        first = obs.last_seq + missing + 1
+        images = [_obs(1, 10.0 * k + i, first + i) for i in range(received)]
+        links.judge(1, obs, images, True, 10.0 * (k + 1))
+        flags.append(obs.lossy)
+    assert flags == [False, False, True, False]
+    links.judge(1, obs, [], True, 50.0)
+    assert obs.lossy
+    links.judge(1, obs, [], False, 60.0)
+    assert not obs.lossy
+
+
+def test_a_dump_losing_more_than_its_link_explains_is_a_link_fault() -> None:
+    """The store sends a lost message again, so the loss shows in its accounting only: on a
+    15% link, 15 of 100 transmissions lost is healthy, 90 of 100 a link fault (once per
+    episode, until a dump window within the limit); a window not over, or with nothing
+    dumped (between passes), decides nothing."""
+    links = LinkChecks(small_scenario(comms={"packet_loss": 0.15}), "ground", LOG)
+    obs, dumped, again, out = ObserverState(), 0, 0, []
+    for t, sent, lost in [(0, 0, 0), (30, 100, 15), (45, 100, 90), (60, 100, 90), (90, 100, 90),
+                          (120, 0, 0), (150, 100, 10), (180, 100, 90)]:
+        dumped, again = dumped + sent - lost, again + lost
+        out.append(len(links.dump(1, obs, StoreCounter(dumped=dumped, retransmitted=again),
+                                  float(t))))
+    assert out == [0, 0, 0, 1, 0, 0, 0, 1]
+    assert obs.dump_declared
 
 
 def _lossy_windows(links: LinkChecks, missing: list[int], received: int = 10
@@ -103,9 +159,13 @@ def test_one_window_decides_when_a_healthy_link_could_hardly_lose_as_much() -> N
 
 
 def test_the_window_after_a_silence_counts_its_missing_observations() -> None:
-    """One silent window (not yet a link fault), then 2 received after 18 missing: 90% of 20
-    lost at a nominal 5% decides alone."""
-    links = LinkChecks(small_scenario(comms={"packet_loss": 0.05}), "ground", LOG)
+    """One silent window (not yet a link fault on a link losing 30% in bursts of 3), then 2
+    received after 18 missing: 90% of 20 lost, beyond the link's limit (one window persists)."""
+    links = LinkChecks(small_scenario(comms={"packet_loss": 0.3,
+                                             "burst": {"mean_length_packets": 3.0}},
+                                      fdir={"checks_persistence": 1, "loss_tol": 0.1}),
+                       "ground", LOG)
+    assert links.limit(20) < 0.9
     obs = ObserverState()
     first = [_obs(1, float(i), i + 1) for i in range(10)]
     assert links.judge(1, obs, first, True, 10.0) == (0, [])
@@ -203,7 +263,7 @@ def _integrity_over_two_boundaries(observers: dict[int, ObserverState],
             check.reported(InfoCostTelemetry(
                 sender=f"sc{sc}", t_sim=10.0 * j, spacecraft=sc,
                 h_i=factor * float(truth[sc - 1]), h_local=1.0, prior_term=0.5,
-                pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=0), j)
+                pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=1), j)
         out.append(check.check(j, 10.0 * j, settled, views, observers))
     return out
 
@@ -237,6 +297,16 @@ def test_no_integrity_verdict_when_the_crosslinks_lose_more_than_it_allows() -> 
     assert [u for _, u in out] == [{1: "crosslink_loss", 2: "crosslink_loss"}] * 2
     assert [len(r) for r, _ in _integrity_over_two_boundaries(
         {1: ObserverState(), 2: ObserverState()}, 0.05)] == [0, 1]
+
+
+def test_no_integrity_verdict_while_an_observer_s_latest_window_is_lossy() -> None:
+    """sc2's latest window lost more than its link explains (a packet-loss fault that began
+    in it, say), though its share lost since the start is small: no report is judged."""
+    observers = {1: ObserverState(received=100), 2: ObserverState(received=99, lost=1,
+                                                                 lossy=True)}
+    out = _integrity_over_two_boundaries(observers)
+    assert [r for r, _ in out] == [[], []]
+    assert [u for _, u in out] == [{1: "lost", 2: "lost"}] * 2
 
 
 def test_no_integrity_verdict_while_reports_before_the_boundary_are_still_aboard() -> None:

@@ -100,6 +100,32 @@ def test_with_passes_the_first_phase_is_loaded_before_the_run(contact: str) -> N
         assert len(plan.issued) == 1
 
 
+def test_with_passes_a_phase_held_for_a_pass_departs_after_it() -> None:
+    """Under passes.toml's station (passes 29-498 s, then 5,963-6,367 s): phase a's uplink
+    (440 s) is in contact and keeps its time; phase b's (1,440 s) waits for the pass at
+    5,963 s and departs UPLINK_LEAD_S after it, with its whole transfer time; continuous
+    contact keeps both times."""
+    phases = [{"name": "a", "start_s": 500.0, "transfer_s": 300.0, "rho_x_m": 12.0},
+              {"name": "b", "start_s": 1500.0, "transfer_s": 400.0, "rho_x_m": 14.0}]
+    station = {"name": "mid", "latitude_deg": 48.08, "longitude_deg": 11.28}
+    data = _scenario(phases).model_dump()
+    fused = PoiMap.uniform(400, 1.0, 3)
+    for contact in ("continuous", "passes"):
+        sc = Scenario.model_validate({**data, "orbit": {"raan_deg": 255.0,
+                                                         "arg_latitude_deg": 90.0},
+                                      "ground": {"contact": contact, "stations": [station]}})
+        plan = MissionPlan(sc, MissionConstants.of(sc))
+        plan.update(440.0, fused)
+        plan.update(1440.0, fused)
+        a, b = plan.issued[1:]
+        assert (a.t_depart_s, a.t_arrive_s) == (500.0, 800.0)
+        if contact == "continuous":
+            assert (b.t_depart_s, b.t_arrive_s) == (1500.0, 1900.0)
+        else:
+            assert b.t_depart_s == pytest.approx(5963.0 + UPLINK_LEAD_S, abs=1.0)
+            assert b.t_arrive_s == pytest.approx(b.t_depart_s + 400.0)
+
+
 def test_information_phase_takes_the_greedy_set_matched_to_the_observers() -> None:
     sc = _scenario([{"name": "insp", "start_s": 600.0, "transfer_s": 500.0,
                      "assign": "information"}])
