@@ -12,7 +12,8 @@ so ψ is as consistent as the ground can make it: the observer's H_i holds all o
 Without the thinning a packet-loss fault on an observer's links, which starves its view of
 its neighbours' images, read as a corrupt report (space campaign, faults 0038 and 0098).
 The two then differ only by what the scalings miss, so a relative difference above
-``fdir.integrity_tol`` is an inconsistent report, and ``fdir.checks_persistence`` of them in a row a data-integrity fault.
+``fdir.integrity_tol`` is an inconsistent report, and ``fdir.checks_persistence`` of them in
+a row a data-integrity fault.
 
 The recomputation holds only while the ground has nearly every observation: ψ depends on every
 observer's images, and lost ones are lost in bursts, from particular views, which no uniform

@@ -38,8 +38,8 @@ from gnc.hardware_threshold import window_false_alarm
 from ground.fdir.observer import ObserverState, loss_limit, loss_tail
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, PoiObservations, StoreCounter
-from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.timing import TIME_TOL_S
 
 LOSSY_TAIL = 0.05
 """A window losing as many observations as a healthy link would with at most this probability
