@@ -19,6 +19,10 @@ that does not reach the ground is a link fault, never zero information gain.
   ``LOSSY_TAIL``, or a silent one, marks its observer ``lossy`` (``ObserverState.lossy``):
   the data-integrity check judges no report while one is (its loss is not spread over the
   run, so no rescaling of the ground's map rebuilds what the observers fused).
+* **Silent in a pass** (ground passes): an observer of which nothing came down an FDI period
+  and the FDIR's latency after a pass's acquisition, while others were heard in it (the dump
+  brings the reports the FDIR judges first), has lost its link: declared then, once per
+  episode, instead of at the pass's end, when its silent windows could first be judged.
 * **Dump loss** (ground passes): the store sends a lost message again, so nothing is missing
   by sequence number; the loss shows in the store's accounting (sent again vs dumped) as it
   comes down with the ground's link counters.  Counted over ``rates.fdi_period_s`` of dump,
@@ -118,6 +122,17 @@ class LinkChecks:
                          100.0 * fraction)
         return FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
                            metric=fraction, threshold=limit, window_end_s=b)
+
+    def pass_silence(self, sc: int, obs: ObserverState, t: float) -> list[FaultReport]:
+        """Observer ``sc``, of which nothing came down in the pass in progress by ``t`` (s)
+        while others were heard (the caller's judgement): a link fault, once per episode."""
+        if obs.link_declared:
+            return []
+        obs.link_declared, obs.silent = True, max(obs.silent, 1)
+        self.log.warning("FDIR: nothing of sc%d came down in the pass by %.0f s: link fault",
+                         sc, t)
+        return [FaultReport(sender=self.node, t_sim=t, spacecraft=sc, fault_class="link",
+                            window_end_s=t)]
 
     def dump(self, sc: int, obs: ObserverState, store: StoreCounter, t: float
              ) -> list[FaultReport]:

@@ -236,6 +236,7 @@ class FdirPipeline:
                 o.fresh = False
                 if o.aboard_pass < now:  # not heard of in this pass: not known to be aboard
                     o.aboard_since_s = None
+            out += self._pass_silences(t, now)
         while (t >= self.schedule.end(self.next_window) + self.latency_s - TIME_TOL_S
                and self._data_in(self.next_window, t)):
             k = self.next_window
@@ -302,6 +303,21 @@ class FdirPipeline:
         return [m.model_copy(update={"integrity_unjudged": unjudged[m.spacecraft]})
                 if isinstance(m, FdirWindow) and m.spacecraft in unjudged else m
                 for m in out] + reports
+
+    def _pass_silences(self, t: float, now: int) -> list[FaultReport]:
+        """With ground passes, by ``t`` (s) in pass ``now``: the observers of which nothing
+        came down an FDI period and the FDIR's latency after its acquisition, while others
+        were heard in it (``LinkChecks.pass_silence``)."""
+        assert self.contact is not None
+        if now < 0 or not self.contact.in_contact(t):
+            return []
+        if t < self.contact.windows[now][0] + self.schedule.period_s + self.latency_s:
+            return []
+        heard = {sc for sc, o in self.observers.items() if o.heard_pass == now}
+        if not heard:  # nobody heard: the ground's own link, or nothing to say
+            return []
+        return [r for sc, o in self.observers.items() if sc not in heard
+                for r in self.links.pass_silence(sc, o, t)]
 
     def _lost_aboard(self, sc: int, obs: ObserverState, a: float, b: float
                      ) -> tuple[Unjudged, list[FaultReport]] | None:

@@ -164,6 +164,21 @@ def test_an_assignment_the_observer_refused_is_no_plan_of_the_twins(status: str)
     assert obs.plans[1].transfer is not None and obs.plans[1].holds_from_s == 700.0
 
 
+def test_an_observer_nothing_of_which_comes_down_in_a_pass_has_lost_its_link() -> None:
+    """The pass acquired at 29 s: by 62 s (an FDI period and the FDIR's latency after it)
+    sc1 has been heard and sc2 not: sc2's link fault is declared then, once; with nobody
+    heard, nothing is."""
+    pipeline = _passes_app().pipeline
+    aos = pipeline.contact.windows[0][0]
+    assert aos == pytest.approx(29.0, abs=1.0)
+    quiet = pipeline.due(aos + 33.0)
+    assert not [m for m in quiet if isinstance(m, FaultReport)]  # nobody heard yet
+    pipeline.observations(_obs(1, aos + 1.0, 1, [1]))
+    reports = [[(r.spacecraft, r.fault_class) for r in pipeline.due(t)
+                if isinstance(r, FaultReport)] for t in (aos + 20.0, aos + 34.0, aos + 40.0)]
+    assert reports == [[], [(2, "link")], []]
+
+
 def test_a_window_whose_reports_are_lost_or_aboard_is_not_judged_and_says_why() -> None:
     pipeline = _passes_app().pipeline
     obs = pipeline.observers
