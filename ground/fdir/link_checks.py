@@ -9,7 +9,7 @@ that does not reach the ground is a link fault, never zero information gain.
   with a probability (``observer.loss_tail``) below the window's false-alarm share of
   ``fdir.false_alarms_per_observer_hour`` (a link losing 6 of 7 observations at a nominal
   10%: 6e-6 against 8e-5 for 30 s windows and 0.01 per hour).
-* **Silence**: an observer with a plan that sends no image for ``fdir.silent_windows``
+* **Silence**: an observer with its camera on that sends no image for ``fdir.silent_windows``
   windows in a row (once per episode, and not when its loss was declared already: one link
   fault, declared once).  One silent window decides alone when a healthy link would lose all
   of a window's images (one per ω_mid period) with a probability below the window's share,
@@ -69,15 +69,16 @@ class LinkChecks:
         """the images an observer takes in a window (one per ω_mid period)"""
 
     def judge(self, sc: int, obs: ObserverState, images: list[PoiObservations],
-              planned: bool, b: float) -> tuple[int, list[FaultReport]]:
-        """One observer's window ending at b (s): its received ``images`` and whether a plan
-        is in force.  Returns the observations lost and the link faults declared."""
+              expected: bool, b: float) -> tuple[int, list[FaultReport]]:
+        """One observer's window ending at b (s): its received ``images`` and whether any
+        were ``expected`` (its camera on: it images every ω_mid period, with a plan or
+        without).  Returns the observations lost and the link faults declared."""
         lost, reports = self._loss(sc, obs, images, b)
         obs.lossy = (loss_tail(lost, lost + len(images), self.comms.packet_loss, self.burst)
-                     < LOSSY_TAIL) if images else planned
-        if planned and not images:
+                     < LOSSY_TAIL) if images else expected
+        if expected and not images:
             reports += self._silence(sc, obs, b)
-        elif planned:
+        elif expected:
             obs.silent, obs.link_declared = 0, False
         obs.overflow_declared = False
         return lost, reports

@@ -277,8 +277,9 @@ class FdirPipeline:
             if lost_aboard is not None:  # data lost or still aboard, of known cause
                 out += [*lost_aboard[1], window.model_copy(update={"unjudged": lost_aboard[0]})]
                 continue
-            planned = obs.plan_at(a) is not None and not obs.camera_off_before(b)
-            lost, reports = self.links.judge(sc, obs, mine, planned, b)
+            imaging = not obs.camera_off_before(b)
+            planned = obs.plan_at(a) is not None and imaging
+            lost, reports = self.links.judge(sc, obs, mine, imaging, b)
             out += reports
             window = window.model_copy(update={"lost": lost})
             ctx, images, why = (window_context(sc, obs, mine, a, b, settled, self.n,
