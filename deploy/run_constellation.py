@@ -69,7 +69,7 @@ from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
 from interfaces.contracts.topology import RECORDER, ROUTER, SIM, topology  # noqa: E402
-from interfaces.runtime.arguments import add_log_level, mission_name  # noqa: E402
+from interfaces.runtime.arguments import add_log_level, endpoint, mission_name  # noqa: E402
 from interfaces.runtime.cds import read_starts, write_run_key  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
@@ -105,10 +105,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--hard-deadline", action="store_true",
                    help="with --realtime: keep the wall clock; an answer later than the next "
                         "tick is a missed tick of its node (hardware-in-the-loop style)")
-    p.add_argument("--endpoint", default=DEFAULT_ENDPOINT,
+    p.add_argument("--endpoint", default=DEFAULT_ENDPOINT, type=endpoint,
                    help="Zenoh endpoint of the run's router (default %(default)s; tls/HOST:PORT "
                         "for TLS)")
-    p.add_argument("--advertise", metavar="ENDPOINT",
+    p.add_argument("--advertise", metavar="ENDPOINT", type=endpoint,
                    help="endpoint the clients connect to (default: --endpoint); for nodes on "
                         "other hosts")
     p.add_argument("--external", action="append", default=[], metavar="NODE",
@@ -197,8 +197,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time" if rtf else "")
           + (f", at most {args.realtime:g}x" if rtf and args.realtime else "")
           + (")" if rtf else "")
-          + f"\n  {out}/run.mcap\n  {layout}"
-          f"\n  {out}/summary.json" + ("" if args.no_report else f"\n  {out}/report.md"))
+          + "".join(f"\n  {p}" for p in _written(out, layout, not args.no_report)))
     if error:
         print(f"error: {error}", file=sys.stderr)
     if status == "interrupted":
@@ -293,6 +292,19 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
     return add_recovery_comparison(out, summary, counter, scenario.fdir.recovery)
 
 
+def _written(out: Path, layout: Path, report: bool) -> list[Path]:
+    """The run's files the console names: those that exist (a run that failed before its
+    recorder started has no archive)."""
+    paths = [out / "run.mcap", layout, out / "summary.json"] + ([out / "report.md"] * report)
+    return [p for p in paths if p.exists()]
+
+
+def _in_use(log_tail: str) -> str:
+    """'; another run uses it?' when the router's log says its address is taken."""
+    taken = ("address already in use", "addrinuse", "address in use")
+    return "; is another run using it?" if any(t in log_tail.lower() for t in taken) else ""
+
+
 def _run_zenoh(scenario: Scenario, mission: str, out: Path,
                args: argparse.Namespace) -> tuple[str, str | None]:
     try:
@@ -307,8 +319,9 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
     hub = _join(access, router, timeout_s=30.0)
     if hub is None:
         sup.stop_all()
-        return "failed", (f"the router did not start on {args.endpoint} ({router.describe_exit()}; "
-                          f"is another run using it?):\n{router.log_tail()}")
+        return "failed", (f"the router did not start on {args.endpoint} "
+                          f"({router.describe_exit()}{_in_use(router.log_tail())}):\n"
+                          f"{router.log_tail()}")
     progress = _Progress(scenario)
     live = None
     try:

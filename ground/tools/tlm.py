@@ -18,7 +18,7 @@ import threading
 import time
 from dataclasses import dataclass
 
-from interfaces.runtime.arguments import prog_name
+from interfaces.runtime.arguments import endpoint, prog_name
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
 
 SKIP_FIELDS = {"sender", "seq", "t_sim", "t_wall"}
@@ -83,8 +83,8 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog=prog_name("python -m ground.tools.tlm"), description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--filter", default="insp/**", help="Zenoh key expression (default insp/**)")
-    p.add_argument("--connect", default=DEFAULT_ENDPOINT,
-                   help="Zenoh endpoint of the constellation")
+    p.add_argument("--connect", default=DEFAULT_ENDPOINT, type=endpoint,
+                   help="Zenoh endpoint of the constellation (default %(default)s)")
     p.add_argument("--zenoh-config", help="client configuration with credentials (the run's "
                    "access/tlm.json5)")
     p.add_argument("--stream", action="store_true", help="print every message instead of a table")

@@ -1,6 +1,7 @@
 """Command-line values every tool checks the same way (issue 40): a log level among the
-logging module's, a count of at least one.  Each is an ``argparse`` type, so a bad value is
-refused by the parser with exit 2 and a line naming the option, never a traceback."""
+logging module's, a count of at least one, a Zenoh endpoint's form.  Each is an ``argparse``
+type, so a bad value is refused by the parser with exit 2 and a line naming the option, never
+a traceback."""
 
 from __future__ import annotations
 
@@ -29,6 +30,28 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"{value}: at least 1")
     return value
+
+
+ENDPOINT_PROTOCOLS = ("tcp", "tls", "udp", "quic", "ws", "unixsock-stream")
+"""The link protocols a Zenoh endpoint may name."""
+
+
+def endpoint(text: str) -> str:
+    """A Zenoh endpoint ``<protocol>/<address>``: tcp, tls, udp, quic and ws with
+    ``host:port`` (a port of 1-65535), unixsock-stream with a path; anything after ``?`` or
+    ``#`` (metadata, configuration) is left to Zenoh."""
+    proto, sep, rest = text.partition("/")
+    address = rest.split("?", 1)[0].split("#", 1)[0]
+    if not sep or proto not in ENDPOINT_PROTOCOLS or not address:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a Zenoh endpoint: <protocol>/<address> with a protocol among "
+            f"{', '.join(ENDPOINT_PROTOCOLS)} (e.g. tcp/127.0.0.1:7447)")
+    if proto != "unixsock-stream":
+        host, colon, port = address.rpartition(":")
+        if not colon or not host or not port.isdigit() or not 1 <= int(port) <= 65535:
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: a {proto} endpoint is {proto}/HOST:PORT with a port of 1-65535")
+    return text
 
 
 def mission_name(text: str) -> str:

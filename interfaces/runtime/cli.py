@@ -13,7 +13,7 @@ from pathlib import Path
 from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.contracts.topology import topology
-from interfaces.runtime.arguments import add_log_level, mission_name
+from interfaces.runtime.arguments import add_log_level, endpoint, mission_name
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore
 from interfaces.runtime.executive import Executive, TickClient
@@ -29,7 +29,7 @@ def add_node_args(parser: argparse.ArgumentParser) -> None:
                         help="key-space name (default: the scenario name)")
     parser.add_argument("--seed", type=int, help="override the scenario seed")
     parser.add_argument("--duration", type=float, help="override duration_s (s)")
-    parser.add_argument("--connect", default=DEFAULT_ENDPOINT,
+    parser.add_argument("--connect", default=DEFAULT_ENDPOINT, type=endpoint,
                         help=f"Zenoh endpoint to join (default {DEFAULT_ENDPOINT})")
     parser.add_argument("--zenoh-config", help="Zenoh JSON5 config file (overrides --connect)")
     add_log_level(parser)

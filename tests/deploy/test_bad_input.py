@@ -49,7 +49,7 @@ CASES = [
     ("fault after the end", ["run"], ("camera_degradation", "magnitude = 0.5", 1300.0),
      "not before the end of the run"),
     ("scenario not UTF-8", ["run"], b"name = \"x\"\n\xff\xfe\n", "not UTF-8"),
-    ("endpoint in process", ["run", "--endpoint", "garbage"], None,
+    ("endpoint in process", ["run", "--endpoint", "tcp/127.0.0.1:7500"], None,
      "--endpoint apply only to --transport zenoh"),
     ("restarts in process", ["run", "--restart-on-crash", "--audit-access"], None,
      "--restart-on-crash, --audit-access apply only"),
@@ -111,6 +111,14 @@ def _snapshot(path: Path) -> dict[str, bytes]:
 PARSER_CASES = [
     ("mission with a slash", ["run", "--mission", "a/b"], "--mission: 'a/b': letters"),
     ("log level bogus", ["run", "--log-level", "bogus"], "--log-level: 'bogus': one of DEBUG"),
+    ("endpoint garbage", ["run", "--endpoint", "garbage"],
+     "--endpoint: 'garbage' is not a Zenoh endpoint"),
+    ("endpoint without a port", ["run", "--endpoint", "tcp/localhost"],
+     "tcp endpoint is tcp/HOST:PORT"),
+    ("advertise port out of range", ["run", "--advertise", "tls/example.org:70000"],
+     "port of 1-65535"),
+    ("telemetry endpoint garbage", ["tlm", "--connect", "http://x"],
+     "--connect: 'http://x' is not a Zenoh endpoint"),
     ("workers zero", ["campaign", "--workers", "0"], "--workers: 0: at least 1"),
     ("limit negative", ["campaign", "--limit", "-1"], "--limit: -1: at least 1"),
     ("limit zero", ["campaign", "--limit", "0"], "--limit: 0: at least 1"),
@@ -159,3 +167,17 @@ def test_an_unreachable_cluster_is_named_within_the_stated_time(
     err = capsys.readouterr().err
     assert code == 2 and "no Dask scheduler answered within 1 s" in err, err
     assert "Traceback" not in err
+
+
+def test_a_router_that_did_not_start_is_named_for_what_its_log_says(tmp_path: Path) -> None:
+    """The guess 'another run?' only when the router's log says its address is taken, and the
+    console names only the run's files that exist (no archive when the router never came)."""
+    from deploy.run_constellation import _in_use, _written
+
+    taken = "Unable to open listener tcp/127.0.0.1:1: Address already in use (os error 98)"
+    assert "another run" in _in_use(taken)
+    assert _in_use("JSON error: Endpoints must be of the form <protocol>/<address>") == ""
+    (tmp_path / "summary.json").write_text("{}")
+    layout = tmp_path / "run.foxglove.json"
+    layout.write_text("{}")
+    assert _written(tmp_path, layout, report=True) == [layout, tmp_path / "summary.json"]
