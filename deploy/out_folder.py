@@ -54,3 +54,11 @@ def prepare(out: Path | None, default: Path, overwrite: bool,
     except OSError as e:
         raise OutFolderError(f"--out {out}: cannot make the folder: {e.strerror or e}") from None
     return out
+
+
+def written(out: Path, layout: Path, report: bool) -> list[Path]:
+    """The run's files in ``out`` the console names at the end (the archive, the Foxglove
+    ``layout``, the summary and, with ``report``, the report): those that exist (a run that
+    failed before its recorder started has no archive)."""
+    paths = [out / "run.mcap", layout, out / "summary.json"] + ([out / "report.md"] * report)
+    return [p for p in paths if p.exists()]

@@ -44,6 +44,16 @@ _LOGIN = re.compile(r"UsrPwd extension.*(?P<why>Invalid password|Invalid user|"
 log = logging.getLogger("insp.router")
 
 
+
+ADDRESS_TAKEN = ("address already in use", "addrinuse", "address in use")
+"""What the router's log says when its endpoint's address is another process's."""
+
+
+def address_taken(log: str) -> bool:
+    """Whether the router's ``log`` says its endpoint's address is taken (another run on it,
+    say), rather than another failure (a malformed endpoint, a bad configuration)."""
+    return any(t in log.lower() for t in ADDRESS_TAKEN)
+
 class Audit:
     """Counts of the router's refusals, by kind (``<flow> <what> by <user>`` or
     ``login: <why>``), written to ``path``."""

@@ -52,9 +52,10 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
 
 from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
 from deploy.interrupts import Interrupts, raise_keyboard_interrupt  # noqa: E402
-from deploy.out_folder import OutFolderError  # noqa: E402
+from deploy.out_folder import OutFolderError, written  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor  # noqa: E402
+from deploy.router import address_taken  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
 from ground.archive.segments import remove_segments, run_archive  # noqa: E402
@@ -197,7 +198,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time" if rtf else "")
           + (f", at most {args.realtime:g}x" if rtf and args.realtime else "")
           + (")" if rtf else "")
-          + "".join(f"\n  {p}" for p in _written(out, layout, not args.no_report)))
+          + "".join(f"\n  {p}" for p in written(out, layout, not args.no_report)))
     if error:
         print(f"error: {error}", file=sys.stderr)
     if status == "interrupted":
@@ -292,19 +293,6 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
     return add_recovery_comparison(out, summary, counter, scenario.fdir.recovery)
 
 
-def _written(out: Path, layout: Path, report: bool) -> list[Path]:
-    """The run's files the console names: those that exist (a run that failed before its
-    recorder started has no archive)."""
-    paths = [out / "run.mcap", layout, out / "summary.json"] + ([out / "report.md"] * report)
-    return [p for p in paths if p.exists()]
-
-
-def _in_use(log_tail: str) -> str:
-    """'; another run uses it?' when the router's log says its address is taken."""
-    taken = ("address already in use", "addrinuse", "address in use")
-    return "; is another run using it?" if any(t in log_tail.lower() for t in taken) else ""
-
-
 def _run_zenoh(scenario: Scenario, mission: str, out: Path,
                args: argparse.Namespace) -> tuple[str, str | None]:
     try:
@@ -319,8 +307,9 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
     hub = _join(access, router, timeout_s=30.0)
     if hub is None:
         sup.stop_all()
+        clash = "; is another run using it?" if address_taken(router.log_tail()) else ""
         return "failed", (f"the router did not start on {args.endpoint} "
-                          f"({router.describe_exit()}{_in_use(router.log_tail())}):\n"
+                          f"({router.describe_exit()}{clash}):\n"
                           f"{router.log_tail()}")
     progress = _Progress(scenario)
     live = None

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from deploy.cli import main
-from deploy.out_folder import OutFolderError, prepare
+from deploy.out_folder import OutFolderError, prepare, written
+from deploy.router import address_taken
 
 REPO = Path(__file__).resolve().parents[2]
 NOMINAL = REPO / "deploy" / "scenarios" / "nominal.toml"
@@ -172,12 +173,10 @@ def test_an_unreachable_cluster_is_named_within_the_stated_time(
 def test_a_router_that_did_not_start_is_named_for_what_its_log_says(tmp_path: Path) -> None:
     """The guess 'another run?' only when the router's log says its address is taken, and the
     console names only the run's files that exist (no archive when the router never came)."""
-    from deploy.run_constellation import _in_use, _written
-
-    taken = "Unable to open listener tcp/127.0.0.1:1: Address already in use (os error 98)"
-    assert "another run" in _in_use(taken)
-    assert _in_use("JSON error: Endpoints must be of the form <protocol>/<address>") == ""
+    assert address_taken("Unable to open listener tcp/127.0.0.1:1: Address already in use "
+                         "(os error 98)")
+    assert not address_taken("JSON error: Endpoints must be of the form <protocol>/<address>")
     (tmp_path / "summary.json").write_text("{}")
     layout = tmp_path / "run.foxglove.json"
     layout.write_text("{}")
-    assert _written(tmp_path, layout, report=True) == [layout, tmp_path / "summary.json"]
+    assert written(tmp_path, layout, report=True) == [layout, tmp_path / "summary.json"]

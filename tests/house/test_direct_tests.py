@@ -80,9 +80,6 @@ INDIRECT: dict[str, str] = {
     "deploy.processes": (
         "the launcher's supervision of OS processes: tests/missions/test_constellation.py "
         "(dead, stalled and restarted processes, a terminated launcher)"),
-    "deploy.router": (
-        "the run's Zenoh router as a process of its own: the launcher starts it in "
-        "tests/missions/test_access_run.py, which reads its count of refused messages"),
 }
 """Module -> why no test imports it directly (and which test exercises it)."""
 

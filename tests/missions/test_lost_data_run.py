@@ -1,8 +1,9 @@
 """Lost data is not corrupt data, and neighbours judge the plan a neighbour flies (issue 39),
 flown: the case a new user found, shortened.  Three observers under two stations' passes
 (107-537 s and 3,163-3,624 s: a 2,626 s gap), the neighbours' FDIR on, a store too small for
-the gap, and an inspection phase uplinked at 1,000 s, out of contact: it waits for the pass,
-so the observers start their transfers at 3,163 s, not at 1,000 s.  Observer 2's camera
+the gap, and an inspection phase uplinked at 1,000 s, out of contact: it waits for the pass
+at 3,163 s, and the observers start their transfers a minute after it (the planner departs a
+held uplink UPLINK_LEAD_S after its pass's acquisition), not at 1,000 s.  Observer 2's camera
 degrades at 3,700 s, after the second pass.
 
 Before (main 24321f4, the same set-up at full size): the ground declared data integrity on
