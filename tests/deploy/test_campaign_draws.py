@@ -19,10 +19,11 @@ import pytest
 from deploy.campaign import CampaignError, RunSpec, fingerprint, finished, load_campaign
 from deploy.campaign_file import FaultSpec
 from deploy.draws import Choice, Record, Uniform, draw_tree, parse_tree, rng_for
-from deploy.onsets import heard_by_s, phase_spans
+from deploy.onsets import WINDOWS_AFTER, heard_by_s, phase_spans
 from deploy.run_campaign import main as run_campaign
 from harness.campaign.dimensions import Binning, campaign_domains
 from harness.campaign.rescore import CampaignRun
+from gnc.passes import scenario_pass_table
 from harness.summary import RunSummary
 from interfaces.contracts.scenario import load_scenario
 from tests.deploy.test_campaign import BASE
@@ -262,6 +263,12 @@ def test_a_passes_run_lasts_until_the_ground_hears_its_fault() -> None:
     assert heard_by_s(continuous, [600.0], 6000.0) == 1200.0
 
 
+def a_period(runs: list[RunSpec]) -> float:
+    """The FDI period the runs share, s."""
+    (period,) = {r.scenario.rates.fdi_period_s for r in runs}
+    return period
+
+
 def test_a_campaign_lengthens_its_passes_runs(tmp_path: Path) -> None:
     """``extend_to_pass_s``: a fault run is lengthened as heard_by_s says, recorded as
     ``run.lengthened_s``; nominal runs and runs that need nothing keep their length."""
@@ -269,9 +276,15 @@ def test_a_campaign_lengthens_its_passes_runs(tmp_path: Path) -> None:
                                                    "duration_s = 200.0\nextend_to_pass_s = 9000.0")
     _, plain = load_campaign(_drawn_campaign(tmp_path))
     _, runs = load_campaign(_write(tmp_path, text))
+    margin = WINDOWS_AFTER * a_period(plain)
     for a, b in zip(plain, runs, strict=True):
         need = heard_by_s(a.scenario, [f.start_s for f in a.scenario.faults], 9000.0)
         assert b.scenario.duration_s == pytest.approx(need)
+        if need > 200.0:  # on the lengthened run's own pass table: it ends just after the
+            # loss of signal of the first pass lasting past the onset, with the dump's margin
+            onset = b.scenario.faults[0].start_s
+            los = [w.los_s for w in scenario_pass_table(b.scenario) if w.los_s > onset + margin]
+            assert los and los[0] + margin == pytest.approx(b.scenario.duration_s, abs=1.0)
         assert b.drawn.get("run.lengthened_s") == (None if need == 200.0
                                                    else pytest.approx(need - 200.0, abs=1e-3))
         assert b.scenario.faults == a.scenario.faults
