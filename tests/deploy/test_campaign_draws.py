@@ -21,9 +21,9 @@ from deploy.campaign_file import FaultSpec
 from deploy.draws import Choice, Record, Uniform, draw_tree, parse_tree, rng_for
 from deploy.onsets import WINDOWS_AFTER, heard_by_s, phase_spans
 from deploy.run_campaign import main as run_campaign
+from gnc.passes import scenario_pass_table
 from harness.campaign.dimensions import Binning, campaign_domains
 from harness.campaign.rescore import CampaignRun
-from gnc.passes import scenario_pass_table
 from harness.summary import RunSummary
 from interfaces.contracts.scenario import load_scenario
 from tests.deploy.test_campaign import BASE
