@@ -123,9 +123,9 @@ def _judgeable_s(fault: FaultScore, end_s: float | None,
     """When a fault could first be judged, s (None: never in the run).
 
     * A link fault: once the ground hears the constellation after the onset (at once, or at
-      the next pass's acquisition: a link is judged on what arrives, not in windows), if the
-      run lasts until that contact's end and a window more (a silence is known only when the
-      pass is over).
+      the next pass's acquisition: a link is judged on what arrives, not in windows: a
+      silence an FDI period after it, a dump's loss as it comes down), if the run lasts until
+      that contact's end and a window more (the pass's dump judged).
     * A data-integrity fault in a run whose integrity check never judged (``integrity_blind``:
       the crosslinks lose more than ``fdir.integrity_max_loss``): never.
     * Any other: the start of the first judged window of its observer (of any observer for a
