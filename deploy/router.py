@@ -44,15 +44,15 @@ _LOGIN = re.compile(r"UsrPwd extension.*(?P<why>Invalid password|Invalid user|"
 log = logging.getLogger("insp.router")
 
 
-
 ADDRESS_TAKEN = ("address already in use", "addrinuse", "address in use")
 """What the router's log says when its endpoint's address is another process's."""
 
 
-def address_taken(log: str) -> bool:
-    """Whether the router's ``log`` says its endpoint's address is taken (another run on it,
-    say), rather than another failure (a malformed endpoint, a bad configuration)."""
-    return any(t in log.lower() for t in ADDRESS_TAKEN)
+def address_taken(log_text: str) -> bool:
+    """Whether the router's log (``log_text``) says its endpoint's address is taken (another
+    run on it, say), rather than another failure (a malformed endpoint, a bad configuration)."""
+    return any(t in log_text.lower() for t in ADDRESS_TAKEN)
+
 
 class Audit:
     """Counts of the router's refusals, by kind (``<flow> <what> by <user>`` or

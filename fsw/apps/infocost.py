@@ -32,7 +32,8 @@ class InfoCostApp(App):
               Input(cat.NEIGHBOUR_DECLARATION, "on_declaration"),
               Input(cat.NEIGHBOUR_RULING, "on_ruling"))
     OUTPUTS = (Output("telemetry", cat.INFO_COST),)
-    CRITICAL = ("map", "last_boundary", "images", "shared", "rejected", "exclusions")
+    CRITICAL = ("map", "last_boundary", "images", "shared", "shared_by", "rejected",
+                "exclusions")
     REBUILT = ("report_factor",)  # the software-fault hook, set at start (fsw/spacecraft.py)
 
     def __init__(self, ctx: AppContext) -> None:
@@ -45,6 +46,8 @@ class InfoCostApp(App):
         """the FDI window boundary last reported (``interfaces.contracts.fdi_schedule``)"""
         self.images = 0
         self.shared = 0
+        self.shared_by: dict[int, int] = {}
+        """the neighbours' images fused, by spacecraft id"""
         self.rejected = 0
         """observations dropped for naming a spacecraft outside the constellation"""
         self.exclusions = Exclusions()
@@ -65,7 +68,7 @@ class InfoCostApp(App):
         if msg.spacecraft == self.sc_id:
             self.images += 1
         else:
-            self.shared += 1
+            self._shared(msg.spacecraft)
 
     def on_declaration(self, msg: NeighbourDeclaration) -> None:
         self.exclusions.declared(msg, self.sc_id)
@@ -73,7 +76,7 @@ class InfoCostApp(App):
     def on_ruling(self, msg: NeighbourRuling) -> None:
         for m in self.exclusions.ruled(msg):
             self.map.add(m.spacecraft, *m.arrays())
-            self.shared += 1
+            self._shared(m.spacecraft)
 
     def step(self, t: float) -> None:
         j = self.schedule.boundary_at(t)
@@ -87,4 +90,10 @@ class InfoCostApp(App):
             h_local=self.map.cost(), prior_term=self.map.prior_term(),
             contributions={str(j + 1): float(h) for j, h in enumerate(h_j)},
             pois_seen_own=self.map.seen(self.sc_id), pois_seen_fused=self.map.seen(),
-            images=self.images, shared_received=self.shared))
+            images=self.images, shared_received=self.shared,
+            shared_by={str(k): n for k, n in sorted(self.shared_by.items())}))
+
+    def _shared(self, source: int) -> None:
+        """Count a neighbour's image fused."""
+        self.shared += 1
+        self.shared_by[source] = self.shared_by.get(source, 0) + 1

@@ -6,10 +6,11 @@ Rate group mid. Inputs, each handed to the pipeline: every observer's POI observ
 images that reached the ground), its transfer plans, its nav, attitude, guidance and H_i
 telemetry, its onboard FDIR's events (a camera turned off onboard is expected to send no image),
 the ground's own PRO assignments, its own link counters (with ground passes, what each
-observer's onboard store lost to overflow), and the faults the observers' neighbours declared
-aboard, which it rules on (``NeighbourRuling`` on ``ground/fdir/ruling``). Outputs: one
-``FdirWindow`` per observer and FDI window on ``ground/fdir/window``, one
-``ConstellationWindow`` per FDI window on ``ground/fdir/constellation``, and a ``FaultReport``
+observer's onboard store lost to overflow, and sent again after a loss), and the faults the
+observers' neighbours declared aboard, which it rules on (``NeighbourRuling`` on
+``ground/fdir/ruling``). Outputs: one ``FdirWindow`` per observer and FDI window on
+``ground/fdir/window``, one ``ConstellationWindow`` per FDI window on
+``ground/fdir/constellation``, and a ``FaultReport``
 on ``ground/fdir/report`` for each fault declared or identified. Each window is judged
 ``fdir.latency_s`` after it closes."""
 

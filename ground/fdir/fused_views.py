@@ -23,16 +23,23 @@ from interfaces.contracts.messages import PoiObservations
 
 @dataclass
 class FusedViews:
-    """The precision each observer has fused per POI (N, M), its own and its neighbours', and
-    how many of each observer's images each fused (N receivers, N observers)."""
+    """The precision each observer has fused per POI from each observer's images, its own and
+    its neighbours' (``by_source``: N receivers, N sources, M POIs), and how many of each
+    observer's images each fused (N receivers, N observers)."""
 
     range_m: float
-    fused: np.ndarray
+    by_source: np.ndarray
     images: np.ndarray
 
     @classmethod
     def of(cls, observers: int, pois: int, range_m: float) -> FusedViews:
-        return cls(range_m, np.zeros((observers, pois)), np.zeros((observers, observers)))
+        return cls(range_m, np.zeros((observers, observers, pois)),
+                   np.zeros((observers, observers)))
+
+    @property
+    def fused(self) -> np.ndarray:
+        """The precision each observer has fused per POI (N, M), from every source."""
+        return self.by_source.sum(axis=1)
 
     def add(self, images: list[PoiObservations], observers: dict[int, ObserverState]) -> None:
         """``images`` join their observers' views, and the view of every observer that was in
@@ -41,7 +48,7 @@ class FusedViews:
         if not images:
             return
         times = np.array([m.image_t_s for m in images])
-        pos = np.full((len(self.fused), len(images), 3), np.nan)
+        pos = np.full((len(self.images), len(images), 3), np.nan)
         for sc, obs in observers.items():
             values = obs.nav.at_each(times)
             if values is not None:
@@ -52,7 +59,7 @@ class FusedViews:
         reach[own, k] = True
         for m, rows in zip(images, reach.T, strict=True):
             idx, prec = m.arrays()
-            self.fused[np.ix_(np.flatnonzero(rows), idx)] += prec
+            self.by_source[np.flatnonzero(rows)[:, None], m.spacecraft - 1, idx[None, :]] += prec
             self.images[rows, m.spacecraft - 1] += 1
 
     def contributions(self, settled: PoiMap, lost: np.ndarray,
@@ -60,37 +67,39 @@ class FusedViews:
         """Each observer's H_i (N,) on its own view: ψ from what it fused, every observer's
         precision scaled up by the share of its observations lost on the way to the ground
         (``lost``, capped at ``MAX_JUDGED_LOSS``: such an observer is not judged), in each
-        view by the share of its images that view holds.  With ``shared`` (N,), the
-        neighbours' images each observer says it fused (``InfoCostTelemetry.shared_received``;
-        NaN: not known), the neighbours' part of its view is thinned to that count
-        (:func:`thinned`): what the crosslinks lost into it."""
+        view by the share of its images that view holds.  With ``shared`` (N, N), the count
+        of each neighbour's images each observer says it fused (``InfoCostTelemetry.
+        shared_by``; NaN: not known), each neighbour's part of each view is scaled to that
+        count (:func:`fused_shares`): what the crosslinks lost into it, neighbour by
+        neighbour."""
         extra = 1.0 / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS)) - 1.0
-        held = np.divide(self.images, np.diag(self.images)[None, :],
-                         out=np.zeros_like(self.images), where=np.diag(self.images) > 0)
-        view = self.fused + (held * extra[None, :]) @ settled.F
-        if shared is not None:
-            view = thinned(view, settled.F * (1.0 + extra)[:, None],
-                           self.images * (1.0 + extra)[None, :], shared)
+        diag = np.diag(self.images)
+        held = np.divide(self.images, diag[None, :], out=np.zeros_like(self.images),
+                         where=diag > 0)
+        parts = self.by_source + (held * extra[None, :])[:, :, None] * settled.F[None, :, :]
+        counted = self.images * (1.0 + extra)[None, :]
+        share = np.ones_like(counted) if shared is None else fused_shares(counted, shared)
+        view = np.einsum("ij,ijm->im", share, parts)
         psi = 1.0 / (settled.w_inv[None, :] + view) ** 2
         own = settled.F * (1.0 + extra)[:, None]
         return np.einsum("im,im->i", own, psi * settled.phi[None, :])
 
 
-MAX_THINNING = 2.0
-"""The largest factor :func:`thinned` applies (an observer that fused more of its neighbours'
-images than the ground counts in range: the range's edge, by the nav positions)."""
+MAX_SHARE = 2.0
+"""The largest factor :func:`fused_shares` gives (an observer that fused more of a
+neighbour's images than the ground counts in range: the range's edge, by the nav positions)."""
 
 
-def thinned(view: np.ndarray, own: np.ndarray, counted: np.ndarray,
-            shared: np.ndarray) -> np.ndarray:
-    """Each observer's view (N, M) with its neighbours' part scaled by the share of their
-    images it says it fused: ``shared[i]`` (NaN: unknown, unscaled) over the ground's count
-    of their images in its range (``counted[i, j]``, j ≠ i, lost ones included); ``own``
-    (N, M) is each observer's own part of its view.  The crosslinks lose images uniformly
-    over time and POIs, so the scaling rebuilds the view the observer fused (at 15% loss,
-    an observer lacks 15% of every neighbour's precision)."""
-    expected = counted.sum(axis=1) - np.diag(counted)
-    known = np.isfinite(shared) & (expected > 0)
-    ratio = np.ones(len(view))
-    ratio[known] = np.clip(shared[known] / expected[known], 0.0, MAX_THINNING)
-    return own + ratio[:, None] * (view - own)
+def fused_shares(counted: np.ndarray, shared: np.ndarray) -> np.ndarray:
+    """The factor (N, N) on each source's part of each observer's view: ``shared[i, j]``, the
+    images of observer j that observer i says it fused (NaN: unknown), over the ground's count
+    of them in i's range, lost ones included (``counted[i, j]``), within [0, MAX_SHARE]; 1 on
+    the diagonal (its own images), where unknown, and where the ground counts none.  The
+    crosslinks lose a neighbour's images evenly over time and POIs, so the factor rebuilds
+    the view the observer fused (a packet-loss fault on one observer starves every other's
+    view of its images alone)."""
+    out = np.ones_like(counted, dtype=float)
+    known = np.isfinite(shared) & (counted > 0)
+    np.fill_diagonal(known, False)
+    out[known] = np.clip(shared[known] / counted[known], 0.0, MAX_SHARE)
+    return out

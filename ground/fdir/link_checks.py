@@ -25,11 +25,12 @@ that does not reach the ground is a link fault, never zero information gain.
   episode, instead of at the pass's end, when its silent windows could first be judged.
 * **Dump loss** (ground passes): the store sends a lost message again, so nothing is missing
   by sequence number; the loss shows in the store's accounting (sent again vs dumped) as it
-  comes down with the ground's link counters.  Counted over ``rates.fdi_period_s`` of dump,
-  a loss beyond the link's limit that a healthy link would reach with a probability below the
-  window's share (``decisive``) is a link fault, declared once per episode (a dump window
-  within the limit ends it).  Without it a packet-loss fault that began between passes was
-  invisible to the ground (space campaign, fault-0028: 86% on a 15% link, every image in).
+  comes down with the ground's link counters.  Counted over ``rates.fdi_period_s`` of sim
+  time at a time (the part of it a pass covers), a loss beyond the link's limit that a
+  healthy link would reach with a probability below the window's share (``decisive``) is a
+  link fault, declared once per episode (a dump window within the limit ends it).  Without
+  it a packet-loss fault that began between passes was invisible to the ground (space
+  campaign, fault-0028: 86% on a 15% link, every image in).
 * **Store overflow** (ground passes): a window whose reports the observer's onboard store
   lost is a link fault of known cause (once per episode), never judged for information.
 """
@@ -51,8 +52,10 @@ is lossy (one healthy window in twenty at most)."""
 
 
 class LinkChecks:
-    """Loss and silence of every observer, window by window; ``judge`` returns the link
-    faults it declares."""
+    """Loss and silence of every observer, window by window (``judge``), and with ground
+    passes its silence in a pass (``pass_silence``), its dump's loss (``dump``) and its
+    store's overflow (``overflow``): each returns the link faults it declares, one per
+    episode across them (module docstring)."""
 
     def __init__(self, scenario: Scenario, node: str, log: logging.Logger) -> None:
         self.cfg = scenario.fdir
@@ -127,7 +130,7 @@ class LinkChecks:
     def pass_silence(self, sc: int, obs: ObserverState, t: float) -> list[FaultReport]:
         """Observer ``sc``, of which nothing came down in the pass in progress by ``t`` (s)
         while others were heard (the caller's judgement): a link fault, once per episode."""
-        if obs.link_declared:
+        if obs.link_declared or obs.dump_declared:
             return []
         obs.link_declared, obs.silent = True, max(obs.silent, 1)
         self.log.warning("FDIR: nothing of sc%d came down in the pass by %.0f s: link fault",
@@ -137,9 +140,10 @@ class LinkChecks:
 
     def dump(self, sc: int, obs: ObserverState, store: StoreCounter, t: float
              ) -> list[FaultReport]:
-        """Observer ``sc``'s ``store`` accounting as it came down at ``t`` (s): once a dump
-        window of ``rates.fdi_period_s`` is over, the share of its transmissions lost (sent
-        again) against the link's limit; returns the link fault declared (module docstring)."""
+        """Observer ``sc``'s ``store`` accounting as it came down at ``t`` (s): once
+        ``rates.fdi_period_s`` has passed since the last look, the share of its transmissions
+        lost (sent again) against the link's limit; returns the link fault declared (module
+        docstring)."""
         start = obs.dump_start
         if start is None or store.dumped < start[1]:
             obs.dump_start = (t, store.dumped, store.retransmitted)
@@ -155,7 +159,7 @@ class LinkChecks:
         if fraction <= limit:
             obs.dump_declared = False
             return []
-        if obs.dump_declared or not self.decisive(lost, sent):
+        if obs.dump_declared or obs.link_declared or not self.decisive(lost, sent):
             return []
         obs.dump_declared = True
         self.log.warning("FDIR: sc%d's dump lost %.0f%% of %d transmissions: link fault", sc,
@@ -181,8 +185,8 @@ class LinkChecks:
         if self.loss.declared(sc):  # the loss that went silent is the link fault declared
             obs.link_declared = True
         n = self.images_per_window
-        if obs.link_declared or (obs.silent < self.cfg.silent_windows
-                                 and not self.decisive(n, n)):
+        if obs.link_declared or obs.dump_declared or (obs.silent < self.cfg.silent_windows
+                                                      and not self.decisive(n, n)):
             return []
         obs.link_declared = True
         self.log.warning("FDIR: sc%d silent for %d windows: link fault", sc, obs.silent)

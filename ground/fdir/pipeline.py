@@ -2,7 +2,9 @@
 FDIR knows of each observer, fed message by message, and every FDI window judged through its
 stages, in this order:
 
-1. **link checks** (``link_checks.py``): observations missing by sequence number, silence;
+1. **link checks** (``link_checks.py``): observations missing by sequence number, silence
+   (and, with ground passes, out of the windows: silence in a pass, a dump's loss, as the
+   pass and the store's accounting come);
 2. **information test** (``information.py``) on the window's context (``window.py``: a, b,
    ψ, φ, h_prev, the judged images and their poses), with the identification evidence;
 3. **global check** (``global_check.py``, Eq. 6) over the observers the test judged;
@@ -326,6 +328,7 @@ class FdirPipeline:
         ground passes: its store lost its reports (a link fault of known cause, once per
         episode) or still holds some (docs/fdir.md, "Lost is not corrupt"); None: neither."""
         if obs.overflowed(a, b):
+            obs.lossy = True  # the window's data lost: no view rebuilt on it
             return "store_overflow", self.links.overflow(sc, obs, b)
         if obs.aboard_before(b):  # what came down is counted afresh once it is all in
             obs.resync = True

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from typing import ClassVar, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, NonNegativeInt, model_validator
 
 from interfaces.contracts.messages.base import (
     MAX_SPEED_MPS,
@@ -178,6 +178,10 @@ class InfoCostTelemetry(Message):
     pois_seen_fused: int = Field(ge=0)
     images: int = Field(ge=0)
     shared_received: int = Field(ge=0)
+    shared_by: dict[str, NonNegativeInt] = Field(
+        default_factory=dict, max_length=256,
+        description="the neighbours' images fused here, by spacecraft id (the ground rebuilds "
+                    "this observer's view from them: docs/fdir.md, \"Link and data faults\")")
 
 
 class PointingTarget(Message):

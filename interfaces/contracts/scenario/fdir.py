@@ -28,7 +28,9 @@ class FdirSettings(Section):
     (or, with ``persistence_window`` = n, on the window that brings the failures among the last
     n decided windows to ``persistence``); the constellation's ratio (the global check, Eq. 6)
     declares a fault no single observer explains; an observer whose observations stay missing
-    for ``silent_windows`` windows is reported as a link fault.
+    for ``silent_windows`` windows (one, when a healthy link could hardly empty a window) is
+    reported as a link fault, as, with ground passes, one of which nothing came down early in
+    a pass, or whose dump loses more than the link explains (ground/fdir/link_checks.py).
     A reported H_i off the ground's recomputation from the observer's own observations by more
     than ``integrity_tol`` (relative) for ``checks_persistence`` windows is a data-integrity
     fault (judged while the ground holds all but ``integrity_max_loss`` of every observer's
@@ -79,7 +81,10 @@ class FdirSettings(Section):
     checks_persistence: int = Field(
         default=2, ge=1, description="failed windows in a row that declare a data-integrity or "
                                      "packet-loss link fault")
-    silent_windows: int = Field(default=2, ge=1)
+    silent_windows: int = Field(
+        default=2, ge=1, description="silent windows in a row that declare a link fault when "
+                                     "one alone does not (a link whose healthy bursts can "
+                                     "empty a window)")
     latency_s: float = Field(default=3.0, ge=0.0)
     settle_s: float = Field(default=30.0, ge=0.0,
                             description="images this soon after a slew are not judged")

@@ -10,7 +10,7 @@ import pytest
 
 from gnc.infocost import agent_contributions
 from gnc.poi_map import PoiMap
-from ground.fdir.fused_views import MAX_THINNING, FusedViews
+from ground.fdir.fused_views import MAX_SHARE, FusedViews
 from ground.fdir.observer import MAX_JUDGED_LOSS, ObserverState
 from interfaces.contracts.messages import PoiObservations
 
@@ -46,10 +46,11 @@ def test_h_i_on_a_view_of_everything_is_the_grounds_and_less_fused_raises_it() -
     m = PoiMap.uniform(30, 2.0, 2)
     for agent in (1, 2):
         m.add(agent, np.arange(30), rng.uniform(0.2, 1.0, 30))
-    everything = FusedViews(80.0, np.tile(m.F.sum(axis=0), (2, 1)), np.ones((2, 2)))
+    everything = FusedViews(80.0, np.tile(m.F[None], (2, 1, 1)), np.ones((2, 2)))
     ground = agent_contributions(m.phi, m.w_inv, m.F)
     assert everything.contributions(m, np.zeros(2)) == pytest.approx(ground)
-    alone = FusedViews(80.0, m.F.copy(), np.eye(2))  # each fused only its own: ψ larger
+    # each fused only its own: ψ larger
+    alone = FusedViews(80.0, np.einsum("ij,jm->ijm", np.eye(2), m.F), np.eye(2))
     own = alone.contributions(m, np.zeros(2))
     assert np.all(own > ground)
     expected = [float(np.sum(m.phi * m.F[i] / (m.w_inv + m.F[i]) ** 2)) for i in range(2)]
@@ -75,7 +76,7 @@ def test_what_was_lost_on_the_way_is_scaled_up_on_each_view() -> None:
     m = PoiMap.uniform(50, 4.0, 3)
     for agent in range(1, 4):
         m.add(agent, rng.choice(50, 20, replace=False), rng.uniform(0.5, 2.0, 20))
-    views = FusedViews(80.0, np.tile(m.F.sum(axis=0), (3, 1)), np.ones((3, 3)))
+    views = FusedViews(80.0, np.tile(m.F[None], (3, 1, 1)), np.ones((3, 3)))
     assert views.contributions(m, np.zeros(3)) == pytest.approx(
         agent_contributions(m.phi, m.w_inv, m.F))
     for lost, scale in ((0.5, 2.0), (0.99, 1.0 / (1.0 - MAX_JUDGED_LOSS))):
@@ -85,23 +86,37 @@ def test_what_was_lost_on_the_way_is_scaled_up_on_each_view() -> None:
             agent_contributions(m.phi, m.w_inv, scaled))
 
 
-def test_a_view_is_thinned_to_the_neighbours_images_its_observer_fused() -> None:
-    """Three observers, each with 10 images every view holds; sc1 says it fused 5 of its
-    neighbours' 20 (a crosslink losing 75% into it): its H_i is Eq. 8 on its own precision
-    plus a quarter of its neighbours'; sc2 and sc3, who fused all 20 (or said nothing), keep
-    the full view; one who fused more than the ground counts is scaled up, at most by
-    MAX_THINNING."""
+def test_each_neighbours_part_of_a_view_is_scaled_to_the_images_its_observer_fused() -> None:
+    """Three observers, each with 10 images every view holds.  sc1 says it fused 5 of sc2's
+    and all 10 of sc3's (a crosslink from sc2 losing half): its H_i is Eq. 8 on its own
+    precision, half of sc2's and all of sc3's; sc2 fused everything; sc3 said nothing (no
+    scaling).  One who fused more than the ground counts is scaled up, at most MAX_SHARE."""
     rng = np.random.default_rng(5)
     m = PoiMap.uniform(40, 3.0, 3)
     for agent in range(1, 4):
         m.add(agent, rng.choice(40, 15, replace=False), rng.uniform(0.5, 2.0, 15))
-    views = FusedViews(80.0, np.tile(m.F.sum(axis=0), (3, 1)), np.full((3, 3), 10.0))
-    got = views.contributions(m, np.zeros(3), np.array([5.0, 20.0, np.nan]))
+    views = FusedViews(80.0, np.tile(m.F[None], (3, 1, 1)), np.full((3, 3), 10.0))
+    nan = np.nan
+    shared = np.array([[nan, 5.0, 10.0], [10.0, nan, 10.0], [nan, nan, nan]])
+    got = views.contributions(m, np.zeros(3), shared)
     full = agent_contributions(m.phi, m.w_inv, m.F)
-    view1 = m.F[0] + 0.25 * (m.F[1] + m.F[2])
+    view1 = m.F[0] + 0.5 * m.F[1] + m.F[2]
     h1 = float(np.sum(m.phi * m.F[0] / (m.w_inv + view1) ** 2))
     assert got == pytest.approx([h1, full[1], full[2]])
-    assert got[0] / full[0] - 1.0 > 0.2  # unthinned, its honest report would read as corrupt
-    doubled = m.F[0] + MAX_THINNING * (m.F[1] + m.F[2])
-    assert views.contributions(m, np.zeros(3), np.array([100.0, 20.0, 20.0]))[0] == \
-        pytest.approx(float(np.sum(m.phi * m.F[0] / (m.w_inv + doubled) ** 2)))
+    assert abs(got[0] / full[0] - 1.0) > 0.05  # unscaled, its honest report would be off
+    more = np.array([[nan, 100.0, 10.0], [nan, nan, nan], [nan, nan, nan]])
+    view1 = m.F[0] + MAX_SHARE * m.F[1] + m.F[2]
+    assert views.contributions(m, np.zeros(3), more)[0] == pytest.approx(
+        float(np.sum(m.phi * m.F[0] / (m.w_inv + view1) ** 2)))
+
+
+def test_views_are_kept_by_source() -> None:
+    """An image joins the view of each observer in range under its own source: the sum over
+    sources is the view."""
+    observers = _at((0.0, 0.0, 0.0), (50.0, 0.0, 0.0), (0.0, 90.0, 0.0))
+    views = FusedViews.of(3, 4, 80.0)
+    views.add([_image(1, [0, 2], [0.5, 0.25]), _image(2, [2], [1.0])], observers)
+    assert views.by_source[1, 0].tolist() == [0.5, 0.0, 0.25, 0.0]  # sc1's image in sc2's view
+    assert views.by_source[0, 1].tolist() == [0.0, 0.0, 1.0, 0.0]
+    assert views.by_source[2].sum() == 0.0  # sc3 out of range of both
+    assert views.fused[0].tolist() == [0.5, 0.0, 1.25, 0.0]

@@ -61,7 +61,7 @@ def test_silence_is_a_link_fault_once_per_episode() -> None:
     assert links.judge(1, obs, [_obs(1, 31.0, 1)], True, 40.0) == (0, [])  # speaks again
     assert obs.silent == 0 and not obs.link_declared
     assert [len(links.judge(1, obs, [], True, b)[1]) for b in (50.0, 60.0)] == [0, 1]
-    assert links.judge(2, ObserverState(), [], False, 10.0) == (0, [])  # no plan: no silence
+    assert links.judge(2, ObserverState(), [], False, 10.0) == (0, [])  # camera off: none
 
 
 @pytest.mark.parametrize("loss", [0.0, 0.15])
@@ -80,7 +80,7 @@ def test_one_silent_window_decides_when_a_healthy_link_could_hardly_empty_it(los
 
 def test_a_window_losing_more_than_its_link_explains_is_lossy() -> None:
     """At a nominal 5%: 1 of 10 lost is healthy (P = 0.40), 4 of 10 is not (P = 1e-3), and a
-    silent window with a plan is (without one it says nothing)."""
+    silent window with its camera on is (with it off it says nothing)."""
     links = LinkChecks(small_scenario(comms={"packet_loss": 0.05}), "ground", LOG)
     obs = ObserverState()
     flags = []
@@ -255,7 +255,7 @@ def _integrity_over_two_boundaries(observers: dict[int, ObserverState],
     settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
     settled.add(2, np.array([2, 3]), np.array([0.5, 0.5]))
     truth = settled.contributions()
-    views = FusedViews(80.0, np.tile(settled.F.sum(axis=0), (2, 1)),
+    views = FusedViews(80.0, np.tile(settled.F[None], (2, 1, 1)),
                        np.ones((2, 2)))  # each fused everything
     out = []
     for j in (1, 2):
@@ -275,6 +275,27 @@ def test_a_reported_h_i_off_the_grounds_recomputation_is_a_data_integrity_fault(
     report = out[1][0][0]
     assert report.spacecraft == 1 and report.fault_class == "data_integrity"
     assert report.metric == pytest.approx(0.5)
+
+
+def test_an_observer_starved_of_a_neighbours_images_reports_honestly() -> None:
+    """sc1 fused none of sc2's image (a packet-loss fault on sc2's links) and says so
+    (shared_by {"2": 0}); its honest H_i, on its own precision alone, is well off the H_i on a
+    view holding everything, but matches the ground's rebuilding of its view: no fault."""
+    cfg = small_scenario(fdir={"checks_persistence": 1, "integrity_tol": 0.2}).fdir
+    check = IntegrityCheck(cfg, "ground", LOG)
+    settled = PoiMap.uniform(10, 1.0, 2)
+    settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
+    settled.add(2, np.array([1, 2]), np.array([2.0, 2.0]))
+    views = FusedViews(80.0, np.tile(settled.F[None], (2, 1, 1)), np.ones((2, 2)))
+    alone = float(np.sum(settled.phi * settled.F[0] / (settled.w_inv + settled.F[0]) ** 2))
+    assert alone / float(settled.contributions()[0]) > 1.5
+    for sc, h_i, by in ((1, alone, {"2": 0}), (2, float(settled.contributions()[1]), {"1": 1})):
+        check.reported(InfoCostTelemetry(
+            sender=f"sc{sc}", t_sim=10.0, spacecraft=sc, h_i=h_i, h_local=1.0, prior_term=0.5,
+            pois_seen_own=2, pois_seen_fused=2, images=1, shared_received=sum(by.values()),
+            shared_by=by), 1)
+    assert check.check(1, 10.0, settled, views, {1: ObserverState(), 2: ObserverState()}) \
+        == ([], {})
 
 
 def test_no_integrity_verdict_rests_on_observations_lost_to_a_stores_overflow() -> None:
@@ -326,7 +347,7 @@ def test_no_integrity_verdict_while_an_observer_is_not_heard_from() -> None:
     check = IntegrityCheck(cfg, "ground", LOG, period_s=10.0)
     settled = PoiMap.uniform(10, 1.0, 2)
     settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
-    views = FusedViews(80.0, np.tile(settled.F.sum(axis=0), (2, 1)),
+    views = FusedViews(80.0, np.tile(settled.F[None], (2, 1, 1)),
                        np.ones((2, 2)))
     observers = {1: ObserverState(heard_s=19.0), 2: ObserverState(heard_s=5.0)}
     report = InfoCostTelemetry(
