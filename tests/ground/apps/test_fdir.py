@@ -179,6 +179,10 @@ def test_an_observer_nothing_of_which_comes_down_in_a_pass_has_lost_its_link() -
     reports = [[(r.spacecraft, r.fault_class) for r in pipeline.due(t)
                 if isinstance(r, FaultReport)] for t in (aos + 20.0, aos + 34.0, aos + 40.0)]
     assert reports == [[], [(2, "link")], []]
+    late = _passes_app().pipeline  # out of contact (after the pass's LOS at 498 s): no
+    late.observations(_obs(1, 600.0, 1, [1]))  # silence of a pass (its windows' are theirs)
+    assert not [m for m in late.due(640.0)
+                if isinstance(m, FaultReport) and m.window_end_s == 640.0]
 
 
 def test_a_window_whose_reports_are_lost_or_aboard_is_not_judged_and_says_why() -> None:
