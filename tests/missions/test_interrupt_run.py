@@ -1,7 +1,8 @@
 """A run interrupted ends as a run (issue 40): SIGINT (Ctrl-C) or SIGTERM to an in-process
 run stops it at a tick boundary, writes summary.json with ``status: interrupted`` and the sim
 time reached, closes an archive the reader reads whole, prints no traceback, says in its last
-line how far it got (as summary.json does), and exits 128 + the signal's number."""
+line how far it got (as summary.json does), and exits 128 + the signal's number; the replay
+reads it, judging nothing past where it ends, and reproduces its ground."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from harness.archive.reader import load_run
+from harness.replay import replay_run
 from harness.summary import RunSummary
 from tests.conftest import REPO
 
@@ -55,3 +57,6 @@ def test_an_interrupted_run_is_written_as_one(tmp_path: Path, free_port: int, tr
     assert last.startswith("interrupted: ") and f"{reached:.0f} of 1200 s simulated" in last
     archive = load_run(out / "run.mcap")
     assert not archive.truncated
+    replay = replay_run(out / "run.mcap", {})  # what replay and reports read of it
+    assert replay.span.end_s <= reached + 1.0 and replay.faithful_until_s() <= reached + 1.0
+    assert replay.matches_live()
