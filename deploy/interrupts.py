@@ -1,9 +1,12 @@
 """SIGINT (Ctrl-C) and SIGTERM (``kill``, a job scheduler) while a run goes (issue 40): the run
 ends as a run, never with a traceback.  :class:`Interrupts` installs a handler for both in the
 main thread for the span of a ``with`` block, notes which signal came, and calls the run's own
-reaction: the in-process run sets its sim's stop event (it stops at the next tick boundary),
-the multi-process launcher raises ``KeyboardInterrupt`` into its supervision loop.  The exit
-status of an interrupted run is 128 + the signal's number (130, 143)."""
+reaction: the run's stop event is set, and the in-process sim stops at the next tick boundary,
+the multi-process launcher's watch over its processes at its next look (nothing is raised into
+the code that runs: a signal that comes while the run is being written changes nothing).  The
+exit status of an interrupted run is 128 + the signal's number (130, 143).  Before this, a
+SIGINT to the launcher after its sim had finished raised into its shutdown: a traceback and
+no summary.json."""
 
 from __future__ import annotations
 
@@ -46,7 +49,3 @@ class Interrupts:
         """128 + the signal's number (0 when none came)."""
         return 128 + self.signum if self.signum is not None else 0
 
-
-def raise_keyboard_interrupt(signum: int) -> None:
-    """The launcher's reaction: its supervision loop stops the children and writes the run."""
-    raise KeyboardInterrupt(f"signal {signum}")

@@ -51,7 +51,7 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
-from deploy.interrupts import Interrupts, raise_keyboard_interrupt  # noqa: E402
+from deploy.interrupts import Interrupts  # noqa: E402
 from deploy.out_folder import OutFolderError, written  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor  # noqa: E402
@@ -173,14 +173,15 @@ def main(argv: list[str] | None = None) -> int:
     scenario_text = args.scenario.read_text(encoding="utf-8")
     wall0 = time.monotonic()
     digest: RunDigest | None = None
-    if args.transport == "inproc":
-        stop = threading.Event()
-        with Interrupts(lambda signum: _stopping(stop, signum)) as caught:
+    stop = threading.Event()
+    # SIGINT or SIGTERM: the sim stops at the next tick (in process) or the children are
+    # stopped (over Zenoh), and the archive and summary are written
+    with Interrupts(lambda signum: _stopping(stop, signum)) as caught:
+        if args.transport == "inproc":
             status, error, digest = _run_inproc(scenario, mission, out, scenario_text, args,
                                                 stop)
-    else:  # SIGINT or SIGTERM: the children are stopped and the archive and summary written
-        with Interrupts(raise_keyboard_interrupt) as caught:
-            status, error = _run_zenoh(scenario, mission, out, args)
+        else:
+            status, error = _run_zenoh(scenario, mission, out, args, stop)
     wall_s = time.monotonic() - wall0
     digest = digest or _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
@@ -215,9 +216,10 @@ def _zenoh_only(args: argparse.Namespace) -> list[str]:
 
 
 def _stopping(stop: threading.Event, signum: int) -> None:
-    """The in-process run's reaction to SIGINT or SIGTERM: its sim stops at the next tick."""
-    log.warning("signal %d: stopping at the next tick; the archive and summary are written",
-                signum)
+    """The run's reaction to SIGINT or SIGTERM: ``stop`` is set, and the in-process sim stops
+    at the next tick, the launcher's watch over its processes at its next look (a run whose
+    sim had finished is complete)."""
+    log.warning("signal %d: stopping; the archive and summary are written", signum)
     stop.set()
 
 
@@ -293,8 +295,8 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
     return add_recovery_comparison(out, summary, counter, scenario.fdir.recovery)
 
 
-def _run_zenoh(scenario: Scenario, mission: str, out: Path,
-               args: argparse.Namespace) -> tuple[str, str | None]:
+def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
+               stop: threading.Event) -> tuple[str, str | None]:
     try:
         access = _write_access(out, mission, scenario, args)
     except ValueError as e:
@@ -320,7 +322,7 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path,
         live = _live_view(args)
         if live is not None:
             hub.subscribe(topics.mission_wildcard(mission), live.forward)
-        return _supervise(scenario, mission, out, args, progress, hub, sup, access)
+        return _supervise(scenario, mission, out, args, progress, hub, sup, access, stop)
     finally:
         hub.close()
         if live is not None:
@@ -374,7 +376,7 @@ def _access_audit(out: Path) -> AccessAudit | None:
 
 def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
                progress: _Progress, hub: ZenohTransport, sup: Supervisor,
-               access: RunAccess) -> tuple[str, str | None]:
+               access: RunAccess, stop: threading.Event) -> tuple[str, str | None]:
     common = ["--scenario", str(args.scenario.resolve()), "--mission", mission,
               "--log-level", args.log_level]
     if args.seed is not None:
@@ -414,7 +416,8 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
             sup.start(Child(node, argv, logs / f"{node}.log"))
     watch = _Watch(sup, progress, flight=[n for n in topo.participants if n not in args.external],
                    restart=args.restart_on_crash, recorder_up=recorder_up.count,
-                   sim_up=_Appearances(hub, topics.alive_token(mission, SIM.name)).count)
+                   sim_up=_Appearances(hub, topics.alive_token(mission, SIM.name)).count,
+                   stop=stop)
     error = watch.run()
     progress.report(final=True)
     watch.read_restores(out / "cds")
@@ -486,9 +489,12 @@ class _Watch:
 
     def __init__(self, sup: Supervisor, progress: _Progress, flight: list[str],
                  restart: bool, recorder_up: Callable[[], int] = lambda: 0,
-                 sim_up: Callable[[], int] = lambda: 0) -> None:
+                 sim_up: Callable[[], int] = lambda: 0,
+                 stop: threading.Event | None = None) -> None:
         self.sup, self.progress, self.flight, self.restart = sup, progress, flight, restart
         self.recorder_up, self.sim_up = recorder_up, sim_up
+        self.stop = stop or threading.Event()
+        """set by SIGINT or SIGTERM: the watch ends at its next look"""
         self.incidents: list[Incident] = []
         self.restarts: dict[str, int] = {}
         """Restarts so far, per process."""
@@ -500,29 +506,29 @@ class _Watch:
         restart, and the wall time (monotonic s) by which it must have grown."""
 
     def run(self) -> str | None:
-        """Watch until every process has finished; the error that ended the run, or None."""
+        """Watch until every process has finished, or ``stop`` is set; the error that ended
+        the run, or None (a run whose sim had finished when stopped is complete)."""
         done_since: float | None = None
-        try:
-            while True:
-                sim_done = (self.progress.finished.is_set()
-                            or self.sup.named(SIM.name).returncode == 0)
-                error = self._essential_stopped() or self._services_stopped(sim_done)
-                if error is not None:
-                    return error
-                self._flight_stopped(sim_done)
-                running = [n for n in self.flight
-                           if n not in self.down and self.sup.named(n).returncode is None]
-                if sim_done and not running:
-                    return None
-                if sim_done:
-                    done_since = done_since or time.monotonic()
-                    if time.monotonic() - done_since > 15.0:
-                        return ("processes still running 15 s after the run finished: "
-                                + ", ".join(running))
-                time.sleep(0.1)
-                self.progress.report()
-        except KeyboardInterrupt:  # a run whose sim had finished is complete
-            return None if self.progress.finished.is_set() else INTERRUPTED
+        while True:
+            sim_done = (self.progress.finished.is_set()
+                        or self.sup.named(SIM.name).returncode == 0)
+            if self.stop.is_set():
+                return None if sim_done else INTERRUPTED
+            error = self._essential_stopped() or self._services_stopped(sim_done)
+            if error is not None:
+                return error
+            self._flight_stopped(sim_done)
+            running = [n for n in self.flight
+                       if n not in self.down and self.sup.named(n).returncode is None]
+            if sim_done and not running:
+                return None
+            if sim_done:
+                done_since = done_since or time.monotonic()
+                if time.monotonic() - done_since > 15.0:
+                    return ("processes still running 15 s after the run finished: "
+                            + ", ".join(running))
+            self.stop.wait(0.1)
+            self.progress.report()
 
     def read_restores(self, directory: Path) -> None:
         """Name in each restart's incident how the process came back (restored from its

@@ -68,3 +68,17 @@ def test_a_router_dead_after_every_restart_stops_the_run_naming_it(tmp_path: Pat
     assert error is not None and error.startswith("router (pid ")
     assert "the bus is down" in error and f"(restarted {launcher.MAX_RESTARTS} times)" in error
     assert [i.node for i in watch.incidents] == [ROUTER.name] * launcher.MAX_RESTARTS
+
+
+def test_a_stop_ends_the_watch_interrupted_unless_the_sim_had_finished(tmp_path: Path) -> None:
+    """SIGINT or SIGTERM set the watch's stop: with the sim still flying the run is
+    interrupted; with the sim finished it is complete (nothing raised into the shutdown)."""
+    for finished, expected in ((False, launcher.INTERRUPTED), (True, None)):
+        watch = _watch(tmp_path, "import time; time.sleep(60)", recorder_up=1)
+        if finished:
+            watch.progress.finished.set()
+        watch.stop.set()
+        try:
+            assert watch.run() == expected
+        finally:
+            watch.sup.stop_all()
