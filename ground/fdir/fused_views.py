@@ -36,11 +36,6 @@ class FusedViews:
         return cls(range_m, np.zeros((observers, observers, pois)),
                    np.zeros((observers, observers)))
 
-    @property
-    def fused(self) -> np.ndarray:
-        """The precision each observer has fused per POI (N, M), from every source."""
-        return self.by_source.sum(axis=1)
-
     def add(self, images: list[PoiObservations], observers: dict[int, ObserverState]) -> None:
         """``images`` join their observers' views, and the view of every observer that was in
         range of theirs at the image time (both nav positions known: ``ObserverState.nav``,

@@ -73,7 +73,7 @@ def gnc_series(archive: RunArchive, scenario: Scenario, mission: str,
     _delta_v(truth, out, scenario.rates.mid_hz)
     _hold_errors(archive, scenario, mission, truth, out)
     for plan in archive.of(cat.TRANSFER_PLAN, mission):
-        if plan.spacecraft in out and plan.status == "solved":
+        if plan.spacecraft in out and not plan.refused:
             out[plan.spacecraft].dv_planned_mps += plan.dv_mps
             out[plan.spacecraft].transfers += 1
     _pointing(archive, scenario, mission, truth, out)
