@@ -232,6 +232,19 @@ NOMINAL = dict(beta_hat=1.0, camera_vs_nav_m=0.1, nav_vs_plan_m=0.05, pointing_e
     # a biased nav walks off ahead of the truth it steers; a leak's truth leads its nav
     ({"nav_vs_plan_m": 0.45, "camera_vs_nav_m": 0.33, "camera_vs_plan_m": 0.23,
       "offset_alignment": 0.7, "camera_se_m": 0.05}, None),
+    # a 3.75 m nav bias through a noisy camera (space campaign, fault-0099, its identifying
+    # window): 0.42 m off the plan is within the fixes' noise (0.36 m), 1.30 m off the nav is
+    # not; moving onto the biased orbit spends Δv above a leak's bound
+    ({"beta_hat": 0.987, "camera_vs_nav_m": 1.296, "nav_vs_plan_m": 1.163,
+      "pointing_error_deg": 0.377, "seen_overlap": 0.989, "explained_reported": -47.8,
+      "explained_located": -20.3, "dv_rate_mps2": 6.4e-4, "offset_alignment": -0.10,
+      "camera_vs_plan_m": 0.420, "camera_se_m": 0.362}, "state_sensor"),
+    # the same fixes' noise with the truth ahead of its nav: a leak
+    ({"camera_vs_nav_m": 1.296, "nav_vs_plan_m": 1.163, "camera_vs_plan_m": 2.4,
+      "offset_alignment": 0.9, "dv_rate_mps2": 6.4e-4, "camera_se_m": 0.362}, "actuator"),
+    # on the plan within the noise, but not beyond it off the nav: no evidence either way
+    ({"camera_vs_nav_m": 0.9, "nav_vs_plan_m": 0.8, "camera_vs_plan_m": 0.42,
+      "offset_alignment": 0.1, "dv_rate_mps2": 6.4e-4, "camera_se_m": 0.362}, "actuator"),
     ({}, None),  # nothing stands out
     # β̂ off by more than beta_tol, but within the scatter of a noisy narrow camera's images
     ({"beta_hat": 0.85, "beta_se": 0.05}, None),
