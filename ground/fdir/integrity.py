@@ -120,11 +120,11 @@ class IntegrityCheck:
         if any(o.aboard_before(b) for o in observers.values()):
             return "aboard"
         if any(o.heard_s < b - period_s for o in observers.values()):
-            return "lost"
+            return "not_heard"
         if self.crosslink_loss > self.cfg.integrity_max_loss:
             return "crosslink_loss"
         if any(o.lossy for o in observers.values()):
-            return "lost"
+            return "lossy"
         return "lost" if float(lost.max(initial=0.0)) > self.cfg.integrity_max_loss else None
 
     def _unjudged(self, sc: int, reason: Unjudged, lost: np.ndarray) -> None:
@@ -136,6 +136,9 @@ class IntegrityCheck:
             self.log.info("FDIR: sc%d's H_i report not judged: the crosslinks lose %.0f%% "
                           "(data integrity needs at most %.0f%%; %d unjudged so far)", sc,
                           100 * self.crosslink_loss, 100 * self.cfg.integrity_max_loss, count)
+        elif reason != "lost":
+            self.log.info("FDIR: sc%d's H_i report not judged (%s; %d unjudged so far)", sc,
+                          reason, count)
         else:
             self.log.info("FDIR: sc%d's H_i report not judged (%s): %.0f%% of sc%d's "
                           "observations lost (data integrity needs at most %.0f%%; %d unjudged "

@@ -104,6 +104,8 @@ class UnjudgedCounts(Counts):
     store_overflow: int = 0
     aboard: int = 0
     lost: int = 0
+    not_heard: int = 0
+    lossy: int = 0
     crosslink_loss: int = 0
     no_plan: int = 0
     camera_off: int = 0

@@ -184,12 +184,14 @@ class PoiPrecisions(Message):
         self.__pydantic_private__["_arrays"] = (self.poi, idx, prec)  # type: ignore[index]
 
 
-Unjudged = Literal["store_overflow", "aboard", "lost", "crosslink_loss", "no_plan", "camera_off",
-                   "no_images", "not_tracking", "plan_unknown", "transfer", "excluded"]
+Unjudged = Literal["store_overflow", "aboard", "lost", "not_heard", "lossy", "crosslink_loss",
+                   "no_plan", "camera_off", "no_images", "not_tracking", "plan_unknown", "transfer",
+                   "excluded"]
 """Why a window, or the H_i report at its end, has no decision (docs/fdir.md, "Lost is not
 corrupt"): its reports lost to the store's overflow (``store_overflow``) or still aboard
 (``aboard``); too many of the observers' observations lost for the report's recomputation
-(``lost``); no plan in force; its camera turned off aboard; no image received; no image taken
+(``lost``: since the start; ``lossy``: in an observer's latest window, beyond what its link
+explains); an observer not heard from since the window's start (``not_heard``); no plan in force; its camera turned off aboard; no image received; no image taken
 while tracking; a transfer whose plan never reached the judge (``plan_unknown``), or any
 transfer (``transfer``: the neighbours judge only held PROs); an observer its neighbours left
 out of their fusion (``excluded``)."""

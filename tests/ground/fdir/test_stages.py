@@ -327,7 +327,7 @@ def test_no_integrity_verdict_while_an_observer_s_latest_window_is_lossy() -> No
                                                                  lossy=True)}
     out = _integrity_over_two_boundaries(observers)
     assert [r for r, _ in out] == [[], []]
-    assert [u for _, u in out] == [{1: "lost", 2: "lost"}] * 2
+    assert [u for _, u in out] == [{1: "lossy", 2: "lossy"}] * 2
 
 
 def test_no_integrity_verdict_while_reports_before_the_boundary_are_still_aboard() -> None:
@@ -354,7 +354,7 @@ def test_no_integrity_verdict_while_an_observer_is_not_heard_from() -> None:
         sender="sc1", t_sim=20.0, spacecraft=1, h_i=9.0, h_local=1.0, prior_term=0.5,
         pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=0)  # far off
     check.reported(report, 2)
-    assert check.check(2, 20.0, settled, views, observers) == ([], {1: "lost"})
+    assert check.check(2, 20.0, settled, views, observers) == ([], {1: "not_heard"})
     observers[2].heard_s = 12.0  # heard in the window: judged, and found off
     check.reported(report, 2)
     reports, unjudged = check.check(2, 20.0, settled, views, observers)
