@@ -281,7 +281,8 @@ class FdirPipeline:
                 continue
             imaging = not obs.camera_off_before(b)
             planned = obs.plan_at(a) is not None and imaging
-            lost, reports = self.links.judge(sc, obs, mine, imaging, b)
+            reach = self.links.in_reach(obs, self.n, a, b)
+            lost, reports = self.links.judge(sc, obs, mine, imaging, b, reach)
             out += reports
             window = window.model_copy(update={"lost": lost})
             ctx, images, why = (window_context(sc, obs, mine, a, b, settled, self.n,
@@ -289,7 +290,8 @@ class FdirPipeline:
                                 if planned and mine else (None, len(mine), None))
             if ctx is None:
                 out.append(window.model_copy(update={
-                    "images": images, "unjudged": why or _unplanned(obs, b, mine)}))
+                    "images": images,
+                    "unjudged": why or _unplanned(obs, b, mine, reach)}))
                 continue
             judged[sc] = self.information.judge(
                 ctx, obs, window.model_copy(update={"images": images}),
@@ -319,7 +321,9 @@ class FdirPipeline:
         heard = {sc for sc, o in self.observers.items() if o.heard_pass == now}
         if not heard:  # nobody heard: the ground's own link, or nothing to say
             return []
-        return [r for sc, o in self.observers.items() if sc not in heard
+        since = t - self.schedule.period_s
+        return [r for sc, o in self.observers.items()
+                if sc not in heard and self.links.in_reach(o, self.n, since, t)
                 for r in self.links.pass_silence(sc, o, t)]
 
     def _lost_aboard(self, sc: int, obs: ObserverState, a: float, b: float
@@ -350,8 +354,12 @@ class FdirPipeline:
         return float(np.sum(self.settled.phi * self.settled.variance()))
 
 
-def _unplanned(obs: ObserverState, b: float, images: list[PoiObservations]) -> Unjudged:
-    """Why a window without a context was not judged, before its images were looked at."""
+def _unplanned(obs: ObserverState, b: float, images: list[PoiObservations],
+               reach: bool = True) -> Unjudged:
+    """Why a window without a context was not judged, before its images were looked at
+    (``reach``: whether the plan kept the observer in the relay's reach)."""
     if obs.camera_off_before(b):
         return "camera_off"
+    if not reach and not images:
+        return "out_of_range"
     return "no_images" if not images else "no_plan"

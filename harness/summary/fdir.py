@@ -110,6 +110,7 @@ class UnjudgedCounts(Counts):
     no_plan: int = 0
     camera_off: int = 0
     no_images: int = 0
+    out_of_range: int = 0
     not_tracking: int = 0
     plan_unknown: int = 0
     transfer: int = 0

@@ -175,6 +175,35 @@ def test_the_window_after_a_silence_counts_its_missing_observations() -> None:
     assert reports[0].metric == pytest.approx(0.9)
 
 
+def test_an_observer_its_plan_puts_beyond_the_relays_reach_is_no_link_fault() -> None:
+    """The ground is reached through the target: on a PRO 10-20 m from it with a 16 m range
+    (15.05 m less the margin) the observer is out of reach half of each orbit.  Its silent
+    windows there are no link fault, and the observations it could not send down are not
+    lost: the next window in reach counts afresh."""
+    n = 1.1e-3
+    links = LinkChecks(small_scenario(comms={"range_m": 16.0}, fdir={"checks_persistence": 1}),
+                       "ground", LOG)
+    obs = ObserverState()
+    obs.plans[1] = FlightPlan(0.0, Pro(10.0, 0.0, 0.0, 0.0, 0.0), None, None)
+    starts = np.arange(0.0, 5700.0, 30.0)
+    far = [float(np.linalg.norm(obs.planned(n, np.array([a, a + 29.0]))[0], axis=1).min())
+           for a in starts]
+    out_a = float(starts[int(np.argmax(far))])  # 20 m off: beyond reach
+    in_a = next(float(a) for a, d in zip(starts, far) if a > out_a and d < 12.0)
+    assert not links.in_reach(obs, n, out_a, out_a + 30.0)
+    assert links.in_reach(obs, n, in_a, in_a + 30.0)
+    assert links.in_reach(ObserverState(), n, 0.0, 30.0)  # no plan: the deployment, in reach
+    first = [_obs(1, out_a - 30.0 + i, i + 1) for i in range(30)]
+    assert links.judge(1, obs, first, True, out_a) == (0, [])
+    assert links.judge(1, obs, [], True, out_a + 30.0, reachable=False) == (0, [])
+    assert obs.silent == 0 and not obs.link_declared
+    back = [_obs(1, in_a + i, 1000 + i) for i in range(30)]  # 900-odd numbers never sent down
+    assert links.judge(1, obs, back, True, in_a + 30.0) == (0, [])
+    assert obs.lost == 0 and obs.received == 60
+    assert [len(links.judge(1, obs, [], True, b)[1]) for b in (in_a + 60.0, in_a + 90.0)] \
+        == [1, 0]  # silent in reach: a link fault, once
+
+
 def test_window_context_judges_tracked_images_under_a_plan() -> None:
     obs = ObserverState()
     obs.modes = [(0.0, "slew"), (40.0, "track")]
