@@ -189,7 +189,8 @@ def test_an_observer_its_plan_puts_beyond_the_relays_reach_is_no_link_fault() ->
     far = [float(np.linalg.norm(obs.planned(n, np.array([a, a + 29.0]))[0], axis=1).min())
            for a in starts]
     out_a = float(starts[int(np.argmax(far))])  # 20 m off: beyond reach
-    in_a = next(float(a) for a, d in zip(starts, far) if a > out_a and d < 12.0)
+    in_a = next(float(a) for a, d in zip(starts, far, strict=True)
+                if a > out_a and d < 12.0)
     assert not links.in_reach(obs, n, out_a, out_a + 30.0)
     assert links.in_reach(obs, n, in_a, in_a + 30.0)
     assert links.in_reach(ObserverState(), n, 0.0, 30.0)  # no plan: the deployment, in reach
