@@ -323,7 +323,8 @@ class FdirPipeline:
             return []
         since = t - self.schedule.period_s
         return [r for sc, o in self.observers.items()
-                if sc not in heard and self.links.in_reach(o, self.n, since, t)
+                if sc not in heard and not (o.link_declared or o.dump_declared)
+                and self.links.in_reach(o, self.n, since, t)
                 for r in self.links.pass_silence(sc, o, t)]
 
     def _lost_aboard(self, sc: int, obs: ObserverState, a: float, b: float
