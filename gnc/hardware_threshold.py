@@ -43,12 +43,15 @@ FloatArray = npt.NDArray[np.float64]
 @dataclass(frozen=True)
 class RatioModel:
     """x = ΔH_i / ΔH_i^pred under no fault: mean and 1σ, with the parts of the spread that come
-    from the camera's noise and from the pose."""
+    from the camera's noise and from the pose; ``image_pose_std``: the pose's part of one
+    image's ratio (its RMS over the imaged poses; 0: not drawn), which a window's sum can
+    average away where a tilt helps one image and costs another."""
 
     mean: float
     std: float
     camera_std: float
     pose_std: float
+    image_pose_std: float = 0.0
 
     def threshold(self, q: float) -> float:
         """τ with P(|1 − x| > τ) = ``q`` for x ~ N(mean, std²) (0 < q < 1)."""
@@ -125,14 +128,25 @@ def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: F
     true_pos = (pos[None, :, :] + offsets).reshape(-1, 3)
     bore = small_rotations(_aimed(np.tile(aim, (samples, 1)), true_pos),
                            np.repeat(tilts, len(pos), axis=1).reshape(-1, 3))  # one per draw
-    per_image = twin.precision(true_pos, bore) @ weight
-    draws = per_image.reshape(samples, len(pos)).sum(axis=1) / ref
+    per_image = (twin.precision(true_pos, bore) @ weight).reshape(samples, len(pos))
+    draws = per_image.sum(axis=1) / ref
     pose_mean = float(draws.mean())
     pose_var = float(draws.var(ddof=1)) if samples > 1 else 0.0
     mean = m1 * pose_mean
     var = m1 * m1 * pose_var + camera_var * pose_mean**2
     return RatioModel(mean, math.sqrt(var), math.sqrt(camera_var) * abs(pose_mean),
-                      m1 * math.sqrt(pose_var))
+                      m1 * math.sqrt(pose_var), m1 * _image_spread(per_image, prec[::k] @ weight))
+
+
+def _image_spread(per_image: FloatArray, predicted: FloatArray) -> float:
+    """The RMS over images of each image's 1σ ratio across the pose draws (``per_image``:
+    samples × images of drawn gains; ``predicted``: each image's predicted gain); 0 with one
+    draw or no informative image."""
+    seen = predicted > 0.0
+    if per_image.shape[0] < 2 or not seen.any():
+        return 0.0
+    ratios = per_image[:, seen] / predicted[seen]
+    return math.sqrt(float(np.mean(ratios.var(axis=0, ddof=1))))
 
 
 def _aimed(aims: FloatArray, positions: FloatArray) -> FloatArray:

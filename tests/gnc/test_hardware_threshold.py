@@ -98,16 +98,28 @@ def test_camera_part_matches_the_sims_cameras(nu: float) -> None:
     assert model.std == pytest.approx(x.std(ddof=1), rel=0.15)
 
 
+POSE_ERRORS = (0.3, math.radians(0.5))
+"""Position (m) and pointing (rad) 1σ per axis of the pose tests below."""
+
+
+def _pose_model(k: int) -> tuple[TwinModel, np.ndarray, np.ndarray, np.ndarray, RatioModel]:
+    """The ratio model of a k-image window under ``POSE_ERRORS`` alone (400 draws), with the
+    twin, positions and map it was drawn on."""
+    twin = _twin()
+    pos = _window(k)
+    psi, phi = _map(twin)
+    model = ratio_model(twin, pos, np.zeros_like(pos), psi, phi, *POSE_ERRORS, 0.0, 400,
+                        np.random.default_rng(1))
+    assert model is not None
+    return twin, pos, psi, phi, model
+
+
 def test_pose_part_matches_brute_force_offsets() -> None:
     """The pose spread equals the spread of the exact ratio under the same position and
     pointing errors, drawn by hand with the sim's geometry (no camera noise)."""
-    twin = _twin()
-    pos = _window(10)
-    psi, phi = _map(twin)
-    sigma_p, sigma_b = 0.3, math.radians(0.5)
-    model = ratio_model(twin, pos, np.zeros_like(pos), psi, phi, sigma_p, sigma_b, 0.0, 400,
-                        np.random.default_rng(1))
-    assert model is not None and model.camera_std == 0.0
+    twin, pos, psi, phi, model = _pose_model(10)
+    sigma_p, sigma_b = POSE_ERRORS
+    assert model.camera_std == 0.0
     rng = np.random.default_rng(2)
     pred = twin.predicted(pos, centre_boresights(pos), psi, phi)
     x = []
@@ -118,6 +130,25 @@ def test_pose_part_matches_brute_force_offsets() -> None:
     assert model.pose_std == pytest.approx(np.std(x, ddof=1), rel=0.2)
     assert model.mean == pytest.approx(np.mean(x), abs=3.0 * np.std(x) / 20.0)
     assert model.pose_std > 0.005  # the errors matter at this geometry
+
+
+def test_an_images_pose_part_matches_brute_force_offsets() -> None:
+    """Each image's own spread under the window's pose errors (what the sequential test takes
+    for one image), RMS over the window's images, against the same errors drawn by hand."""
+    twin, pos, psi, phi, model = _pose_model(6)
+    sigma_p, sigma_b = POSE_ERRORS
+    rng = np.random.default_rng(2)
+    pred = np.array([twin.predicted(pos[k:k + 1], centre_boresights(pos[k:k + 1]), psi, phi)
+                     for k in range(len(pos))])
+    x = []
+    for _ in range(400):
+        p = pos + rng.normal(0.0, sigma_p, 3)
+        b = small_rotations(centre_boresights(p), rng.normal(0.0, sigma_b, 3))
+        x.append([twin.predicted(p[k:k + 1], b[k:k + 1], psi, phi) / pred[k]
+                  for k in range(len(pos))])
+    rms = math.sqrt(float(np.mean(np.var(np.array(x), axis=0, ddof=1))))
+    assert model.image_pose_std == pytest.approx(rms, rel=0.2)
+    assert model.image_pose_std >= model.pose_std * 0.9  # a sum averages, an image does not
 
 
 def test_no_information_gives_no_model() -> None:

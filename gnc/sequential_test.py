@@ -1,0 +1,103 @@
+"""The sequential test on per-image evidence (issue 41; docs/fdir.md, "The sequential test"): each
+image's information gain against the nominal twin's prediction, x_k = ΔH_k / ΔH_k^pred (Eq. 9
+image by image), judged the moment it arrives instead of once per FDI window.
+
+The nominal model of the relative residual r_k = x_k / μ − 1 (μ: the hardware model's mean
+ratio, ``gnc/hardware_threshold.py``) has two parts:
+
+* b_k, the pose's effect (station keeping, the nav-aimed camera, pointing jitter), 1σ = σ_b
+  (the hardware model's ``image_pose_std`` over μ: an image's spread under the window's pose
+  draws), correlated from image to image in whatever way the loops make it;
+* e_k, the camera's precision noise, independent per image, 1σ = σ_e (v Σw²/(Σw)² of the
+  image's predicted weights, as the hardware model has it for the window).
+
+A change of the mean by δ (Table 3: δ < 0 degraded, δ > 0 improved) is sought by a scan over
+the most recent n images, n in ``lengths``: Z_n = m_n / √(σ_b² + σ_e²/n), m_n their mean
+residual (the generalised likelihood ratio of a mean shift after an unknown change point,
+restricted to those spans, with b the nuisance the spans share).  A fault is declared when
+max_n |Z_n| exceeds c.  A shift of 20% against σ_b = 0.5% crosses on its first image; one
+near σ_b needs the window's images, as Eq. 9 per window does.
+
+c comes from the false-alarm budget, not from campaigns (:func:`scan_threshold`).  Whatever
+the pose effect's correlation from image to image, the mean of n residuals has a variance of
+at most σ_b² + σ_e²/n (the camera's noise is independent, and a mean of terms of 1σ σ_b has at
+most σ_b), so every Z_n has at most unit variance under the model, and the union bound over
+the spans makes the probability that the scan crosses at a given image at most 2 L Φ(−c).  The
+budget per observer-hour over the images of an hour sets it; the mean time to a false alarm
+(the average run length) is at least its inverse.  Were the pose effect constant over a
+window, a lower c would do (the window is then nearly one test), but the pointing jitter is
+not: in the paper's set-up consecutive images' ratios correlate at 0.55, at 0.03 five apart.
+
+The delay's lower bound (Lorden 1971; ``../shared/REFERENCE.md``, "Detection statistics"):
+no test with a mean time to false alarm of γ images has a smaller worst-case mean delay than
+about log γ / D images, D = δ² / (2σ²) the per-image Kullback-Leibler divergence of the shift
+(:func:`kl_gaussian_shift`, :func:`delay_bound`).  Pure functions.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+from scipy.special import ndtri
+
+FloatArray = npt.NDArray[np.float64]
+
+SCAN_LENGTHS: tuple[int, ...] = (1, 2, 4, 8, 16, 32)
+"""The spans (images) the scan tries: dyadic, so a shift sustained over n images is within a
+factor of two of a span that matches it (the usual stand-in for every change point)."""
+
+@dataclass(frozen=True)
+class ScanResult:
+    """The scan at one image: the largest |Z_n|, its signed value and its span n (images)."""
+
+    z: float
+    signed: float
+    span: int
+
+
+def scan_statistic(residuals: FloatArray, sigma_e: float, sigma_b: float,
+                   lengths: Sequence[int] = SCAN_LENGTHS) -> ScanResult | None:
+    """The scan at the newest of ``residuals`` (r_k, oldest first): for each span n of
+    ``lengths`` the newest n hold, Z_n = m_n / √(σ_b² + σ_e²/n); the largest |Z_n|.  None with
+    no residual.  ``sigma_e``, ``sigma_b``: the per-image and common 1σ (relative)."""
+    r = np.asarray(residuals, dtype=float)
+    spans = [n for n in lengths if n <= len(r)]
+    if not spans:
+        return None
+    means = np.cumsum(r[::-1])[np.array(spans) - 1] / np.array(spans)
+    sd = np.sqrt(sigma_b**2 + sigma_e**2 / np.array(spans, dtype=float))
+    z = means / sd
+    best = int(np.argmax(np.abs(z)))
+    return ScanResult(float(abs(z[best])), float(z[best]), spans[best])
+
+
+def scan_threshold(q_image: float, lengths: Sequence[int] = SCAN_LENGTHS) -> float:
+    """c with 2 L Φ(−c) = ``q_image``, the per-image share of the false-alarm budget, over the
+    L = len(``lengths``) spans: the union bound on the probability that the scan at one image
+    crosses, whatever the dependence between its spans and between images (each Z_n has at
+    most unit variance under the model).  The mean time to a false alarm is then at least
+    1 / ``q_image`` images."""
+    if not 0.0 < q_image < 1.0:
+        raise ValueError(f"false-alarm probability must be in (0, 1), got {q_image!r}")
+    return float(-ndtri(q_image / (2.0 * len(lengths))))
+
+
+def kl_gaussian_shift(delta: float, sigma: float) -> float:
+    """D = δ² / (2σ²), nats per image: the Kullback-Leibler divergence of N(δ, σ²) from
+    N(0, σ²)."""
+    if not sigma > 0.0:
+        raise ValueError(f"sigma must be positive, got {sigma!r}")
+    return delta * delta / (2.0 * sigma * sigma)
+
+
+def delay_bound(gamma: float, divergence: float) -> float:
+    """log γ / D (images): the smallest worst-case mean delay of any test whose mean time to a
+    false alarm is γ images, for a change of per-image divergence D (Lorden 1971); inf for
+    D = 0."""
+    if not gamma > 1.0:
+        raise ValueError(f"gamma must exceed 1, got {gamma!r}")
+    return math.log(gamma) / divergence if divergence > 0.0 else math.inf

@@ -1,0 +1,101 @@
+"""The sequential per-image test (gnc/sequential_test.py) against closed forms, the reference's
+worked numbers and a seeded simulation of its own null model."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.special import ndtr, ndtri
+
+from gnc.sequential_test import (
+    SCAN_LENGTHS,
+    delay_bound,
+    kl_gaussian_shift,
+    scan_statistic,
+    scan_threshold,
+)
+
+
+def test_the_threshold_is_the_union_bound_over_the_spans() -> None:
+    q = 1e-5
+    c = scan_threshold(q)
+    assert 2 * len(SCAN_LENGTHS) * ndtr(-c) == pytest.approx(q, rel=1e-9)
+    assert scan_threshold(q, (1,)) == pytest.approx(-ndtri(q / 2))
+
+
+def _null_crossings(c: float, sigma_e: float, sigma_b: float, correlation: float,
+                    images: int, runs: int, rng: np.random.Generator) -> float:
+    """Share of images at which the scan over simulated nominal residuals crosses c: the pose
+    effect an AR(1) process of 1σ σ_b and lag-1 ``correlation`` (1: constant over the run),
+    the camera's noise white."""
+    b = np.empty((runs, images))
+    b[:, 0] = rng.normal(0.0, sigma_b, runs)
+    innovation = sigma_b * math.sqrt(1.0 - correlation**2)
+    for k in range(1, images):
+        b[:, k] = correlation * b[:, k - 1] + rng.normal(0.0, innovation, runs)
+    r = b + rng.normal(0.0, sigma_e, (runs, images))
+    cums = np.concatenate([np.zeros((runs, 1)), np.cumsum(r, axis=1)], axis=1)
+    hit = np.zeros((runs, images), dtype=bool)
+    for n in SCAN_LENGTHS:
+        means = (cums[:, n:] - cums[:, :-n]) / n
+        hit[:, n - 1:] |= np.abs(means) / math.sqrt(sigma_b**2 + sigma_e**2 / n) > c
+    return float(hit[:, max(SCAN_LENGTHS) - 1:].mean())
+
+
+@pytest.mark.parametrize(("sigma_e", "sigma_b", "correlation"), [
+    (0.002, 0.005, 1.0), (0.002, 0.005, 0.55), (0.002, 0.005, 0.0), (0.009, 0.002, 0.55),
+    (0.01, 0.0, 0.0)])
+def test_the_threshold_holds_its_budget_whatever_the_pose_correlation(
+        sigma_e: float, sigma_b: float, correlation: float) -> None:
+    """The nominal model simulated with the pose effect constant, correlated as the paper's
+    set-up measures it (0.55 image to image) and white: no more crossings per image than
+    the budget."""
+    q = 2e-3
+    rate = _null_crossings(scan_threshold(q), sigma_e, sigma_b, correlation, 96, 4000,
+                           np.random.default_rng(41))
+    assert rate <= q
+
+
+def test_the_scan_takes_the_span_that_holds_the_shift() -> None:
+    residuals = np.array([0.0, 0.0, 0.0, 0.0, -0.03, -0.03])
+    result = scan_statistic(residuals, 0.002, 0.005)
+    assert result is not None and result.span == 2
+    assert result.signed == pytest.approx(-0.03 / math.sqrt(0.005**2 + 0.002**2 / 2))
+    assert result.z == pytest.approx(abs(result.signed))
+    assert scan_statistic(np.array([]), 0.002, 0.005) is None
+
+
+def test_a_degraded_camera_crosses_on_its_first_image() -> None:
+    """β = 0.8 moves an image's gain by 20%: against σ_b 0.5% and σ_e 0.2% one image is
+    ~37σ, far beyond any budget's threshold."""
+    rng = np.random.default_rng(7)
+    nominal = rng.normal(0.0, 0.002, 40) + 0.004
+    c = scan_threshold(1e-6)
+    before = [scan_statistic(nominal[: k + 1], 0.002, 0.005) for k in range(40)]
+    assert max(s.z for s in before if s is not None) < c
+    after = scan_statistic(np.append(nominal, -0.2), 0.002, 0.005)
+    assert after is not None and after.z > c and after.signed < 0 and after.span == 1
+
+
+def test_the_delay_bound_gives_the_reference_numbers() -> None:
+    """../shared/REFERENCE.md: γ ≈ 3e4 samples is log γ ≈ 10.3 nats; a 1σ shift has D = 0.5
+    and needs ≈ 21 samples; a 100σ shift, D = 5000, less than one."""
+    gamma = 3e4
+    assert math.log(gamma) == pytest.approx(10.3, abs=0.05)
+    assert kl_gaussian_shift(0.002, 0.002) == pytest.approx(0.5)
+    assert delay_bound(gamma, kl_gaussian_shift(0.002, 0.002)) == pytest.approx(20.6, abs=0.1)
+    assert delay_bound(gamma, kl_gaussian_shift(0.2, 0.002)) < 1.0
+    assert delay_bound(gamma, 0.0) == math.inf
+
+
+@pytest.mark.parametrize(("call", "match"), [
+    (lambda: scan_threshold(0.0), "in \\(0, 1\\)"),
+    (lambda: scan_threshold(1.0), "in \\(0, 1\\)"),
+    (lambda: kl_gaussian_shift(0.1, 0.0), "sigma must be positive"),
+    (lambda: delay_bound(1.0, 0.5), "gamma must exceed 1"),
+])
+def test_bad_settings_are_refused(call, match: str) -> None:  # type: ignore[no-untyped-def]
+    with pytest.raises(ValueError, match=match):
+        call()
