@@ -59,20 +59,38 @@ class ScanResult:
     span: int
 
 
-def scan_statistic(residuals: FloatArray, sigma_e: float, sigma_b: float,
+def scan_statistic(residuals: npt.ArrayLike, sigma_e: npt.ArrayLike, sigma_b: npt.ArrayLike,
                    lengths: Sequence[int] = SCAN_LENGTHS) -> ScanResult | None:
     """The scan at the newest of ``residuals`` (r_k, oldest first): for each span n of
-    ``lengths`` the newest n hold, Z_n = m_n / √(σ_b² + σ_e²/n); the largest |Z_n|.  None with
-    no residual.  ``sigma_e``, ``sigma_b``: the per-image and common 1σ (relative)."""
+    ``lengths`` the newest n hold, Z_n = m_n / S_n; the largest |Z_n|.  None with no residual.
+    ``sigma_e``, ``sigma_b``: each image's camera and pose 1σ (relative; one value for all, or
+    one per residual), and S_n² = (mean σ_b)² + Σ σ_e² / n² over the span, the bound on the
+    variance of m_n whatever the pose's correlation (Minkowski)."""
     r = np.asarray(residuals, dtype=float)
-    spans = [n for n in lengths if n <= len(r)]
-    if not spans:
+    spans = np.array([n for n in lengths if n <= len(r)])
+    if not len(spans):
         return None
-    means = np.cumsum(r[::-1])[np.array(spans) - 1] / np.array(spans)
-    sd = np.sqrt(sigma_b**2 + sigma_e**2 / np.array(spans, dtype=float))
-    z = means / sd
+    sum_r = np.cumsum(r[::-1])[spans - 1]
+    sum_b = np.cumsum(np.broadcast_to(np.asarray(sigma_b, dtype=float), r.shape)[::-1])
+    sum_e2 = np.cumsum(np.broadcast_to(np.asarray(sigma_e, dtype=float), r.shape)[::-1] ** 2)
+    sd = np.sqrt((sum_b[spans - 1] / spans) ** 2 + sum_e2[spans - 1] / spans**2)
+    z = sum_r / spans / sd
     best = int(np.argmax(np.abs(z)))
-    return ScanResult(float(abs(z[best])), float(z[best]), spans[best])
+    return ScanResult(float(abs(z[best])), float(z[best]), int(spans[best]))
+
+
+def image_evidence(gains: FloatArray, predicted: FloatArray, weights: FloatArray,
+                   mean: float, noise_var: float) -> tuple[FloatArray, FloatArray]:
+    """Each image's residual r_k = (ΔH_k / ΔH_k^pred) / μ − 1 and its camera 1σ σ_e,k =
+    √(v Σ w²) / Σ w (``gnc.hardware_threshold``'s camera part, image by image); ``gains``,
+    ``predicted``: ΔH_k and ΔH_k^pred (K,); ``weights``: the predicted images' w = φψσ⁻¹
+    (K, M); ``mean``: μ; ``noise_var``: v, the clipped noise factor's variance.  Images the
+    twin predicts nothing of are dropped (no evidence)."""
+    keep = predicted > 0.0
+    w = weights[keep]
+    total = w.sum(axis=1)
+    sigma_e = np.sqrt(noise_var * np.sum(w * w, axis=1)) / total
+    return gains[keep] / predicted[keep] / mean - 1.0, sigma_e
 
 
 def scan_threshold(q_image: float, lengths: Sequence[int] = SCAN_LENGTHS) -> float:

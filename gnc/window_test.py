@@ -218,13 +218,24 @@ def hardware_threshold(pose: WindowPose, twin: TwinModel, psi: FloatArray, phi: 
     with the pose's spreads, its quantile for the false-alarm probability ``q``, raised to
     the floor guard; ``prec``: the twin's predicted precisions.  None when the prediction
     holds no information (no threshold, no decision)."""
-    aims = pose.aims if pose.aims is not None else np.zeros_like(pose.planned)
-    model = ratio_model(twin, pose.planned, aims, psi, phi, pose.position_sigma(cfg),
-                        pose.pointing_sigma(cfg), cfg.noise_frac, cfg.model_samples, rng, prec)
+    model = pose_ratio_model(pose, twin, psi, phi, prec, cfg, rng)
     if model is None:
         return None
     quantile = model.threshold(q)
     return HardwareThreshold(model, quantile, *floor_guard(quantile, cfg.floor))
+
+
+def pose_ratio_model(pose: WindowPose, twin: TwinModel, psi: FloatArray, phi: FloatArray,
+                     prec: FloatArray, cfg: WindowTestSettings, rng: np.random.Generator
+                     ) -> RatioModel | None:
+    """The ratio's nominal distribution for the images of ``pose``
+    (``gnc.hardware_threshold.ratio_model``): the pose's spreads as the observer reports them
+    (``WindowPose.position_sigma``, ``pointing_sigma``), ``cfg.model_samples`` pose draws from
+    ``rng``; ``prec``: the twin's predicted precisions.  None when the prediction holds no
+    information."""
+    aims = pose.aims if pose.aims is not None else np.zeros_like(pose.planned)
+    return ratio_model(twin, pose.planned, aims, psi, phi, pose.position_sigma(cfg),
+                       pose.pointing_sigma(cfg), cfg.noise_frac, cfg.model_samples, rng, prec)
 
 
 def pose_tests(pose: WindowPose, dv_rate_mps2: float | None, cfg: WindowTestSettings

@@ -15,6 +15,7 @@ from gnc.window_test import exceeded as window_exceeded
 from ground.fdir.constellation import ConstellationVerdict
 from ground.fdir.identify import Evidence, Tolerances, classify
 from ground.fdir.information import Judgement
+from ground.fdir.sequential import Crossing
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, FdirWindow, Message
 from interfaces.contracts.scenario import FdirSettings
@@ -64,6 +65,26 @@ class Declarer:
                 self.log.warning("FDIR: sc%d identified at %.0f s: %s", sc, w.t_end_s, cls)
                 out.append(self._report(sc, cls, w, j.evidence))
         return out
+
+    def declared(self, sc: int) -> bool:
+        """Whether observer ``sc``'s declared fault's episode is going on."""
+        return self.persistence.declared(sc)
+
+    def declare_crossing(self, sc: int, crossing: Crossing, window_end_s: float
+                         ) -> FaultReport:
+        """A fault declared by the sequential test at an image (docs/fdir.md, "The sequential
+        test"), in the window ending at ``window_end_s``: without a class, which the windows
+        of its episode then look for."""
+        self.persistence.declare(sc)
+        self._unidentified.add(sc)
+        self.log.warning("FDIR: fault declared on sc%d at its image of %.0f s (sequential: "
+                         "|Z| %.3g over %d images, mean shift %.3g, %s)", sc, crossing.image_t_s,
+                         crossing.scan.z, crossing.scan.span, crossing.shift, crossing.direction)
+        return FaultReport(sender=self.node, t_sim=crossing.image_t_s, spacecraft=sc,
+                           fault_class=None, direction=crossing.direction,
+                           metric=abs(crossing.shift), threshold=crossing.limit,
+                           window_end_s=window_end_s, detector="sequential",
+                           evidence={"z": crossing.scan.z, "span": float(crossing.scan.span)})
 
     def _report(self, sc: int, cls: str | None, w: FdirWindow, ev: Evidence) -> FaultReport:
         return FaultReport(sender=self.node, t_sim=w.t_end_s, spacecraft=sc, fault_class=cls,

@@ -69,7 +69,10 @@ class InformationTest:
         self.seed = scenario.seed
         self.settings = WindowTestSettings.of(scenario)
         self.twin = twin
-        self.q_window = self.settings.false_alarm(2 if self.cfg.fuse_nis else 1)
+        self.tests = 1 + int(self.cfg.fuse_nis) + int(self.cfg.detector == "sequential")
+        """the statistical tests sharing the false-alarm budget: this one, the NIS test and
+        the sequential test, as fused"""
+        self.q_window = self.settings.false_alarm(self.tests)
 
     def judge(self, ctx: WindowContext, obs: ObserverState, window: FdirWindow,
               identifying: bool, naming: bool) -> Judgement:

@@ -40,6 +40,7 @@ from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
 from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
+from ground.fdir.sequential import SequentialTest, image_false_alarm
 from ground.fdir.window import SettledMap, window_context
 from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS, OBSERVATIONS
 from interfaces.contracts.fdi_schedule import FdiSchedule
@@ -87,6 +88,10 @@ class FdirPipeline:
         self.boresight_body = constants.boresight_body
         self.links = LinkChecks(sc, node, log)
         self.information = InformationTest(sc, self.twin)
+        self.sequential = (SequentialTest(sc, self.twin,
+                                          image_false_alarm(sc, self.information.tests))
+                           if cfg.detector == "sequential" else None)
+        """the sequential test on each image as it comes (None: the windows alone)"""
         self.global_check = GlobalCheck(cfg, self.information.q_window, node, log)
         self.declarer = Declarer(cfg, node, log)
         self.integrity = IntegrityCheck(cfg, node, log, sc.rates.fdi_period_s,
@@ -242,8 +247,10 @@ class FdirPipeline:
         while (t >= self.schedule.end(self.next_window) + self.latency_s - TIME_TOL_S
                and self._data_in(self.next_window, t)):
             k = self.next_window
+            out += self._scan(k)
             self.next_window += 1  # first: a failing window is not retried forever
             out += self.evaluate(k)
+        out += self._scan(self.next_window)
         return [m.model_copy(update={"declared_s": t}) if isinstance(m, FaultReport) else m
                 for m in out]
 
@@ -308,6 +315,35 @@ class FdirPipeline:
         return [m.model_copy(update={"integrity_unjudged": unjudged[m.spacecraft]})
                 if isinstance(m, FdirWindow) and m.spacecraft in unjudged else m
                 for m in out] + reports
+
+    def _scan(self, k: int) -> list[Message]:
+        """With the sequential test: window k's images come so far and not yet scored, each
+        observer's in time order, against the map settled at the window's start (windows
+        before k judged); the faults whose scan crossed (docs/fdir.md, "The sequential
+        test")."""
+        if self.sequential is None:
+            return []
+        a, b = self.schedule.start(k), self.schedule.end(k)
+        settled: SettledMap | None = None
+        out: list[Message] = []
+        for sc, obs in self.observers.items():
+            if self.declarer.declared(sc):
+                self.sequential.reset(sc)
+                continue
+            last = self.sequential.last_scored_s(sc) + TIME_TOL_S
+            mine = sorted((m for m in self.pending
+                           if m.spacecraft == sc and a <= m.image_t_s < b and m.image_t_s > last),
+                          key=lambda m: m.image_t_s)
+            if not mine:
+                continue
+            settled = settled or SettledMap.of(self.settled)
+            ctx = (window_context(sc, obs, mine, a, b, settled, self.n, self.settle_s)[0]
+                   if obs.plan_at(a) is not None and not obs.camera_off_before(b) else None)
+            crossing = self.sequential.score(ctx) if ctx is not None else None
+            self.sequential.passed(sc, mine[-1].image_t_s)
+            if crossing is not None:
+                out.append(self.declarer.declare_crossing(sc, crossing, b))
+        return out
 
     def _pass_silences(self, t: float, now: int) -> list[FaultReport]:
         """With ground passes, by ``t`` (s) in pass ``now``: the observers of which nothing

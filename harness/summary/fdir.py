@@ -29,10 +29,11 @@ from interfaces.contracts.scenario import FdirSettings, Scenario
 class Detection(SummaryRecord):
     """A fault the ground declared (a ``FaultReport``)."""
 
-    FILLABLE: ClassVar[tuple[str, ...]] = ("evidence",)
+    FILLABLE: ClassVar[tuple[str, ...]] = ("evidence", "detector")
 
     spacecraft: int = Field(ge=0, description="the faulty observer; 0: the constellation")
-    time_s: float = Field(description="end of the declaring window, sim s")
+    time_s: float = Field(description="end of the declaring window, sim s (the sequential "
+                                      "test: the time of the image that crossed)")
     declared_s: float | None = Field(
         default=None, description="when the ground declared it, sim s (with ground passes: "
                                   "once the window's data came down)")
@@ -43,6 +44,9 @@ class Detection(SummaryRecord):
                                       "neighbours by agreement aboard")
     judges: list[int] | None = Field(
         default=None, description="the neighbours that found the window failed")
+    detector: Literal["window", "sequential"] = Field(
+        default="window", description="what declared it: a window's tests, or the sequential "
+                                      "test at an image (docs/fdir.md)")
     fault_class: FaultClass | None = Field(alias="class",
                                            description="identified class (null: not yet)")
     direction: Literal["improved", "degraded"] | None = Field(
@@ -235,7 +239,8 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
                               direction=r.direction, metric=r.metric, threshold=r.threshold,
                               evidence=dict(r.evidence), declared_s=r.declared_s,
                               declared_by="ground",
-                              **({"cause": r.cause} if r.cause else {}))
+                              **({"cause": r.cause} if r.cause else {}),
+                              **({"detector": r.detector} if r.detector != "window" else {}))
                     for r in reports],
         scores=score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
         baselines=baseline_scores(verdicts, scenario),

@@ -154,6 +154,11 @@ class FaultReport(Message):
         default=None, description="when the ground judged the window and declared, s: "
                                   "fdir.latency_s after its end, or, with ground passes, "
                                   "once its data came down")
+    detector: Literal["window", "sequential"] = Field(
+        default="window", description="what declared it: a window's tests, or the sequential "
+                                      "test at an image (then t_sim is the image's time, "
+                                      "metric the span's mean shift and threshold the shift "
+                                      "it had to exceed)")
 
 
 class BaselineVerdict(Message):

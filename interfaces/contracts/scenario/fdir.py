@@ -49,6 +49,11 @@ class FdirSettings(Section):
         default="hardware",
         description="the threshold that decides: the quantile of the hardware's nominal ratio "
                     "distribution, or Eq. 11-12's ε-sampling (both are computed and archived)")
+    detector: Literal["window", "sequential"] = Field(
+        default="window",
+        description="what declares an observer's information fault: the window test alone "
+                    "(Eq. 9 per FDI window), or also the sequential test on each image as it "
+                    "arrives (gnc/sequential_test.py), the budget split between them")
     false_alarms_per_observer_hour: float = Field(
         default=0.01, gt=0.0, le=100.0,
         description="false-alarm budget of the hardware threshold, per observer-hour")

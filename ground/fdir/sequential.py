@@ -1,0 +1,141 @@
+"""The FDIR pipeline's sequential test (issue 41; docs/fdir.md, "The sequential test"): with
+``fdir.detector = "sequential"``, each observer's images are scored as they reach the ground,
+each against the nominal twin at the plan (Eq. 9 image by image), and the scan over the
+newest images (``gnc/sequential_test.py``) declares the moment it crosses its threshold,
+instead of waiting for the window's end.
+
+The images of window [a, b) are scored once the ground's map is settled at a (window k − 1
+judged), with ψ held at a as the window test holds it.  The ratio's nominal distribution comes
+from the hardware model once per observer and window, on the images then in (their planned
+poses and the pose spreads the observer reports).  An observer whose fault is declared is not
+scored until its episode ends; its scan then starts afresh.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gnc.fdi_metric import Direction
+from gnc.hardware_threshold import RatioModel, clipped_noise_moments
+from gnc.sequential_test import SCAN_LENGTHS, ScanResult, image_evidence, scan_statistic
+from gnc.sequential_test import scan_threshold as scan_threshold_for
+from gnc.twin import TwinModel, delta_h
+from gnc.window_test import WindowTestSettings, pose_ratio_model
+from ground.fdir.window import WindowContext
+from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.timing import TIME_TOL_S
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """The scan crossing its threshold at one image: the image's time (s), the scan there,
+    the span's mean relative shift and the shift it had to exceed."""
+
+    image_t_s: float
+    scan: ScanResult
+    shift: float
+    limit: float
+
+    @property
+    def direction(self) -> Direction:
+        """Table 3's direction: the gain below the prediction is degraded."""
+        return "degraded" if self.scan.signed < 0.0 else "improved"
+
+
+@dataclass
+class _Scan:
+    """One observer's newest residuals and their 1σ parts (oldest first, at most the longest
+    span), and the time of the last image scored."""
+
+    r: list[float] = field(default_factory=list)
+    sigma_e: list[float] = field(default_factory=list)
+    sigma_b: list[float] = field(default_factory=list)
+    last_t: float = -math.inf
+
+    def push(self, r: float, sigma_e: float, sigma_b: float, t: float) -> None:
+        keep = max(SCAN_LENGTHS) - 1
+        self.r = [*self.r[-keep:], r]
+        self.sigma_e = [*self.sigma_e[-keep:], sigma_e]
+        self.sigma_b = [*self.sigma_b[-keep:], sigma_b]
+        self.last_t = t
+
+    def scan(self) -> ScanResult | None:
+        return scan_statistic(np.array(self.r), np.array(self.sigma_e), np.array(self.sigma_b))
+
+
+def image_false_alarm(scenario: Scenario, tests: int) -> float:
+    """The sequential test's false-alarm probability per image: its share (one of ``tests``
+    fused tests) of ``fdir.false_alarms_per_observer_hour`` over the images of an hour (one
+    every ω_mid period)."""
+    cfg = scenario.fdir
+    return min(cfg.false_alarms_per_observer_hour / max(tests, 1)
+               / (3600.0 * scenario.rates.mid_hz), 0.5)
+
+
+class SequentialTest:
+    """The scans of every observer against the nominal ``twin``, the threshold c from the
+    per-image false-alarm probability ``q_image`` (:func:`image_false_alarm`)."""
+
+    def __init__(self, scenario: Scenario, twin: TwinModel, q_image: float) -> None:
+        self.settings = WindowTestSettings.of(scenario)
+        self.seed = scenario.seed
+        self.twin = twin
+        self.c = scan_threshold_for(q_image)
+        self.noise_var = clipped_noise_moments(scenario.camera.noise_frac)[1]
+        self._scans: dict[int, _Scan] = {}
+        self._models: dict[int, tuple[float, RatioModel | None]] = {}
+        """each observer's window start (s) and its ratio model"""
+
+    def last_scored_s(self, spacecraft: int) -> float:
+        """The time of observer ``spacecraft``'s last scored image, s."""
+        scan = self._scans.get(spacecraft)
+        return scan.last_t if scan is not None else -math.inf
+
+    def passed(self, spacecraft: int, t: float) -> None:
+        """Observer ``spacecraft``'s images up to ``t`` (s) pass unscored (none can be judged:
+        a slew, no plan known)."""
+        scan = self._scans.setdefault(spacecraft, _Scan())
+        scan.last_t = max(scan.last_t, t)
+
+    def reset(self, spacecraft: int) -> None:
+        """Observer ``spacecraft``'s scan starts afresh (its declared episode), keeping the
+        time of its last scored image."""
+        self._scans[spacecraft] = _Scan(last_t=self.last_scored_s(spacecraft))
+
+    def score(self, ctx: WindowContext) -> Crossing | None:
+        """Score ``ctx``'s images (those of its observer not yet scored, in time order): the
+        first at which the scan crosses c, or None."""
+        scan = self._scans.setdefault(ctx.spacecraft, _Scan())
+        pose = ctx.pose()
+        prec = self.twin.precision(pose.planned, pose.boresights())
+        model = self._model(ctx, prec)
+        scan.last_t = float(ctx.times[-1])
+        if model is None:
+            return None
+        weights = prec * (ctx.phi * ctx.psi)
+        gains = np.array([delta_h(ctx.psi[poi], ctx.phi[poi], p) for poi, p in ctx.seen])
+        keep = weights.sum(axis=1) > 0.0
+        r, sigma_e = image_evidence(gains, weights.sum(axis=1), weights, model.mean,
+                                    self.noise_var)
+        sigma_b = model.image_pose_std / model.mean
+        for t, rk, ek in zip(ctx.times[keep], r, sigma_e, strict=True):
+            scan.push(float(rk), float(ek), sigma_b, float(t))
+            result = scan.scan()
+            if result is not None and result.z > self.c:
+                shift = float(np.mean(scan.r[-result.span:]))
+                return Crossing(float(t), result, shift, self.c * abs(shift) / result.z)
+        return None
+
+    def _model(self, ctx: WindowContext, prec: np.ndarray) -> RatioModel | None:
+        """The ratio model of the observer's window, drawn on its first scored images."""
+        held = self._models.get(ctx.spacecraft)
+        if held is not None and abs(held[0] - ctx.a) < TIME_TOL_S:
+            return held[1]
+        rng = np.random.default_rng([self.seed, ctx.spacecraft, int(round(ctx.a)), 2])
+        model = pose_ratio_model(ctx.pose(), self.twin, ctx.psi, ctx.phi, prec, self.settings,
+                                 rng)
+        self._models[ctx.spacecraft] = (ctx.a, model)
+        return model

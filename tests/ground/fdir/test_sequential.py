@@ -1,0 +1,82 @@
+"""The FDIR pipeline's sequential test (ground/fdir/sequential.py) on windows of images made
+by the twin's own camera model: a nominal camera (the sim's multiplicative noise) never
+crosses, a degraded one crosses on its first image, and the crossing declares a fault whose
+class the windows then look for."""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+import pydantic
+import pytest
+
+from gnc.infocost import Camera
+from gnc.poi import sphere_pois
+from gnc.poi_map import PoiMap
+from gnc.twin import TwinModel, centre_boresights
+from ground.fdir.declaration import Declarer
+from ground.fdir.sequential import SequentialTest, image_false_alarm
+from ground.fdir.window import SettledMap, WindowContext
+from tests.conftest import small_scenario
+
+NOISE = 0.05
+SCENARIO = small_scenario(fdir={"detector": "sequential"}, camera={"noise_frac": NOISE})
+TWIN = TwinModel(*sphere_pois(2000, 5.0), Camera(math.radians(12.0), 200.0, 1.0), 5.0)
+
+
+def _window(a: float, beta: list[float], rng: np.random.Generator) -> WindowContext:
+    """Window [a, a + len(beta)) of one image a second on an arc 20 m out, each image seen
+    by a camera of health ``beta[k]`` with the sim's noise max(0, 1 + ν ε) per POI."""
+    t = a + np.arange(len(beta), dtype=float)
+    ang = 1e-3 * t
+    planned = np.stack([20.0 * np.cos(ang), 20.0 * np.sin(ang), 3.0 * np.ones(len(t))], axis=1)
+    prec = TWIN.precision(planned, centre_boresights(planned))
+    seen = []
+    for p, b in zip(prec, beta, strict=True):
+        poi = np.flatnonzero(p > 0.0)
+        noise = np.maximum(0.0, 1.0 + NOISE * rng.standard_normal(len(poi)))
+        seen.append((poi, b * p[poi] * noise))
+    settled = SettledMap.of(PoiMap.uniform(len(TWIN.poi_pos), 1.0, 3))
+    return WindowContext(1, a, a + len(beta), settled, [], t, planned, False, None, None, None,
+                         seen, 0.0)
+
+
+def test_a_nominal_camera_does_not_cross() -> None:
+    test = SequentialTest(SCENARIO, TWIN, 1e-6)
+    rng = np.random.default_rng(5)
+    assert all(test.score(_window(a, [1.0] * 30, rng)) is None for a in (0.0, 30.0, 60.0))
+    assert test.last_scored_s(1) == 89.0
+
+
+def test_a_degraded_camera_crosses_on_its_first_image() -> None:
+    test = SequentialTest(SCENARIO, TWIN, 1e-6)
+    rng = np.random.default_rng(6)
+    assert test.score(_window(0.0, [1.0] * 30, rng)) is None
+    crossing = test.score(_window(30.0, [1.0] * 10 + [0.8] * 20, rng))
+    assert crossing is not None and crossing.image_t_s == 40.0
+    assert crossing.direction == "degraded" and crossing.scan.span == 1
+    assert crossing.shift == pytest.approx(-0.2, abs=0.02)
+    assert crossing.scan.z > test.c and crossing.limit < abs(crossing.shift)
+
+
+def test_a_crossing_declares_a_fault_the_windows_then_name() -> None:
+    declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
+    test = SequentialTest(SCENARIO, TWIN, 1e-6)
+    crossing = test.score(_window(0.0, [0.5] * 30, np.random.default_rng(7)))
+    assert crossing is not None and crossing.image_t_s == 0.0
+    report = declarer.declare_crossing(1, crossing, 30.0)
+    assert report.detector == "sequential" and report.fault_class is None
+    assert report.t_sim == 0.0 and report.window_end_s == 30.0
+    assert declarer.declared(1) and declarer.identifying(1)
+
+
+def test_the_budget_is_shared_image_by_image() -> None:
+    """0.01 false alarms per observer-hour, three fused tests, one image a second."""
+    assert image_false_alarm(SCENARIO, 3) == pytest.approx(0.01 / 3 / 3600)
+
+
+def test_an_unknown_detector_is_refused_naming_the_key() -> None:
+    with pytest.raises(pydantic.ValidationError, match="detector"):
+        small_scenario(fdir={"detector": "cusum"})
