@@ -40,7 +40,7 @@ from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
 from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
-from ground.fdir.sequential import SequentialTest, image_false_alarm
+from ground.fdir.sequential import Crossing, SequentialTest, image_false_alarm
 from ground.fdir.window import SettledMap, window_context
 from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS, OBSERVATIONS
 from interfaces.contracts.fdi_schedule import FdiSchedule
@@ -92,6 +92,8 @@ class FdirPipeline:
                                           image_false_alarm(sc, self.information.tests))
                            if cfg.detector == "sequential" else None)
         """the sequential test on each image as it comes (None: the windows alone)"""
+        self._crossings: dict[int, Crossing] = {}
+        """the sequential test's crossings waiting for the other observers' images"""
         self.global_check = GlobalCheck(cfg, self.information.q_window, node, log)
         self.declarer = Declarer(cfg, node, log)
         self.integrity = IntegrityCheck(cfg, node, log, sc.rates.fdi_period_s,
@@ -247,10 +249,10 @@ class FdirPipeline:
         while (t >= self.schedule.end(self.next_window) + self.latency_s - TIME_TOL_S
                and self._data_in(self.next_window, t)):
             k = self.next_window
-            out += self._scan(k)
+            out += self._scan(k, final=True)
             self.next_window += 1  # first: a failing window is not retried forever
             out += self.evaluate(k)
-        out += self._scan(self.next_window)
+        out += self._scan(self.next_window, final=False)
         return [m.model_copy(update={"declared_s": t}) if isinstance(m, FaultReport) else m
                 for m in out]
 
@@ -316,16 +318,15 @@ class FdirPipeline:
                 if isinstance(m, FdirWindow) and m.spacecraft in unjudged else m
                 for m in out] + reports
 
-    def _scan(self, k: int) -> list[Message]:
+    def _scan(self, k: int, final: bool) -> list[Message]:
         """With the sequential test: window k's images come so far and not yet scored, each
         observer's in time order, against the map settled at the window's start (windows
-        before k judged); the faults whose scan crossed (docs/fdir.md, "The sequential
-        test")."""
+        before k judged), and the crossings then decided (:meth:`_decide_crossings`;
+        ``final``: window k's data is all in).  docs/fdir.md, "The sequential test"."""
         if self.sequential is None:
             return []
         a, b = self.schedule.start(k), self.schedule.end(k)
         settled: SettledMap | None = None
-        out: list[Message] = []
         for sc, obs in self.observers.items():
             if self.declarer.declared(sc):
                 self.sequential.reset(sc)
@@ -342,7 +343,28 @@ class FdirPipeline:
             crossing = self.sequential.score(ctx) if ctx is not None else None
             self.sequential.passed(sc, mine[-1].image_t_s)
             if crossing is not None:
-                out.append(self.declarer.declare_crossing(sc, crossing, b))
+                self._crossings[sc] = crossing
+        return self._decide_crossings(a, b, final)
+
+    def _decide_crossings(self, a: float, b: float, final: bool) -> list[Message]:
+        """The pending crossings of window [a, b) declared, each once every other observer
+        scored in the window has been scored past its image (or ``final``): unless every one
+        of them crossed the same way, a change no single observer explains, which the
+        window's global check judges (Eq. 6)."""
+        scored = [sc for sc in self.observers if self.sequential is not None
+                  and self.sequential.last_scored_s(sc) >= a and not self.declarer.declared(sc)]
+        ways = {c.direction for c in self._crossings.values()}
+        if len(scored) > 1 and set(scored) <= set(self._crossings) and len(ways) == 1:
+            self._crossings.clear()  # common to all: the window's global check decides
+            return []
+        out: list[Message] = []
+        for sc, crossing in sorted(self._crossings.items()):
+            waiting = [o for o in scored if o != sc and self.sequential is not None
+                       and self.sequential.last_scored_s(o) < crossing.image_t_s]
+            if waiting and not final:
+                continue
+            del self._crossings[sc]
+            out.append(self.declarer.declare_crossing(sc, crossing, b))
         return out
 
     def _pass_silences(self, t: float, now: int) -> list[FaultReport]:

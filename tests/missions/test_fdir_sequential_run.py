@@ -1,0 +1,76 @@
+"""The sequential test in real (in-process) runs (``fdir.detector = "sequential"``): a degraded
+camera is declared within seconds of its onset, on its observer only and by the sequential
+test, and named a camera fault by a later window; a calibration error common to every camera
+is still the constellation's alone (the window's global check, Eq. 6), not each observer's;
+and the replay of the archive gives the live declarations, at the same times."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from harness.replay import replay_run
+from harness.summary import RunSummary
+from interfaces.contracts.messages import FaultReport
+from interfaces.contracts.scenario import Scenario
+from tests.conftest import recorded_run, small_scenario
+
+ONSET_S = 213.0
+"""Inside a window, so that a declaration at its end would come 37 s late (the observers
+track from 137 s, judged from 167 s)."""
+
+SETTINGS = {"duration_s": 330.0, "target": {"pois": 1000}, "rates": {"fdi_period_s": 50.0},
+            "observers": {"count": 4, "initial_attitude": "lvlh"},
+            "fdir": {"detector": "sequential"}}
+
+
+def _scenario(fault: dict[str, object]) -> Scenario:
+    return small_scenario("seq", **SETTINGS, faults=[fault])
+
+
+def _run(tmp: Path, fault: dict[str, object]) -> tuple[list[FaultReport], RunSummary]:
+    got, summary = recorded_run(_scenario(fault), tmp, FaultReport)
+    return got["FaultReport"], summary
+
+
+DEGRADED = {"spacecraft": 2, "kind": "camera_degradation", "start_s": ONSET_S,
+            "magnitude": 0.7}
+
+
+@pytest.fixture(scope="module")
+def degraded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[FaultReport],
+                                                                  RunSummary]:
+    out = tmp_path_factory.mktemp("seq_degraded")
+    return out, *_run(out, DEGRADED)
+
+
+def test_a_degraded_camera_is_declared_within_seconds(degraded: Any) -> None:
+    _, reports, summary = degraded
+    first = reports[0]
+    assert first.spacecraft == 2 and first.detector == "sequential"
+    assert first.fault_class is None and first.direction == "degraded"
+    assert ONSET_S <= first.t_sim <= ONSET_S + 3.0
+    assert first.declared_s is not None and first.declared_s <= ONSET_S + 8.0
+    assert first.metric == pytest.approx(0.3, abs=0.05)  # 1 − β: the image's own shortfall
+    named = [r for r in reports[1:] if r.fault_class is not None]
+    assert named and named[0].spacecraft == 2 and named[0].fault_class == "camera"
+    assert {r.spacecraft for r in reports} == {2}
+    (f,) = summary.scores.per_fault
+    assert f.isolated and f.identified_correctly and f.declared_latency_s <= 8.0
+    assert summary.detections[0].detector == "sequential"
+
+
+def test_the_replay_declares_as_the_live_run(degraded: Any) -> None:
+    out, _, _ = degraded
+    replay = replay_run(out, scenario=_scenario(DEGRADED))
+    assert replay.matches_live()
+
+
+def test_a_common_mode_fault_stays_the_constellations(
+        tmp_path_factory: pytest.TempPathFactory) -> None:
+    reports, _ = _run(tmp_path_factory.mktemp("seq_common"),
+                      {"spacecraft": 0, "kind": "camera_calibration", "start_s": ONSET_S,
+                       "magnitude": 0.6})
+    assert [(r.spacecraft, r.fault_class) for r in reports] == [(0, "common_mode")]
