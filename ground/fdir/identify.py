@@ -36,6 +36,7 @@ or ``SE_MARGIN`` standard errors of the located camera
 while beyond them off the nav), or off it the other way
 (``offset_alignment`` < −0.5)
 pointing error reported, and the pose explains the ΔH gap   ``actuator``
+(or there is none: the information test passed)
 the seen POIs show a boresight > 2 × pointing_tol_deg off    ``camera``
 (and ``SE_MARGIN`` standard errors of the located camera)
 Δv commanded while holding, above ``dv_rate_tol_mps2``      ``actuator``
@@ -286,21 +287,24 @@ class Tolerances:
                    fdir.explained_min, fdir.dv_rate_tol_mps2)
 
 
-def classify(ev: Evidence, tol: Tolerances, failed: Sequence[str] = ()) -> str | None:
+def classify(ev: Evidence, tol: Tolerances, failed: Sequence[str] | None = None
+             ) -> str | None:
     """The fault class the evidence points to (module docstring table), or None when nothing
-    stands out.  ``failed``: the detector's tests the window failed.  A window failed by the
-    nav's NIS test alone is not called ``state_sensor``, and one whose NIS test fails while the
-    truth has left a nav still on its plan names no class but ``actuator`` (module
-    docstring)."""
-    cls = _evidence_class(ev, tol)
-    if cls == "state_sensor" and list(failed) == ["nis"]:
+    stands out.  ``failed``: the detector's tests the window failed (None: not known).  A
+    window failed by the nav's NIS test alone is not called ``state_sensor``, and one whose
+    NIS test fails while the truth has left a nav still on its plan names no class but
+    ``actuator`` (module docstring).  A window whose information test passed has no ΔH gap
+    for the pose to explain."""
+    failed = ["information"] if failed is None else list(failed)
+    cls = _evidence_class(ev, tol, gap="information" in failed)
+    if cls == "state_sensor" and failed == ["nis"]:
         return None
     if cls != "actuator" and "nis" in failed and _truth_not_followed(ev, tol):
         return None
     return cls
 
 
-def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
+def _evidence_class(ev: Evidence, tol: Tolerances, gap: bool = True) -> str | None:
     if ev.beta_hat is not None and abs(ev.beta_hat - 1.0) > max(
             tol.beta, BETA_SE_MARGIN * (ev.beta_se or 0.0)):
         return "camera"
@@ -311,7 +315,7 @@ def _evidence_class(ev: Evidence, tol: Tolerances) -> str | None:
                                       or (align or 0.0) < -SAME_WAY or _nav_left_camera(ev)):
         return "state_sensor"  # the nav left the plan; the spacecraft did not, or the other way
     explained = [e for e in (ev.explained_reported, ev.explained_located) if e is not None]
-    pose_explains = not explained or max(explained) >= tol.explained
+    pose_explains = not gap or not explained or max(explained) >= tol.explained
     if (ev.pointing_error_deg or 0.0) > tol.pointing_deg and pose_explains:
         return "actuator"
     if (ev.camera_offset_deg or 0.0) > (2.0 * tol.pointing_deg  # beyond the fit's spread

@@ -297,6 +297,18 @@ def test_a_truth_the_nav_has_not_followed_names_no_class(change: dict[str, float
     assert classify(leak, TOL, ["information", "nis"]) == "actuator"  # actuator verdicts stand
 
 
+def test_a_pointing_fault_that_costs_no_information_is_an_actuator_fault() -> None:
+    """fault-0072 of the space campaign: a 2.4° pointing fault on a 19° camera, declared on the
+    pointing test (1.9° reported) while the information test passed (H_m 1e-4 against τ 0.02):
+    the "explained" fractions of a gap of nothing (−2.0, −3.1) say nothing, so the pointing
+    error names it; with a real gap the pose must explain it, as before."""
+    ev = Evidence(**{**NOMINAL, "pointing_error_deg": 1.89, "explained_reported": -2.03,
+                     "explained_located": -3.12, "camera_offset_deg": 0.0})
+    assert classify(ev, TOL, ["pointing"]) == "actuator"
+    assert classify(ev, TOL, ["information", "pointing"]) is None
+    assert classify(ev, TOL) is None  # the tests failed unknown: a gap is assumed
+
+
 def test_classify_without_evidence() -> None:
     assert classify(Evidence(), TOL) is None
     assert Evidence(beta_hat=0.9).as_dict() == {"beta_hat": 0.9}
