@@ -67,17 +67,32 @@ class FusedViews:
         shared_by``; NaN: not known), each neighbour's part of each view is scaled to that
         count (:func:`fused_shares`): what the crosslinks lost into it, neighbour by
         neighbour."""
-        extra = 1.0 / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS)) - 1.0
+        extra, counted = self._counted(lost)
         diag = np.diag(self.images)
         held = np.divide(self.images, diag[None, :], out=np.zeros_like(self.images),
                          where=diag > 0)
         parts = self.by_source + (held * extra[None, :])[:, :, None] * settled.F[None, :, :]
-        counted = self.images * (1.0 + extra)[None, :]
         share = np.ones_like(counted) if shared is None else fused_shares(counted, shared)
         view = np.einsum("ij,ijm->im", share, parts)
         psi = 1.0 / (settled.w_inv[None, :] + view) ** 2
         own = settled.F * (1.0 + extra)[:, None]
         return np.einsum("im,im->i", own, psi * settled.phi[None, :])
+
+    def fused_fraction(self, lost: np.ndarray, shared: np.ndarray) -> np.ndarray:
+        """Each observer's share (N,) of its neighbours' images that it says it fused
+        (``shared``, as :meth:`contributions` takes it) of those the ground counts in its range,
+        lost ones included; 1 where the ground counts none or the counts are unknown."""
+        _, counted = self._counted(lost)
+        off = ~np.eye(len(counted), dtype=bool)
+        total = np.sum(counted * off, axis=1)
+        fused = np.sum(np.minimum(fused_shares(counted, shared), 1.0) * counted * off, axis=1)
+        return np.divide(fused, total, out=np.ones_like(total), where=total > 0)
+
+    def _counted(self, lost: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The factor each observer's lost share adds to its images (N,), and the images of
+        each observer j in each view i, lost ones included (N, N)."""
+        extra = 1.0 / (1.0 - np.minimum(lost, MAX_JUDGED_LOSS)) - 1.0
+        return extra, self.images * (1.0 + extra)[None, :]
 
 
 MAX_SHARE = 2.0

@@ -111,6 +111,7 @@ class UnjudgedCounts(Counts):
     not_heard: int = 0
     lossy: int = 0
     crosslink_loss: int = 0
+    crosslink_shortfall: int = 0
     no_plan: int = 0
     camera_off: int = 0
     no_images: int = 0

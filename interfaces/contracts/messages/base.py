@@ -185,13 +185,15 @@ class PoiPrecisions(Message):
 
 
 Unjudged = Literal["store_overflow", "aboard", "lost", "not_heard", "lossy", "crosslink_loss",
-                   "no_plan", "camera_off", "no_images", "out_of_range", "not_tracking",
-                   "plan_unknown", "transfer", "excluded"]
+                   "crosslink_shortfall", "no_plan", "camera_off", "no_images", "out_of_range",
+                   "not_tracking", "plan_unknown", "transfer", "excluded"]
 """Why a window, or the H_i report at its end, has no decision (docs/fdir.md, "Lost is not
 corrupt"): its reports lost to the store's overflow (``store_overflow``) or still aboard
 (``aboard``); too many of the observers' observations lost for the report's recomputation
 (``lost``: since the start; ``lossy``: in an observer's latest window, beyond what its link
-explains); an observer not heard from since the window's start (``not_heard``); no plan in
+explains); an observer not heard from since the window's start (``not_heard``); the
+crosslinks' nominal loss (``crosslink_loss``) or the share of its neighbours' images an
+observer fused (``crosslink_shortfall``) beyond what the recomputation allows; no plan in
 force; its camera turned off aboard; no image received; none expected, its plan putting it
 beyond the relay's reach (``out_of_range``: ``comms.range_m`` of the target); no image taken
 while tracking; a transfer whose plan never reached the judge (``plan_unknown``), or any

@@ -307,25 +307,41 @@ def test_a_reported_h_i_off_the_grounds_recomputation_is_a_data_integrity_fault(
     assert report.metric == pytest.approx(0.5)
 
 
-def test_an_observer_starved_of_a_neighbours_images_reports_honestly() -> None:
-    """sc1 fused none of sc2's image (a packet-loss fault on sc2's links) and says so
-    (shared_by {"2": 0}); its honest H_i, on its own precision alone, is well off the H_i on a
-    view holding everything, but matches the ground's rebuilding of its view: no fault."""
+def _starved_check(fused_of_sc2: int, received_of_sc2: int = 20
+                   ) -> tuple[list[FaultReport], dict[int, str]]:
+    """sc1 fused ``fused_of_sc2`` of the ``received_of_sc2`` images of sc2 the ground counts
+    in its range (a packet-loss fault on sc2's links) and says so (``shared_by``); both report
+    honestly: sc1 on its own precision and that share of sc2's."""
     cfg = small_scenario(fdir={"checks_persistence": 1, "integrity_tol": 0.2}).fdir
     check = IntegrityCheck(cfg, "ground", LOG)
     settled = PoiMap.uniform(10, 1.0, 2)
     settled.add(1, np.array([1, 2]), np.array([0.5, 0.5]))
     settled.add(2, np.array([1, 2]), np.array([2.0, 2.0]))
-    views = FusedViews(80.0, np.tile(settled.F[None], (2, 1, 1)), np.ones((2, 2)))
-    alone = float(np.sum(settled.phi * settled.F[0] / (settled.w_inv + settled.F[0]) ** 2))
-    assert alone / float(settled.contributions()[0]) > 1.5
-    for sc, h_i, by in ((1, alone, {"2": 0}), (2, float(settled.contributions()[1]), {"1": 1})):
+    counts = np.full((2, 2), float(received_of_sc2))
+    views = FusedViews(80.0, np.tile(settled.F[None], (2, 1, 1)), counts)
+    share = fused_of_sc2 / received_of_sc2
+    view1 = settled.F[0] + share * settled.F[1]
+    honest1 = float(np.sum(settled.phi * settled.F[0] / (settled.w_inv + view1) ** 2))
+    for sc, h_i, by in ((1, honest1, {"2": fused_of_sc2}),
+                        (2, float(settled.contributions()[1]), {"1": received_of_sc2})):
         check.reported(InfoCostTelemetry(
             sender=f"sc{sc}", t_sim=10.0, spacecraft=sc, h_i=h_i, h_local=1.0, prior_term=0.5,
             pois_seen_own=2, pois_seen_fused=2, images=1, shared_received=sum(by.values()),
             shared_by=by), 1)
-    assert check.check(1, 10.0, settled, views, {1: ObserverState(), 2: ObserverState()}) \
-        == ([], {})
+    return check.check(1, 10.0, settled, views, {1: ObserverState(), 2: ObserverState()})
+
+
+def test_an_observer_short_of_a_few_of_a_neighbours_images_reports_honestly() -> None:
+    """sc1 fused 19 of sc2's 20 images: its honest H_i matches the ground's rebuilding of its
+    view, each neighbour's part scaled to the count it says it fused: judged, no fault."""
+    assert _starved_check(19) == ([], {})
+
+
+def test_an_observer_starved_of_a_neighbours_images_is_not_judged() -> None:
+    """sc1 fused 3 of sc2's 20 images (85% lost on the crosslinks): no count's rescaling gives
+    the view it fused, so its report is not judged, and says why; sc2's still is."""
+    assert _starved_check(3) == ([], {1: "crosslink_shortfall"})
+    assert _starved_check(0) == ([], {1: "crosslink_shortfall"})
 
 
 def test_no_integrity_verdict_rests_on_observations_lost_to_a_stores_overflow() -> None:
@@ -382,7 +398,8 @@ def test_no_integrity_verdict_while_an_observer_is_not_heard_from() -> None:
     observers = {1: ObserverState(heard_s=19.0), 2: ObserverState(heard_s=5.0)}
     report = InfoCostTelemetry(
         sender="sc1", t_sim=20.0, spacecraft=1, h_i=9.0, h_local=1.0, prior_term=0.5,
-        pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=0)  # far off
+        pois_seen_own=2, pois_seen_fused=3, images=1, shared_received=1,
+        shared_by={"2": 1})  # far off
     check.reported(report, 2)
     assert check.check(2, 20.0, settled, views, observers) == ([], {1: "not_heard"})
     observers[2].heard_s = 12.0  # heard in the window: judged, and found off
