@@ -45,13 +45,16 @@ class RatioModel:
     """x = ΔH_i / ΔH_i^pred under no fault: mean and 1σ, with the parts of the spread that come
     from the camera's noise and from the pose; ``image_pose_std``: the pose's part of one
     image's ratio (its RMS over the imaged poses; 0: not drawn), which a window's sum can
-    average away where a tilt helps one image and costs another."""
+    average away where a tilt helps one image and costs another; ``image_spreads``: that
+    part for each imaged pose (every ``POSE_IMAGES``-th of the window's; 0 where the
+    prediction sees nothing)."""
 
     mean: float
     std: float
     camera_std: float
     pose_std: float
     image_pose_std: float = 0.0
+    image_spreads: tuple[float, ...] = ()
 
     def threshold(self, q: float) -> float:
         """τ with P(|1 − x| > τ) = ``q`` for x ~ N(mean, std²) (0 < q < 1)."""
@@ -134,19 +137,23 @@ def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: F
     pose_var = float(draws.var(ddof=1)) if samples > 1 else 0.0
     mean = m1 * pose_mean
     var = m1 * m1 * pose_var + camera_var * pose_mean**2
+    spreads = m1 * _image_spreads(per_image, prec[::k] @ weight)
+    seen = spreads > 0.0
     return RatioModel(mean, math.sqrt(var), math.sqrt(camera_var) * abs(pose_mean),
-                      m1 * math.sqrt(pose_var), m1 * _image_spread(per_image, prec[::k] @ weight))
+                      m1 * math.sqrt(pose_var),
+                      math.sqrt(float(np.mean(spreads[seen] ** 2))) if seen.any() else 0.0,
+                      tuple(float(x) for x in spreads))
 
 
-def _image_spread(per_image: FloatArray, predicted: FloatArray) -> float:
-    """The RMS over images of each image's 1σ ratio across the pose draws (``per_image``:
-    samples × images of drawn gains; ``predicted``: each image's predicted gain); 0 with one
-    draw or no informative image."""
+def _image_spreads(per_image: FloatArray, predicted: FloatArray) -> FloatArray:
+    """Each image's 1σ ratio across the pose draws (``per_image``: samples × images of drawn
+    gains; ``predicted``: each image's predicted gain); 0 with one draw, and where the
+    prediction sees nothing."""
+    out = np.zeros(len(predicted))
     seen = predicted > 0.0
-    if per_image.shape[0] < 2 or not seen.any():
-        return 0.0
-    ratios = per_image[:, seen] / predicted[seen]
-    return math.sqrt(float(np.mean(ratios.var(axis=0, ddof=1))))
+    if per_image.shape[0] >= 2 and seen.any():
+        out[seen] = np.std(per_image[:, seen] / predicted[seen], axis=0, ddof=1)
+    return out
 
 
 def _aimed(aims: FloatArray, positions: FloatArray) -> FloatArray:

@@ -6,8 +6,9 @@ The nominal model of the relative residual r_k = x_k / μ − 1 (μ: the hardwar
 ratio, ``gnc/hardware_threshold.py``) has two parts:
 
 * b_k, the pose's effect (station keeping, the nav-aimed camera, pointing jitter), 1σ = σ_b
-  (the hardware model's ``image_pose_std`` over μ: an image's spread under the window's pose
-  draws), correlated from image to image in whatever way the loops make it;
+  (the hardware model's ``image_spreads`` over μ: an image's spread under the window's pose
+  draws, at its own geometry), correlated from image to image in whatever way the loops make
+  it;
 * e_k, the camera's precision noise, independent per image, 1σ = σ_e (v Σw²/(Σw)² of the
   image's predicted weights, as the hardware model has it for the window).
 

@@ -19,11 +19,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gnc.fdi_metric import Direction
-from gnc.hardware_threshold import RatioModel, clipped_noise_moments
+from gnc.hardware_threshold import POSE_IMAGES, RatioModel, clipped_noise_moments, ratio_model
 from gnc.sequential_test import SCAN_LENGTHS, ScanResult, image_evidence, scan_statistic
 from gnc.sequential_test import scan_threshold as scan_threshold_for
-from gnc.twin import TwinModel, delta_h
-from gnc.window_test import WindowTestSettings, pose_ratio_model
+from gnc.twin import TwinModel, delta_h, sample_stride
+from gnc.window_test import WindowTestSettings
 from ground.fdir.window import WindowContext
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.timing import TIME_TOL_S
@@ -86,8 +86,9 @@ class SequentialTest:
         self.c = scan_threshold_for(q_image)
         self.noise_var = clipped_noise_moments(scenario.camera.noise_frac)[1]
         self._scans: dict[int, _Scan] = {}
-        self._models: dict[int, tuple[float, RatioModel | None]] = {}
-        """each observer's window start (s) and its ratio model"""
+        self.image_period_s = 1.0 / scenario.rates.mid_hz
+        self._models: dict[int, tuple[float, RatioModel | None, np.ndarray]] = {}
+        """each observer's window start (s), its ratio model and the times of its poses"""
 
     def last_scored_s(self, spacecraft: int) -> float:
         """The time of observer ``spacecraft``'s last scored image, s."""
@@ -105,13 +106,20 @@ class SequentialTest:
         time of its last scored image."""
         self._scans[spacecraft] = _Scan(last_t=self.last_scored_s(spacecraft))
 
-    def score(self, ctx: WindowContext) -> Crossing | None:
+    def plan_times(self, a: float, b: float) -> np.ndarray:
+        """The times (s) of window [a, b)'s images the ratio model draws on: one every ω_mid
+        period, every k-th of them (``gnc.hardware_threshold.POSE_IMAGES`` at most)."""
+        times = np.arange(a, b - TIME_TOL_S, self.image_period_s)
+        return times[::sample_stride(len(times), POSE_IMAGES)]
+
+    def score(self, ctx: WindowContext, plan: np.ndarray | None) -> Crossing | None:
         """Score ``ctx``'s images (those of its observer not yet scored, in time order): the
-        first at which the scan crosses c, or None."""
+        first at which the scan crosses c, or None.  ``plan``: the planned positions (K, 3) at
+        :meth:`plan_times` (None: not known there), where the ratio model is drawn."""
         scan = self._scans.setdefault(ctx.spacecraft, _Scan())
         pose = ctx.pose()
         prec = self.twin.precision(pose.planned, pose.boresights())
-        model = self._model(ctx, prec)
+        model, times = self._model(ctx, plan)
         scan.last_t = float(ctx.times[-1])
         if model is None:
             return None
@@ -120,22 +128,45 @@ class SequentialTest:
         keep = weights.sum(axis=1) > 0.0
         r, sigma_e = image_evidence(gains, weights.sum(axis=1), weights, model.mean,
                                     self.noise_var)
-        sigma_b = model.image_pose_std / model.mean
-        for t, rk, ek in zip(ctx.times[keep], r, sigma_e, strict=True):
-            scan.push(float(rk), float(ek), sigma_b, float(t))
+        sigma_b = pose_spreads_at(model, times, ctx.times[keep])
+        for t, rk, ek, bk in zip(ctx.times[keep], r, sigma_e, sigma_b, strict=True):
+            scan.push(float(rk), float(ek), float(bk), float(t))
             result = scan.scan()
             if result is not None and result.z > self.c:
                 shift = float(np.mean(scan.r[-result.span:]))
                 return Crossing(float(t), result, shift, self.c * abs(shift) / result.z)
         return None
 
-    def _model(self, ctx: WindowContext, prec: np.ndarray) -> RatioModel | None:
-        """The ratio model of the observer's window, drawn on its first scored images."""
+    def _model(self, ctx: WindowContext, plan: np.ndarray | None
+               ) -> tuple[RatioModel | None, np.ndarray]:
+        """The ratio model of the observer's window and the times of the poses it imaged:
+        drawn once a window, on the planned poses at :meth:`plan_times` (on the first scored
+        images where the plan is not known there), with the pose spreads the observer
+        reports there."""
         held = self._models.get(ctx.spacecraft)
         if held is not None and abs(held[0] - ctx.a) < TIME_TOL_S:
-            return held[1]
+            return held[1], held[2]
         rng = np.random.default_rng([self.seed, ctx.spacecraft, int(round(ctx.a)), 2])
-        model = pose_ratio_model(ctx.pose(), self.twin, ctx.psi, ctx.phi, prec, self.settings,
-                                 rng)
-        self._models[ctx.spacecraft] = (ctx.a, model)
-        return model
+        pose = ctx.pose()
+        times, positions = ((self.plan_times(ctx.a, ctx.b), plan) if plan is not None
+                            else (ctx.times, pose.planned))
+        aims = (np.repeat(pose.aims[-1:], len(positions), axis=0) if pose.aims is not None
+                else np.zeros_like(positions))
+        model = ratio_model(self.twin, positions, aims, ctx.psi, ctx.phi,
+                            pose.position_sigma(self.settings),
+                            pose.pointing_sigma(self.settings), self.settings.noise_frac,
+                            self.settings.model_samples, rng)
+        times = times[::sample_stride(len(times), POSE_IMAGES)]
+        self._models[ctx.spacecraft] = (ctx.a, model, times)
+        return model, times
+
+
+def pose_spreads_at(model: RatioModel, times: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """σ_b (relative) at each of the image times ``at``: the larger of the model's spreads at
+    the two imaged poses (``times``) about it, so an image between a quiet pose and a
+    sensitive one counts as the sensitive one."""
+    spreads = np.asarray(model.image_spreads) / model.mean
+    if len(spreads) == 1:
+        return np.full(len(at), spreads[0])
+    j = np.clip(np.searchsorted(times, at), 1, len(spreads) - 1)
+    return np.maximum(spreads[j - 1], spreads[j])

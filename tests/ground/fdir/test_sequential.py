@@ -12,12 +12,18 @@ import numpy as np
 import pydantic
 import pytest
 
+from gnc.hardware_threshold import RatioModel
 from gnc.infocost import Camera
 from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
 from gnc.twin import TwinModel, centre_boresights
 from ground.fdir.declaration import Declarer
-from ground.fdir.sequential import SequentialTest, image_false_alarm
+from ground.fdir.sequential import (
+    Crossing,
+    SequentialTest,
+    image_false_alarm,
+    pose_spreads_at,
+)
 from ground.fdir.window import SettledMap, WindowContext
 from tests.conftest import small_scenario
 
@@ -26,12 +32,22 @@ SCENARIO = small_scenario(fdir={"detector": "sequential"}, camera={"noise_frac":
 TWIN = TwinModel(*sphere_pois(2000, 5.0), Camera(math.radians(12.0), 200.0, 1.0), 5.0)
 
 
+def _arc(t: np.ndarray) -> np.ndarray:
+    """The plan: an arc 20 m out, (K, 3) LVLH m at times ``t`` (s)."""
+    ang = 1e-3 * t
+    return np.stack([20.0 * np.cos(ang), 20.0 * np.sin(ang), 3.0 * np.ones(len(t))], axis=1)
+
+
+def _score(test: SequentialTest, ctx: WindowContext) -> Crossing | None:
+    """The test's score of ``ctx``, its model drawn on the plan over the whole window."""
+    return test.score(ctx, _arc(test.plan_times(ctx.a, ctx.b)))
+
+
 def _window(a: float, beta: list[float], rng: np.random.Generator) -> WindowContext:
     """Window [a, a + len(beta)) of one image a second on an arc 20 m out, each image seen
     by a camera of health ``beta[k]`` with the sim's noise max(0, 1 + ν ε) per POI."""
     t = a + np.arange(len(beta), dtype=float)
-    ang = 1e-3 * t
-    planned = np.stack([20.0 * np.cos(ang), 20.0 * np.sin(ang), 3.0 * np.ones(len(t))], axis=1)
+    planned = _arc(t)
     prec = TWIN.precision(planned, centre_boresights(planned))
     seen = []
     for p, b in zip(prec, beta, strict=True):
@@ -46,15 +62,15 @@ def _window(a: float, beta: list[float], rng: np.random.Generator) -> WindowCont
 def test_a_nominal_camera_does_not_cross() -> None:
     test = SequentialTest(SCENARIO, TWIN, 1e-6)
     rng = np.random.default_rng(5)
-    assert all(test.score(_window(a, [1.0] * 30, rng)) is None for a in (0.0, 30.0, 60.0))
+    assert all(_score(test, _window(a, [1.0] * 30, rng)) is None for a in (0.0, 30.0, 60.0))
     assert test.last_scored_s(1) == 89.0
 
 
 def test_a_degraded_camera_crosses_on_its_first_image() -> None:
     test = SequentialTest(SCENARIO, TWIN, 1e-6)
     rng = np.random.default_rng(6)
-    assert test.score(_window(0.0, [1.0] * 30, rng)) is None
-    crossing = test.score(_window(30.0, [1.0] * 10 + [0.8] * 20, rng))
+    assert _score(test, _window(0.0, [1.0] * 30, rng)) is None
+    crossing = _score(test, _window(30.0, [1.0] * 10 + [0.8] * 20, rng))
     assert crossing is not None and crossing.image_t_s == 40.0
     assert crossing.direction == "degraded" and crossing.scan.span == 1
     assert crossing.shift == pytest.approx(-0.2, abs=0.02)
@@ -64,12 +80,23 @@ def test_a_degraded_camera_crosses_on_its_first_image() -> None:
 def test_a_crossing_declares_a_fault_the_windows_then_name() -> None:
     declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
     test = SequentialTest(SCENARIO, TWIN, 1e-6)
-    crossing = test.score(_window(0.0, [0.5] * 30, np.random.default_rng(7)))
+    crossing = _score(test, _window(0.0, [0.5] * 30, np.random.default_rng(7)))
     assert crossing is not None and crossing.image_t_s == 0.0
     report = declarer.declare_crossing(1, crossing, 30.0)
     assert report.detector == "sequential" and report.fault_class is None
     assert report.t_sim == 0.0 and report.window_end_s == 30.0
     assert declarer.declared(1) and declarer.identifying(1)
+
+
+def test_an_image_takes_the_larger_pose_spread_of_the_poses_about_it() -> None:
+    model = RatioModel(1.0, 0.02, 0.001, 0.02, 0.02, (0.01, 0.03, 0.02))
+    times = np.array([0.0, 10.0, 20.0])
+    at = np.array([0.0, 5.0, 15.0, 25.0])
+    assert np.allclose(pose_spreads_at(model, times, at), [0.03, 0.03, 0.03, 0.03])
+    quiet = RatioModel(2.0, 0.02, 0.001, 0.02, 0.02, (0.01, 0.01, 0.04))
+    assert np.allclose(pose_spreads_at(quiet, times, at), [0.005, 0.005, 0.02, 0.02])
+    assert np.allclose(pose_spreads_at(RatioModel(1.0, 0.0, 0.0, 0.0, 0.0, (0.02,)),
+                                       times[:1], at), 0.02)
 
 
 def test_the_budget_is_shared_image_by_image() -> None:
