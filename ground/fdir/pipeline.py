@@ -340,7 +340,8 @@ class FdirPipeline:
             settled = settled or SettledMap.of(self.settled)
             ctx = (window_context(sc, obs, mine, a, b, settled, self.n, self.settle_s)[0]
                    if obs.plan_at(a) is not None and not obs.camera_off_before(b) else None)
-            plan = obs.planned(self.n, self.sequential.plan_times(a, b))
+            plan = (obs.planned(self.n, self.sequential.plan_times(a, b))
+                    if ctx is not None and not self.sequential.modelled(sc, a) else None)
             crossing = (self.sequential.score(ctx, plan[0] if plan is not None and plan[2].all()
                                               else None)
                         if ctx is not None else None)

@@ -112,6 +112,12 @@ class SequentialTest:
         times = np.arange(a, b - TIME_TOL_S, self.image_period_s)
         return times[::sample_stride(len(times), POSE_IMAGES)]
 
+    def modelled(self, spacecraft: int, a: float) -> bool:
+        """Whether observer ``spacecraft``'s ratio model of the window starting at ``a`` (s)
+        is drawn already (its plan is then not needed)."""
+        held = self._models.get(spacecraft)
+        return held is not None and abs(held[0] - a) < TIME_TOL_S
+
     def score(self, ctx: WindowContext, plan: np.ndarray | None) -> Crossing | None:
         """Score ``ctx``'s images (those of its observer not yet scored, in time order): the
         first at which the scan crosses c, or None.  ``plan``: the planned positions (K, 3) at
@@ -144,7 +150,7 @@ class SequentialTest:
         images where the plan is not known there), with the pose spreads the observer
         reports there."""
         held = self._models.get(ctx.spacecraft)
-        if held is not None and abs(held[0] - ctx.a) < TIME_TOL_S:
+        if held is not None and self.modelled(ctx.spacecraft, ctx.a):
             return held[1], held[2]
         rng = np.random.default_rng([self.seed, ctx.spacecraft, int(round(ctx.a)), 2])
         pose = ctx.pose()
