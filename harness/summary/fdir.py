@@ -29,7 +29,7 @@ from interfaces.contracts.scenario import FdirSettings, Scenario
 class Detection(SummaryRecord):
     """A fault the ground declared (a ``FaultReport``)."""
 
-    FILLABLE: ClassVar[tuple[str, ...]] = ("evidence", "detector")
+    FILLABLE: ClassVar[tuple[str, ...]] = ("evidence",)
 
     spacecraft: int = Field(ge=0, description="the faulty observer; 0: the constellation")
     time_s: float = Field(description="end of the declaring window, sim s (the sequential "
