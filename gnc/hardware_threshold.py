@@ -137,7 +137,7 @@ def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: F
     pose_var = float(draws.var(ddof=1)) if samples > 1 else 0.0
     mean = m1 * pose_mean
     var = m1 * m1 * pose_var + camera_var * pose_mean**2
-    spreads = m1 * _image_spreads(per_image, prec[::k] @ weight)
+    spreads = m1 * _image_spreads(per_image, prec[::k] @ weight, pose_mean)
     seen = spreads > 0.0
     return RatioModel(mean, math.sqrt(var), math.sqrt(camera_var) * abs(pose_mean),
                       m1 * math.sqrt(pose_var),
@@ -145,14 +145,16 @@ def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: F
                       tuple(float(x) for x in spreads))
 
 
-def _image_spreads(per_image: FloatArray, predicted: FloatArray) -> FloatArray:
-    """Each image's 1σ ratio across the pose draws (``per_image``: samples × images of drawn
-    gains; ``predicted``: each image's predicted gain); 0 with one draw, and where the
-    prediction sees nothing."""
+def _image_spreads(per_image: FloatArray, predicted: FloatArray, mean: float) -> FloatArray:
+    """Each image's RMS ratio about the window's mean ratio ``mean`` across the pose draws
+    (``per_image``: samples × images of drawn gains; ``predicted``: each image's predicted
+    gain): its spread and its own offset from the window's mean, about which the sequential
+    test takes its residual; 0 with one draw, and where the prediction sees nothing."""
     out = np.zeros(len(predicted))
     seen = predicted > 0.0
     if per_image.shape[0] >= 2 and seen.any():
-        out[seen] = np.std(per_image[:, seen] / predicted[seen], axis=0, ddof=1)
+        deviation = per_image[:, seen] / predicted[seen] - mean
+        out[seen] = np.sqrt(np.mean(deviation**2, axis=0))
     return out
 
 

@@ -328,9 +328,8 @@ class FdirPipeline:
         a, b = self.schedule.start(k), self.schedule.end(k)
         settled: SettledMap | None = None
         for sc, obs in self.observers.items():
-            if self.declarer.declared(sc):
-                self.sequential.reset(sc)
-                continue
+            if self.declarer.declared(sc) or sc in self._crossings:
+                continue  # declared, or its crossing waits: scored again once decided
             last = self.sequential.last_scored_s(sc) + TIME_TOL_S
             mine = sorted((m for m in self.pending
                            if m.spacecraft == sc and a <= m.image_t_s < b and m.image_t_s > last),
@@ -345,8 +344,9 @@ class FdirPipeline:
             crossing = (self.sequential.score(ctx, plan[0] if plan is not None and plan[2].all()
                                               else None)
                         if ctx is not None else None)
-            self.sequential.passed(sc, mine[-1].image_t_s)
-            if crossing is not None:
+            if crossing is None:
+                self.sequential.passed(sc, mine[-1].image_t_s)
+            else:  # the images after it are scored once it is decided
                 self._crossings[sc] = crossing
         return self._decide_crossings(a, b, final)
 
@@ -355,19 +355,24 @@ class FdirPipeline:
         scored in the window has been scored past its image (or ``final``): unless every one
         of them crossed the same way, a change no single observer explains, which the
         window's global check judges (Eq. 6)."""
-        scored = [sc for sc in self.observers if self.sequential is not None
-                  and self.sequential.last_scored_s(sc) >= a and not self.declarer.declared(sc)]
+        if self.sequential is None:
+            return []
+        scored = [sc for sc in self.observers
+                  if self.sequential.last_scored_s(sc) >= a and not self.declarer.declared(sc)]
         ways = {c.direction for c in self._crossings.values()}
         if len(scored) > 1 and set(scored) <= set(self._crossings) and len(ways) == 1:
-            self._crossings.clear()  # common to all: the window's global check decides
+            for sc in self._crossings:  # common to all: the window's global check decides
+                self.sequential.reset(sc)
+            self._crossings.clear()
             return []
         out: list[Message] = []
         for sc, crossing in sorted(self._crossings.items()):
-            waiting = [o for o in scored if o != sc and self.sequential is not None
-                       and self.sequential.last_scored_s(o) < crossing.image_t_s]
+            waiting = [o for o in scored
+                       if o != sc and self.sequential.last_scored_s(o) < crossing.image_t_s]
             if waiting and not final:
                 continue
             del self._crossings[sc]
+            self.sequential.reset(sc)  # its evidence spent: a later crossing is a new one
             out.append(self.declarer.declare_crossing(sc, crossing, b))
         return out
 

@@ -102,7 +102,7 @@ class SequentialTest:
         scan.last_t = max(scan.last_t, t)
 
     def reset(self, spacecraft: int) -> None:
-        """Observer ``spacecraft``'s scan starts afresh (its declared episode), keeping the
+        """Observer ``spacecraft``'s scan starts afresh (its crossing decided), keeping the
         time of its last scored image."""
         self._scans[spacecraft] = _Scan(last_t=self.last_scored_s(spacecraft))
 
@@ -126,8 +126,8 @@ class SequentialTest:
         pose = ctx.pose()
         prec = self.twin.precision(pose.planned, pose.boresights())
         model, times = self._model(ctx, plan)
-        scan.last_t = float(ctx.times[-1])
         if model is None:
+            scan.last_t = float(ctx.times[-1])
             return None
         weights = prec * (ctx.phi * ctx.psi)
         gains = np.array([delta_h(ctx.psi[poi], ctx.phi[poi], p) for poi, p in ctx.seen])
@@ -141,6 +141,7 @@ class SequentialTest:
             if result is not None and result.z > self.c:
                 shift = float(np.mean(scan.r[-result.span:]))
                 return Crossing(float(t), result, shift, self.c * abs(shift) / result.z)
+        scan.last_t = float(ctx.times[-1])
         return None
 
     def _model(self, ctx: WindowContext, plan: np.ndarray | None

@@ -57,6 +57,7 @@ def test_a_degraded_camera_is_declared_within_seconds(degraded: Any) -> None:
     named = [r for r in reports[1:] if r.fault_class is not None]
     assert named and named[0].spacecraft == 2 and named[0].fault_class == "camera"
     assert {r.spacecraft for r in reports} == {2}
+    assert [r.detector for r in reports].count("sequential") == 1  # one fault, declared once
     (f,) = summary.scores.per_fault
     assert f.isolated and f.identified_correctly and f.declared_latency_s <= 8.0
     assert summary.detections[0].detector == "sequential"
