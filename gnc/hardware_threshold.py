@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -43,18 +44,23 @@ FloatArray = npt.NDArray[np.float64]
 @dataclass(frozen=True)
 class RatioModel:
     """x = ΔH_i / ΔH_i^pred under no fault: mean and 1σ, with the parts of the spread that come
-    from the camera's noise and from the pose; ``image_pose_std``: the pose's part of one
-    image's ratio (its RMS over the imaged poses; 0: not drawn), which a window's sum can
-    average away where a tilt helps one image and costs another; ``image_spreads``: that
-    part for each imaged pose (every ``POSE_IMAGES``-th of the window's; 0 where the
-    prediction sees nothing)."""
+    from the camera's noise and from the pose; ``image_spreads``: the pose's part of one
+    image's ratio for each imaged pose (:func:`imaged`; 0 where the prediction sees
+    nothing; empty: not drawn)."""
 
     mean: float
     std: float
     camera_std: float
     pose_std: float
-    image_pose_std: float = 0.0
     image_spreads: tuple[float, ...] = ()
+
+    @property
+    def image_pose_std(self) -> float:
+        """The pose's part of one image's ratio, its RMS over the imaged poses the prediction
+        sees (0: none), which a window's sum can average away where a tilt helps one image
+        and costs another."""
+        seen = [x for x in self.image_spreads if x > 0.0]
+        return math.sqrt(sum(x * x for x in seen) / len(seen)) if seen else 0.0
 
     def threshold(self, q: float) -> float:
         """τ with P(|1 − x| > τ) = ``q`` for x ~ N(mean, std²) (0 < q < 1)."""
@@ -102,6 +108,12 @@ POSE_IMAGES = 6
 offsets are common to the window, so a few images carry its geometry)."""
 
 
+def imaged(rows: npt.NDArray[Any]) -> npt.NDArray[Any]:
+    """The rows of a window's planned poses (or their times) the pose draws image: every
+    k-th, at most ``POSE_IMAGES``."""
+    return rows[::sample_stride(len(rows), POSE_IMAGES)]
+
+
 def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: FloatArray,
                 phi: FloatArray, position_sigma_m: float, pointing_sigma_rad: float,
                 noise_frac: float, samples: int, rng: np.random.Generator,
@@ -121,9 +133,8 @@ def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: F
         return None
     m1, v = clipped_noise_moments(noise_frac)
     camera_var = v * float(np.sum(w * w)) / total**2
-    k = sample_stride(len(positions), POSE_IMAGES)
-    pos, aim = positions[::k], aims[::k]
-    ref = float(np.sum(prec[::k] @ weight))
+    pos, aim, imaged_prec = imaged(positions), imaged(aims), imaged(prec)
+    ref = float(np.sum(imaged_prec @ weight))
     if not ref > 0.0:
         return None
     offsets = rng.normal(0.0, position_sigma_m, (samples, 1, 3))
@@ -137,12 +148,9 @@ def ratio_model(twin: TwinModel, positions: FloatArray, aims: FloatArray, psi: F
     pose_var = float(draws.var(ddof=1)) if samples > 1 else 0.0
     mean = m1 * pose_mean
     var = m1 * m1 * pose_var + camera_var * pose_mean**2
-    spreads = m1 * _image_spreads(per_image, prec[::k] @ weight, pose_mean)
-    seen = spreads > 0.0
+    spreads = m1 * _image_spreads(per_image, imaged_prec @ weight, pose_mean)
     return RatioModel(mean, math.sqrt(var), math.sqrt(camera_var) * abs(pose_mean),
-                      m1 * math.sqrt(pose_var),
-                      math.sqrt(float(np.mean(spreads[seen] ** 2))) if seen.any() else 0.0,
-                      tuple(float(x) for x in spreads))
+                      m1 * math.sqrt(pose_var), tuple(float(x) for x in spreads))
 
 
 def _image_spreads(per_image: FloatArray, predicted: FloatArray, mean: float) -> FloatArray:

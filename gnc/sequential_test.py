@@ -80,18 +80,28 @@ def scan_statistic(residuals: npt.ArrayLike, sigma_e: npt.ArrayLike, sigma_b: np
     return ScanResult(float(abs(z[best])), float(z[best]), int(spans[best]))
 
 
-def image_evidence(gains: FloatArray, predicted: FloatArray, weights: FloatArray,
-                   mean: float, noise_var: float) -> tuple[FloatArray, FloatArray]:
+@dataclass(frozen=True)
+class ImageEvidence:
+    """The images' residuals r_k and camera 1σ σ_e,k (relative), for the images ``kept``
+    (a mask over those given: the twin predicts something of them)."""
+
+    residuals: FloatArray
+    sigma_e: FloatArray
+    kept: npt.NDArray[np.bool_]
+
+
+def image_evidence(gains: FloatArray, weights: FloatArray, mean: float,
+                   noise_var: float) -> ImageEvidence:
     """Each image's residual r_k = (ΔH_k / ΔH_k^pred) / μ − 1 and its camera 1σ σ_e,k =
-    √(v Σ w²) / Σ w (``gnc.hardware_threshold``'s camera part, image by image); ``gains``,
-    ``predicted``: ΔH_k and ΔH_k^pred (K,); ``weights``: the predicted images' w = φψσ⁻¹
-    (K, M); ``mean``: μ; ``noise_var``: v, the clipped noise factor's variance.  Images the
-    twin predicts nothing of are dropped (no evidence)."""
-    keep = predicted > 0.0
-    w = weights[keep]
-    total = w.sum(axis=1)
-    sigma_e = np.sqrt(noise_var * np.sum(w * w, axis=1)) / total
-    return gains[keep] / predicted[keep] / mean - 1.0, sigma_e
+    √(v Σ w²) / Σ w (``gnc.hardware_threshold``'s camera part, image by image); ``gains``:
+    ΔH_k (K,); ``weights``: the predicted images' w = φψσ⁻¹ (K, M), whose sum is ΔH_k^pred;
+    ``mean``: μ; ``noise_var``: v, the clipped noise factor's variance.  Images the twin
+    predicts nothing of are dropped (no evidence)."""
+    predicted = weights.sum(axis=1)
+    kept = predicted > 0.0
+    w = weights[kept]
+    sigma_e = np.sqrt(noise_var * np.sum(w * w, axis=1)) / predicted[kept]
+    return ImageEvidence(gains[kept] / predicted[kept] / mean - 1.0, sigma_e, kept)
 
 
 def scan_threshold(q_image: float, lengths: Sequence[int] = SCAN_LENGTHS) -> float:

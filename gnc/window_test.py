@@ -226,15 +226,20 @@ def hardware_threshold(pose: WindowPose, twin: TwinModel, psi: FloatArray, phi: 
 
 
 def pose_ratio_model(pose: WindowPose, twin: TwinModel, psi: FloatArray, phi: FloatArray,
-                     prec: FloatArray, cfg: WindowTestSettings, rng: np.random.Generator
-                     ) -> RatioModel | None:
+                     prec: FloatArray | None, cfg: WindowTestSettings, rng: np.random.Generator,
+                     positions: FloatArray | None = None) -> RatioModel | None:
     """The ratio's nominal distribution for the images of ``pose``
     (``gnc.hardware_threshold.ratio_model``): the pose's spreads as the observer reports them
     (``WindowPose.position_sigma``, ``pointing_sigma``), ``cfg.model_samples`` pose draws from
-    ``rng``; ``prec``: the twin's predicted precisions.  None when the prediction holds no
-    information."""
-    aims = pose.aims if pose.aims is not None else np.zeros_like(pose.planned)
-    return ratio_model(twin, pose.planned, aims, psi, phi, pose.position_sigma(cfg),
+    ``rng``; ``prec``: the twin's predicted precisions (None: computed).  ``positions``: other
+    planned poses (K, 3) to draw on instead of the images' (the plan over the whole window),
+    aimed as the last image was.  None when the prediction holds no information."""
+    if positions is None:
+        positions, aims = pose.planned, pose.aims
+    else:
+        aims = None if pose.aims is None else np.repeat(pose.aims[-1:], len(positions), axis=0)
+    aims = aims if aims is not None else np.zeros_like(positions)
+    return ratio_model(twin, positions, aims, psi, phi, pose.position_sigma(cfg),
                        pose.pointing_sigma(cfg), cfg.noise_frac, cfg.model_samples, rng, prec)
 
 

@@ -40,7 +40,7 @@ from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
 from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
-from ground.fdir.sequential import Crossing, SequentialTest, image_false_alarm
+from ground.fdir.sequential import Crossing, SequentialTest, decided, image_false_alarm
 from ground.fdir.window import SettledMap, window_context
 from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS, OBSERVATIONS
 from interfaces.contracts.fdi_schedule import FdiSchedule
@@ -351,29 +351,23 @@ class FdirPipeline:
         return self._decide_crossings(a, b, final)
 
     def _decide_crossings(self, a: float, b: float, final: bool) -> list[Message]:
-        """The pending crossings of window [a, b) declared, each once every other observer
-        scored in the window has been scored past its image (or ``final``): unless every one
-        of them crossed the same way, a change no single observer explains, which the
-        window's global check judges (Eq. 6)."""
+        """The pending crossings of window [a, b) declared once decided
+        (:func:`ground.fdir.sequential.decided`; ``final``: the window's data is all in), or
+        dropped when common to every observer scored in it (the global check's, Eq. 6).  An
+        observer whose images were passed over (no plan, camera off) has no say."""
         if self.sequential is None:
             return []
+        test = self.sequential
         scored = [sc for sc in self.observers
-                  if self.sequential.last_scored_s(sc) >= a and not self.declarer.declared(sc)]
-        ways = {c.direction for c in self._crossings.values()}
-        if len(scored) > 1 and set(scored) <= set(self._crossings) and len(ways) == 1:
-            for sc in self._crossings:  # common to all: the window's global check decides
-                self.sequential.reset(sc)
-            self._crossings.clear()
-            return []
+                  if test.evidence_since(sc, a) and not self.declarer.declared(sc)]
+        now = decided(self._crossings, scored,
+                      {sc: test.last_scored_s(sc) for sc in self.observers}, final)
         out: list[Message] = []
-        for sc, crossing in sorted(self._crossings.items()):
-            waiting = [o for o in scored
-                       if o != sc and self.sequential.last_scored_s(o) < crossing.image_t_s]
-            if waiting and not final:
-                continue
-            del self._crossings[sc]
-            self.sequential.reset(sc)  # its evidence spent: a later crossing is a new one
-            out.append(self.declarer.declare_crossing(sc, crossing, b))
+        for sc in list(self._crossings) if now is None else now:
+            crossing = self._crossings.pop(sc)
+            test.reset(sc)  # its evidence spent: a later crossing is a new one
+            if now is not None:
+                out.append(self.declarer.declare_crossing(sc, crossing, b))
         return out
 
     def _pass_silences(self, t: float, now: int) -> list[FaultReport]:

@@ -19,11 +19,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gnc.fdi_metric import Direction
-from gnc.hardware_threshold import POSE_IMAGES, RatioModel, clipped_noise_moments, ratio_model
+from gnc.hardware_threshold import RatioModel, clipped_noise_moments, imaged
 from gnc.sequential_test import SCAN_LENGTHS, ScanResult, image_evidence, scan_statistic
 from gnc.sequential_test import scan_threshold as scan_threshold_for
-from gnc.twin import TwinModel, delta_h, sample_stride
-from gnc.window_test import WindowTestSettings
+from gnc.twin import TwinModel, delta_h
+from gnc.window_test import WindowTestSettings, pose_ratio_model
 from ground.fdir.window import WindowContext
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.timing import TIME_TOL_S
@@ -48,19 +48,21 @@ class Crossing:
 @dataclass
 class _Scan:
     """One observer's newest residuals and their 1σ parts (oldest first, at most the longest
-    span), and the time of the last image scored."""
+    span), the time of the last image looked at (scored or passed over) and of the last one
+    scored."""
 
     r: list[float] = field(default_factory=list)
     sigma_e: list[float] = field(default_factory=list)
     sigma_b: list[float] = field(default_factory=list)
     last_t: float = -math.inf
+    scored_t: float = -math.inf
 
     def push(self, r: float, sigma_e: float, sigma_b: float, t: float) -> None:
         keep = max(SCAN_LENGTHS) - 1
         self.r = [*self.r[-keep:], r]
         self.sigma_e = [*self.sigma_e[-keep:], sigma_e]
         self.sigma_b = [*self.sigma_b[-keep:], sigma_b]
-        self.last_t = t
+        self.last_t = self.scored_t = t
 
     def scan(self) -> ScanResult | None:
         return scan_statistic(np.array(self.r), np.array(self.sigma_e), np.array(self.sigma_b))
@@ -91,9 +93,16 @@ class SequentialTest:
         """each observer's window start (s), its ratio model and the times of its poses"""
 
     def last_scored_s(self, spacecraft: int) -> float:
-        """The time of observer ``spacecraft``'s last scored image, s."""
+        """The time of observer ``spacecraft``'s last image looked at (scored or passed
+        over), s."""
         scan = self._scans.get(spacecraft)
         return scan.last_t if scan is not None else -math.inf
+
+    def evidence_since(self, spacecraft: int, a: float) -> bool:
+        """Whether observer ``spacecraft`` has an image scored at or after ``a`` (s): its
+        evidence counts in the window starting there."""
+        scan = self._scans.get(spacecraft)
+        return scan is not None and scan.scored_t >= a - TIME_TOL_S
 
     def passed(self, spacecraft: int, t: float) -> None:
         """Observer ``spacecraft``'s images up to ``t`` (s) pass unscored (none can be judged:
@@ -103,14 +112,14 @@ class SequentialTest:
 
     def reset(self, spacecraft: int) -> None:
         """Observer ``spacecraft``'s scan starts afresh (its crossing decided), keeping the
-        time of its last scored image."""
-        self._scans[spacecraft] = _Scan(last_t=self.last_scored_s(spacecraft))
+        times of its last images."""
+        old = self._scans.get(spacecraft, _Scan())
+        self._scans[spacecraft] = _Scan(last_t=old.last_t, scored_t=old.scored_t)
 
     def plan_times(self, a: float, b: float) -> np.ndarray:
         """The times (s) of window [a, b)'s images the ratio model draws on: one every ω_mid
-        period, every k-th of them (``gnc.hardware_threshold.POSE_IMAGES`` at most)."""
-        times = np.arange(a, b - TIME_TOL_S, self.image_period_s)
-        return times[::sample_stride(len(times), POSE_IMAGES)]
+        period, those the pose draws image (``gnc.hardware_threshold.imaged``)."""
+        return imaged(np.arange(a, b - TIME_TOL_S, self.image_period_s))
 
     def modelled(self, spacecraft: int, a: float) -> bool:
         """Whether observer ``spacecraft``'s ratio model of the window starting at ``a`` (s)
@@ -129,13 +138,11 @@ class SequentialTest:
         if model is None:
             scan.last_t = float(ctx.times[-1])
             return None
-        weights = prec * (ctx.phi * ctx.psi)
         gains = np.array([delta_h(ctx.psi[poi], ctx.phi[poi], p) for poi, p in ctx.seen])
-        keep = weights.sum(axis=1) > 0.0
-        r, sigma_e = image_evidence(gains, weights.sum(axis=1), weights, model.mean,
-                                    self.noise_var)
-        sigma_b = pose_spreads_at(model, times, ctx.times[keep])
-        for t, rk, ek, bk in zip(ctx.times[keep], r, sigma_e, sigma_b, strict=True):
+        evidence = image_evidence(gains, prec * (ctx.phi * ctx.psi), model.mean, self.noise_var)
+        at = ctx.times[evidence.kept]
+        sigma_b = pose_spreads_at(model, times, at)
+        for t, rk, ek, bk in zip(at, evidence.residuals, evidence.sigma_e, sigma_b, strict=True):
             scan.push(float(rk), float(ek), float(bk), float(t))
             result = scan.scan()
             if result is not None and result.z > self.c:
@@ -154,18 +161,27 @@ class SequentialTest:
         if held is not None and self.modelled(ctx.spacecraft, ctx.a):
             return held[1], held[2]
         rng = np.random.default_rng([self.seed, ctx.spacecraft, int(round(ctx.a)), 2])
-        pose = ctx.pose()
-        times, positions = ((self.plan_times(ctx.a, ctx.b), plan) if plan is not None
-                            else (ctx.times, pose.planned))
-        aims = (np.repeat(pose.aims[-1:], len(positions), axis=0) if pose.aims is not None
-                else np.zeros_like(positions))
-        model = ratio_model(self.twin, positions, aims, ctx.psi, ctx.phi,
-                            pose.position_sigma(self.settings),
-                            pose.pointing_sigma(self.settings), self.settings.noise_frac,
-                            self.settings.model_samples, rng)
-        times = times[::sample_stride(len(times), POSE_IMAGES)]
-        self._models[ctx.spacecraft] = (ctx.a, model, times)
-        return model, times
+        times = self.plan_times(ctx.a, ctx.b) if plan is not None else ctx.times
+        model = pose_ratio_model(ctx.pose(), self.twin, ctx.psi, ctx.phi, None, self.settings,
+                                 rng, plan)
+        self._models[ctx.spacecraft] = (ctx.a, model, imaged(times))
+        return model, imaged(times)
+
+
+def decided(crossings: dict[int, Crossing], scored: list[int], looked_s: dict[int, float],
+            final: bool) -> list[int] | None:
+    """Which observers' ``crossings`` (pending, by observer) are decided now, given the
+    observers ``scored`` in the window (their images scored in it, not declared) and the time
+    of the last image looked at of each (``looked_s``): a crossing waits until every other
+    scored observer has been looked at past its image, unless the window's data is all in
+    (``final``).  None when every scored observer (two or more) crossed the same way: a
+    change no single observer explains, left to the window's global check (Eq. 6)."""
+    ways = {c.direction for c in crossings.values()}
+    if len(scored) > 1 and set(scored) <= set(crossings) and len(ways) == 1:
+        return None
+    return sorted(sc for sc, crossing in crossings.items()
+                  if final or all(looked_s[o] >= crossing.image_t_s
+                                  for o in scored if o != sc))
 
 
 def pose_spreads_at(model: RatioModel, times: np.ndarray, at: np.ndarray) -> np.ndarray:

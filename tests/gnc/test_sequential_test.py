@@ -12,6 +12,7 @@ from scipy.special import ndtr, ndtri
 from gnc.sequential_test import (
     SCAN_LENGTHS,
     delay_bound,
+    image_evidence,
     kl_gaussian_shift,
     scan_statistic,
     scan_threshold,
@@ -25,23 +26,28 @@ def test_the_threshold_is_the_union_bound_over_the_spans() -> None:
     assert scan_threshold(q, (1,)) == pytest.approx(-ndtri(q / 2))
 
 
-def _null_crossings(c: float, sigma_e: float, sigma_b: float, correlation: float,
-                    images: int, runs: int, rng: np.random.Generator) -> float:
-    """Share of images at which the scan over simulated nominal residuals crosses c: the pose
-    effect an AR(1) process of 1σ σ_b and lag-1 ``correlation`` (1: constant over the run),
-    the camera's noise white."""
+def _scans(r: np.ndarray, sigma_e: float, sigma_b: float) -> np.ndarray:
+    """max |Z_n| at every image of every run of ``r`` (runs × images), from the longest span
+    on: the scan of :func:`scan_statistic`, vectorised over runs and images."""
+    cums = np.concatenate([np.zeros((len(r), 1)), np.cumsum(r, axis=1)], axis=1)
+    z = np.zeros(r.shape)
+    for n in SCAN_LENGTHS:
+        means = (cums[:, n:] - cums[:, :-n]) / n
+        z[:, n - 1:] = np.maximum(z[:, n - 1:],
+                                  np.abs(means) / math.sqrt(sigma_b**2 + sigma_e**2 / n))
+    return z[:, max(SCAN_LENGTHS) - 1:]
+
+
+def _null_residuals(sigma_e: float, sigma_b: float, correlation: float, images: int,
+                    runs: int, rng: np.random.Generator) -> np.ndarray:
+    """Simulated nominal residuals (runs × images): the pose effect an AR(1) process of 1σ
+    σ_b and lag-1 ``correlation`` (1: constant over the run), the camera's noise white."""
     b = np.empty((runs, images))
     b[:, 0] = rng.normal(0.0, sigma_b, runs)
     innovation = sigma_b * math.sqrt(1.0 - correlation**2)
     for k in range(1, images):
         b[:, k] = correlation * b[:, k - 1] + rng.normal(0.0, innovation, runs)
-    r = b + rng.normal(0.0, sigma_e, (runs, images))
-    cums = np.concatenate([np.zeros((runs, 1)), np.cumsum(r, axis=1)], axis=1)
-    hit = np.zeros((runs, images), dtype=bool)
-    for n in SCAN_LENGTHS:
-        means = (cums[:, n:] - cums[:, :-n]) / n
-        hit[:, n - 1:] |= np.abs(means) / math.sqrt(sigma_b**2 + sigma_e**2 / n) > c
-    return float(hit[:, max(SCAN_LENGTHS) - 1:].mean())
+    return b + rng.normal(0.0, sigma_e, (runs, images))
 
 
 @pytest.mark.parametrize(("sigma_e", "sigma_b", "correlation"), [
@@ -51,11 +57,15 @@ def test_the_threshold_holds_its_budget_whatever_the_pose_correlation(
         sigma_e: float, sigma_b: float, correlation: float) -> None:
     """The nominal model simulated with the pose effect constant, correlated as the paper's
     set-up measures it (0.55 image to image) and white: no more crossings per image than
-    the budget."""
+    the budget (the simulated scan checked against :func:`scan_statistic` on some runs)."""
     q = 2e-3
-    rate = _null_crossings(scan_threshold(q), sigma_e, sigma_b, correlation, 96, 4000,
-                           np.random.default_rng(41))
-    assert rate <= q
+    r = _null_residuals(sigma_e, sigma_b, correlation, 96, 4000, np.random.default_rng(41))
+    z = _scans(r, sigma_e, sigma_b)
+    for run, image in [(0, 0), (1, 40), (2, 64), (3, 5)]:
+        k = image + max(SCAN_LENGTHS)
+        scan = scan_statistic(r[run, :k], sigma_e, sigma_b)
+        assert scan is not None and scan.z == pytest.approx(z[run, image], rel=1e-9)
+    assert float(np.mean(z > scan_threshold(q))) <= q
 
 
 def test_the_scan_takes_the_span_that_holds_the_shift() -> None:
@@ -63,8 +73,23 @@ def test_the_scan_takes_the_span_that_holds_the_shift() -> None:
     result = scan_statistic(residuals, 0.002, 0.005)
     assert result is not None and result.span == 2
     assert result.signed == pytest.approx(-0.03 / math.sqrt(0.005**2 + 0.002**2 / 2))
-    assert result.z == pytest.approx(abs(result.signed))
+    assert result.z == -result.signed
+    mixed = scan_statistic(residuals, np.array([0.001] * 5 + [0.004]),
+                           np.array([0.01] * 4 + [0.002, 0.004]))
+    assert mixed is not None and mixed.span == 2  # S_2² = (mean σ_b)² + Σσ_e² / 4
+    assert mixed.signed == pytest.approx(-0.03 / math.sqrt(0.003**2 + (0.001**2 + 0.004**2) / 4))
     assert scan_statistic(np.array([]), 0.002, 0.005) is None
+
+
+def test_an_image_s_evidence_is_its_gain_against_the_prediction() -> None:
+    """Two POIs of weights 1 and 3 (ΔH^pred 4): a gain of 3.6 at μ = 0.9 is no change;
+    σ_e = √(v (1 + 9)) / 4; an image the twin predicts nothing of is dropped."""
+    weights = np.array([[1.0, 3.0], [0.0, 0.0], [2.0, 2.0]])
+    evidence = image_evidence(np.array([3.6, 1.0, 2.88]), weights, 0.9, 0.0025)
+    assert evidence.kept.tolist() == [True, False, True]
+    assert evidence.residuals == pytest.approx([0.0, -0.2])
+    assert evidence.sigma_e == pytest.approx([math.sqrt(0.0025 * 10) / 4,
+                                              math.sqrt(0.0025 * 8) / 4])
 
 
 def test_a_degraded_camera_crosses_on_its_first_image() -> None:

@@ -16,11 +16,13 @@ from gnc.hardware_threshold import RatioModel
 from gnc.infocost import Camera
 from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
+from gnc.sequential_test import ScanResult
 from gnc.twin import TwinModel, centre_boresights
 from ground.fdir.declaration import Declarer
 from ground.fdir.sequential import (
     Crossing,
     SequentialTest,
+    decided,
     image_false_alarm,
     pose_spreads_at,
 )
@@ -89,13 +91,13 @@ def test_a_crossing_declares_a_fault_the_windows_then_name() -> None:
 
 
 def test_an_image_takes_the_larger_pose_spread_of_the_poses_about_it() -> None:
-    model = RatioModel(1.0, 0.02, 0.001, 0.02, 0.02, (0.01, 0.03, 0.02))
+    model = RatioModel(1.0, 0.02, 0.001, 0.02, (0.01, 0.03, 0.02))
     times = np.array([0.0, 10.0, 20.0])
     at = np.array([0.0, 5.0, 15.0, 25.0])
     assert np.allclose(pose_spreads_at(model, times, at), [0.03, 0.03, 0.03, 0.03])
-    quiet = RatioModel(2.0, 0.02, 0.001, 0.02, 0.02, (0.01, 0.01, 0.04))
+    quiet = RatioModel(2.0, 0.02, 0.001, 0.02, (0.01, 0.01, 0.04))
     assert np.allclose(pose_spreads_at(quiet, times, at), [0.005, 0.005, 0.02, 0.02])
-    assert np.allclose(pose_spreads_at(RatioModel(1.0, 0.0, 0.0, 0.0, 0.0, (0.02,)),
+    assert np.allclose(pose_spreads_at(RatioModel(1.0, 0.0, 0.0, 0.0, (0.02,)),
                                        times[:1], at), 0.02)
 
 
@@ -107,3 +109,29 @@ def test_the_budget_is_shared_image_by_image() -> None:
 def test_an_unknown_detector_is_refused_naming_the_key() -> None:
     with pytest.raises(pydantic.ValidationError, match="detector"):
         small_scenario(fdir={"detector": "cusum"})
+
+
+def _crossing(t: float, signed: float) -> Crossing:
+    return Crossing(t, ScanResult(abs(signed), signed, 1), signed / 100.0, 0.05)
+
+
+def test_a_crossing_waits_for_the_other_observers_images() -> None:
+    """sc1 crossed at 12 s: declared once sc2 and sc3 are looked at up to 12 s, or at the
+    window's end; an observer not scored in the window is not waited for."""
+    crossings = {1: _crossing(12.0, -8.0)}
+    assert decided(crossings, [1, 2, 3], {1: 12.0, 2: 14.0, 3: 11.0}, False) == []
+    assert decided(crossings, [1, 2, 3], {1: 12.0, 2: 14.0, 3: 11.0}, True) == [1]
+    assert decided(crossings, [1, 2, 3], {1: 12.0, 2: 14.0, 3: 12.0}, False) == [1]
+    assert decided(crossings, [1, 2], {1: 12.0, 2: 14.0, 3: 0.0}, False) == [1]
+
+
+def test_a_change_every_observer_sees_alike_is_left_to_the_global_check() -> None:
+    both_down = {1: _crossing(12.0, -8.0), 2: _crossing(13.0, -9.0)}
+    assert decided(both_down, [1, 2], {1: 12.0, 2: 13.0}, True) is None
+    opposite = {1: _crossing(12.0, -8.0), 2: _crossing(13.0, 9.0)}
+    assert decided(opposite, [1, 2], {1: 12.0, 2: 13.0}, True) == [1, 2]
+    # sc3 saw nothing: sc1's is decided; sc2's waits for sc1's images after 12 s, which are
+    # scored once sc1's crossing is decided
+    assert decided(both_down, [1, 2, 3], {1: 12.0, 2: 13.0, 3: 13.0}, False) == [1]
+    alone = {1: _crossing(12.0, -8.0)}
+    assert decided(alone, [1], {1: 12.0}, False) == [1]  # one observer: its own fault
