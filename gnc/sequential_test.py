@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.special import ndtri
+from scipy.special import ndtr, ndtri
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -113,6 +113,12 @@ def scan_threshold(q_image: float, lengths: Sequence[int] = SCAN_LENGTHS) -> flo
     if not 0.0 < q_image < 1.0:
         raise ValueError(f"false-alarm probability must be in (0, 1), got {q_image!r}")
     return float(-ndtri(q_image / (2.0 * len(lengths))))
+
+
+def scan_false_alarm(c: float, lengths: Sequence[int] = SCAN_LENGTHS) -> float:
+    """2 L Φ(−c): the bound on the probability that the scan at one image crosses ``c``
+    (:func:`scan_threshold`'s inverse)."""
+    return float(2.0 * len(lengths) * ndtr(-c))
 
 
 def kl_gaussian_shift(delta: float, sigma: float) -> float:

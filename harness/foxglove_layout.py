@@ -8,7 +8,8 @@ changed.  Three tabs:
 
 - **FDIR**: H, the ground's information cost at each FDI window's start
   (``ground/fdir/constellation.cost``), and each H_i (``sc/<i>/infocost/telemetry.h_i``);
-  per observer the metric H_m against its threshold τ (``ground/fdir/window``); the faults
+  per observer the metric H_m against its threshold τ (``ground/fdir/window``), and with
+  ``fdir.detector = "sequential"`` the scan statistic against its threshold c; the faults
   injected (``sim/truth/faults``, when the scenario has any) and declared
   (``ground/fdir/report``), as state transitions and the latest of each in full.
 - **LVLH**: the truth poses in the 3D panel (``harness.foxglove_scene``: a user script of the
@@ -108,10 +109,13 @@ def _fdir_tab(scenario: Scenario, mission: str) -> Tab:
                         _series(f"{cat.INFO_COST.key(mission, sc_node(i))}.h_i", f"H_{i}",
                                 _colour(i)) for i in _observers(scenario)])}
     metric = {f"Plot!metric-sc{i}": _metric_plot(mission, i) for i in _observers(scenario)}
+    scan = ({f"Plot!scan-sc{i}": _scan_plot(mission, i) for i in _observers(scenario)}
+            if scenario.fdir.detector == "sequential" else {})
     faults = _fault_panels(scenario, mission)
-    tree = _split([_split(list(info), "column"), _split(list(metric), "column"),
+    tree = _split([_split(list(info), "column"),
+                   *(_split(list(panels), "column") for panels in (metric, scan) if panels),
                    _split(list(faults), "column")], "row")
-    return "FDIR", tree, {**info, **metric, **faults}
+    return "FDIR", tree, {**info, **metric, **scan, **faults}
 
 
 def _metric_plot(mission: str, i: int) -> dict[str, Any]:
@@ -119,6 +123,14 @@ def _metric_plot(mission: str, i: int) -> dict[str, Any]:
     return _plot(f"sc{i}: metric H_m against its threshold τ (Eq. 9)",
                  [_series(f"{window}.metric", "H_m", METRIC_COLOUR),
                   _series(f"{window}.threshold", "τ", THRESHOLD_COLOUR)])
+
+
+def _scan_plot(mission: str, i: int) -> dict[str, Any]:
+    window = f"{cat.FDIR_WINDOW.key(mission)}{{spacecraft=={i}}}"
+    return _plot(f"sc{i}: the sequential test's largest scan statistic in each window "
+                 f"against its threshold c",
+                 [_series(f"{window}.scan_z_max", "max |Z|", METRIC_COLOUR),
+                  _series(f"{window}.scan_threshold", "c", THRESHOLD_COLOUR)])
 
 
 def _fault_panels(scenario: Scenario, mission: str) -> Panels:

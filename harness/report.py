@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -218,14 +219,7 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: RunSumm
                 label="log H_m")
         ax.plot(t, np.log10([max(w.threshold, floor) for w in mine]), "--", lw=1.0,
                 label="log τ")
-        for f in summary.injected_faults:
-            if f.spacecraft == sc:
-                ax.axvline(f.start_s, color="tab:red", lw=1.0)
-        for d in summary.detections or []:
-            if d.spacecraft == sc:
-                ax.axvline(d.time_s, color="k", lw=1.0, ls=":")
-        ax.set_ylabel(f"sc{sc}")
-        ax.grid(True, alpha=0.3)
+        _mark_faults(ax, sc, summary)
     axes[0, 0].legend(fontsize=8, loc="upper right")
     axes[-1, 0].set_xlabel("sim time (s)  (red: fault onset, dotted: fault declared)")
     fig.suptitle("FDIR: metric against adaptive threshold (Eq. 9, 12)")
@@ -233,7 +227,8 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: RunSumm
     fig.savefig(out / "fdir.png", dpi=110)
     plt.close(fig)
     _gain_plot(out, judged, ids)
-    rows = ["## FDIR", "", "![fdir](fdir.png)", "", "![fdir gain](fdir_gain.png)", "",
+    scan = _scan_plot(out, windows, ids, summary)
+    rows = ["## FDIR", "", "![fdir](fdir.png)", "", "![fdir gain](fdir_gain.png)", "", *scan,
             "| fault | spacecraft | onset (s) | detected | isolated | latency (s) | class |",
             "|---|---|---|---|---|---|---|"]
     scores = summary.scores
@@ -248,6 +243,44 @@ def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: RunSumm
                  f"{scores.nominal_cycles if scores else 0} nominal FDI cycles.", ""]
     return (rows + _identification_rows(summary) + _table4_rows(summary)
             + _detector_rows(summary) + _recovery_rows(summary))
+
+
+def _mark_faults(ax: Any, sc: int, summary: RunSummary) -> None:
+    """Observer ``sc``'s fault onsets (red) and declarations (dotted) on ``ax``, its label
+    and grid."""
+    for f in summary.injected_faults:
+        if f.spacecraft == sc:
+            ax.axvline(f.start_s, color="tab:red", lw=1.0)
+    for d in summary.detections or []:
+        if d.spacecraft == sc:
+            ax.axvline(d.time_s, color="k", lw=1.0, ls=":")
+    ax.set_ylabel(f"sc{sc}")
+    ax.grid(True, alpha=0.3)
+
+
+def _scan_plot(out: Path, windows: list[FdirWindow], ids: list[int], summary: RunSummary
+               ) -> list[str]:
+    """With the sequential test: per observer, the largest scan statistic of each window
+    against its threshold c (fdir_scan.png), the report's lines for it (none without)."""
+    scanned = [w for w in windows if w.scan_z_max is not None and w.scan_threshold is not None]
+    if not scanned:
+        return []
+    fig, axes = plt.subplots(len(ids), 1, figsize=(10, 1.8 * len(ids) + 1), sharex=True,
+                             squeeze=False)
+    for ax, sc in zip(axes[:, 0], ids, strict=True):
+        mine = [w for w in scanned if w.spacecraft == sc]
+        t = [w.t_end_s for w in mine]
+        ax.plot(t, [w.scan_z_max for w in mine], "o-", ms=3, lw=1.0, label="max |Z|")
+        ax.plot(t, [w.scan_threshold for w in mine], "--", lw=1.0, label="c")
+        _mark_faults(ax, sc, summary)
+    axes[0, 0].legend(fontsize=8, loc="upper right")
+    axes[-1, 0].set_xlabel("window end, sim time (s)  (red: fault onset, dotted: declared)")
+    fig.suptitle("FDIR: the sequential test's scan statistic, largest in each window, "
+                 "against its threshold")
+    fig.tight_layout()
+    fig.savefig(out / "fdir_scan.png", dpi=110)
+    plt.close(fig)
+    return ["![fdir scan](fdir_scan.png)", ""]
 
 
 def _identification_rows(summary: RunSummary) -> list[str]:

@@ -283,7 +283,9 @@ class FdirPipeline:
         for sc, obs in self.observers.items():
             mine = sorted((m for m in inside if m.spacecraft == sc), key=lambda m: m.image_t_s)
             window = FdirWindow(sender=self.node, t_sim=b, spacecraft=sc, t_start_s=a,
-                                t_end_s=b, images=len(mine))
+                                t_end_s=b, images=len(mine),
+                                **(self.sequential.window_fields(sc, a)
+                                   if self.sequential is not None else {}))
             lost_aboard = self._lost_aboard(sc, obs, a, b)
             if lost_aboard is not None:  # data lost or still aboard, of known cause
                 out += [*lost_aboard[1], window.model_copy(update={"unjudged": lost_aboard[0]})]

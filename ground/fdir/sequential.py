@@ -20,7 +20,13 @@ import numpy as np
 
 from gnc.fdi_metric import Direction
 from gnc.hardware_threshold import RatioModel, clipped_noise_moments, imaged
-from gnc.sequential_test import SCAN_LENGTHS, ScanResult, image_evidence, scan_statistic
+from gnc.sequential_test import (
+    SCAN_LENGTHS,
+    ImageEvidence,
+    ScanResult,
+    image_evidence,
+    scan_statistic,
+)
 from gnc.sequential_test import scan_threshold as scan_threshold_for
 from gnc.twin import TwinModel, delta_h
 from gnc.window_test import WindowTestSettings, pose_ratio_model
@@ -68,6 +74,22 @@ class _Scan:
         return scan_statistic(np.array(self.r), np.array(self.sigma_e), np.array(self.sigma_b))
 
 
+@dataclass
+class _WindowStats:
+    """What one observer's scored images of the window starting at ``a`` (s) showed: the
+    largest scan statistic, and the sum of their nominal variances over their number."""
+
+    a: float
+    z_max: float = 0.0
+    var_sum: float = 0.0
+    images: int = 0
+
+    def add(self, z: float, sigma_e: float, sigma_b: float) -> None:
+        self.z_max = max(self.z_max, z)
+        self.var_sum += sigma_e * sigma_e + sigma_b * sigma_b
+        self.images += 1
+
+
 def image_false_alarm(scenario: Scenario, tests: int) -> float:
     """The sequential test's false-alarm probability per image: its share (one of ``tests``
     fused tests) of ``fdir.false_alarms_per_observer_hour`` over the images of an hour (one
@@ -91,6 +113,18 @@ class SequentialTest:
         self.image_period_s = 1.0 / scenario.rates.mid_hz
         self._models: dict[int, tuple[float, RatioModel | None, np.ndarray]] = {}
         """each observer's window start (s), its ratio model and the times of its poses"""
+        self._stats: dict[int, _WindowStats] = {}
+        """each observer's scored images of its latest window"""
+
+    def window_fields(self, spacecraft: int, a: float) -> dict[str, float]:
+        """The scan's record of observer ``spacecraft``'s window starting at ``a`` (s), as
+        ``FdirWindow``'s ``scan_z_max``, ``scan_threshold`` and ``image_sigma``; empty when
+        no image of it was scored."""
+        stats = self._stats.get(spacecraft)
+        if stats is None or abs(stats.a - a) > TIME_TOL_S or not stats.images:
+            return {}
+        return {"scan_z_max": stats.z_max, "scan_threshold": self.c,
+                "image_sigma": math.sqrt(stats.var_sum / stats.images)}
 
     def last_scored_s(self, spacecraft: int) -> float:
         """The time of observer ``spacecraft``'s last image looked at (scored or passed
@@ -141,14 +175,26 @@ class SequentialTest:
         gains = np.array([delta_h(ctx.psi[poi], ctx.phi[poi], p) for poi, p in ctx.seen])
         evidence = image_evidence(gains, prec * (ctx.phi * ctx.psi), model.mean, self.noise_var)
         at = ctx.times[evidence.kept]
-        sigma_b = pose_spreads_at(model, times, at)
+        crossing = self._push(ctx, at, evidence, pose_spreads_at(model, times, at))
+        if crossing is None:
+            scan.last_t = float(ctx.times[-1])
+        return crossing
+
+    def _push(self, ctx: WindowContext, at: np.ndarray, evidence: ImageEvidence,
+              sigma_b: np.ndarray) -> Crossing | None:
+        """The images at ``at`` (s) pushed onto the observer's scan one by one until the scan
+        crosses c (that image's crossing), each counted in the window's record."""
+        scan = self._scans[ctx.spacecraft]
+        stats = self._stats.get(ctx.spacecraft)
+        if stats is None or abs(stats.a - ctx.a) > TIME_TOL_S:
+            stats = self._stats[ctx.spacecraft] = _WindowStats(ctx.a)
         for t, rk, ek, bk in zip(at, evidence.residuals, evidence.sigma_e, sigma_b, strict=True):
             scan.push(float(rk), float(ek), float(bk), float(t))
             result = scan.scan()
+            stats.add(result.z if result is not None else 0.0, float(ek), float(bk))
             if result is not None and result.z > self.c:
                 shift = float(np.mean(scan.r[-result.span:]))
                 return Crossing(float(t), result, shift, self.c * abs(shift) / result.z)
-        scan.last_t = float(ctx.times[-1])
         return None
 
     def _model(self, ctx: WindowContext, plan: np.ndarray | None

@@ -36,6 +36,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from harness.campaign.bound_report import bound_lines  # noqa: E402
 from harness.campaign.dimensions import BinFigures, Dimension, by_dimension  # noqa: E402
 from harness.campaign.rescore import (  # noqa: E402
     PERSISTENCE_RULES,
@@ -111,7 +112,8 @@ RESULT_FIELDS = ["run", "group", "seed", "status", "detector", "kind", "spacecra
                  "magnitude", "detected", "isolated", "latency_s", "identified_class",
                  "identification_latency_s", "expected_class", "judgeable_s", "unjudged",
                  "window_latency_s", "declared_latency_s", "contact", "neighbours_latency_s",
-                 "first_latency_s", "false_alarms", "nominal_cycles"]
+                 "first_latency_s", "declaring_test", "image_divergence", "delay_bound_s",
+                 "false_alarms", "nominal_cycles"]
 """The columns of results.csv."""
 
 
@@ -133,6 +135,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     lines += _group_lines(runs, rows, detectors, groups)
     lines += _dimension_lines(out, by_dimension(loaded, rows))
     lines += _magnitude_lines(rows, detectors, hours)
+    lines += bound_lines(out, rows)
     lines += _identification_lines(out, rows, hours["main"])
     lines += _rescoring_lines(runs)
     lines += _threshold_lines(runs)

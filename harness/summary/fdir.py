@@ -13,6 +13,7 @@ from typing import Any, ClassVar, Literal, Self
 from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
 
 from harness.archive.reader import RunArchive
+from harness.summary.delay_bound import with_delay_bounds
 from harness.summary.records import SummaryRecord
 from harness.summary.scoring import Alarm, FaultClass, Judged, Scores, overlaps_fault, score
 from harness.summary.series import FdirSeries, MainWindow, SeriesWindow
@@ -231,10 +232,13 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
                  verdicts: list[BaselineVerdict], scenario: Scenario) -> FdirResults:
     """The FDIR part of summary.json from the ground's own output messages (a live run's
     archive or a replay): detections, scores, baselines, series and settings."""
-    alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class, r.declared_s) for r in reports
+    sequential = scenario.fdir.detector == "sequential"
+    alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class, r.declared_s,
+                    r.detector if sequential else None) for r in reports
               if r.cause is None]  # a known cause (store overflow) is no alarm of a fault
     judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
               if w.exceeded is not None]
+    scores = score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s)
     return FdirResults(
         detections=[Detection(spacecraft=r.spacecraft, time_s=r.t_sim, fault_class=r.fault_class,
                               direction=r.direction, metric=r.metric, threshold=r.threshold,
@@ -243,7 +247,8 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
                               **({"cause": r.cause} if r.cause else {}),
                               **({"detector": r.detector} if r.detector != "window" else {}))
                     for r in reports],
-        scores=score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s),
+        scores=(with_delay_bounds(scores, windows, 1.0 / scenario.rates.mid_hz)
+                if sequential else scores),
         baselines=baseline_scores(verdicts, scenario),
         fdir_series=series_of(windows, verdicts),
         fdir_thresholds=threshold_census(windows, scenario),

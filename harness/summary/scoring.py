@@ -49,6 +49,8 @@ class Alarm:
     fault_class: FaultClass | None
     declared_s: float | None = None
     """when it was declared (s; None: not known)"""
+    detector: Literal["window", "sequential"] | None = None
+    """what declared it, where the sequential test runs (None: the window test alone)"""
 
     @property
     def at_s(self) -> float:
@@ -100,6 +102,8 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
             identification_latency_s=classed[0].at_s - f.start_s if classed else None,
             declared_latency_s=(first.declared_s - f.start_s
                                 if first is not None and first.declared_s is not None else None),
+            **({"detector": first.detector}
+               if first is not None and first.detector is not None else {}),
         ))
 
     def faulty(sc: int, t: float) -> bool:  # a common-mode fault (0) acts on every observer
@@ -146,6 +150,20 @@ class FaultScore(SummaryRecord):
         default=None, description="onset to the first (isolating) alarm's declaration, s: "
                                   "what the ground knew when (with ground passes, the gap "
                                   "to the pass is in it)")
+    detector: Literal["window", "sequential"] | None = Field(
+        default=None, description="what declared the first (isolating) alarm, where the "
+                                  "sequential test runs: a window's tests or the scan")
+    image_divergence: float | None = Field(
+        default=None, ge=0.0,
+        description="where the sequential test runs: the fault's per-image Kullback-Leibler "
+                    "divergence D = δ²/2σ² (nats), δ its observer's mean relative shift of the "
+                    "information ratio over the first whole window after onset, σ one image's "
+                    "nominal 1σ (harness/summary/delay_bound.py)")
+    delay_bound_s: float | None = Field(
+        default=None, ge=0.0,
+        description="log γ / D images in s, at least one image (γ: the scan's mean time to a "
+                    "false alarm, images): the smallest worst-case mean delay of any test as "
+                    "quick to false-alarm (Lorden 1971)")
 
 
 class Scores(SummaryRecord):

@@ -14,6 +14,7 @@ from gnc.sequential_test import (
     delay_bound,
     image_evidence,
     kl_gaussian_shift,
+    scan_false_alarm,
     scan_statistic,
     scan_threshold,
 )
@@ -24,6 +25,7 @@ def test_the_threshold_is_the_union_bound_over_the_spans() -> None:
     c = scan_threshold(q)
     assert 2 * len(SCAN_LENGTHS) * ndtr(-c) == pytest.approx(q, rel=1e-9)
     assert scan_threshold(q, (1,)) == pytest.approx(-ndtri(q / 2))
+    assert scan_false_alarm(c) == pytest.approx(q, rel=1e-9)
 
 
 def _scans(r: np.ndarray, sigma_e: float, sigma_b: float) -> np.ndarray:

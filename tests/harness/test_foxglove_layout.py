@@ -25,6 +25,8 @@ PASSES = load_scenario(REPO / "deploy" / "scenarios" / "passes.toml")
 """Five observers, ground passes, a thruster fault on observer 2."""
 PLAIN = small_scenario(M, observers={"count": 3})
 """Three observers heard continuously, no fault."""
+SEQUENTIAL = small_scenario(M, observers={"count": 3}, fdir={"detector": "sequential"})
+"""The same, judged by the sequential test."""
 
 _TOKEN = re.compile(r"\.(\w+)|\[(-?\d+|:)\]|\{(\w+)==('[^']*'|-?\d+|true|false)\}")
 
@@ -85,7 +87,8 @@ def _splits_add_up(tree: fl.Mosaic) -> None:
         _splits_add_up(tree["second"])
 
 
-@pytest.mark.parametrize("scenario", [PASSES, PLAIN], ids=["passes", "plain"])
+@pytest.mark.parametrize("scenario", [PASSES, PLAIN, SEQUENTIAL],
+                         ids=["passes", "plain", "sequential"])
 def test_every_path_is_a_key_of_the_mission_with_fields_its_message_has(
         scenario: Scenario) -> None:
     doc = fl.layout(scenario, M)
@@ -113,6 +116,9 @@ def test_the_panels_follow_the_scenario() -> None:
     passes, plain = fl.layout(PASSES, M)["configById"], fl.layout(PLAIN, M)["configById"]
     assert sum(pid.startswith("Plot!metric-sc") for pid in passes) == 5
     assert sum(pid.startswith("Plot!track-sc") for pid in plain) == 3
+    sequential = fl.layout(SEQUENTIAL, M)["configById"]  # the scan against c, per observer
+    assert sum(pid.startswith("Plot!scan-sc") for pid in sequential) == 3
+    assert not any(pid.startswith("Plot!scan-sc") for pid in plain)
     # passes: what waits aboard, and the pass table in the title (no topic carries it)
     assert "passes (AOS–LOS, s): mid 29–498, mid 5963–6367" in passes["Plot!aboard"][fl.TITLE]
     assert "Plot!aboard" not in plain

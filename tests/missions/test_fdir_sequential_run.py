@@ -60,6 +60,9 @@ def test_a_degraded_camera_is_declared_within_seconds(degraded: Any) -> None:
     assert [r.detector for r in reports].count("sequential") == 1  # one fault, declared once
     (f,) = summary.scores.per_fault
     assert f.isolated and f.identified_correctly and f.declared_latency_s <= 8.0
+    # the bound: a 30% shift is many σ per image, so one image; the scan took one or two
+    assert f.detector == "sequential" and f.image_divergence > 50.0
+    assert f.delay_bound_s == 1.0 and f.latency_s <= 2.0 * f.delay_bound_s + 1.0
     assert summary.detections[0].detector == "sequential"
 
 

@@ -110,6 +110,17 @@ class FdirWindow(Message):
     integrity_unjudged: Unjudged | None = Field(
         default=None, description="why the H_i the observer reported at the window's end was "
                                   "not judged for data integrity (None: judged, or none came)")
+    scan_z_max: float | None = Field(
+        default=None, ge=0.0,
+        description="the sequential test's largest scan statistic max_n |Z_n| at the window's "
+                    "images it scored (docs/fdir.md, 'The sequential test'); None: none scored "
+                    "or the window test alone")
+    scan_threshold: float | None = Field(
+        default=None, gt=0.0, description="the threshold c the scan statistic is held to")
+    image_sigma: float | None = Field(
+        default=None, gt=0.0,
+        description="one image's nominal relative 1σ √(σ_b² + σ_e²), RMS over the images "
+                    "scored (the per-image divergence of a shift δ is δ² / 2σ²)")
 
 
 class ConstellationWindow(Message):

@@ -66,6 +66,10 @@ def test_a_nominal_camera_does_not_cross() -> None:
     rng = np.random.default_rng(5)
     assert all(_score(test, _window(a, [1.0] * 30, rng)) is None for a in (0.0, 30.0, 60.0))
     assert test.last_scored_s(1) == 89.0
+    record = test.window_fields(1, 60.0)  # what FdirWindow carries of the scan
+    assert 0.0 < record["scan_z_max"] < record["scan_threshold"] == test.c
+    assert 0.0 < record["image_sigma"] < NOISE  # one POI's noise, averaged over an image's
+    assert test.window_fields(1, 30.0) == {} and test.window_fields(2, 60.0) == {}
 
 
 def test_a_degraded_camera_crosses_on_its_first_image() -> None:
@@ -77,6 +81,7 @@ def test_a_degraded_camera_crosses_on_its_first_image() -> None:
     assert crossing.direction == "degraded" and crossing.scan.span == 1
     assert crossing.shift == pytest.approx(-0.2, abs=0.02)
     assert crossing.scan.z > test.c and crossing.limit < abs(crossing.shift)
+    assert test.window_fields(1, 30.0)["scan_z_max"] == crossing.scan.z
 
 
 def test_a_crossing_declares_a_fault_the_windows_then_name() -> None:

@@ -1,0 +1,91 @@
+"""The campaign report's "Delay against the bound" section (issue 41; docs/fdir.md, "The
+bound"): where the sequential test ran, each fault kind's measured delay beside the smallest
+delay any test as quick to false-alarm could have, log γ / D (``harness/summary/delay_bound.py``
+computes each fault's D and bound; results.csv's ``image_divergence``, ``delay_bound_s``).
+
+The delay is the main detector's from the fault's first judgeable window (``window_latency_s``:
+from onset for a fault that starts while its observer is judged), to the first isolating
+alarm, whichever test declared it (``declaring_test``).  A table per kind and a plot,
+bound.png: each fault's delay against its magnitude, its bound beneath it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+WITHIN = 2.0
+"""The factor of the bound a delay is judged against (issue 41: "within 2×")."""
+
+
+def bounded_rows(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The main detector's isolated faults with a delay and a bound."""
+    return [r for r in rows if r["detector"] == "main" and r["kind"] != "none"
+            and r.get("delay_bound_s") is not None and r["isolated"]
+            and r.get("window_latency_s") is not None]
+
+
+def kind_figures(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """One kind's figures over its :func:`bounded_rows`: counts by declaring test, medians of
+    the delay, the bound and D, and how many delays are within ``WITHIN`` × the bound."""
+    delay = np.array([r["window_latency_s"] for r in rows], dtype=float)
+    bound = np.array([r["delay_bound_s"] for r in rows], dtype=float)
+    return {"faults": len(rows),
+            "scan": sum(r.get("declaring_test") == "sequential" for r in rows),
+            "delay": float(np.median(delay)), "bound": float(np.median(bound)),
+            "divergence": float(np.median([r["image_divergence"] for r in rows])),
+            "within": int(np.sum(delay <= WITHIN * bound))}
+
+
+def bound_lines(out: Path, rows: list[dict[str, Any]]) -> list[str]:
+    """The section's lines (none where the sequential test did not run), and bound.png."""
+    bounded = bounded_rows(rows)
+    if not bounded:
+        return []
+    kinds = sorted({r["kind"] for r in bounded})
+    lines = ["", "## Delay against the bound (sequential test)", "",
+             "Per fault: D = δ²/2σ² nats per image (δ: the observer's mean relative shift of "
+             "ΔH/ΔH^pred over its first whole window after onset; σ: one image's nominal 1σ), "
+             "and the bound log γ / D images (γ: the scan's mean time to a false alarm), at "
+             "least one image. Delay: from the first judgeable window (from onset for a fault "
+             "that starts while its observer is judged) to the first isolating alarm, by "
+             "either test. Medians.", "",
+             "![bound](bound.png)", "",
+             f"| kind | faults | declared by the scan | delay (s) | bound (s) | D (nats) | "
+             f"within {WITHIN:.0f}× |", "|---|---|---|---|---|---|---|"]
+    for kind in kinds:
+        st = kind_figures([r for r in bounded if r["kind"] == kind])
+        lines.append(f"| {kind} | {st['faults']} | {st['scan']} | {st['delay']:.0f} | "
+                     f"{st['bound']:.1f} | {st['divergence']:.3g} | "
+                     f"{st['within']} of {st['faults']} |")
+    _bound_plot(out, bounded, kinds)
+    return lines
+
+
+def _bound_plot(out: Path, rows: list[dict[str, Any]], kinds: list[str]) -> None:
+    """Per kind: each fault's delay (dot: the scan declared it; triangle: a window's tests)
+    over its magnitude, a line down to its bound (cross)."""
+    fig, axes = plt.subplots(1, len(kinds), figsize=(3.6 * len(kinds), 3.8), squeeze=False)
+    for ax, kind in zip(axes[0], kinds, strict=True):
+        mine = [r for r in rows if r["kind"] == kind]
+        for r in mine:
+            x, delay = r["magnitude"] or 0.0, max(r["window_latency_s"], 0.5)
+            ax.plot([x, x], [r["delay_bound_s"], delay], "-", color="0.7", lw=0.8)
+            ax.plot(x, r["delay_bound_s"], "x", color="0.3", ms=5)
+            ax.plot(x, delay, "o" if r.get("declaring_test") == "sequential" else "^",
+                    color="C0" if r.get("declaring_test") == "sequential" else "C1", ms=4)
+        ax.set_yscale("log")
+        ax.set_title(kind, fontsize=9)
+        ax.set_xlabel("magnitude")
+        ax.grid(True, alpha=0.3, which="both")
+    axes[0][0].set_ylabel("delay (s): o scan, ^ window; x bound log γ / D")
+    fig.suptitle("delay against the information bound, per fault kind")
+    fig.tight_layout()
+    fig.savefig(out / "bound.png", dpi=100)
+    plt.close(fig)
