@@ -43,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.special import ndtr, ndtri
+from scipy.special import chdtrc, chdtri, ndtr, ndtri
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -104,21 +104,49 @@ def image_evidence(gains: FloatArray, weights: FloatArray, mean: float,
     return ImageEvidence(gains[kept] / predicted[kept] / mean - 1.0, sigma_e, kept)
 
 
-def scan_threshold(q_image: float, lengths: Sequence[int] = SCAN_LENGTHS) -> float:
-    """c with 2 L Φ(−c) = ``q_image``, the per-image share of the false-alarm budget, over the
-    L = len(``lengths``) spans: the union bound on the probability that the scan at one image
-    crosses, whatever the dependence between its spans and between images (each Z_n has at
-    most unit variance under the model).  The mean time to a false alarm is then at least
-    1 / ``q_image`` images."""
+def scan_threshold(q_image: float, lengths: Sequence[int] = SCAN_LENGTHS,
+                   sides: int = 2) -> float:
+    """c with ``sides`` L Φ(−c) = ``q_image``, the per-image share of the false-alarm budget,
+    over the L = len(``lengths``) spans: the union bound on the probability that the scan at
+    one image crosses, whatever the dependence between its spans and between images (each
+    Z_n has at most unit variance under the model; ``sides`` 1 for a scan that looks one way,
+    :func:`chi2_scan`).  The mean time to a false alarm is then at least 1 / ``q_image``
+    images."""
     if not 0.0 < q_image < 1.0:
         raise ValueError(f"false-alarm probability must be in (0, 1), got {q_image!r}")
-    return float(-ndtri(q_image / (2.0 * len(lengths))))
+    return float(-ndtri(q_image / (sides * len(lengths))))
 
 
-def scan_false_alarm(c: float, lengths: Sequence[int] = SCAN_LENGTHS) -> float:
-    """2 L Φ(−c): the bound on the probability that the scan at one image crosses ``c``
-    (:func:`scan_threshold`'s inverse)."""
-    return float(2.0 * len(lengths) * ndtr(-c))
+def scan_false_alarm(c: float, lengths: Sequence[int] = SCAN_LENGTHS, sides: int = 2) -> float:
+    """``sides`` L Φ(−c): the bound on the probability that the scan at one image crosses
+    ``c`` (:func:`scan_threshold`'s inverse)."""
+    return float(sides * len(lengths) * ndtr(-c))
+
+
+MIN_TAIL = 1e-300
+"""The smallest upper-tail probability :func:`chi2_scan` scores (z ≈ 37): beyond, the same."""
+
+
+def chi2_scan(values: npt.ArrayLike, dof: int, lengths: Sequence[int] = SCAN_LENGTHS
+              ) -> ScanResult | None:
+    """The scan for a growth of a statistic that is χ²(``dof``) under no fault, independent
+    from value to value (the nav's NIS, one per measurement update): for each span n the
+    newest n of ``values`` (oldest first) hold, their sum S_n is χ²(n dof), and z_n =
+    Φ⁻¹(P(χ²(n dof) ≤ S_n)) is standard normal; the largest z_n (one-sided: only a growth is a
+    fault; ``scan_threshold(q, sides=1)``).  None with no value."""
+    v = np.asarray(values, dtype=float)
+    spans = np.array([n for n in lengths if n <= len(v)])
+    if not len(spans):
+        return None
+    sums = np.cumsum(v[::-1])[spans - 1]
+    z = -ndtri(np.maximum(chdtrc(dof * spans, sums), MIN_TAIL))
+    best = int(np.argmax(z))
+    return ScanResult(float(z[best]), float(z[best]), int(spans[best]))
+
+
+def chi2_span_limit(c: float, dof: int, span: int) -> float:
+    """The sum of ``span`` values of a :func:`chi2_scan` at which its z_n reaches ``c``."""
+    return float(chdtri(dof * span, ndtr(-c)))
 
 
 def kl_gaussian_shift(delta: float, sigma: float) -> float:

@@ -77,14 +77,17 @@ class Declarer:
         of its episode then look for."""
         self.persistence.declare(sc)
         self._unidentified.add(sc)
-        self.log.warning("FDIR: fault declared on sc%d at its image of %.0f s (sequential: "
-                         "|Z| %.3g over %d images, mean shift %.3g, %s)", sc, crossing.image_t_s,
-                         crossing.scan.z, crossing.scan.span, crossing.shift, crossing.direction)
+        self.log.warning("FDIR: fault declared on sc%d at %.0f s (sequential, %s: |Z| %.3g "
+                         "over %d, mean %.3g against %.3g, %s)", sc, crossing.image_t_s,
+                         crossing.test, crossing.scan.z, crossing.scan.span, crossing.shift,
+                         crossing.limit, crossing.direction)
+        nis = {"nis_scan": 1.0} if crossing.test == "nis" else {}
         return FaultReport(sender=self.node, t_sim=crossing.image_t_s, spacecraft=sc,
                            fault_class=None, direction=crossing.direction,
                            metric=abs(crossing.shift), threshold=crossing.limit,
                            window_end_s=window_end_s, detector="sequential",
-                           evidence={"z": crossing.scan.z, "span": float(crossing.scan.span)})
+                           evidence={"z": crossing.scan.z, "span": float(crossing.scan.span),
+                                     **nis})
 
     def _report(self, sc: int, cls: str | None, w: FdirWindow, ev: Evidence) -> FaultReport:
         return FaultReport(sender=self.node, t_sim=w.t_end_s, spacecraft=sc, fault_class=cls,

@@ -69,9 +69,10 @@ class InformationTest:
         self.seed = scenario.seed
         self.settings = WindowTestSettings.of(scenario)
         self.twin = twin
-        self.tests = 1 + int(self.cfg.fuse_nis) + int(self.cfg.detector == "sequential")
+        sequential = int(self.cfg.detector == "sequential")
+        self.tests = 1 + int(self.cfg.fuse_nis) * (1 + sequential) + sequential
         """the statistical tests sharing the false-alarm budget: this one, the NIS test and
-        the sequential test, as fused"""
+        the sequential scans (of the information, and of the NIS), as fused"""
         self.q_window = self.settings.false_alarm(self.tests)
 
     def judge(self, ctx: WindowContext, obs: ObserverState, window: FdirWindow,

@@ -350,7 +350,28 @@ class FdirPipeline:
                 self.sequential.passed(sc, mine[-1].image_t_s)
             else:  # the images after it are scored once it is decided
                 self._crossings[sc] = crossing
-        return self._decide_crossings(a, b, final)
+        return self._scan_nis(b) + self._decide_crossings(a, b, final)
+
+    def _scan_nis(self, b: float) -> list[Message]:
+        """With ``fdir.fuse_nis``: each observer's nav updates come since the last call and
+        before ``b`` (s; the end of the window being collected: a declaration in the next
+        would come before this one's verdict, which may end its episode) on its NIS scan,
+        not scored while its fault is declared or a crossing of its information scan waits;
+        a crossing is declared at once (the observer's own nav: nothing common to the
+        constellation), and its information scan starts afresh."""
+        test = self.sequential
+        if test is None or not self.information.cfg.fuse_nis:
+            return []
+        out: list[Message] = []
+        for sc, obs in self.observers.items():
+            judged = not self.declarer.declared(sc) and sc not in self._crossings
+            crossing = test.score_nis(sc, [u for u in obs.nis if u[0] < b - TIME_TOL_S],
+                                      judged)
+            if crossing is not None:
+                test.reset(sc)
+                end = self.schedule.end(int(crossing.image_t_s // self.schedule.period_s))
+                out.append(self.declarer.declare_crossing(sc, crossing, end))
+        return out
 
     def _decide_crossings(self, a: float, b: float, final: bool) -> list[Message]:
         """The pending crossings of window [a, b) declared once decided

@@ -9,12 +9,18 @@ judged), with ψ held at a as the window test holds it.  The ratio's nominal dis
 from the hardware model once per observer and window, on the images then in (their planned
 poses and the pose spreads the observer reports).  An observer whose fault is declared is not
 scored until its episode ends; its scan then starts afresh.
+
+With ``fdir.fuse_nis``, the nav's NIS is scanned the same way, update by update
+(``gnc.sequential_test.chi2_scan``): the window's NIS test (Σ NIS over a window against
+χ²(6N)) is its span of a window; its shorter spans declare an orbit actuator fault, whose
+innovations grow within seconds, before the window ends.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -24,12 +30,15 @@ from gnc.sequential_test import (
     SCAN_LENGTHS,
     ImageEvidence,
     ScanResult,
+    chi2_scan,
+    chi2_span_limit,
     image_evidence,
     scan_statistic,
 )
 from gnc.sequential_test import scan_threshold as scan_threshold_for
 from gnc.twin import TwinModel, delta_h
 from gnc.window_test import WindowTestSettings, pose_ratio_model
+from ground.fdir.baselines import NIS_DOF
 from ground.fdir.window import WindowContext
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.timing import TIME_TOL_S
@@ -37,17 +46,23 @@ from interfaces.contracts.timing import TIME_TOL_S
 
 @dataclass(frozen=True)
 class Crossing:
-    """The scan crossing its threshold at one image: the image's time (s), the scan there,
-    the span's mean relative shift and the shift it had to exceed."""
+    """A scan crossing its threshold: at an image (the information scan: the image's time,
+    s; the span's mean relative shift and the shift it had to exceed) or at a nav update (the
+    NIS scan, ``test = "nis"``: the update's time; the span's mean NIS per degree of freedom
+    and the mean it had to exceed)."""
 
     image_t_s: float
     scan: ScanResult
     shift: float
     limit: float
+    test: Literal["information", "nis"] = "information"
 
     @property
-    def direction(self) -> Direction:
-        """Table 3's direction: the gain below the prediction is degraded."""
+    def direction(self) -> Direction | None:
+        """Table 3's direction: the gain below the prediction is degraded (None: the NIS
+        scan, which judges no gain)."""
+        if self.test == "nis":
+            return None
         return "degraded" if self.scan.signed < 0.0 else "improved"
 
 
@@ -72,6 +87,15 @@ class _Scan:
 
     def scan(self) -> ScanResult | None:
         return scan_statistic(np.array(self.r), np.array(self.sigma_e), np.array(self.sigma_b))
+
+
+@dataclass
+class _NisScan:
+    """One observer's newest NIS values (oldest first, at most the longest span) and the time
+    of the last update looked at."""
+
+    values: list[float] = field(default_factory=list)
+    last_t: float = -math.inf
 
 
 @dataclass
@@ -115,6 +139,34 @@ class SequentialTest:
         """each observer's window start (s), its ratio model and the times of its poses"""
         self._stats: dict[int, _WindowStats] = {}
         """each observer's scored images of its latest window"""
+        self.c_nis = scan_threshold_for(q_image, sides=1)
+        self._nis: dict[int, _NisScan] = {}
+
+    def score_nis(self, spacecraft: int, updates: list[tuple[float, float]], judged: bool
+                  ) -> Crossing | None:
+        """Observer ``spacecraft``'s nav updates ``updates`` ((time s, NIS), time order) not
+        yet looked at pushed onto its NIS scan one by one, to the first at which the scan
+        crosses ``c_nis`` (that update's crossing), or None.  ``judged`` False (its fault
+        declared, or a crossing of its waiting): looked at, not scored, and its scan starts
+        afresh."""
+        scan = self._nis.setdefault(spacecraft, _NisScan())
+        fresh = [(t, v) for t, v in updates if t > scan.last_t + TIME_TOL_S]
+        if fresh:
+            scan.last_t = fresh[-1][0]
+        if not judged:
+            scan.values = []
+            return None
+        keep = max(SCAN_LENGTHS) - 1
+        for t, v in fresh:
+            scan.values = [*scan.values[-keep:], v]
+            result = chi2_scan(scan.values, NIS_DOF)
+            if result is not None and result.z > self.c_nis:
+                n = result.span
+                mean = float(np.mean(scan.values[-n:])) / NIS_DOF
+                scan.values = []  # its evidence spent
+                return Crossing(t, result, mean,
+                                chi2_span_limit(self.c_nis, NIS_DOF, n) / (n * NIS_DOF), "nis")
+        return None
 
     def window_fields(self, spacecraft: int, a: float) -> dict[str, float]:
         """The scan's record of observer ``spacecraft``'s window starting at ``a`` (s), as

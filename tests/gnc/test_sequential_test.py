@@ -8,9 +8,12 @@ import math
 import numpy as np
 import pytest
 from scipy.special import ndtr, ndtri
+from scipy.stats import chi2
 
 from gnc.sequential_test import (
     SCAN_LENGTHS,
+    chi2_scan,
+    chi2_span_limit,
     delay_bound,
     image_evidence,
     kl_gaussian_shift,
@@ -126,3 +129,43 @@ def test_the_delay_bound_gives_the_reference_numbers() -> None:
 def test_bad_settings_are_refused(call, match: str) -> None:  # type: ignore[no-untyped-def]
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_the_chi2_scan_is_the_normal_score_of_each_span_s_tail() -> None:
+    """Four NIS values of 6 (their mean): span n sums 6n, z_n = Φ⁻¹(P(χ²(6n) ≤ 6n)), the
+    largest at n = 1 (the mean lies further above the median the fewer the degrees); the
+    last one 30: span 1, z_1 = Φ⁻¹(P(χ²(6) ≤ 30))."""
+    flat = chi2_scan([6.0, 6.0, 6.0, 6.0], 6)
+    assert flat is not None and flat.span == 1
+    assert flat.z == pytest.approx(max(ndtri(chi2.cdf(6.0 * n, 6 * n)) for n in (1, 2, 4)))
+    jump = chi2_scan([6.0, 6.0, 6.0, 30.0], 6)
+    assert jump is not None and jump.span == 1
+    assert jump.z == pytest.approx(ndtri(chi2.cdf(30.0, 6)))
+    assert chi2_scan([], 6) is None
+    assert chi2_scan([1e6], 6).z == pytest.approx(-ndtri(1e-300))  # the tail's floor
+    c = scan_threshold(1e-5, sides=1)
+    assert chi2_span_limit(c, 6, 4) == pytest.approx(chi2.isf(1e-5 / len(SCAN_LENGTHS), 24))
+
+
+def test_the_chi2_scan_holds_its_budget_on_nominal_nis() -> None:
+    """χ²(6) draws, independent: no more crossings per update than the one-sided budget (the
+    scan vectorised over runs and updates, checked against :func:`chi2_scan` on some)."""
+    q = 0.01
+    values = np.random.default_rng(43).chisquare(6, (3000, 96))
+    cums = np.concatenate([np.zeros((len(values), 1)), np.cumsum(values, axis=1)], axis=1)
+    z = np.full(values.shape, -np.inf)
+    for n in SCAN_LENGTHS:
+        z[:, n - 1:] = np.maximum(z[:, n - 1:],
+                                  ndtri(chi2.cdf(cums[:, n:] - cums[:, :-n], 6 * n)))
+    for run, k in [(0, 40), (1, 95), (2, 31)]:
+        assert chi2_scan(values[run, : k + 1], 6).z == pytest.approx(z[run, k], rel=1e-9)
+    assert float(np.mean(z[:, 31:] > scan_threshold(q, sides=1))) <= q
+
+
+def test_a_growing_nis_crosses_within_a_few_updates() -> None:
+    """An unmodelled force: innovations 5× their 1σ (NIS 25× its mean) cross on the second
+    update at a budget of 1e-6 per update."""
+    c = scan_threshold(1e-6, sides=1)
+    values = [6.0] * 20 + [150.0, 150.0, 150.0]
+    crossed = [k for k in range(20, 23) if chi2_scan(values[: k + 1], 6).z > c]
+    assert crossed and crossed[0] <= 21

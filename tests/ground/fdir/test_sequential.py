@@ -140,3 +140,27 @@ def test_a_change_every_observer_sees_alike_is_left_to_the_global_check() -> Non
     assert decided(both_down, [1, 2, 3], {1: 12.0, 2: 13.0, 3: 13.0}, False) == [1]
     alone = {1: _crossing(12.0, -8.0)}
     assert decided(alone, [1], {1: 12.0}, False) == [1]  # one observer: its own fault
+
+
+def test_the_nis_scan_declares_a_growing_nis_and_nothing_nominal() -> None:
+    """Nominal NIS (χ²(6) draws, one a second for an hour) never crosses at 1e-6 per update;
+    an unmodelled force's innovations (NIS ×30) cross within two updates, named the NIS
+    scan's, with the span's mean NIS per degree above the mean it had to exceed."""
+    test = SequentialTest(SCENARIO, TWIN, 1e-6)
+    rng = np.random.default_rng(8)
+    nominal = [(float(t), float(v)) for t, v in enumerate(rng.chisquare(6, 3600))]
+    assert test.score_nis(1, nominal, True) is None
+    faulty = nominal + [(3600.0 + k, 30.0 * float(v)) for k, v in
+                        enumerate(rng.chisquare(6, 5))]
+    crossing = test.score_nis(1, faulty, True)
+    assert crossing is not None and crossing.test == "nis" and crossing.direction is None
+    assert 3600.0 <= crossing.image_t_s <= 3601.0 and crossing.scan.z > test.c_nis
+    assert crossing.shift > crossing.limit > 1.0
+
+
+def test_the_nis_scan_looks_at_a_declared_observer_s_updates_without_scoring_them() -> None:
+    test = SequentialTest(SCENARIO, TWIN, 1e-6)
+    big = [(float(t), 200.0) for t in range(5)]
+    assert test.score_nis(2, big, False) is None  # declared: looked at, not scored
+    assert test.score_nis(2, big, True) is None  # nothing new since
+    assert test.score_nis(2, [*big, (5.0, 200.0)], True) is not None
