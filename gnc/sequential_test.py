@@ -157,6 +157,16 @@ def kl_gaussian_shift(delta: float, sigma: float) -> float:
     return delta * delta / (2.0 * sigma * sigma)
 
 
+def kl_chi2_scale(scale: float, dof: int) -> float:
+    """(dof / 2)(λ − 1 − ln λ), nats per update: the Kullback-Leibler divergence of a
+    ``dof``-dimensional Gaussian innovation whose covariance grew by λ = ``scale`` from the
+    one its filter predicts (the NIS then λ χ²(dof)); 0 for λ ≤ 1 (the NIS scan looks for a
+    growth only)."""
+    if not scale > 1.0:
+        return 0.0
+    return 0.5 * dof * (scale - 1.0 - math.log(scale))
+
+
 def delay_bound(gamma: float, divergence: float) -> float:
     """log γ / D (images): the smallest worst-case mean delay of any test whose mean time to a
     false alarm is γ images, for a change of per-image divergence D (Lorden 1971); inf for

@@ -86,8 +86,8 @@ class InformationTest:
         located = located_cameras(self.twin, ctx.seen)
         ev = pose_evidence(located, pose, self.twin.radius_m, obs.dv_rate(ctx.a, ctx.b))
         failed = failed_tests(info, th.tau, pose, ev.dv_rate_mps2, self.settings)
-        nis = nis_test(obs.nis_between(ctx.a, ctx.b), self.q_window) if self.cfg.fuse_nis \
-            else None
+        updates = obs.nis_between(ctx.a, ctx.b)
+        nis = nis_test(updates, self.q_window) if self.cfg.fuse_nis else None
         if nis is not None and nis[0] > nis[1]:
             failed.append("nis")
         if failed or identifying:
@@ -99,6 +99,7 @@ class InformationTest:
             "threshold_model": th.model_tau, "threshold_sampled": th.sampled,
             "threshold_by": th.by, "failed": failed,
             "nis_sum": nis[0] if nis else None, "nis_limit": nis[1] if nis else None,
+            "nis_updates": len(updates) if nis else None,
             "ratio_mean": th.model.mean if th.model else None,
             "ratio_std": th.model.std if th.model else None})
         return Judgement(window, ev, th)

@@ -36,10 +36,12 @@ def kind_figures(rows: list[dict[str, Any]]) -> dict[str, Any]:
     the delay, the bound and D, and how many delays are within ``WITHIN`` × the bound."""
     delay = np.array([r["window_latency_s"] for r in rows], dtype=float)
     bound = np.array([r["delay_bound_s"] for r in rows], dtype=float)
+    nis = [r["nis_divergence"] for r in rows if r.get("nis_divergence") is not None]
     return {"faults": len(rows),
             "scan": sum(r.get("declaring_test") == "sequential" for r in rows),
             "delay": float(np.median(delay)), "bound": float(np.median(bound)),
             "divergence": float(np.median([r["image_divergence"] for r in rows])),
+            "nis": float(np.median(nis)) if nis else None,
             "within": int(np.sum(delay <= WITHIN * bound))}
 
 
@@ -52,17 +54,19 @@ def bound_lines(out: Path, rows: list[dict[str, Any]]) -> list[str]:
     lines = ["", "## Delay against the bound (sequential test)", "",
              "Per fault: D = δ²/2σ² nats per image (δ: the observer's mean relative shift of "
              "ΔH/ΔH^pred over its first whole window after onset; σ: one image's nominal 1σ), "
-             "and the bound log γ / D images (γ: the scan's mean time to a false alarm), at "
-             "least one image. Delay: from the first judgeable window (from onset for a fault "
-             "that starts while its observer is judged) to the first isolating alarm, by "
-             "either test. Medians.", "",
+             "D of the NIS per update, 3(λ − 1 − ln λ) (λ: the window's mean NIS over its "
+             "6 degrees), and the bound log γ / D images with the larger D (γ: the scans' "
+             "mean time to a false alarm), at least one image. Delay: from the first "
+             "judgeable window (from onset for a fault that starts while its observer is "
+             "judged) to the first isolating alarm, by any test. Medians.", "",
              "![bound](bound.png)", "",
-             f"| kind | faults | declared by the scan | delay (s) | bound (s) | D (nats) | "
-             f"within {WITHIN:.0f}× |", "|---|---|---|---|---|---|---|"]
+             f"| kind | faults | declared by a scan | delay (s) | bound (s) | D ratio (nats) | "
+             f"D NIS (nats) | within {WITHIN:.0f}× |", "|---|---|---|---|---|---|---|---|"]
     for kind in kinds:
         st = kind_figures([r for r in bounded if r["kind"] == kind])
+        nis = "-" if st["nis"] is None else f"{st['nis']:.3g}"
         lines.append(f"| {kind} | {st['faults']} | {st['scan']} | {st['delay']:.0f} | "
-                     f"{st['bound']:.1f} | {st['divergence']:.3g} | "
+                     f"{st['bound']:.1f} | {st['divergence']:.3g} | {nis} | "
                      f"{st['within']} of {st['faults']} |")
     _bound_plot(out, bounded, kinds)
     return lines

@@ -112,7 +112,8 @@ RESULT_FIELDS = ["run", "group", "seed", "status", "detector", "kind", "spacecra
                  "magnitude", "detected", "isolated", "latency_s", "identified_class",
                  "identification_latency_s", "expected_class", "judgeable_s", "unjudged",
                  "window_latency_s", "declared_latency_s", "contact", "neighbours_latency_s",
-                 "first_latency_s", "declaring_test", "image_divergence", "delay_bound_s",
+                 "first_latency_s", "declaring_test", "image_divergence", "nis_divergence",
+                 "delay_bound_s",
                  "false_alarms", "nominal_cycles"]
 """The columns of results.csv."""
 

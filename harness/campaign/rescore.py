@@ -79,7 +79,8 @@ def fault_rows(runs: list[CampaignRun]) -> list[dict[str, Any]]:
     onset fell (``contact``: continuous, in_pass, between_passes), when the neighbours aboard
     declared it (``neighbours_latency_s``, from onset) and the first of the two
     (``first_latency_s``); where the sequential test ran, which test declared it
-    (``declaring_test``) and its delay bound (``image_divergence``, ``delay_bound_s``;
+    (``declaring_test``) and its delay bound (``image_divergence``, ``nis_divergence``,
+    ``delay_bound_s``;
     ``harness/summary/delay_bound.py``)."""
     rows = []
     for run in runs:
@@ -107,6 +108,7 @@ def fault_rows(runs: list[CampaignRun]) -> list[dict[str, Any]]:
                              "expected_class": f.expected_class,
                              "declaring_test": f.detector if main else None,
                              "image_divergence": f.image_divergence if main else None,
+                             "nis_divergence": f.nis_divergence if main else None,
                              "delay_bound_s": f.delay_bound_s if main else None,
                              **_timing(f, s.injected_faults[i].end_s, windows, run,
                                        neighbours[i] if i < len(neighbours) else None)})

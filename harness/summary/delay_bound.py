@@ -6,17 +6,22 @@ D = δ² / 2σ² (``gnc.sequential_test.kl_gaussian_shift``): δ is the faulty o
 relative shift of the information ratio, (ΔH/ΔH^pred)/μ − 1, over its first whole window
 after the onset (the window test's own ΔH and ΔH^pred, judged for every window of a declared
 observer too), σ one image's nominal 1σ, √(σ_b² + σ_e²), as the scan held it there
-(``FdirWindow.image_sigma``; the nearest window that has it).  The bound is log γ / D images
-(``gnc.sequential_test.delay_bound``), γ = 1 / (2 L Φ(−c)) the scan's mean time to a false
-alarm, at least one image.  A fault whose effect grows (a thruster's drift) has a D that grows
-with it: the window's mean then stands for its first 30 s.  Pure functions.
+(``FdirWindow.image_sigma``; the nearest window that has it).  With the nav's NIS, its
+divergence per update too: (6/2)(λ − 1 − ln λ), λ the window's mean NIS over its 6 degrees
+(``gnc.sequential_test.kl_chi2_scale``), the NIS scan's evidence.  The bound is log γ / D
+images (``gnc.sequential_test.delay_bound``), D the larger of the two (one update an image:
+both at ω_mid), γ = 1 / (2 L Φ(−c)) the scans' mean time to a false alarm (both scans hold
+the same per-update probability), at least one image.  A fault whose effect grows (a
+thruster's drift) has a D that grows with it: the window's mean then stands for its first
+30 s.  Pure functions.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
-from gnc.sequential_test import delay_bound, kl_gaussian_shift, scan_false_alarm
+from gnc.sequential_test import delay_bound, kl_chi2_scale, kl_gaussian_shift, scan_false_alarm
+from ground.fdir.baselines import NIS_DOF
 from harness.summary.scoring import FaultScore, Scores
 from interfaces.contracts.messages import FdirWindow
 from interfaces.contracts.timing import TIME_TOL_S
@@ -40,9 +45,11 @@ def scan_record_near(window: FdirWindow, windows: Sequence[FdirWindow]) -> FdirW
 
 
 def fault_bound(fault: FaultScore, windows: Sequence[FdirWindow], image_period_s: float
-                ) -> tuple[float, float] | None:
-    """(D nats per image, the delay bound s) of ``fault`` (module docstring); None where no
-    window after its onset has a ratio, or no window of its observer a scan record."""
+                ) -> tuple[float, float | None, float] | None:
+    """(D of the information nats per image, D of the NIS per update (None: no NIS summed),
+    the delay bound s) of ``fault`` (module docstring): log γ / D images with D the larger of
+    the two, the evidence the ground has at its fastest; None where no window after its
+    onset has a ratio, or no window of its observer a scan record."""
     window = first_faulty_window(fault, windows)
     record = scan_record_near(window, windows) if window is not None else None
     if window is None or record is None:
@@ -51,8 +58,11 @@ def fault_bound(fault: FaultScore, windows: Sequence[FdirWindow], image_period_s
     assert record.image_sigma is not None and record.scan_threshold is not None
     shift = window.dh / window.dh_pred / window.ratio_mean - 1.0
     divergence = kl_gaussian_shift(shift, record.image_sigma)
+    nis = (kl_chi2_scale(window.nis_sum / (NIS_DOF * window.nis_updates), NIS_DOF)
+           if window.nis_sum is not None and window.nis_updates else None)
     gamma = 1.0 / scan_false_alarm(record.scan_threshold)
-    return divergence, max(delay_bound(gamma, divergence), 1.0) * image_period_s
+    bound = delay_bound(gamma, max(divergence, nis or 0.0))
+    return divergence, nis, max(bound, 1.0) * image_period_s
 
 
 def with_delay_bounds(scores: Scores, windows: Sequence[FdirWindow],
@@ -63,5 +73,6 @@ def with_delay_bounds(scores: Scores, windows: Sequence[FdirWindow],
     for f in scores.per_fault:
         bound = fault_bound(f, windows, image_period_s)
         per_fault.append(f if bound is None else f.model_copy(update={
-            "image_divergence": bound[0], "delay_bound_s": bound[1]}))
+            "image_divergence": bound[0], "delay_bound_s": bound[2],
+            **({"nis_divergence": bound[1]} if bound[1] is not None else {})}))
     return scores.model_copy(update={"per_fault": per_fault})

@@ -159,11 +159,15 @@ class FaultScore(SummaryRecord):
                     "divergence D = δ²/2σ² (nats), δ its observer's mean relative shift of the "
                     "information ratio over the first whole window after onset, σ one image's "
                     "nominal 1σ (harness/summary/delay_bound.py)")
+    nis_divergence: float | None = Field(
+        default=None, ge=0.0,
+        description="where the sequential test runs: the Kullback-Leibler divergence per nav "
+                    "update of the NIS's growth over the same window, nats (3(λ − 1 − ln λ))")
     delay_bound_s: float | None = Field(
         default=None, ge=0.0,
-        description="log γ / D images in s, at least one image (γ: the scan's mean time to a "
-                    "false alarm, images): the smallest worst-case mean delay of any test as "
-                    "quick to false-alarm (Lorden 1971)")
+        description="log γ / D images in s, D the larger divergence, at least one image (γ: "
+                    "the scans' mean time to a false alarm, images): the smallest worst-case "
+                    "mean delay of any test as quick to false-alarm (Lorden 1971)")
 
 
 class Scores(SummaryRecord):

@@ -16,6 +16,7 @@ from gnc.sequential_test import (
     chi2_span_limit,
     delay_bound,
     image_evidence,
+    kl_chi2_scale,
     kl_gaussian_shift,
     scan_false_alarm,
     scan_statistic,
@@ -118,6 +119,16 @@ def test_the_delay_bound_gives_the_reference_numbers() -> None:
     assert delay_bound(gamma, kl_gaussian_shift(0.002, 0.002)) == pytest.approx(20.6, abs=0.1)
     assert delay_bound(gamma, kl_gaussian_shift(0.2, 0.002)) < 1.0
     assert delay_bound(gamma, 0.0) == math.inf
+
+
+def test_the_nis_growth_s_divergence_is_the_gaussian_covariance_one() -> None:
+    """KL(N(0, λS) ‖ N(0, S)) in d dimensions, by its general form ½(tr(Σ₀⁻¹Σ₁) − d +
+    ln det Σ₀/det Σ₁), against the closed form; nothing for a NIS that did not grow."""
+    cov0, cov1 = np.diag([1.0, 4.0, 9.0]), np.diag([2.5, 10.0, 22.5])
+    general = 0.5 * (np.trace(np.linalg.solve(cov0, cov1)) - 3
+                     + math.log(np.linalg.det(cov0) / np.linalg.det(cov1)))
+    assert kl_chi2_scale(2.5, 3) == pytest.approx(general)
+    assert kl_chi2_scale(1.0, 6) == 0.0 and kl_chi2_scale(0.5, 6) == 0.0
 
 
 @pytest.mark.parametrize(("call", "match"), [

@@ -101,6 +101,7 @@ class FdirWindow(Message):
         description="Σ NIS of the observer's nav updates in the window (fdir.fuse_nis)")
     nis_limit: float | None = Field(
         default=None, description="its χ²(6N) quantile at the window's false-alarm probability")
+    nis_updates: int | None = Field(default=None, ge=0, description="N, the updates summed")
     failed: list[WindowTest] = Field(
         default_factory=list, max_length=len(WINDOW_TESTS),
         description="the detector's tests this window failed (ground/fdir/consistency.py)")

@@ -38,7 +38,8 @@ def test_the_bound_is_log_gamma_over_the_divergence() -> None:
     about 18 images); the window before the onset and the one it falls in are not used."""
     windows = [_window(1, 0.0, 1.0, 0.008), _window(1, 30.0, 0.5, 0.008),
                _window(1, 60.0, 1.01, 0.008), _window(1, 90.0, 0.9, 0.008)]
-    divergence, bound_s = fault_bound(_fault(45.0), windows, 1.0)  # type: ignore[arg-type]
+    divergence, nis, bound_s = fault_bound(_fault(45.0), windows, 1.0)  # type: ignore[arg-type]
+    assert nis is None
     assert divergence == pytest.approx(0.01**2 / (2 * 0.008**2))
     gamma = 1.0 / (2 * len(SCAN_LENGTHS) * ndtr(-C))
     assert bound_s == pytest.approx(math.log(gamma) / divergence)
@@ -47,8 +48,8 @@ def test_the_bound_is_log_gamma_over_the_divergence() -> None:
 
 def test_a_large_shift_is_bounded_by_one_image() -> None:
     """β = 0.8 (δ = −0.2) against σ = 1%: D = 200 nats, below one image: one image."""
-    divergence, bound_s = fault_bound(_fault(0.0), [_window(1, 0.0, 0.8, 0.01)],  # type: ignore[arg-type]
-                                      0.5)
+    divergence, _, bound_s = fault_bound(_fault(0.0), [_window(1, 0.0, 0.8, 0.01)],  # type: ignore[arg-type]
+                                         0.5)
     assert divergence == pytest.approx(200.0)
     assert bound_s == 0.5
 
@@ -57,8 +58,21 @@ def test_the_scan_record_comes_from_the_nearest_window_that_has_one() -> None:
     """The faulty window was not scored (its observer declared): σ from the nearest one."""
     windows = [_window(1, 0.0, 1.0, 0.02), _window(1, 30.0, 1.01), _window(1, 90.0, 1.0, 0.01),
                _window(2, 30.0, 1.0, 0.001)]
-    divergence, _ = fault_bound(_fault(30.0), windows, 1.0)  # type: ignore[arg-type]
+    divergence, _, _ = fault_bound(_fault(30.0), windows, 1.0)  # type: ignore[arg-type]
     assert divergence == pytest.approx(0.01**2 / (2 * 0.02**2))
+
+
+def test_the_nis_s_growth_bounds_the_delay_where_it_says_more() -> None:
+    """The window's NIS 4× its mean over 30 updates: D = 3(4 − 1 − ln 4) = 4.84 nats per
+    update, against the ratio's 0.78: the bound is log γ / 4.84."""
+    window = _window(1, 60.0, 1.01, 0.008).model_copy(
+        update={"nis_sum": 4.0 * 6 * 30, "nis_updates": 30})
+    divergence, nis, bound_s = fault_bound(_fault(45.0), [window], 1.0)  # type: ignore[arg-type]
+    assert nis == pytest.approx(3.0 * (3.0 - math.log(4.0)))
+    gamma = 1.0 / (2 * len(SCAN_LENGTHS) * ndtr(-C))
+    assert bound_s == pytest.approx(math.log(gamma) / nis) and nis > divergence
+    calm = window.model_copy(update={"nis_sum": 0.5 * 6 * 30})  # a NIS that fell: no evidence
+    assert fault_bound(_fault(45.0), [calm], 1.0)[1] == 0.0  # type: ignore[arg-type, index]
 
 
 def test_no_bound_without_a_faulty_window_or_a_scan_record() -> None:
