@@ -132,14 +132,15 @@ def chi2_scan(values: npt.ArrayLike, dof: int, lengths: Sequence[int] = SCAN_LEN
     """The scan for a growth of a statistic that is χ²(``dof``) under no fault, independent
     from value to value (the nav's NIS, one per measurement update): for each span n the
     newest n of ``values`` (oldest first) hold, their sum S_n is χ²(n dof), and z_n =
-    Φ⁻¹(P(χ²(n dof) ≤ S_n)) is standard normal; the largest z_n (one-sided: only a growth is a
-    fault; ``scan_threshold(q, sides=1)``).  None with no value."""
+    Φ⁻¹(P(χ²(n dof) ≤ S_n)) is standard normal; the largest z_n, at least 0 (one-sided: only
+    a growth is a fault, ``scan_threshold(q, sides=1)``; a sum below its median scores 0).
+    None with no value."""
     v = np.asarray(values, dtype=float)
     spans = np.array([n for n in lengths if n <= len(v)])
     if not len(spans):
         return None
     sums = np.cumsum(v[::-1])[spans - 1]
-    z = -ndtri(np.maximum(chdtrc(dof * spans, sums), MIN_TAIL))
+    z = -ndtri(np.clip(chdtrc(dof * spans, sums), MIN_TAIL, 0.5))
     best = int(np.argmax(z))
     return ScanResult(float(z[best]), float(z[best]), int(spans[best]))
 
@@ -157,14 +158,15 @@ def kl_gaussian_shift(delta: float, sigma: float) -> float:
     return delta * delta / (2.0 * sigma * sigma)
 
 
-def kl_chi2_scale(scale: float, dof: int) -> float:
-    """(dof / 2)(λ − 1 − ln λ), nats per update: the Kullback-Leibler divergence of a
-    ``dof``-dimensional Gaussian innovation whose covariance grew by λ = ``scale`` from the
-    one its filter predicts (the NIS then λ χ²(dof)); 0 for λ ≤ 1 (the NIS scan looks for a
-    growth only)."""
-    if not scale > 1.0:
-        return 0.0
-    return 0.5 * dof * (scale - 1.0 - math.log(scale))
+def kl_nis_growth(mean_nis: float, dof: int) -> float:
+    """(dof / 2)(λ − 1), nats per update, λ = ``mean_nis`` / ``dof``: the Kullback-Leibler
+    divergence of a ``dof``-dimensional Gaussian innovation whose mean moved by μ, with
+    μᵀS⁻¹μ = dof (λ − 1), from the zero-mean one of covariance S its filter predicts (an
+    unmodelled force biases the innovations).  Of all Gaussian innovations whose NIS has that
+    mean and whose covariance is no smaller than S, the largest (a covariance grown by λ
+    instead gives (dof / 2)(λ − 1 − ln λ)): the bound it sets is the lowest.  0 for λ ≤ 1 (the
+    NIS scan looks for a growth only)."""
+    return 0.5 * max(mean_nis - dof, 0.0)
 
 
 def delay_bound(gamma: float, divergence: float) -> float:

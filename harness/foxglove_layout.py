@@ -127,10 +127,12 @@ def _metric_plot(mission: str, i: int) -> dict[str, Any]:
 
 def _scan_plot(mission: str, i: int) -> dict[str, Any]:
     window = f"{cat.FDIR_WINDOW.key(mission)}{{spacecraft=={i}}}"
-    return _plot(f"sc{i}: the sequential test's largest scan statistic in each window "
-                 f"against its threshold c",
-                 [_series(f"{window}.scan_z_max", "max |Z|", METRIC_COLOUR),
-                  _series(f"{window}.scan_threshold", "c", THRESHOLD_COLOUR)])
+    return _plot(f"sc{i}: the sequential test's largest scan statistics in each window "
+                 f"(images, NIS) against their thresholds",
+                 [_series(f"{window}.scan_z_max", "images: max |Z|", METRIC_COLOUR),
+                  _series(f"{window}.scan_threshold", "c", THRESHOLD_COLOUR),
+                  _series(f"{window}.nis_scan_z_max", "NIS: max z"),
+                  _series(f"{window}.nis_scan_threshold", "c NIS")])
 
 
 def _fault_panels(scenario: Scenario, mission: str) -> Panels:

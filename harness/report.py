@@ -260,8 +260,9 @@ def _mark_faults(ax: Any, sc: int, summary: RunSummary) -> None:
 
 def _scan_plot(out: Path, windows: list[FdirWindow], ids: list[int], summary: RunSummary
                ) -> list[str]:
-    """With the sequential test: per observer, the largest scan statistic of each window
-    against its threshold c (fdir_scan.png), the report's lines for it (none without)."""
+    """With the sequential test: per observer, the largest statistic of each window of the
+    image scan and the NIS scan against their thresholds (fdir_scan.png), the report's lines
+    for it (none without)."""
     scanned = [w for w in windows if w.scan_z_max is not None and w.scan_threshold is not None]
     if not scanned:
         return []
@@ -270,8 +271,14 @@ def _scan_plot(out: Path, windows: list[FdirWindow], ids: list[int], summary: Ru
     for ax, sc in zip(axes[:, 0], ids, strict=True):
         mine = [w for w in scanned if w.spacecraft == sc]
         t = [w.t_end_s for w in mine]
-        ax.plot(t, [w.scan_z_max for w in mine], "o-", ms=3, lw=1.0, label="max |Z|")
+        ax.plot(t, [w.scan_z_max for w in mine], "o-", ms=3, lw=1.0, label="images: max |Z|")
         ax.plot(t, [w.scan_threshold for w in mine], "--", lw=1.0, label="c")
+        nis = [w for w in windows if w.spacecraft == sc and w.nis_scan_z_max is not None]
+        if nis:
+            ax.plot([w.t_end_s for w in nis], [w.nis_scan_z_max for w in nis], "s-", ms=2,
+                    lw=0.8, label="NIS: max z")
+            ax.plot([w.t_end_s for w in nis], [w.nis_scan_threshold for w in nis], ":",
+                    lw=1.0, label="c NIS")
         _mark_faults(ax, sc, summary)
     axes[0, 0].legend(fontsize=8, loc="upper right")
     axes[-1, 0].set_xlabel("window end, sim time (s)  (red: fault onset, dotted: declared)")

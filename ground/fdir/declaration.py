@@ -19,6 +19,7 @@ from ground.fdir.sequential import Crossing
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, FdirWindow, Message
 from interfaces.contracts.scenario import FdirSettings
+from interfaces.contracts.timing import TIME_TOL_S
 
 
 class Declarer:
@@ -31,6 +32,9 @@ class Declarer:
         self.node = node
         self.log = log
         self._unidentified: set[int] = set()
+        self._crossed_s: dict[int, float] = {}
+        """observers declared by a scan, with the time it crossed (s), until a window that
+        began at or after it is judged"""
 
     def identifying(self, sc: int) -> bool:
         """Whether observer ``sc``'s declared fault still has no class."""
@@ -49,7 +53,8 @@ class Declarer:
         exceeded = window_exceeded(failed, j.decided)
         w = j.window.model_copy(update={"exceeded": exceeded})
         out: list[Message] = [w]
-        if self.persistence.update(sc, exceeded):
+        counted = None if self._before_crossing(sc, w.t_start_s) and not exceeded else exceeded
+        if self.persistence.update(sc, counted):
             cls = classify(j.evidence, self.tol, failed)
             self.log.warning("FDIR: fault declared on sc%d at %.0f s (failed %s; H_m %s, τ %s, "
                              "%s): %s", sc, w.t_end_s, "+".join(failed), _g(w.metric),
@@ -59,12 +64,24 @@ class Declarer:
                 self._unidentified.add(sc)
         elif sc in self._unidentified:
             cls = classify(j.evidence, self.tol, failed)
-            if cls is not None or not exceeded:
+            if cls is not None or counted is False:
                 self._unidentified.discard(sc)
             if cls is not None:
                 self.log.warning("FDIR: sc%d identified at %.0f s: %s", sc, w.t_end_s, cls)
                 out.append(self._report(sc, cls, w, j.evidence))
         return out
+
+    def _before_crossing(self, sc: int, t_start_s: float) -> bool:
+        """Whether observer ``sc`` was declared by a scan crossing after ``t_start_s`` (s): a
+        window that began before the crossing, passed on the whole, neither ends the episode
+        nor its identification (the fault may have begun late in it)."""
+        crossed = self._crossed_s.get(sc)
+        if crossed is None:
+            return False
+        if t_start_s >= crossed - TIME_TOL_S:
+            del self._crossed_s[sc]
+            return False
+        return True
 
     def declared(self, sc: int) -> bool:
         """Whether observer ``sc``'s declared fault's episode is going on."""
@@ -77,10 +94,11 @@ class Declarer:
         of its episode then look for."""
         self.persistence.declare(sc)
         self._unidentified.add(sc)
-        self.log.warning("FDIR: fault declared on sc%d at %.0f s (sequential, %s: |Z| %.3g "
-                         "over %d, mean %.3g against %.3g, %s)", sc, crossing.image_t_s,
+        self._crossed_s[sc] = crossing.image_t_s
+        self.log.warning("FDIR: fault declared on sc%d at %.0f s (sequential, %s scan: |Z| "
+                         "%.3g over %d, mean %.3g against %.3g%s)", sc, crossing.image_t_s,
                          crossing.test, crossing.scan.z, crossing.scan.span, crossing.shift,
-                         crossing.limit, crossing.direction)
+                         crossing.limit, f", {crossing.direction}" if crossing.direction else "")
         nis = {"nis_scan": 1.0} if crossing.test == "nis" else {}
         return FaultReport(sender=self.node, t_sim=crossing.image_t_s, spacecraft=sc,
                            fault_class=None, direction=crossing.direction,

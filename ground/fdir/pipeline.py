@@ -330,8 +330,11 @@ class FdirPipeline:
         a, b = self.schedule.start(k), self.schedule.end(k)
         settled: SettledMap | None = None
         for sc, obs in self.observers.items():
-            if self.declarer.declared(sc) or sc in self._crossings:
-                continue  # declared, or its crossing waits: scored again once decided
+            if self.declarer.declared(sc):  # scored afresh once its episode ends
+                self.sequential.reset(sc)
+                continue
+            if sc in self._crossings:
+                continue  # its crossing waits: scored again once decided
             last = self.sequential.last_scored_s(sc) + TIME_TOL_S
             mine = sorted((m for m in self.pending
                            if m.spacecraft == sc and a <= m.image_t_s < b and m.image_t_s > last),
@@ -350,27 +353,25 @@ class FdirPipeline:
                 self.sequential.passed(sc, mine[-1].image_t_s)
             else:  # the images after it are scored once it is decided
                 self._crossings[sc] = crossing
-        return self._scan_nis(b) + self._decide_crossings(a, b, final)
+        return self._scan_nis(a, b) + self._decide_crossings(a, b, final)
 
-    def _scan_nis(self, b: float) -> list[Message]:
+    def _scan_nis(self, a: float, b: float) -> list[Message]:
         """With ``fdir.fuse_nis``: each observer's nav updates come since the last call and
-        before ``b`` (s; the end of the window being collected: a declaration in the next
-        would come before this one's verdict, which may end its episode) on its NIS scan,
-        not scored while its fault is declared or a crossing of its information scan waits;
-        a crossing is declared at once (the observer's own nav: nothing common to the
-        constellation), and its information scan starts afresh."""
+        before ``b`` (s; the end of the window [a, b) being collected, whose verdict comes next) on
+        its NIS scan, not scored while its fault is declared; a crossing is declared at once
+        (the observer's own nav: nothing common to the constellation), in place of a crossing
+        of its information scan still waiting, and that scan starts afresh."""
         test = self.sequential
         if test is None or not self.information.cfg.fuse_nis:
             return []
         out: list[Message] = []
         for sc, obs in self.observers.items():
-            judged = not self.declarer.declared(sc) and sc not in self._crossings
-            crossing = test.score_nis(sc, [u for u in obs.nis if u[0] < b - TIME_TOL_S],
-                                      judged)
+            crossing = test.score_nis(sc, [u for u in obs.nis if u[0] < b],
+                                      not self.declarer.declared(sc), a)
             if crossing is not None:
+                self._crossings.pop(sc, None)
                 test.reset(sc)
-                end = self.schedule.end(int(crossing.image_t_s // self.schedule.period_s))
-                out.append(self.declarer.declare_crossing(sc, crossing, end))
+                out.append(self.declarer.declare_crossing(sc, crossing, b))
         return out
 
     def _decide_crossings(self, a: float, b: float, final: bool) -> list[Message]:

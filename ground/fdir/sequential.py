@@ -96,6 +96,8 @@ class _NisScan:
 
     values: list[float] = field(default_factory=list)
     last_t: float = -math.inf
+    window: tuple[float, float] | None = None
+    """the start of the window its last updates were scored in (s) and their largest z"""
 
 
 @dataclass
@@ -142,13 +144,14 @@ class SequentialTest:
         self.c_nis = scan_threshold_for(q_image, sides=1)
         self._nis: dict[int, _NisScan] = {}
 
-    def score_nis(self, spacecraft: int, updates: list[tuple[float, float]], judged: bool
-                  ) -> Crossing | None:
+    def score_nis(self, spacecraft: int, updates: list[tuple[float, float]], judged: bool,
+                  a: float) -> Crossing | None:
         """Observer ``spacecraft``'s nav updates ``updates`` ((time s, NIS), time order) not
-        yet looked at pushed onto its NIS scan one by one, to the first at which the scan
-        crosses ``c_nis`` (that update's crossing), or None.  ``judged`` False (its fault
-        declared, or a crossing of its waiting): looked at, not scored, and its scan starts
-        afresh."""
+        yet looked at pushed onto its NIS scan one by one (docs/fdir.md, "The nav's NIS,
+        scanned too"), to the first at which the scan crosses ``c_nis`` (that update's
+        crossing), or None; each counted in the record of the window starting at ``a`` (s),
+        the one being collected.  ``judged`` False (its fault declared): looked at, not
+        scored, and its scan starts afresh."""
         scan = self._nis.setdefault(spacecraft, _NisScan())
         fresh = [(t, v) for t, v in updates if t > scan.last_t + TIME_TOL_S]
         if fresh:
@@ -160,6 +163,10 @@ class SequentialTest:
         for t, v in fresh:
             scan.values = [*scan.values[-keep:], v]
             result = chi2_scan(scan.values, NIS_DOF)
+            z = result.z if result is not None else 0.0
+            held = scan.window if scan.window is not None and abs(scan.window[0] - a) <= \
+                TIME_TOL_S else (a, 0.0)
+            scan.window = (a, max(held[1], z))
             if result is not None and result.z > self.c_nis:
                 n = result.span
                 mean = float(np.mean(scan.values[-n:])) / NIS_DOF
@@ -169,14 +176,19 @@ class SequentialTest:
         return None
 
     def window_fields(self, spacecraft: int, a: float) -> dict[str, float]:
-        """The scan's record of observer ``spacecraft``'s window starting at ``a`` (s), as
-        ``FdirWindow``'s ``scan_z_max``, ``scan_threshold`` and ``image_sigma``; empty when
-        no image of it was scored."""
+        """The scans' record of observer ``spacecraft``'s window starting at ``a`` (s), the
+        latest it scored, as ``FdirWindow``'s ``scan_z_max``, ``scan_threshold`` and
+        ``image_sigma`` (none when no image of it was scored), ``nis_scan_z_max`` and
+        ``nis_scan_threshold`` (none when no nav update)."""
+        out: dict[str, float] = {}
         stats = self._stats.get(spacecraft)
-        if stats is None or abs(stats.a - a) > TIME_TOL_S or not stats.images:
-            return {}
-        return {"scan_z_max": stats.z_max, "scan_threshold": self.c,
-                "image_sigma": math.sqrt(stats.var_sum / stats.images)}
+        if stats is not None and abs(stats.a - a) <= TIME_TOL_S and stats.images:
+            out |= {"scan_z_max": stats.z_max, "scan_threshold": self.c,
+                    "image_sigma": math.sqrt(stats.var_sum / stats.images)}
+        nis = self._nis.get(spacecraft)
+        if nis is not None and nis.window is not None and abs(nis.window[0] - a) <= TIME_TOL_S:
+            out |= {"nis_scan_z_max": nis.window[1], "nis_scan_threshold": self.c_nis}
+        return out
 
     def last_scored_s(self, spacecraft: int) -> float:
         """The time of observer ``spacecraft``'s last image looked at (scored or passed

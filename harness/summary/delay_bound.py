@@ -1,78 +1,99 @@
-"""Each fault's delay against the information bound (issue 41; docs/fdir.md, "The bound"):
-where the sequential test runs, the per-image divergence a fault showed and the smallest delay
-any test with the scan's false-alarm rate could have on it.
+"""Each fault's delay against the information bound (issue 41; docs/fdir.md, "Each fault
+against the bound"): where the sequential test runs, the divergence per ω_mid step a fault
+showed and the smallest delay any test with the scans' false-alarm rate could have on it.
 
-D = δ² / 2σ² (``gnc.sequential_test.kl_gaussian_shift``): δ is the faulty observer's mean
-relative shift of the information ratio, (ΔH/ΔH^pred)/μ − 1, over its first whole window
-after the onset (the window test's own ΔH and ΔH^pred, judged for every window of a declared
-observer too), σ one image's nominal 1σ, √(σ_b² + σ_e²), as the scan held it there
-(``FdirWindow.image_sigma``; the nearest window that has it).  With the nav's NIS, its
-divergence per update too: (6/2)(λ − 1 − ln λ), λ the window's mean NIS over its 6 degrees
-(``gnc.sequential_test.kl_chi2_scale``), the NIS scan's evidence.  The bound is log γ / D
-images (``gnc.sequential_test.delay_bound``), D the larger of the two (one update an image:
-both at ω_mid), γ = 1 / (2 L Φ(−c)) the scans' mean time to a false alarm (both scans hold
-the same per-update probability), at least one image.  A fault whose effect grows (a
-thruster's drift) has a D that grows with it: the window's mean then stands for its first
-30 s.  Pure functions.
+Two streams of evidence reach the ground each ω_mid step, independent of each other: an image
+and a nav update.
+
+* The image's: D = δ² / 2σ² (``gnc.sequential_test.kl_gaussian_shift``), δ the faulty
+  observer's mean relative shift of the information ratio, (ΔH/ΔH^pred)/μ − 1, over its first
+  whole window after the onset while the fault lasts (the window test's own ΔH and ΔH^pred,
+  judged for every window of a declared observer too), σ one image's nominal 1σ,
+  √(σ_b² + σ_e²), as the scan held it (``FdirWindow.image_sigma``; the nearest window of the
+  observer that has it).
+* The nav update's: (6/2)(λ − 1), λ the same window's mean NIS over its 6 degrees
+  (``gnc.sequential_test.kl_nis_growth``: the innovations' mean moved; the largest divergence
+  that mean NIS allows, so the lowest bound).
+
+The bound is log γ / D steps with D the sum of the two (``gnc.sequential_test.delay_bound``;
+Lorden 1971), γ = 1 / (2 L Φ(−c)) the scans' mean time to a false alarm (both hold the same
+probability per step), at least one step.  A fault whose effect grows (a thruster's drift, a
+pointing error building up) has a D that grows with it: the window's mean then stands for its
+first 30 s, more than its first seconds show.  Pure functions.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
-from gnc.sequential_test import delay_bound, kl_chi2_scale, kl_gaussian_shift, scan_false_alarm
+from gnc.sequential_test import delay_bound, kl_gaussian_shift, kl_nis_growth, scan_false_alarm
 from ground.fdir.baselines import NIS_DOF
-from harness.summary.scoring import FaultScore, Scores
+from harness.summary.scoring import Scores
 from interfaces.contracts.messages import FdirWindow
+from interfaces.contracts.scenario import Fault
 from interfaces.contracts.timing import TIME_TOL_S
 
 
-def first_faulty_window(fault: FaultScore, windows: Sequence[FdirWindow]) -> FdirWindow | None:
-    """The fault's observer's first window wholly after its onset with a ratio and its
-    nominal mean (None: none; a common-mode fault has no observer of its own)."""
+@dataclass(frozen=True)
+class FaultBound:
+    """A fault's divergences per step (nats: the image's, the nav update's, None: no NIS
+    summed) and its delay bound (s)."""
+
+    image: float
+    nis: float | None
+    delay_s: float
+
+
+def first_faulty_window(fault: Fault, windows: Sequence[FdirWindow]) -> FdirWindow | None:
+    """The fault's observer's first window wholly after its onset, begun while it lasts, with a
+    ratio and its nominal mean (None: none; a common-mode fault has no observer of its own)."""
     mine = [w for w in windows if w.spacecraft == fault.spacecraft
-            and w.t_start_s >= fault.start_s - TIME_TOL_S and w.dh is not None
-            and w.dh_pred and w.ratio_mean]
+            and w.t_start_s >= fault.start_s - TIME_TOL_S
+            and (fault.end_s is None or w.t_start_s < fault.end_s)
+            and w.dh is not None and w.dh_pred and w.ratio_mean]
     return min(mine, key=lambda w: w.t_start_s) if mine else None
 
 
 def scan_record_near(window: FdirWindow, windows: Sequence[FdirWindow]) -> FdirWindow | None:
     """The window of ``window``'s observer nearest it in time that holds the scan's record
-    (``image_sigma``, ``scan_threshold``): itself when it does."""
+    (``image_sigma`` above 0, ``scan_threshold``): itself when it does."""
     held = [w for w in windows if w.spacecraft == window.spacecraft
-            and w.image_sigma is not None and w.scan_threshold is not None]
+            and w.image_sigma and w.scan_threshold is not None]
     return min(held, key=lambda w: abs(w.t_start_s - window.t_start_s)) if held else None
 
 
-def fault_bound(fault: FaultScore, windows: Sequence[FdirWindow], image_period_s: float
-                ) -> tuple[float, float | None, float] | None:
-    """(D of the information nats per image, D of the NIS per update (None: no NIS summed),
-    the delay bound s) of ``fault`` (module docstring): log γ / D images with D the larger of
-    the two, the evidence the ground has at its fastest; None where no window after its
-    onset has a ratio, or no window of its observer a scan record."""
+def fault_bound(fault: Fault, windows: Sequence[FdirWindow], step_s: float
+                ) -> FaultBound | None:
+    """``fault``'s divergences and delay bound (module docstring; ``step_s``: the ω_mid
+    period, s); None where no window after its onset has a ratio, no window of its observer
+    a scan record, or the window shows no divergence at all."""
     window = first_faulty_window(fault, windows)
     record = scan_record_near(window, windows) if window is not None else None
     if window is None or record is None:
         return None
     assert window.dh is not None and window.dh_pred and window.ratio_mean
-    assert record.image_sigma is not None and record.scan_threshold is not None
-    shift = window.dh / window.dh_pred / window.ratio_mean - 1.0
-    divergence = kl_gaussian_shift(shift, record.image_sigma)
-    nis = (kl_chi2_scale(window.nis_sum / (NIS_DOF * window.nis_updates), NIS_DOF)
+    assert record.image_sigma and record.scan_threshold is not None
+    image = kl_gaussian_shift(window.dh / window.dh_pred / window.ratio_mean - 1.0,
+                              record.image_sigma)
+    nis = (kl_nis_growth(window.nis_sum / window.nis_updates, NIS_DOF)
            if window.nis_sum is not None and window.nis_updates else None)
+    total = image + (nis or 0.0)
+    if not total > 0.0:
+        return None
     gamma = 1.0 / scan_false_alarm(record.scan_threshold)
-    bound = delay_bound(gamma, max(divergence, nis or 0.0))
-    return divergence, nis, max(bound, 1.0) * image_period_s
+    return FaultBound(image, nis, max(delay_bound(gamma, total), 1.0) * step_s)
 
 
-def with_delay_bounds(scores: Scores, windows: Sequence[FdirWindow],
-                      image_period_s: float) -> Scores:
-    """``scores`` with each fault's ``image_divergence`` and ``delay_bound_s`` where
-    :func:`fault_bound` has them (unchanged where the scan did not run)."""
+def with_delay_bounds(scores: Scores, faults: Sequence[Fault], windows: Sequence[FdirWindow],
+                      step_s: float) -> Scores:
+    """``scores`` (per fault, in the order of ``faults``) with each fault's
+    ``image_divergence``, ``nis_divergence`` and ``delay_bound_s`` where :func:`fault_bound`
+    has them (unchanged where the scan did not run)."""
     per_fault = []
-    for f in scores.per_fault:
-        bound = fault_bound(f, windows, image_period_s)
-        per_fault.append(f if bound is None else f.model_copy(update={
-            "image_divergence": bound[0], "delay_bound_s": bound[2],
-            **({"nis_divergence": bound[1]} if bound[1] is not None else {})}))
+    for score, fault in zip(scores.per_fault, faults, strict=True):
+        bound = fault_bound(fault, windows, step_s)
+        per_fault.append(score if bound is None else score.model_copy(update={
+            "image_divergence": bound.image, "delay_bound_s": bound.delay_s,
+            **({"nis_divergence": bound.nis} if bound.nis is not None else {})}))
     return scores.model_copy(update={"per_fault": per_fault})

@@ -234,7 +234,7 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
     archive or a replay): detections, scores, baselines, series and settings."""
     sequential = scenario.fdir.detector == "sequential"
     alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class, r.declared_s,
-                    r.detector if sequential else None) for r in reports
+                    _declaring_test(r) if sequential else None) for r in reports
               if r.cause is None]  # a known cause (store overflow) is no alarm of a fault
     judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
               if w.exceeded is not None]
@@ -247,13 +247,20 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
                               **({"cause": r.cause} if r.cause else {}),
                               **({"detector": r.detector} if r.detector != "window" else {}))
                     for r in reports],
-        scores=(with_delay_bounds(scores, windows, 1.0 / scenario.rates.mid_hz)
+        scores=(with_delay_bounds(scores, scenario.faults, windows, 1.0 / scenario.rates.mid_hz)
                 if sequential else scores),
         baselines=baseline_scores(verdicts, scenario),
         fdir_series=series_of(windows, verdicts),
         fdir_thresholds=threshold_census(windows, scenario),
         fdir_settings=RunFdirSettings.model_validate(
             {"fdi_period_s": scenario.rates.fdi_period_s, **scenario.fdir.model_dump()}))
+
+
+def _declaring_test(report: FaultReport) -> Literal["window", "sequential", "nis_scan"]:
+    """What declared ``report``: a window's tests, the image scan or the NIS scan."""
+    if report.detector == "sequential" and report.evidence.get("nis_scan"):
+        return "nis_scan"
+    return report.detector
 
 
 def threshold_census(windows: list[FdirWindow], scenario: Scenario) -> ThresholdCensus:

@@ -49,8 +49,9 @@ class Alarm:
     fault_class: FaultClass | None
     declared_s: float | None = None
     """when it was declared (s; None: not known)"""
-    detector: Literal["window", "sequential"] | None = None
-    """what declared it, where the sequential test runs (None: the window test alone)"""
+    detector: Literal["window", "sequential", "nis_scan"] | None = None
+    """what declared it, where the sequential test runs: a window's tests, the image scan or
+    the NIS scan (None: the window test alone)"""
 
     @property
     def at_s(self) -> float:
@@ -150,9 +151,10 @@ class FaultScore(SummaryRecord):
         default=None, description="onset to the first (isolating) alarm's declaration, s: "
                                   "what the ground knew when (with ground passes, the gap "
                                   "to the pass is in it)")
-    detector: Literal["window", "sequential"] | None = Field(
+    detector: Literal["window", "sequential", "nis_scan"] | None = Field(
         default=None, description="what declared the first (isolating) alarm, where the "
-                                  "sequential test runs: a window's tests or the scan")
+                                  "sequential test runs: a window's tests, the image scan "
+                                  "(sequential) or the NIS scan")
     image_divergence: float | None = Field(
         default=None, ge=0.0,
         description="where the sequential test runs: the fault's per-image Kullback-Leibler "
@@ -162,12 +164,12 @@ class FaultScore(SummaryRecord):
     nis_divergence: float | None = Field(
         default=None, ge=0.0,
         description="where the sequential test runs: the Kullback-Leibler divergence per nav "
-                    "update of the NIS's growth over the same window, nats (3(λ − 1 − ln λ))")
+                    "update of the NIS's growth over the same window, nats (3(λ − 1))")
     delay_bound_s: float | None = Field(
         default=None, ge=0.0,
-        description="log γ / D images in s, D the larger divergence, at least one image (γ: "
-                    "the scans' mean time to a false alarm, images): the smallest worst-case "
-                    "mean delay of any test as quick to false-alarm (Lorden 1971)")
+        description="log γ / D steps in s, D the sum of the two divergences, at least one "
+                    "step (γ: the scans' mean time to a false alarm, steps): the smallest "
+                    "worst-case mean delay of any test as quick to false-alarm (Lorden 1971)")
 
 
 class Scores(SummaryRecord):

@@ -16,8 +16,8 @@ from gnc.sequential_test import (
     chi2_span_limit,
     delay_bound,
     image_evidence,
-    kl_chi2_scale,
     kl_gaussian_shift,
+    kl_nis_growth,
     scan_false_alarm,
     scan_statistic,
     scan_threshold,
@@ -121,14 +121,18 @@ def test_the_delay_bound_gives_the_reference_numbers() -> None:
     assert delay_bound(gamma, 0.0) == math.inf
 
 
-def test_the_nis_growth_s_divergence_is_the_gaussian_covariance_one() -> None:
-    """KL(N(0, λS) ‖ N(0, S)) in d dimensions, by its general form ½(tr(Σ₀⁻¹Σ₁) − d +
-    ln det Σ₀/det Σ₁), against the closed form; nothing for a NIS that did not grow."""
-    cov0, cov1 = np.diag([1.0, 4.0, 9.0]), np.diag([2.5, 10.0, 22.5])
-    general = 0.5 * (np.trace(np.linalg.solve(cov0, cov1)) - 3
-                     + math.log(np.linalg.det(cov0) / np.linalg.det(cov1)))
-    assert kl_chi2_scale(2.5, 3) == pytest.approx(general)
-    assert kl_chi2_scale(1.0, 6) == 0.0 and kl_chi2_scale(0.5, 6) == 0.0
+def test_the_nis_growth_s_divergence_is_the_innovation_mean_shift_s() -> None:
+    """KL(N(μ, S) ‖ N(0, S)) = ½ μᵀS⁻¹μ by its general form, with the NIS's mean d + μᵀS⁻¹μ;
+    a covariance grown instead to the same NIS mean diverges less; nothing for a NIS that did
+    not grow."""
+    cov = np.diag([1.0, 4.0, 9.0])
+    mu = np.array([1.0, -2.0, 3.0])
+    shift = 0.5 * float(mu @ np.linalg.solve(cov, mu))
+    mean_nis = 3.0 + float(mu @ np.linalg.solve(cov, mu))
+    assert kl_nis_growth(mean_nis, 3) == pytest.approx(shift)
+    lam = mean_nis / 3.0
+    assert 1.5 * (lam - 1.0 - math.log(lam)) < kl_nis_growth(mean_nis, 3)
+    assert kl_nis_growth(6.0, 6) == 0.0 and kl_nis_growth(3.0, 6) == 0.0
 
 
 @pytest.mark.parametrize(("call", "match"), [

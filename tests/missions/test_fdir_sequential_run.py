@@ -1,6 +1,7 @@
 """The sequential test in real (in-process) runs (``fdir.detector = "sequential"``): a degraded
 camera is declared within seconds of its onset, on its observer only and by the sequential
-test, and named a camera fault by a later window; a calibration error common to every camera
+test, and named a camera fault by a later window; a thruster leak by the NIS scan, within
+seconds; a calibration error common to every camera
 is still the constellation's alone (the window's global check, Eq. 6), not each observer's;
 and the replay of the archive gives the live declarations, at the same times."""
 
@@ -70,6 +71,26 @@ def test_the_replay_declares_as_the_live_run(degraded: Any) -> None:
     out, _, _ = degraded
     replay = replay_run(out, scenario=_scenario(DEGRADED))
     assert replay.matches_live()
+
+
+def test_a_thruster_leak_is_declared_by_the_nav_s_nis_within_seconds(
+        tmp_path_factory: pytest.TempPathFactory) -> None:
+    """An unmodelled force: the nav's innovations grow at once, the information later; the
+    NIS scan declares it on its observer, once, well before the window's end (the window
+    test's NIS test waits for it: 37 s here)."""
+    reports, summary = _run(tmp_path_factory.mktemp("seq_thruster"),
+                            {"spacecraft": 3, "kind": "thruster_bias", "start_s": ONSET_S,
+                             "magnitude": 0.5})
+    first = reports[0]
+    assert first.spacecraft == 3 and first.detector == "sequential"
+    assert first.evidence.get("nis_scan") == 1.0 and first.direction is None
+    assert first.metric > first.threshold > 1.0  # mean NIS per degree beyond its limit
+    assert ONSET_S < first.t_sim <= ONSET_S + 20.0
+    assert {r.spacecraft for r in reports} == {3}
+    assert [r.detector for r in reports].count("sequential") == 1
+    (f,) = summary.scores.per_fault
+    assert f.isolated and f.detector == "nis_scan"
+    assert f.nis_divergence is not None and f.nis_divergence > 0.0
 
 
 def test_a_common_mode_fault_stays_the_constellations(

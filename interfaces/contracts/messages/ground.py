@@ -118,8 +118,14 @@ class FdirWindow(Message):
                     "or the window test alone")
     scan_threshold: float | None = Field(
         default=None, gt=0.0, description="the threshold c the scan statistic is held to")
+    nis_scan_z_max: float | None = Field(
+        default=None, ge=0.0,
+        description="the NIS scan's largest statistic at the window's nav updates (None: none "
+                    "scored, or the window test alone)")
+    nis_scan_threshold: float | None = Field(
+        default=None, gt=0.0, description="the threshold c_nis the NIS scan is held to")
     image_sigma: float | None = Field(
-        default=None, gt=0.0,
+        default=None, ge=0.0,
         description="one image's nominal relative 1σ √(σ_b² + σ_e²), RMS over the images "
                     "scored (the per-image divergence of a shift δ is δ² / 2σ²)")
 

@@ -19,6 +19,8 @@ from gnc.poi_map import PoiMap
 from gnc.sequential_test import ScanResult
 from gnc.twin import TwinModel, centre_boresights
 from ground.fdir.declaration import Declarer
+from ground.fdir.identify import Evidence
+from ground.fdir.information import InformationTest, Judgement
 from ground.fdir.sequential import (
     Crossing,
     SequentialTest,
@@ -27,6 +29,7 @@ from ground.fdir.sequential import (
     pose_spreads_at,
 )
 from ground.fdir.window import SettledMap, WindowContext
+from interfaces.contracts.messages import FdirWindow
 from tests.conftest import small_scenario
 
 NOISE = 0.05
@@ -69,7 +72,9 @@ def test_a_nominal_camera_does_not_cross() -> None:
     record = test.window_fields(1, 60.0)  # what FdirWindow carries of the scan
     assert 0.0 < record["scan_z_max"] < record["scan_threshold"] == test.c
     assert 0.0 < record["image_sigma"] < NOISE  # one POI's noise, averaged over an image's
-    assert test.window_fields(1, 30.0) == {} and test.window_fields(2, 60.0) == {}
+    assert "nis_scan_z_max" not in record  # no nav update came
+    assert test.window_fields(1, 90.0) == {}  # nothing of it scored
+    assert test.window_fields(2, 60.0) == {}
 
 
 def test_a_degraded_camera_crosses_on_its_first_image() -> None:
@@ -107,8 +112,14 @@ def test_an_image_takes_the_larger_pose_spread_of_the_poses_about_it() -> None:
 
 
 def test_the_budget_is_shared_image_by_image() -> None:
-    """0.01 false alarms per observer-hour, three fused tests, one image a second."""
-    assert image_false_alarm(SCENARIO, 3) == pytest.approx(0.01 / 3 / 3600)
+    """0.01 false alarms per observer-hour, one image a second, shared by the window test,
+    the window's NIS test and the two scans; without the NIS, by the window test and the
+    image scan."""
+    tests = InformationTest(SCENARIO, TWIN).tests
+    assert tests == 4 and image_false_alarm(SCENARIO, tests) == pytest.approx(0.01 / 4 / 3600)
+    assert InformationTest(small_scenario(fdir={"detector": "sequential", "fuse_nis": False},
+                                          camera={"noise_frac": NOISE}), TWIN).tests == 2
+    assert InformationTest(small_scenario(), TWIN).tests == 2  # the window and NIS tests
 
 
 def test_an_unknown_detector_is_refused_naming_the_key() -> None:
@@ -145,22 +156,50 @@ def test_a_change_every_observer_sees_alike_is_left_to_the_global_check() -> Non
 def test_the_nis_scan_declares_a_growing_nis_and_nothing_nominal() -> None:
     """Nominal NIS (χ²(6) draws, one a second for an hour) never crosses at 1e-6 per update;
     an unmodelled force's innovations (NIS ×30) cross within two updates, named the NIS
-    scan's, with the span's mean NIS per degree above the mean it had to exceed."""
+    scan's, with the span's mean NIS per degree above the mean it had to exceed; the window
+    records its largest statistic."""
     test = SequentialTest(SCENARIO, TWIN, 1e-6)
     rng = np.random.default_rng(8)
     nominal = [(float(t), float(v)) for t, v in enumerate(rng.chisquare(6, 3600))]
-    assert test.score_nis(1, nominal, True) is None
+    assert test.score_nis(1, nominal, True, 3570.0) is None
+    record = test.window_fields(1, 3570.0)
+    assert 0.0 < record["nis_scan_z_max"] < record["nis_scan_threshold"] == test.c_nis
     faulty = nominal + [(3600.0 + k, 30.0 * float(v)) for k, v in
                         enumerate(rng.chisquare(6, 5))]
-    crossing = test.score_nis(1, faulty, True)
+    crossing = test.score_nis(1, faulty, True, 3600.0)
     assert crossing is not None and crossing.test == "nis" and crossing.direction is None
     assert 3600.0 <= crossing.image_t_s <= 3601.0 and crossing.scan.z > test.c_nis
     assert crossing.shift > crossing.limit > 1.0
+    assert test.window_fields(1, 3600.0)["nis_scan_z_max"] == crossing.scan.z
 
 
-def test_the_nis_scan_looks_at_a_declared_observer_s_updates_without_scoring_them() -> None:
+def test_the_nis_scan_of_a_declared_observer_starts_afresh() -> None:
+    """Updates looked at while declared are not scored, and what was held before is
+    dropped: four NIS of 22 in a row cross (their mean per degree, 3.7, is beyond span 4's
+    3.2 at 1e-6), not when the first two came before a declaration and the third during."""
+    updates = [(float(t), 22.0) for t in range(4)]
     test = SequentialTest(SCENARIO, TWIN, 1e-6)
-    big = [(float(t), 200.0) for t in range(5)]
-    assert test.score_nis(2, big, False) is None  # declared: looked at, not scored
-    assert test.score_nis(2, big, True) is None  # nothing new since
-    assert test.score_nis(2, [*big, (5.0, 200.0)], True) is not None
+    assert test.score_nis(2, updates[:2], True, 0.0) is None
+    assert test.score_nis(2, updates[:3], False, 0.0) is None  # declared: looked at
+    assert test.score_nis(2, updates, True, 0.0) is None  # one value held: no crossing
+    crossing = SequentialTest(SCENARIO, TWIN, 1e-6).score_nis(2, updates, True, 0.0)
+    assert crossing is not None and crossing.image_t_s == 3.0 and crossing.scan.span == 4
+
+
+def test_a_scan_s_declaration_outlives_the_window_it_crossed_in() -> None:
+    """Declared by a crossing late in window [0, 30), which passes on the whole: the episode
+    and its identification go on; a passing window after the crossing ends them."""
+    declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
+    declarer.declare_crossing(1, _crossing(27.0, -8.0), 30.0)
+    passing = Judgement(_judged_window(0.0), Evidence(), None)  # type: ignore[arg-type]
+    assert declarer.declare(1, passing, None) == [passing.window.model_copy(
+        update={"exceeded": False})]
+    assert declarer.declared(1) and declarer.identifying(1)
+    declarer.declare(1, Judgement(_judged_window(30.0), Evidence(), None), None)  # type: ignore[arg-type]
+    assert not declarer.declared(1) and not declarer.identifying(1)
+
+
+def _judged_window(a: float) -> FdirWindow:
+    """A window of observer 1 whose information test passed."""
+    return FdirWindow(sender="ground", t_sim=a + 30.0, spacecraft=1, t_start_s=a,
+                      t_end_s=a + 30.0, images=30, metric=0.001, threshold=0.01)
