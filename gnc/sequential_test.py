@@ -130,7 +130,8 @@ MIN_TAIL = 1e-300
 def chi2_scan(values: npt.ArrayLike, dof: int, lengths: Sequence[int] = SCAN_LENGTHS
               ) -> ScanResult | None:
     """The scan for a growth of a statistic that is χ²(``dof``) under no fault, independent
-    from value to value (the nav's NIS, one per measurement update): for each span n the
+    from value to value (the nav's NIS, one per measurement update; docs/fdir.md, "The nav's
+    NIS, scanned too"): for each span n the
     newest n of ``values`` (oldest first) hold, their sum S_n is χ²(n dof), and z_n =
     Φ⁻¹(P(χ²(n dof) ≤ S_n)) is standard normal; the largest z_n, at least 0 (one-sided: only
     a growth is a fault, ``scan_threshold(q, sides=1)``; a sum below its median scores 0).

@@ -177,9 +177,10 @@ class SequentialTest:
 
     def window_fields(self, spacecraft: int, a: float) -> dict[str, float]:
         """The scans' record of observer ``spacecraft``'s window starting at ``a`` (s), the
-        latest it scored, as ``FdirWindow``'s ``scan_z_max``, ``scan_threshold`` and
-        ``image_sigma`` (none when no image of it was scored), ``nis_scan_z_max`` and
-        ``nis_scan_threshold`` (none when no nav update)."""
+        latest it scored (docs/fdir.md, "Each fault against the bound"), as
+        ``FdirWindow``'s ``scan_z_max``, ``scan_threshold`` and ``image_sigma`` (none when no
+        image of it was scored), ``nis_scan_z_max`` and ``nis_scan_threshold`` (none when no
+        nav update)."""
         out: dict[str, float] = {}
         stats = self._stats.get(spacecraft)
         if stats is not None and abs(stats.a - a) <= TIME_TOL_S and stats.images:
@@ -198,7 +199,7 @@ class SequentialTest:
 
     def evidence_since(self, spacecraft: int, a: float) -> bool:
         """Whether observer ``spacecraft`` has an image scored at or after ``a`` (s): its
-        evidence counts in the window starting there."""
+        evidence counts in the window starting there (the common-mode rule, Eq. 6)."""
         scan = self._scans.get(spacecraft)
         return scan is not None and scan.scored_t >= a - TIME_TOL_S
 
