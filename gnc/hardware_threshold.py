@@ -83,6 +83,17 @@ class RatioModel:
         return (x - self.mean) / self.std if self.std > 0.0 else math.inf
 
 
+def pose_spreads_at(model: RatioModel, times: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """σ_b (relative) at each of the image times ``at``: the larger of the model's spreads at
+    the two imaged poses (``times``) about it, so an image between a quiet pose and a
+    sensitive one counts as the sensitive one."""
+    spreads = np.asarray(model.image_spreads) / model.mean
+    if len(spreads) == 1:
+        return np.full(len(at), spreads[0])
+    j = np.clip(np.searchsorted(times, at), 1, len(spreads) - 1)
+    return np.maximum(spreads[j - 1], spreads[j])
+
+
 def clipped_noise_moments(nu: float) -> tuple[float, float]:
     """Mean and variance of Y = max(0, 1 + ν ε), ε ~ N(0, 1) (the sim's measured-precision
     factor): with a = −1/ν, E[Y] = Φ(−a) + ν φ(a) and E[Y²] = (1 + ν²) Φ(−a) + ν φ(a)."""

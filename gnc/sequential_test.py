@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -88,6 +88,31 @@ class ImageEvidence:
     residuals: FloatArray
     sigma_e: FloatArray
     kept: npt.NDArray[np.bool_]
+
+
+@dataclass
+class ScanBuffer:
+    """One observer's newest residuals and their 1σ parts (oldest first, at most the longest
+    span, :func:`scan_statistic`'s inputs), the time of the last image looked at (scored or
+    passed over) and of the last one scored."""
+
+    r: list[float] = field(default_factory=list)
+    sigma_e: list[float] = field(default_factory=list)
+    sigma_b: list[float] = field(default_factory=list)
+    last_t: float = -math.inf
+    scored_t: float = -math.inf
+
+    def push(self, r: float, sigma_e: float, sigma_b: float, t: float) -> None:
+        """An image of time ``t`` (s) scored: its residual and 1σ parts."""
+        keep = max(SCAN_LENGTHS) - 1
+        self.r = [*self.r[-keep:], r]
+        self.sigma_e = [*self.sigma_e[-keep:], sigma_e]
+        self.sigma_b = [*self.sigma_b[-keep:], sigma_b]
+        self.last_t = self.scored_t = t
+
+    def scan(self) -> ScanResult | None:
+        """The scan at the newest residual (:func:`scan_statistic`)."""
+        return scan_statistic(np.array(self.r), np.array(self.sigma_e), np.array(self.sigma_b))
 
 
 def image_evidence(gains: FloatArray, weights: FloatArray, mean: float,

@@ -25,15 +25,15 @@ from typing import Literal
 import numpy as np
 
 from gnc.fdi_metric import Direction
-from gnc.hardware_threshold import RatioModel, clipped_noise_moments, imaged
+from gnc.hardware_threshold import RatioModel, clipped_noise_moments, imaged, pose_spreads_at
 from gnc.sequential_test import (
     SCAN_LENGTHS,
     ImageEvidence,
+    ScanBuffer,
     ScanResult,
     chi2_scan,
     chi2_span_limit,
     image_evidence,
-    scan_statistic,
 )
 from gnc.sequential_test import scan_threshold as scan_threshold_for
 from gnc.twin import TwinModel, delta_h
@@ -64,29 +64,6 @@ class Crossing:
         if self.test == "nis":
             return None
         return "degraded" if self.scan.signed < 0.0 else "improved"
-
-
-@dataclass
-class _Scan:
-    """One observer's newest residuals and their 1σ parts (oldest first, at most the longest
-    span), the time of the last image looked at (scored or passed over) and of the last one
-    scored."""
-
-    r: list[float] = field(default_factory=list)
-    sigma_e: list[float] = field(default_factory=list)
-    sigma_b: list[float] = field(default_factory=list)
-    last_t: float = -math.inf
-    scored_t: float = -math.inf
-
-    def push(self, r: float, sigma_e: float, sigma_b: float, t: float) -> None:
-        keep = max(SCAN_LENGTHS) - 1
-        self.r = [*self.r[-keep:], r]
-        self.sigma_e = [*self.sigma_e[-keep:], sigma_e]
-        self.sigma_b = [*self.sigma_b[-keep:], sigma_b]
-        self.last_t = self.scored_t = t
-
-    def scan(self) -> ScanResult | None:
-        return scan_statistic(np.array(self.r), np.array(self.sigma_e), np.array(self.sigma_b))
 
 
 @dataclass
@@ -135,7 +112,7 @@ class SequentialTest:
         self.twin = twin
         self.c = scan_threshold_for(q_image)
         self.noise_var = clipped_noise_moments(scenario.camera.noise_frac)[1]
-        self._scans: dict[int, _Scan] = {}
+        self._scans: dict[int, ScanBuffer] = {}
         self.image_period_s = 1.0 / scenario.rates.mid_hz
         self._models: dict[int, tuple[float, RatioModel | None, np.ndarray]] = {}
         """each observer's window start (s), its ratio model and the times of its poses"""
@@ -206,14 +183,14 @@ class SequentialTest:
     def passed(self, spacecraft: int, t: float) -> None:
         """Observer ``spacecraft``'s images up to ``t`` (s) pass unscored (none can be judged:
         a slew, no plan known)."""
-        scan = self._scans.setdefault(spacecraft, _Scan())
+        scan = self._scans.setdefault(spacecraft, ScanBuffer())
         scan.last_t = max(scan.last_t, t)
 
     def reset(self, spacecraft: int) -> None:
         """Observer ``spacecraft``'s scan starts afresh (its crossing decided), keeping the
         times of its last images."""
-        old = self._scans.get(spacecraft, _Scan())
-        self._scans[spacecraft] = _Scan(last_t=old.last_t, scored_t=old.scored_t)
+        old = self._scans.get(spacecraft, ScanBuffer())
+        self._scans[spacecraft] = ScanBuffer(last_t=old.last_t, scored_t=old.scored_t)
 
     def plan_times(self, a: float, b: float) -> np.ndarray:
         """The times (s) of window [a, b)'s images the ratio model draws on: one every ω_mid
@@ -230,7 +207,7 @@ class SequentialTest:
         """Score ``ctx``'s images (those of its observer not yet scored, in time order): the
         first at which the scan crosses c, or None.  ``plan``: the planned positions (K, 3) at
         :meth:`plan_times` (None: not known there), where the ratio model is drawn."""
-        scan = self._scans.setdefault(ctx.spacecraft, _Scan())
+        scan = self._scans.setdefault(ctx.spacecraft, ScanBuffer())
         pose = ctx.pose()
         prec = self.twin.precision(pose.planned, pose.boresights())
         model, times = self._model(ctx, plan)
@@ -293,14 +270,3 @@ def decided(crossings: dict[int, Crossing], scored: list[int], looked_s: dict[in
     return sorted(sc for sc, crossing in crossings.items()
                   if final or all(looked_s[o] >= crossing.image_t_s
                                   for o in scored if o != sc))
-
-
-def pose_spreads_at(model: RatioModel, times: np.ndarray, at: np.ndarray) -> np.ndarray:
-    """σ_b (relative) at each of the image times ``at``: the larger of the model's spreads at
-    the two imaged poses (``times``) about it, so an image between a quiet pose and a
-    sensitive one counts as the sensitive one."""
-    spreads = np.asarray(model.image_spreads) / model.mean
-    if len(spreads) == 1:
-        return np.full(len(at), spreads[0])
-    j = np.clip(np.searchsorted(times, at), 1, len(spreads) - 1)
-    return np.maximum(spreads[j - 1], spreads[j])

@@ -14,6 +14,7 @@ from scipy.stats import norm
 from gnc.hardware_threshold import (
     RatioModel,
     clipped_noise_moments,
+    pose_spreads_at,
     position_sigma,
     ratio_model,
     small_rotations,
@@ -179,3 +180,14 @@ def test_position_sigma_adds_the_reported_offsets_up_to_the_tolerance() -> None:
     offsets = np.tile([0.3, 0.0, 0.4], (10, 1))  # 0.5 m off: 0.5/√3 per axis
     assert position_sigma(0.0, 0.0, offsets, 0.5) == pytest.approx(0.5 / math.sqrt(3.0))
     assert position_sigma(0.0, 0.0, 10.0 * offsets, 0.5) == pytest.approx(0.5)  # capped
+
+
+def test_an_image_takes_the_larger_pose_spread_of_the_poses_about_it() -> None:
+    model = RatioModel(1.0, 0.02, 0.001, 0.02, (0.01, 0.03, 0.02))
+    times = np.array([0.0, 10.0, 20.0])
+    at = np.array([0.0, 5.0, 15.0, 25.0])
+    assert np.allclose(pose_spreads_at(model, times, at), [0.03, 0.03, 0.03, 0.03])
+    quiet = RatioModel(2.0, 0.02, 0.001, 0.02, (0.01, 0.01, 0.04))
+    assert np.allclose(pose_spreads_at(quiet, times, at), [0.005, 0.005, 0.02, 0.02])
+    assert np.allclose(pose_spreads_at(RatioModel(1.0, 0.0, 0.0, 0.0, (0.02,)),
+                                       times[:1], at), 0.02)

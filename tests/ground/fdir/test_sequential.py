@@ -12,7 +12,6 @@ import numpy as np
 import pydantic
 import pytest
 
-from gnc.hardware_threshold import RatioModel
 from gnc.infocost import Camera
 from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
@@ -26,7 +25,6 @@ from ground.fdir.sequential import (
     SequentialTest,
     decided,
     image_false_alarm,
-    pose_spreads_at,
 )
 from ground.fdir.window import SettledMap, WindowContext
 from interfaces.contracts.messages import FdirWindow
@@ -98,17 +96,6 @@ def test_a_crossing_declares_a_fault_the_windows_then_name() -> None:
     assert report.detector == "sequential" and report.fault_class is None
     assert report.t_sim == 0.0 and report.window_end_s == 30.0
     assert declarer.declared(1) and declarer.identifying(1)
-
-
-def test_an_image_takes_the_larger_pose_spread_of_the_poses_about_it() -> None:
-    model = RatioModel(1.0, 0.02, 0.001, 0.02, (0.01, 0.03, 0.02))
-    times = np.array([0.0, 10.0, 20.0])
-    at = np.array([0.0, 5.0, 15.0, 25.0])
-    assert np.allclose(pose_spreads_at(model, times, at), [0.03, 0.03, 0.03, 0.03])
-    quiet = RatioModel(2.0, 0.02, 0.001, 0.02, (0.01, 0.01, 0.04))
-    assert np.allclose(pose_spreads_at(quiet, times, at), [0.005, 0.005, 0.02, 0.02])
-    assert np.allclose(pose_spreads_at(RatioModel(1.0, 0.0, 0.0, 0.0, (0.02,)),
-                                       times[:1], at), 0.02)
 
 
 def test_the_budget_is_shared_image_by_image() -> None:
