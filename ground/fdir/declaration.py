@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import logging
 
+from gnc.image_scan import Crossing
 from gnc.window_test import exceeded as window_exceeded
 from ground.fdir.constellation import ConstellationVerdict
 from ground.fdir.identify import Evidence, Tolerances, classify
 from ground.fdir.information import Judgement
-from ground.fdir.sequential import Crossing
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, FdirWindow, Message
 from interfaces.contracts.scenario import FdirSettings

@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from gnc import quat
+from gnc.image_scan import Crossing
 from gnc.mission import MissionConstants
 from gnc.passes import ContactPlan
 from gnc.poi_map import PoiMap
@@ -40,7 +41,7 @@ from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
 from ground.fdir.neighbour_rulings import NeighbourRulings
 from ground.fdir.observer import ObserverState
-from ground.fdir.sequential import Crossing, SequentialTest, decided, image_false_alarm
+from ground.fdir.sequential import SequentialTest, decided, image_false_alarm
 from ground.fdir.window import SettledMap, window_context
 from interfaces.contracts.catalogue import FDIR_DOWNLINK_TOPICS, OBSERVATIONS
 from interfaces.contracts.fdi_schedule import FdiSchedule

@@ -12,6 +12,7 @@ import numpy as np
 import pydantic
 import pytest
 
+from gnc.image_scan import Crossing
 from gnc.infocost import Camera
 from gnc.poi import sphere_pois
 from gnc.poi_map import PoiMap
@@ -20,12 +21,7 @@ from gnc.twin import TwinModel, centre_boresights
 from ground.fdir.declaration import Declarer
 from ground.fdir.identify import Evidence
 from ground.fdir.information import InformationTest, Judgement
-from ground.fdir.sequential import (
-    Crossing,
-    SequentialTest,
-    decided,
-    image_false_alarm,
-)
+from ground.fdir.sequential import SequentialTest, decided, image_false_alarm
 from ground.fdir.window import SettledMap, WindowContext
 from interfaces.contracts.messages import FdirWindow
 from tests.conftest import small_scenario
