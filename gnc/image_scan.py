@@ -68,6 +68,13 @@ class _WindowStats:
         self.images += 1
 
 
+def step_false_alarm(per_hour: float, tests: int, rate_hz: float) -> float:
+    """A scan's false-alarm probability per image (or nav update): its share, one of
+    ``tests`` fused tests, of the budget ``per_hour`` false alarms per observer-hour over the
+    steps of an hour (one every ω_mid period, ``rate_hz``)."""
+    return min(per_hour / max(tests, 1) / (3600.0 * rate_hz), 0.5)
+
+
 class ImageScans:
     """Every observer's image scan against the nominal ``twin`` at threshold ``c``, its
     ratio models drawn with the generator seeded by ``rng_key`` + (observer, window start,

@@ -23,15 +23,27 @@ from collections import defaultdict
 
 import numpy as np
 
-from fsw.lib.neighbour_judge import Exclusions, FlownReport, agreed, cleared, held_pro, judge
+from fsw.lib.neighbour_judge import (
+    Exclusions,
+    FlownReport,
+    agreed,
+    cleared,
+    held_pro,
+    judge,
+    reported_pose,
+)
+from gnc.hardware_threshold import clipped_noise_moments
+from gnc.image_scan import Crossing, ImageScans, step_false_alarm
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro
+from gnc.sequential_test import scan_threshold
 from gnc.twin import TwinModel
 from gnc.window_test import WindowTestSettings
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.fdi_schedule import FdiSchedule
 from interfaces.contracts.messages import (
     GuidanceStatus,
+    NeighbourCrossing,
     NeighbourDeclaration,
     NeighbourJudgement,
     NeighbourRuling,
@@ -54,7 +66,8 @@ class NeighboursApp(App):
     OUTPUTS = (Output("judgement", cat.NEIGHBOUR_JUDGEMENT),
                Output("declaration", cat.NEIGHBOUR_DECLARATION))
     CRITICAL = ("map", "pending", "flown", "verdicts", "exclusions", "declared", "passing",
-                "next_judge", "next_decide")
+                "next_judge", "next_decide", "crossed", "scans._scans", "scans._models",
+                "scans._stats")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -85,6 +98,18 @@ class NeighboursApp(App):
         """subjects declared aboard (an episode: until the ground overrules)"""
         self.next_judge = 0
         self.next_decide = 0
+        self.sequential = sc.fdir.detector == "sequential"
+        self.tests = 2 if self.sequential else 1
+        """the statistical tests sharing the false-alarm budget: the window test, the scan"""
+        self.scans = ImageScans(self.cfg, self.twin,
+                                clipped_noise_moments(sc.camera.noise_frac)[1],
+                                scan_threshold(step_false_alarm(
+                                    sc.fdir.false_alarms_per_observer_hour, self.tests,
+                                    sc.rates.mid_hz)),
+                                1.0 / sc.rates.mid_hz, (sc.seed, self.sc_id))
+        """with the sequential test, this judge's scan of each neighbour's images"""
+        self.crossed: dict[tuple[int, int], dict[int, float]] = {}
+        """(window index, subject) -> judge -> when it said its scan crossed (s)"""
 
     # --- inputs -------------------------------------------------------------------------------
 
@@ -106,6 +131,9 @@ class NeighboursApp(App):
         for v in msg.verdicts:
             if v.subject != msg.spacecraft:
                 self.verdicts.setdefault((k, v.subject), {})[msg.spacecraft] = v.exceeded
+        for c in msg.crossings:
+            if c.subject != msg.spacecraft:
+                self.crossed.setdefault((k, c.subject), {}).setdefault(msg.spacecraft, c.t_s)
 
     def on_ruling(self, msg: NeighbourRuling) -> None:
         if msg.verdict == "overruled" and msg.subject in self.declared:
@@ -129,6 +157,9 @@ class NeighboursApp(App):
         while t >= self.schedule.end(self.next_judge) + self.latency_s - TIME_TOL_S:
             self._judge(self.next_judge, t)
             self.next_judge += 1
+        if self.sequential:
+            self._decide_crossings(t)
+            self._scan(self.next_judge, t)
 
     def _judge(self, k: int, t: float) -> None:
         """Judge window k's neighbours, then fuse its observations into this observer's map."""
@@ -141,7 +172,7 @@ class NeighboursApp(App):
                             key=lambda m: m.image_t_s)
             rng = np.random.default_rng([self.seed, self.sc_id, subject, k])
             verdicts.append(judge(subject, images, self._pro(subject, a, b), psi, phi,
-                                  self.twin, self.n, self.cfg, rng))
+                                  self.twin, self.n, self.cfg, rng, self.tests))
         if verdicts:
             self.publish("judgement", NeighbourJudgement(
                 sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, t_start_s=a, t_end_s=b,
@@ -153,6 +184,66 @@ class NeighboursApp(App):
         for subject, reports in self.flown.items():  # keep what the next window needs
             self.flown[subject] = [r for r in reports if r.t_s >= b - self.max_gap_s]
 
+    def _scan(self, k: int, t: float) -> None:
+        """With the sequential test: window k's images of each neighbour come since the last
+        step scored on its scan (``gnc/image_scan.py``, the ground's), on this observer's map
+        at the window's start (window k − 1 judged), against the PRO it reports holding since
+        then; the crossings shared at once (docs/fdir.md, "Neighbours judge each other")."""
+        a, b = self.schedule.start(k), self.schedule.end(k)
+        crossings = []
+        held: tuple[np.ndarray, np.ndarray] | None = None  # ψ and φ, once a step
+        for subject in sorted({m.spacecraft for m in self.pending} - {self.sc_id}):
+            fresh = sorted((m for m in self.pending if m.spacecraft == subject
+                            and a <= m.image_t_s < b
+                            and m.image_t_s > self.scans.last_scored_s(subject) + TIME_TOL_S),
+                           key=lambda m: m.image_t_s)
+            if not fresh or subject in self.declared:
+                continue
+            held = held or (self.map.variance() ** 2, self.map.phi)
+            crossing = self._score(subject, fresh, (a, b), held)
+            if crossing is not None:
+                self.scans.reset(subject)
+                crossings.append(NeighbourCrossing(
+                    subject=subject, t_s=crossing.image_t_s, z=crossing.scan.z,
+                    span=crossing.scan.span, shift=crossing.shift, limit=crossing.limit,
+                    direction=crossing.direction or "degraded"))
+        if crossings:
+            self.publish("judgement", NeighbourJudgement(
+                sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, t_start_s=a, t_end_s=b,
+                crossings=crossings))
+
+    def _score(self, subject: int, fresh: list[PoiObservations], window: tuple[float, float],
+               held: tuple[np.ndarray, np.ndarray]) -> Crossing | None:
+        """``subject``'s images ``fresh`` (time order) of ``window`` on its scan, with ψ and
+        φ ``held`` at the window's start: passed over where none is judgeable (not tracking
+        long enough, no PRO held)."""
+        usable = [m for m in fresh if m.pose is not None
+                  and m.pose.tracking_s >= self.cfg.settle_s]
+        pro = self._pro(subject, window[0], fresh[-1].image_t_s)
+        if not usable or not isinstance(pro, Pro):
+            self.scans.passed(subject, fresh[-1].image_t_s)
+            return None
+        times = np.array([m.image_t_s for m in usable])
+        pose = reported_pose(pro.states(self.n, times)[:, :3],
+                             [m.pose for m in usable if m.pose is not None])
+        plan = (None if self.scans.modelled(subject, window[0])
+                else pro.states(self.n, self.scans.plan_times(*window))[:, :3])
+        crossing = self.scans.score_images(subject, window, times,
+                                           [m.arrays() for m in usable], pose, *held, plan)
+        self.scans.passed(subject, fresh[-1].image_t_s)
+        return crossing
+
+    def _decide_crossings(self, t: float) -> None:
+        """With the sequential test: a neighbour is declared at once when ``agree`` judges'
+        scans crossed on its window (the window's verdicts decide otherwise, as without)."""
+        for (k, subject), by_judge in sorted(self.crossed.items()):
+            if subject in self.declared or len(by_judge) < self.agree:
+                continue
+            judges = sorted(by_judge)
+            self._declare(k, subject, judges, judges, t, min(by_judge.values()))
+        self.crossed = {key: v for key, v in self.crossed.items()
+                        if key[0] >= self.next_decide}
+
     def _pro(self, subject: int, a: float, b: float) -> Pro | Unjudged:
         """The PRO ``subject`` held over all of [a, b] (s) by its own guidance reports, or why
         none (``fsw.lib.neighbour_judge.held_pro``)."""
@@ -160,7 +251,7 @@ class NeighboursApp(App):
 
     def _decide(self, k: int, t: float) -> None:
         """Apply the agreement rule to window k's judgements."""
-        a, b = self.schedule.start(k), self.schedule.end(k)
+        b = self.schedule.end(k)
         for (kk, subject), by_judge in sorted(self.verdicts.items()):
             if kk != k:
                 continue
@@ -168,18 +259,26 @@ class NeighboursApp(App):
                 self._still_declared(subject, by_judge, b)
                 continue
             judges = agreed(by_judge, self.agree)
-            if judges is None:
-                continue
-            self.declared.add(subject)
-            if subject != self.sc_id:
-                self.exclusions.exclude(subject, b)
-            decided = sorted(j for j, v in by_judge.items() if v is not None)
-            self.log.warning("neighbours declare sc%d at %.0f s (%s of %s found its window "
-                             "failed)", subject, b, judges, decided)
-            self.publish("declaration", NeighbourDeclaration(
-                sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, subject=subject,
-                t_start_s=a, t_end_s=b, judges=judges, decided=decided))
+            if judges is not None:
+                self._declare(k, subject, judges,
+                              sorted(j for j, v in by_judge.items() if v is not None), t)
         self.verdicts = {key: v for key, v in self.verdicts.items() if key[0] > k}
+
+    def _declare(self, k: int, subject: int, judges: list[int], decided: list[int], t: float,
+                 crossed_s: float | None = None) -> None:
+        """``subject`` declared on window k by ``judges`` of ``decided``: left out of this
+        observer's fusion from the window's end (from its start, ``crossed_s`` the first of
+        the judges' scans crossing mid-window, s) and the declaration sent."""
+        a, b = self.schedule.start(k), self.schedule.end(k)
+        self.declared.add(subject)
+        if subject != self.sc_id:
+            self.exclusions.exclude(subject, b if crossed_s is None else a)
+        self.log.warning("neighbours declare sc%d at %.0f s (%s of %s found its window "
+                         "failed%s)", subject, b if crossed_s is None else crossed_s, judges,
+                         decided, "" if crossed_s is None else ", their scans crossing")
+        self.publish("declaration", NeighbourDeclaration(
+            sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id, subject=subject,
+            t_start_s=a, t_end_s=b, judges=judges, decided=decided, crossed_s=crossed_s))
 
     def _still_declared(self, subject: int, by_judge: dict[int, bool | None], b: float) -> None:
         """A declared subject's window, judged again: ``clear_windows`` in a row agreed

@@ -56,11 +56,12 @@ from interfaces.contracts.messages import (
 
 def judge(subject: int, images: list[PoiObservations], pro: Pro | Unjudged, psi: np.ndarray,
           phi: np.ndarray, twin: TwinModel, n_rad_s: float, cfg: WindowTestSettings,
-          rng: np.random.Generator) -> NeighbourVerdict:
+          rng: np.random.Generator, tests: int = 1) -> NeighbourVerdict:
     """The verdict on ``subject``'s window from the ``images`` it shared (time order), the PRO
     it held over the whole window (``pro``; else why there is none: :func:`held_pro`), ψ and
     φ of the judge's map at the window start: the window test (``gnc/window_test.py``) on the
-    pose the images report, at the information test's false-alarm share."""
+    pose the images report, at the information test's false-alarm share (one of ``tests``:
+    with the sequential test, the image scan has the other)."""
     usable = [m for m in images if m.pose is not None and m.pose.tracking_s >= cfg.settle_s]
     if not isinstance(pro, Pro) or not usable:
         why = pro if not isinstance(pro, Pro) else "not_tracking"
@@ -69,7 +70,7 @@ def judge(subject: int, images: list[PoiObservations], pro: Pro | Unjudged, psi:
     pose = reported_pose(pro.states(n_rad_s, times)[:, :3],
                          [m.pose for m in usable if m.pose is not None])
     info = information([m.arrays() for m in usable], pose, psi, phi, twin)
-    hw = hardware_threshold(pose, twin, psi, phi, info.prec, cfg, cfg.false_alarm(), rng)
+    hw = hardware_threshold(pose, twin, psi, phi, info.prec, cfg, cfg.false_alarm(tests), rng)
     tau = hw.tau if hw is not None else None
     failed = failed_tests(info, tau, pose, None, cfg)
     return NeighbourVerdict(subject=subject, images=len(usable), dh=info.dh,

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gnc.hardware_threshold import clipped_noise_moments
-from gnc.image_scan import Crossing, ImageScans
+from gnc.image_scan import Crossing, ImageScans, step_false_alarm
 from gnc.sequential_test import (
     SCAN_LENGTHS,
     chi2_scan,
@@ -53,9 +53,8 @@ def image_false_alarm(scenario: Scenario, tests: int) -> float:
     """The sequential test's false-alarm probability per image: its share (one of ``tests``
     fused tests) of ``fdir.false_alarms_per_observer_hour`` over the images of an hour (one
     every ω_mid period)."""
-    cfg = scenario.fdir
-    return min(cfg.false_alarms_per_observer_hour / max(tests, 1)
-               / (3600.0 * scenario.rates.mid_hz), 0.5)
+    return step_false_alarm(scenario.fdir.false_alarms_per_observer_hour, tests,
+                            scenario.rates.mid_hz)
 
 
 class SequentialTest(ImageScans):

@@ -275,14 +275,31 @@ class NeighbourVerdict(BaseModel):
                                       description="why the window has no decision (None: judged)")
 
 
+class NeighbourCrossing(BaseModel):
+    """A neighbour's image scan crossing its threshold aboard the judge, mid-window
+    (``fdir.detector = "sequential"``; ``gnc/image_scan.py``): the image's time, the scan
+    statistic and its span, the span's mean relative shift and the shift it had to exceed."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+    subject: int = Field(ge=1)
+    t_s: Time = Field(description="the image at which the scan crossed, sim s")
+    z: float = Field(ge=0.0)
+    span: int = Field(ge=1, le=64)
+    shift: float
+    limit: float = Field(ge=0.0)
+    direction: Literal["improved", "degraded"]
+
+
 class NeighbourJudgement(Message):
     """An observer's verdicts on the neighbours it heard over one FDI window [t_start_s,
-    t_end_s), shared on the crosslinks (``fsw/apps/neighbours.py``)."""
+    t_end_s), shared on the crosslinks (``fsw/apps/neighbours.py``): at the window's end its
+    ``verdicts``; with the sequential test, as they happen, its scans' ``crossings``."""
 
     spacecraft: int = Field(ge=1, description="the judge")
     t_start_s: Time
     t_end_s: Time
     verdicts: list[NeighbourVerdict] = Field(default_factory=list, max_length=64)
+    crossings: list[NeighbourCrossing] = Field(default_factory=list, max_length=64)
 
 
 class NeighbourDeclaration(Message):
@@ -296,3 +313,6 @@ class NeighbourDeclaration(Message):
     t_end_s: Time
     judges: list[int] = Field(min_length=1, max_length=64)
     decided: list[int] = Field(min_length=1, max_length=64)
+    crossed_s: Time | None = Field(
+        default=None, description="declared mid-window on the judges' scans: when the first "
+                                  "of them crossed, sim s (None: on the window's verdicts)")

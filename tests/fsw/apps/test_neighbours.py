@@ -10,6 +10,7 @@ again."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from fsw.apps.neighbours import NeighboursApp
 from gnc.pro import Pro
@@ -150,3 +151,36 @@ def test_an_overruled_neighbour_is_fused_again() -> None:
                                   window_end_s=30.0, verdict="overruled"))
     assert app.declared == set() and app.exclusions.since_s == {}
     assert [m for m in app.pending if m.spacecraft == 2] == held + held
+
+
+SEQ = SC.model_copy(update={"fdir": SC.fdir.model_copy(update={"detector": "sequential"})})
+
+
+def test_with_the_sequential_test_a_neighbour_is_declared_mid_window() -> None:
+    """The judge scans each neighbour's images as they come (the ground's image scan): the
+    camera at β = 0.3 crosses on its first judged image, the one at β = 1 never; the crossing
+    is shared at once, and with a second judge's the neighbour is declared before its
+    window ends, from the first crossing's time."""
+    app, sent = app_alone(NeighboursApp, SEQ)
+    for t in np.arange(0.0, 70.0, 10.0):
+        for sc in PROS:
+            app.on_guidance(_status(sc, float(t)))
+    app.step(30.0 + SEQ.fdir.latency_s)  # window [0, 30) judged: [30, 60) is scored
+    for m in [*_images(app, 2, 0.3), *_images(app, 3, 1.0)]:
+        if m.image_t_s < 45.0:
+            app.on_observations(m)
+    app.step(45.0)
+    (judgement,) = [m for m in sent if isinstance(m, NeighbourJudgement) and m.crossings]
+    assert judgement.verdicts == [] and (judgement.t_start_s, judgement.t_end_s) == (30.0, 60.0)
+    (crossing,) = judgement.crossings
+    assert crossing.subject == 2 and crossing.direction == "degraded"
+    assert 30.0 <= crossing.t_s <= 35.0 and crossing.shift == pytest.approx(-0.7, abs=0.1)
+    app.on_judgement(judgement)
+    app.step(46.0)
+    assert not [m for m in sent if isinstance(m, NeighbourDeclaration)]  # agree = 2: one
+    app.on_judgement(judgement.model_copy(update={"spacecraft": 3, "sender": "sc3"}))
+    app.step(47.0)
+    (declaration,) = [m for m in sent if isinstance(m, NeighbourDeclaration)]
+    assert (declaration.subject, declaration.judges, declaration.t_sim) == (2, [1, 3], 47.0)
+    assert declaration.crossed_s == crossing.t_s and app.exclusions.since_s == {2: 30.0}
+    assert app.scans.c > 5.0  # its share of the budget, one image a second
