@@ -55,7 +55,8 @@ from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
 from harness.archive.run_scenario import scenario_from_metadata
 from harness.archive.span import ArchiveSpan
 from harness.summary import ReplayResults
-from harness.summary.fdir import fdir_results
+from harness.summary.delay_bound import NisSeries
+from harness.summary.fdir import archived_nis, fdir_results
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.messages import (
@@ -137,6 +138,8 @@ class Replay:
     replayed: GroundOutput
     wall_s: float
     span: ArchiveSpan
+    nis: NisSeries | None = None
+    """the nav updates the ground judged, where the sequential test runs (delay bounds)"""
 
     def faithful_until_s(self) -> float:
         """Sim time of the first uplink that differs from the live run's (s); the run's end
@@ -166,14 +169,14 @@ class Replay:
     def results(self) -> ReplayResults:
         """``summary.json``'s FDIR fields for the replay, with its faithfulness."""
         mine = self.replayed
-        out = fdir_results(mine.reports, mine.windows, mine.verdicts, self.scenario)
+        out = fdir_results(mine.reports, mine.windows, mine.verdicts, self.scenario, self.nis)
         horizon = self.faithful_until_s()
         for d in out.detections:
             d.faithful = d.time_s <= horizon
         faithful = fdir_results([r for r in mine.reports if r.t_sim <= horizon],
                                 [w for w in mine.windows if w.t_end_s <= horizon],
                                 [v for v in mine.verdicts if v.t_end_s <= horizon],
-                                self.scenario)
+                                self.scenario, self.nis)
         census = {"fdir_thresholds": faithful.fdir_thresholds}  # the census: faithful span
         return ReplayResults(scenario=self.scenario.name, seed=self.scenario.seed,
                              replay_wall_s=round(self.wall_s, 3),
@@ -247,7 +250,8 @@ def replay_run(path: Path, settings: dict[str, str] | None = None,
     replayed = _run_ground(archive, mission, replay_scenario).within(
         span, replay_scenario.fdir.latency_s)
     live = GroundOutput.of_archive(archive, mission).within(span, flown.fdir.latency_s)
-    return Replay(replay_scenario, live, replayed, time.perf_counter() - start, span)
+    return Replay(replay_scenario, live, replayed, time.perf_counter() - start, span,
+                  archived_nis(archive, replay_scenario, mission))
 
 
 def _run_ground(archive: RunArchive, mission: str, scenario: Scenario) -> GroundOutput:

@@ -13,24 +13,30 @@ and a nav update.
   observer that has it).
 * The nav update's: (6/2)(λ − 1), λ the same window's mean NIS over its 6 degrees
   (``gnc.sequential_test.kl_nis_growth``: the innovations' mean moved; the largest divergence
-  that mean NIS allows, so the lowest bound).
+  that mean NIS allows, so the lowest bound); update by update, (NIS_k − 6)/2, whose sum from
+  the onset is an unbiased estimate of the divergence the updates since carried.
 
-The bound is log γ / D steps with D the sum of the two (``gnc.sequential_test.delay_bound``;
-Lorden 1971), γ = 1 / (2 L Φ(−c)) the scans' mean time to a false alarm (both hold the same
-probability per step), at least one step.  A fault whose effect grows (a thruster's drift, a
-pointing error building up) has a D that grows with it: the window's mean then stands for its
-first 30 s, more than its first seconds show.  Pure functions.
+The bound is the time from onset at which the divergence summed step by step first reaches
+log γ, γ = 1 / (2 L Φ(−c)) the scans' mean time to a false alarm (both hold the same
+probability per step; Lorden 1971: no test as quick to false-alarm has a smaller worst-case
+mean delay), at least one step: with the nav's updates (``nis``), the image's D each step
+plus each update's own; without, log γ / D steps (``gnc.sequential_test.delay_bound``) with D
+the sum of the window's two.  Summed update by update, the bound follows a fault whose effect
+grows (a thruster's drift); the image's part is the window's mean, which for a growing fault
+(a pointing error building up) says more than its first seconds show, so its bound is low.
+Pure functions.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from gnc.sequential_test import delay_bound, kl_gaussian_shift, kl_nis_growth, scan_false_alarm
 from ground.fdir.baselines import NIS_DOF
 from harness.summary.scoring import Scores
-from interfaces.contracts.messages import FdirWindow
+from interfaces.contracts.messages import FdirWindow, StateEstimate
 from interfaces.contracts.scenario import Fault
 from interfaces.contracts.timing import TIME_TOL_S
 
@@ -63,11 +69,40 @@ def scan_record_near(window: FdirWindow, windows: Sequence[FdirWindow]) -> FdirW
     return min(held, key=lambda w: abs(w.t_start_s - window.t_start_s)) if held else None
 
 
-def fault_bound(fault: Fault, windows: Sequence[FdirWindow], step_s: float
-                ) -> FaultBound | None:
+NisSeries = Mapping[int, Sequence[tuple[float, float]]]
+"""Each observer's nav updates: (time s, NIS), in time order."""
+
+
+def nis_series(estimates: Iterable[StateEstimate]) -> dict[int, list[tuple[float, float]]]:
+    """Each observer's nav updates with a NIS, in time order, from its estimates."""
+    out: dict[int, list[tuple[float, float]]] = {}
+    for m in sorted(estimates, key=lambda m: m.t_sim):
+        if m.nis is not None:
+            out.setdefault(m.spacecraft, []).append((m.t_sim, m.nis))
+    return out
+
+
+def summed_bound_s(fault: Fault, image: float, updates: Sequence[tuple[float, float]],
+                   log_gamma: float, step_s: float) -> float | None:
+    """The time from ``fault``'s onset (s) at which ``image`` (nats a step) plus each nav
+    update's (NIS_k − 6)/2 since the onset first sum to ``log_gamma``, at least one step; None
+    when they never do while the fault lasts."""
+    total = 0.0
+    for t, nis in updates:
+        if t < fault.start_s - TIME_TOL_S or (fault.end_s is not None and t > fault.end_s):
+            continue
+        total += image + (nis - NIS_DOF) / 2.0
+        if total >= log_gamma:
+            return max(t - fault.start_s, step_s)
+    return None
+
+
+def fault_bound(fault: Fault, windows: Sequence[FdirWindow], step_s: float,
+                updates: Sequence[tuple[float, float]] = ()) -> FaultBound | None:
     """``fault``'s divergences and delay bound (module docstring; ``step_s``: the ω_mid
-    period, s); None where no window after its onset has a ratio, no window of its observer
-    a scan record, or the window shows no divergence at all."""
+    period, s; ``updates``: its observer's nav updates, (time s, NIS)); None where no window
+    after its onset has a ratio, no window of its observer a scan record, or the window shows
+    no divergence at all."""
     window = first_faulty_window(fault, windows)
     record = scan_record_near(window, windows) if window is not None else None
     if window is None or record is None:
@@ -82,17 +117,19 @@ def fault_bound(fault: Fault, windows: Sequence[FdirWindow], step_s: float
     if not total > 0.0:
         return None
     gamma = 1.0 / scan_false_alarm(record.scan_threshold)
-    return FaultBound(image, nis, max(delay_bound(gamma, total), 1.0) * step_s)
+    summed = summed_bound_s(fault, image, updates, math.log(gamma), step_s)
+    return FaultBound(image, nis, summed if summed is not None
+                      else max(delay_bound(gamma, total), 1.0) * step_s)
 
 
 def with_delay_bounds(scores: Scores, faults: Sequence[Fault], windows: Sequence[FdirWindow],
-                      step_s: float) -> Scores:
+                      step_s: float, nis: NisSeries | None = None) -> Scores:
     """``scores`` (per fault, in the order of ``faults``) with each fault's
     ``image_divergence``, ``nis_divergence`` and ``delay_bound_s`` where :func:`fault_bound`
-    has them (unchanged where the scan did not run)."""
+    has them (unchanged where the scan did not run); ``nis``: the nav updates."""
     per_fault = []
     for score, fault in zip(scores.per_fault, faults, strict=True):
-        bound = fault_bound(fault, windows, step_s)
+        bound = fault_bound(fault, windows, step_s, (nis or {}).get(fault.spacecraft, ()))
         per_fault.append(score if bound is None else score.model_copy(update={
             "image_divergence": bound.image, "delay_bound_s": bound.delay_s,
             **({"nis_divergence": bound.nis} if bound.nis is not None else {})}))

@@ -13,7 +13,7 @@ from typing import Any, ClassVar, Literal, Self
 from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
 
 from harness.archive.reader import RunArchive
-from harness.summary.delay_bound import with_delay_bounds
+from harness.summary.delay_bound import NisSeries, nis_series, with_delay_bounds
 from harness.summary.records import SummaryRecord
 from harness.summary.scoring import Alarm, FaultClass, Judged, Scores, overlaps_fault, score
 from harness.summary.series import FdirSeries, MainWindow, SeriesWindow
@@ -225,13 +225,23 @@ def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> FdirR
     faults (harness/summary/scoring.py; grace of one FDI window)."""
     return fdir_results(archive.of(cat.FAULT_REPORT, mission),
                         archive.of(cat.FDIR_WINDOW, mission), archive.of(cat.BASELINE, mission),
-                        scenario)
+                        scenario, archived_nis(archive, scenario, mission))
+
+
+def archived_nis(archive: RunArchive, scenario: Scenario, mission: str) -> NisSeries | None:
+    """Where the sequential test runs, each observer's nav updates as archived (their NIS
+    bound each fault's delay, ``harness/summary/delay_bound.py``); else None."""
+    if scenario.fdir.detector != "sequential":
+        return None
+    return nis_series(archive.of(cat.NAV_ESTIMATE, mission))
 
 
 def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
-                 verdicts: list[BaselineVerdict], scenario: Scenario) -> FdirResults:
+                 verdicts: list[BaselineVerdict], scenario: Scenario,
+                 nis: NisSeries | None = None) -> FdirResults:
     """The FDIR part of summary.json from the ground's own output messages (a live run's
-    archive or a replay): detections, scores, baselines, series and settings."""
+    archive or a replay): detections, scores, baselines, series and settings; ``nis``: the
+    nav updates the ground judged, for the delay bounds."""
     sequential = scenario.fdir.detector == "sequential"
     alarms = [Alarm(r.spacecraft, r.t_sim, r.fault_class, r.declared_s,
                     _declaring_test(r) if sequential else None) for r in reports
@@ -247,7 +257,8 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
                               **({"cause": r.cause} if r.cause else {}),
                               **({"detector": r.detector} if r.detector != "window" else {}))
                     for r in reports],
-        scores=(with_delay_bounds(scores, scenario.faults, windows, 1.0 / scenario.rates.mid_hz)
+        scores=(with_delay_bounds(scores, scenario.faults, windows, 1.0 / scenario.rates.mid_hz,
+                                  nis)
                 if sequential else scores),
         baselines=baseline_scores(verdicts, scenario),
         fdir_series=series_of(windows, verdicts),

@@ -93,3 +93,20 @@ def test_scores_gain_the_bound_only_where_it_is_known() -> None:
     assert "nis_divergence" not in first.model_fields_set  # no NIS summed
     assert second.delay_bound_s is None and "delay_bound_s" not in second.model_fields_set
     assert "detector" not in second.model_fields_set  # no alarm: nothing declared it
+
+
+def test_summed_update_by_update_the_bound_follows_a_growing_fault() -> None:
+    """A NIS growing from the onset at 100 s by 4 a second: (NIS_k − 6)/2 = 2k nats at the
+    k-th update, their sum k(k + 1) first reaches log γ (≈ 14.4) at the 4th: 3 s after the
+    first update at the onset; the window's mean alone (NIS 30: 12 nats a step) would say
+    log γ / 12 ≈ 1.2 steps.  Updates before the onset or after the fault's end do not
+    count."""
+    fault = _fault(100.0)
+    updates = [(99.0, 500.0)] + [(100.0 + k, 6.0 + 4.0 * (k + 1)) for k in range(10)]
+    window = _window(1, 100.0, 1.0005, 0.01, nis_per_update=30.0)
+    bound = fault_bound(fault, [window], 1.0, updates)
+    assert bound is not None and bound.delay_s == pytest.approx(3.0)
+    by_mean = math.log(GAMMA) / (12.0 + bound.image)
+    assert fault_bound(fault, [window], 1.0).delay_s == pytest.approx(by_mean)  # type: ignore[union-attr]
+    ended = fault_bound(_fault(100.0, end_s=101.5), [window], 1.0, updates)
+    assert ended is not None and ended.delay_s == pytest.approx(by_mean)  # never summed to it
