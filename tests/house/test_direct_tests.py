@@ -62,7 +62,6 @@ INDIRECT: dict[str, str] = {
         "tests/missions/test_digest_run.py and tests/missions/test_campaign_run.py"),
     "harness.summary.control": _EVALUATION.format("tests/missions/test_gnc_run.py"),
     "harness.summary.onboard": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
-    "harness.summary.neighbours": _EVALUATION.format("tests/missions/test_neighbours_run.py"),
     **{f"harness.summary.{m}": _SUMMARY
        for m in ("access", "document", "execution", "fault_events", "recovery", "records",
                  "series")},
