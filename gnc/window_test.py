@@ -94,8 +94,9 @@ class WindowTestSettings:
 
     def false_alarm(self, tests: int = 1) -> float:
         """The false-alarm probability of each of ``tests`` statistical tests fused per window
-        (``gnc.hardware_threshold.window_false_alarm``): the information test alone aboard, the
-        information and NIS tests on the ground with ``fdir.fuse_nis``."""
+        (``gnc.hardware_threshold.window_false_alarm``): aboard, the information test alone
+        (with the image scan, ``fdir.detector = "sequential"``); on the ground, the information
+        and NIS tests with ``fdir.fuse_nis``, and the scans."""
         return window_false_alarm(self.false_alarms_per_hour, self.window_s, self.persistence,
                                   tests)
 

@@ -11,10 +11,13 @@ observer's ``NeighbourJudgement`` of each FDI window, on the crosslinks, and a
 
 Timing, per window [a, b): judged ``fdir.latency_s`` after b (the neighbours' observations up to
 b are in); the judgements of the others arrive one tick later, and the agreement is applied
-one ω_mid cycle after the judging.  ψ is held at a on this observer's own fused map, which
-takes each window's observations once the window is judged, leaving out the observers its
-neighbours declared (until the ground overrules them, or ``[neighbours] clear_windows`` of
-their windows in a row are agreed passing: a declared observer is still judged).
+one ω_mid cycle after the judging.  With ``fdir.detector = "sequential"`` each neighbour's
+images of the window are also scanned as they come (once window k − 1 is judged), the
+crossings shared at once and agreed on each ω_mid step.  ψ is held at a on this observer's
+own fused map, which takes each window's observations once the window is judged, leaving out
+the observers its neighbours declared (until the ground overrules them, or ``[neighbours]
+clear_windows`` of their windows in a row are agreed passing: a declared observer is still
+judged).
 """
 
 from __future__ import annotations
@@ -66,8 +69,8 @@ class NeighboursApp(App):
     OUTPUTS = (Output("judgement", cat.NEIGHBOUR_JUDGEMENT),
                Output("declaration", cat.NEIGHBOUR_DECLARATION))
     CRITICAL = ("map", "pending", "flown", "verdicts", "exclusions", "declared", "passing",
-                "next_judge", "next_decide", "crossed", "scans._scans", "scans._models",
-                "scans._stats")
+                "next_judge", "next_decide", "crossed", "crossed_at", "scans._scans",
+                "scans._models")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -108,8 +111,11 @@ class NeighboursApp(App):
                                     sc.rates.mid_hz)),
                                 1.0 / sc.rates.mid_hz, (sc.seed, self.sc_id))
         """with the sequential test, this judge's scan of each neighbour's images"""
-        self.crossed: dict[tuple[int, int], dict[int, float]] = {}
-        """(window index, subject) -> judge -> when it said its scan crossed (s)"""
+        self.crossed: dict[int, dict[int, float]] = {}
+        """subject -> judge -> the image at which its scan crossed (s), over the last FDI
+        period"""
+        self.crossed_at: dict[int, float] = {}
+        """subjects declared on their judges' scans: when the first crossed (s)"""
 
     # --- inputs -------------------------------------------------------------------------------
 
@@ -133,7 +139,7 @@ class NeighboursApp(App):
                 self.verdicts.setdefault((k, v.subject), {})[msg.spacecraft] = v.exceeded
         for c in msg.crossings:
             if c.subject != msg.spacecraft:
-                self.crossed.setdefault((k, c.subject), {}).setdefault(msg.spacecraft, c.t_s)
+                self.crossed.setdefault(c.subject, {})[msg.spacecraft] = c.t_s
 
     def on_ruling(self, msg: NeighbourRuling) -> None:
         if msg.verdict == "overruled" and msg.subject in self.declared:
@@ -145,6 +151,8 @@ class NeighboursApp(App):
         """``subject``'s declaration ends: it is fused again, with what was held of it."""
         self.declared.discard(subject)
         self.passing.pop(subject, None)
+        self.crossed_at.pop(subject, None)
+        self.scans.reset(subject)  # scanned afresh
         self.pending += self.exclusions.readmit(subject)
 
     # --- the cycle ----------------------------------------------------------------------------
@@ -202,7 +210,7 @@ class NeighboursApp(App):
             held = held or (self.map.variance() ** 2, self.map.phi)
             crossing = self._score(subject, fresh, (a, b), held)
             if crossing is not None:
-                self.scans.reset(subject)
+                self.scans.reset(subject)  # its evidence shared: a later crossing is new
                 crossings.append(NeighbourCrossing(
                     subject=subject, t_s=crossing.image_t_s, z=crossing.scan.z,
                     span=crossing.scan.span, shift=crossing.shift, limit=crossing.limit,
@@ -235,14 +243,19 @@ class NeighboursApp(App):
 
     def _decide_crossings(self, t: float) -> None:
         """With the sequential test: a neighbour is declared at once when ``agree`` judges'
-        scans crossed on its window (the window's verdicts decide otherwise, as without)."""
-        for (k, subject), by_judge in sorted(self.crossed.items()):
-            if subject in self.declared or len(by_judge) < self.agree:
+        scans crossed on it within one FDI period, whatever windows their images fell in (the
+        window's verdicts decide otherwise, as without), on the window of the first."""
+        period = self.schedule.period_s
+        for subject, by_judge in sorted(self.crossed.items()):
+            recent = {j: c for j, c in by_judge.items() if c >= t - period - self.latency_s}
+            self.crossed[subject] = recent
+            if subject in self.declared or len(recent) < self.agree:
                 continue
-            judges = sorted(by_judge)
-            self._declare(k, subject, judges, judges, t, min(by_judge.values()))
-        self.crossed = {key: v for key, v in self.crossed.items()
-                        if key[0] >= self.next_decide}
+            first = min(recent.values())
+            judges = sorted(recent)
+            self._declare(int(first // period), subject, judges, judges, t, first)
+            self.crossed_at[subject] = first
+        self.crossed = {subject: v for subject, v in self.crossed.items() if v}
 
     def _pro(self, subject: int, a: float, b: float) -> Pro | Unjudged:
         """The PRO ``subject`` held over all of [a, b] (s) by its own guidance reports, or why
@@ -256,7 +269,8 @@ class NeighboursApp(App):
             if kk != k:
                 continue
             if subject in self.declared:
-                self._still_declared(subject, by_judge, b)
+                if self.schedule.start(k) >= self.crossed_at.get(subject, -1.0) - TIME_TOL_S:
+                    self._still_declared(subject, by_judge, b)  # not one begun before its scans
                 continue
             judges = agreed(by_judge, self.agree)
             if judges is not None:
@@ -271,6 +285,7 @@ class NeighboursApp(App):
         the judges' scans crossing mid-window, s) and the declaration sent."""
         a, b = self.schedule.start(k), self.schedule.end(k)
         self.declared.add(subject)
+        self.scans.reset(subject)  # its evidence spent
         if subject != self.sc_id:
             self.exclusions.exclude(subject, b if crossed_s is None else a)
         self.log.warning("neighbours declare sc%d at %.0f s (%s of %s found its window "

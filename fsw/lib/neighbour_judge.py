@@ -170,10 +170,11 @@ class Exclusions:
         return self.held.pop(subject, [])
 
     def declared(self, msg: NeighbourDeclaration, own: int) -> None:
-        """This spacecraft's declaration: its subject is left out from the window's end
-        (never the spacecraft itself: its own observations are its own)."""
+        """This spacecraft's declaration: its subject is left out from the window's end, or
+        its start where the judges' scans declared it mid-window (never the spacecraft
+        itself: its own observations are its own)."""
         if msg.subject != own:
-            self.exclude(msg.subject, msg.t_end_s)
+            self.exclude(msg.subject, msg.t_end_s if msg.crossed_s is None else msg.t_start_s)
 
     def ruled(self, msg: NeighbourRuling) -> list[PoiObservations]:
         """The ground's ruling: what to fuse now (all that was held, when overruled)."""

@@ -21,8 +21,9 @@ log γ, γ = 1 / (2 L Φ(−c)) the scans' mean time to a false alarm (both hold
 probability per step; Lorden 1971: no test as quick to false-alarm has a smaller worst-case
 mean delay), at least one step: with the nav's updates (``nis``), the image's D each step
 plus each update's own; without, log γ / D steps (``gnc.sequential_test.delay_bound``) with D
-the sum of the window's two.  Summed update by update, the bound follows a fault whose effect
-grows (a thruster's drift); the image's part is the window's mean, which for a growing fault
+the sum of the window's two.  The nav's updates count only where the window's NIS test failed
+(:func:`nis_moved`).  Summed update by update, the bound follows a fault whose effect grows (a
+thruster's drift); the image's part is the window's mean, which for a growing fault
 (a pointing error building up) says more than its first seconds show, so its bound is low.
 Pure functions.
 """
@@ -101,8 +102,8 @@ def fault_bound(fault: Fault, windows: Sequence[FdirWindow], step_s: float,
                 updates: Sequence[tuple[float, float]] = ()) -> FaultBound | None:
     """``fault``'s divergences and delay bound (module docstring; ``step_s``: the ω_mid
     period, s; ``updates``: its observer's nav updates, (time s, NIS)); None where no window
-    after its onset has a ratio, no window of its observer a scan record, or the window shows
-    no divergence at all."""
+    after its onset has a ratio, no window of its observer a scan record, the window shows no
+    divergence, or the updates' sum never reached log γ while the fault lasted."""
     window = first_faulty_window(fault, windows)
     record = scan_record_near(window, windows) if window is not None else None
     if window is None or record is None:
@@ -117,9 +118,21 @@ def fault_bound(fault: Fault, windows: Sequence[FdirWindow], step_s: float,
     if not total > 0.0:
         return None
     gamma = 1.0 / scan_false_alarm(record.scan_threshold)
+    if not nis_moved(window):
+        return (FaultBound(image, nis, max(delay_bound(gamma, image), 1.0) * step_s)
+                if image > 0.0 else None)
+    if not updates:
+        return FaultBound(image, nis, max(delay_bound(gamma, total), 1.0) * step_s)
     summed = summed_bound_s(fault, image, updates, math.log(gamma), step_s)
-    return FaultBound(image, nis, summed if summed is not None
-                      else max(delay_bound(gamma, total), 1.0) * step_s)
+    return FaultBound(image, nis, summed) if summed is not None else None
+
+
+def nis_moved(window: FdirWindow) -> bool:
+    """Whether the window's NIS test failed (its sum beyond its χ²(6N) limit): only then do
+    the nav's updates count in the bound, since summed update by update a nominal NIS's noise
+    (1.7 nats a step) would reach log γ by chance and set a bound below any test's reach."""
+    return (window.nis_sum is not None and window.nis_limit is not None
+            and window.nis_sum > window.nis_limit)
 
 
 def with_delay_bounds(scores: Scores, faults: Sequence[Fault], windows: Sequence[FdirWindow],

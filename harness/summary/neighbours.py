@@ -64,15 +64,15 @@ class NeighboursSummary(SummaryRecord):
 
 
 def declarations(msgs: Sequence[NeighbourDeclaration]) -> list[Detection]:
-    """One detection per (subject, window): declared when first sent, by every judge named; at
-    the window's end, or where the judges' scans declared it mid-window when they crossed."""
+    """One detection per (subject, window): at the window's end (the ground's rulings are
+    keyed by it), declared when first sent (mid-window where the judges' scans declared it),
+    by every judge named."""
     by_key: dict[tuple[int, float], Detection] = {}
     for d in sorted(msgs, key=lambda m: (m.t_sim, m.spacecraft)):
         key = (d.subject, d.t_end_s)
         seen = by_key.get(key)
         if seen is None:
-            at = d.t_end_s if d.crossed_s is None else d.crossed_s
-            by_key[key] = Detection(spacecraft=d.subject, time_s=at, declared_s=d.t_sim,
+            by_key[key] = Detection(spacecraft=d.subject, time_s=d.t_end_s, declared_s=d.t_sim,
                                     fault_class=None, direction=None, metric=None,
                                     threshold=None, declared_by="neighbours",
                                     judges=sorted(d.judges))

@@ -167,9 +167,10 @@ class FaultScore(SummaryRecord):
                     "update of the NIS's growth over the same window, nats (3(λ − 1))")
     delay_bound_s: float | None = Field(
         default=None, ge=0.0,
-        description="log γ / D steps in s, D the sum of the two divergences, at least one "
-                    "step (γ: the scans' mean time to a false alarm, steps): the smallest "
-                    "worst-case mean delay of any test as quick to false-alarm (Lorden 1971)")
+        description="when the divergence summed from the onset first reaches log γ, s, at "
+                    "least one step (γ: the scans' mean time to a false alarm, steps; "
+                    "harness/summary/delay_bound.py): the smallest worst-case mean delay of "
+                    "any test as quick to false-alarm (Lorden 1971)")
 
 
 class Scores(SummaryRecord):

@@ -18,6 +18,7 @@ from gnc.twin import centre_boresights
 from interfaces.contracts.messages import (
     GuidanceStatus,
     Message,
+    NeighbourCrossing,
     NeighbourDeclaration,
     NeighbourJudgement,
     NeighbourRuling,
@@ -183,4 +184,51 @@ def test_with_the_sequential_test_a_neighbour_is_declared_mid_window() -> None:
     (declaration,) = [m for m in sent if isinstance(m, NeighbourDeclaration)]
     assert (declaration.subject, declaration.judges, declaration.t_sim) == (2, [1, 3], 47.0)
     assert declaration.crossed_s == crossing.t_s and app.exclusions.since_s == {2: 30.0}
-    assert app.scans.c > 5.0  # its share of the budget, one image a second
+
+
+def test_a_window_begun_before_the_scans_crossed_does_not_clear_their_declaration() -> None:
+    """Declared on scans that crossed at 45 s: window [30, 60), passing on the whole (the
+    fault began late in it), does not count towards clearing it; [60, 90) does."""
+    app, _ = app_alone(NeighboursApp, SEQ)
+    app.declared.add(2)
+    app.crossed_at[2] = 45.0
+    for a in (30.0, 60.0):
+        for judge in (1, 3):
+            app.on_judgement(NeighbourJudgement(
+                sender=f"sc{judge}", seq=1, t_sim=a + 33.0, spacecraft=judge, t_start_s=a,
+                t_end_s=a + 30.0, verdicts=[NeighbourVerdict(subject=2, images=30,
+                                                             exceeded=False)]))
+    app.next_judge = 3  # windows 0-2 judged aboard
+    app.step(60.0 + SEQ.fdir.latency_s + 1.0)
+    assert app.passing.get(2, 0) == 0
+    app.step(90.0 + SEQ.fdir.latency_s + 1.0)
+    assert app.passing == {2: 1} and app.declared == {2}
+
+
+def test_judges_scans_agree_across_a_window_s_end() -> None:
+    """Judge 3's scan crossed at 59 s (window [30, 60)), judge 1's at 64 s: one FDI period
+    apart at most, they agree, on the first's window; crossings older than a period are
+    forgotten."""
+    app, sent = app_alone(NeighboursApp, SEQ)
+    app.on_judgement(_crossing_of(3, 59.0))
+    app.step(60.0)
+    app.on_judgement(_crossing_of(1, 64.0))
+    app.step(65.0)
+    (declaration,) = [m for m in sent if isinstance(m, NeighbourDeclaration)]
+    assert (declaration.t_start_s, declaration.judges, declaration.crossed_s) == (30.0, [1, 3],
+                                                                                 59.0)
+    late, sent_late = app_alone(NeighboursApp, SEQ)
+    late.on_judgement(_crossing_of(3, 10.0))
+    late.step(11.0)
+    late.on_judgement(_crossing_of(1, 64.0))
+    late.step(65.0)
+    assert not [m for m in sent_late if isinstance(m, NeighbourDeclaration)]
+
+
+def _crossing_of(judge: int, t: float) -> NeighbourJudgement:
+    """Judge ``judge``'s scan crossing on observer 2 at its image of ``t`` (s)."""
+    a = 30.0 * (t // 30.0)
+    return NeighbourJudgement(sender=f"sc{judge}", seq=1, t_sim=t, spacecraft=judge,
+                              t_start_s=a, t_end_s=a + 30.0, crossings=[NeighbourCrossing(
+                                  subject=2, t_s=t, z=9.0, span=1, shift=-0.5, limit=0.1,
+                                  direction="degraded")])

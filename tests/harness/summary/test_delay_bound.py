@@ -26,7 +26,8 @@ def _window(sc: int, a: float, ratio: float | None, sigma: float | None = None,
     scan = {} if sigma is None else {"scan_z_max": 1.0, "scan_threshold": C,
                                      "image_sigma": sigma}
     info = {} if ratio is None else {"dh": 0.9 * ratio * 2.0, "dh_pred": 2.0, "ratio_mean": 0.9}
-    nis = {} if nis_per_update is None else {"nis_sum": 30 * nis_per_update, "nis_updates": 30}
+    nis = {} if nis_per_update is None else {"nis_sum": 30 * nis_per_update, "nis_updates": 30,
+                                             "nis_limit": 267.0}  # χ²(180) at about 1e-7
     return FdirWindow(sender="ground", t_sim=a + 30.0, spacecraft=sc, t_start_s=a,
                       t_end_s=a + 30.0, images=30, **info, **scan, **nis)
 
@@ -55,14 +56,17 @@ def test_a_large_shift_is_bounded_by_one_step() -> None:
 
 
 def test_the_nav_s_evidence_adds_to_the_image_s() -> None:
-    """The window's NIS 4 × 6 per update: 3(4 − 1) = 9 nats per update, beside the ratio's
-    0.78: the bound is log γ / 9.78; a NIS that fell adds nothing."""
+    """The window's NIS 4 × 6 per update, its NIS test failed: 3(4 − 1) = 9 nats per update,
+    beside the ratio's 0.78: the bound is log γ / 9.78; a NIS within its test's limit adds
+    nothing (a nominal NIS's noise would reach log γ by chance, summed)."""
     windows = [_window(1, 60.0, 1.01, 0.008, nis_per_update=24.0)]
     bound = fault_bound(_fault(45.0), windows, 1.0)
     assert bound is not None and bound.nis == pytest.approx(9.0)
     assert bound.delay_s == pytest.approx(math.log(GAMMA) / (9.0 + bound.image))
-    calm = fault_bound(_fault(45.0), [_window(1, 60.0, 1.01, 0.008, nis_per_update=3.0)], 1.0)
-    assert calm is not None and calm.nis == 0.0
+    calm = fault_bound(_fault(45.0), [_window(1, 60.0, 1.01, 0.008, nis_per_update=6.5)], 1.0,
+                       [(45.0 + k, 30.0) for k in range(20)])  # noise that sums high
+    assert calm is not None and calm.nis == pytest.approx(0.25)  # (6.5 − 6) / 2
+    assert calm.delay_s == pytest.approx(math.log(GAMMA) / calm.image)
 
 
 def test_the_scan_record_comes_from_the_nearest_window_that_has_one() -> None:
@@ -106,7 +110,7 @@ def test_summed_update_by_update_the_bound_follows_a_growing_fault() -> None:
     window = _window(1, 100.0, 1.0005, 0.01, nis_per_update=30.0)
     bound = fault_bound(fault, [window], 1.0, updates)
     assert bound is not None and bound.delay_s == pytest.approx(3.0)
-    by_mean = math.log(GAMMA) / (12.0 + bound.image)
+    by_mean = math.log(GAMMA) / (12.0 + bound.image)  # no updates: the window's means
     assert fault_bound(fault, [window], 1.0).delay_s == pytest.approx(by_mean)  # type: ignore[union-attr]
-    ended = fault_bound(_fault(100.0, end_s=101.5), [window], 1.0, updates)
-    assert ended is not None and ended.delay_s == pytest.approx(by_mean)  # never summed to it
+    # never summed to log γ while the fault lasted: no bound
+    assert fault_bound(_fault(100.0, end_s=101.5), [window], 1.0, updates) is None
