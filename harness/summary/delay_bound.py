@@ -20,12 +20,13 @@ The bound is the time from onset at which the divergence summed step by step fir
 log γ, γ = 1 / (2 L Φ(−c)) the scans' mean time to a false alarm (both hold the same
 probability per step; Lorden 1971: no test as quick to false-alarm has a smaller worst-case
 mean delay), at least one step: with the nav's updates (``nis``), the image's D each step
-plus each update's own; without, log γ / D steps (``gnc.sequential_test.delay_bound``) with D
+plus each update's own; without them, log γ / D steps (``gnc.sequential_test.delay_bound``) with D
 the sum of the window's two.  The nav's updates count only where the window's NIS test failed
-(:func:`nis_moved`).  Summed update by update, the bound follows a fault whose effect grows (a
-thruster's drift); the image's part is the window's mean, which for a growing fault
-(a pointing error building up) says more than its first seconds show, so its bound is low.
-Pure functions.
+(:func:`nis_moved`); summed update by update, with the image's divergence of the window each
+falls in (:func:`image_divergences`), the bound follows a fault whose effect grows (a
+thruster's drift).  Where the NIS did not move, the image's part is the first whole window's
+mean, which for a growing fault (a pointing error building up) says more than its first
+seconds show, so its bound is low.  Pure functions.
 """
 
 from __future__ import annotations
@@ -83,16 +84,29 @@ def nis_series(estimates: Iterable[StateEstimate]) -> dict[int, list[tuple[float
     return out
 
 
-def summed_bound_s(fault: Fault, image: float, updates: Sequence[tuple[float, float]],
-                   log_gamma: float, step_s: float) -> float | None:
-    """The time from ``fault``'s onset (s) at which ``image`` (nats a step) plus each nav
-    update's (NIS_k − 6)/2 since the onset first sum to ``log_gamma``, at least one step; None
-    when they never do while the fault lasts."""
+def image_divergences(fault: Fault, windows: Sequence[FdirWindow], sigma: float
+                      ) -> list[tuple[float, float, float]]:
+    """The image's divergence per step in each window of ``fault``'s observer that ends after
+    its onset and has a ratio: (start s, end s, δ_w² / 2σ²), δ_w the window's own mean
+    shift (the window the onset falls in holds images from before it too)."""
+    return [(w.t_start_s, w.t_end_s, kl_gaussian_shift(
+                w.dh / w.dh_pred / w.ratio_mean - 1.0, sigma))
+            for w in windows if w.spacecraft == fault.spacecraft
+            and w.t_end_s > fault.start_s and w.dh is not None and w.dh_pred and w.ratio_mean]
+
+
+def summed_bound_s(fault: Fault, image: Sequence[tuple[float, float, float]],
+                   updates: Sequence[tuple[float, float]], log_gamma: float, step_s: float
+                   ) -> float | None:
+    """The time from ``fault``'s onset (s) at which the image's divergence of the window each
+    nav update falls in (``image``: :func:`image_divergences`) plus each update's
+    (NIS_k − 6)/2 since the onset first sum to ``log_gamma``, at least one step; None when
+    they never do while the fault lasts."""
     total = 0.0
     for t, nis in updates:
         if t < fault.start_s - TIME_TOL_S or (fault.end_s is not None and t > fault.end_s):
             continue
-        total += image + (nis - NIS_DOF) / 2.0
+        total += next((d for a, b, d in image if a <= t < b), 0.0) + (nis - NIS_DOF) / 2.0
         if total >= log_gamma:
             return max(t - fault.start_s, step_s)
     return None
@@ -123,7 +137,8 @@ def fault_bound(fault: Fault, windows: Sequence[FdirWindow], step_s: float,
                 if image > 0.0 else None)
     if not updates:
         return FaultBound(image, nis, max(delay_bound(gamma, total), 1.0) * step_s)
-    summed = summed_bound_s(fault, image, updates, math.log(gamma), step_s)
+    summed = summed_bound_s(fault, image_divergences(fault, windows, record.image_sigma),
+                            updates, math.log(gamma), step_s)
     return FaultBound(image, nis, summed) if summed is not None else None
 
 

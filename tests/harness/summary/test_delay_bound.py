@@ -114,3 +114,14 @@ def test_summed_update_by_update_the_bound_follows_a_growing_fault() -> None:
     assert fault_bound(fault, [window], 1.0).delay_s == pytest.approx(by_mean)  # type: ignore[union-attr]
     # never summed to log γ while the fault lasted: no bound
     assert fault_bound(_fault(100.0, end_s=101.5), [window], 1.0, updates) is None
+
+
+def test_each_update_counts_the_image_divergence_of_its_own_window() -> None:
+    """The first window after the onset barely moved (D ≈ 0), the next moved by 20% (D = 200):
+    with updates that add nothing, the sum reaches log γ at the next window's first update,
+    30 s after the onset, not at once as the first whole window's mean would have it."""
+    fault = _fault(100.0)
+    windows = [_window(1, 100.0, 1.0005, 0.01, nis_per_update=30.0), _window(1, 130.0, 0.8)]
+    updates = [(100.0 + k, 6.0) for k in range(40)]
+    bound = fault_bound(fault, windows, 1.0, updates)
+    assert bound is not None and bound.delay_s == pytest.approx(30.0)
