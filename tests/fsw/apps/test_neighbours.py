@@ -14,6 +14,7 @@ import pytest
 
 from fsw.apps.neighbours import NeighboursApp
 from gnc.pro import Pro
+from gnc.sequential_test import scan_threshold
 from gnc.twin import centre_boresights
 from interfaces.contracts.messages import (
     GuidanceStatus,
@@ -184,6 +185,9 @@ def test_with_the_sequential_test_a_neighbour_is_declared_mid_window() -> None:
     (declaration,) = [m for m in sent if isinstance(m, NeighbourDeclaration)]
     assert (declaration.subject, declaration.judges, declaration.t_sim) == (2, [1, 3], 47.0)
     assert declaration.crossed_s == crossing.t_s and app.exclusions.since_s == {2: 30.0}
+    # half the budget (the window test has the other half), over an hour's images, 1 a second
+    per_image = SEQ.fdir.false_alarms_per_observer_hour / 2.0 / 3600.0
+    assert app.tests == 2 and app.scans.c == pytest.approx(scan_threshold(per_image))
 
 
 def test_a_window_begun_before_the_scans_crossed_does_not_clear_their_declaration() -> None:
