@@ -35,13 +35,22 @@ class Crossing:
     """A scan crossing its threshold: at an image (the information scan: the image's time,
     s; the span's mean relative shift and the shift it had to exceed) or at a nav update (the
     NIS scan, ``test = "nis"``: the update's time; the span's mean NIS per degree of freedom
-    and the mean it had to exceed)."""
+    and the mean it had to exceed); ``since_s``, the time of the span's first image or update
+    (s; None: the crossing's own)."""
 
     image_t_s: float
     scan: ScanResult
     shift: float
     limit: float
     test: Literal["information", "nis"] = "information"
+    since_s: float | None = None
+
+    @property
+    def change_s(self) -> float:
+        """When the change began, as the scan estimates it (s): the start of the span whose
+        statistic was the largest, the change point the dyadic spans allow (the span that
+        matches a sustained change is within a factor of two of one of them)."""
+        return self.image_t_s if self.since_s is None else self.since_s
 
     @property
     def direction(self) -> Direction | None:
@@ -177,7 +186,8 @@ class ImageScans:
             stats.add(result.z if result is not None else 0.0, float(ek), float(bk))
             if result is not None and result.z > self.c:
                 shift = float(np.mean(scan.r[-result.span:]))
-                return Crossing(float(t), result, shift, self.c * abs(shift) / result.z)
+                return Crossing(float(t), result, shift, self.c * abs(shift) / result.z,
+                                since_s=scan.times[-result.span])
         return None
 
     def _model(self, observer: int, window: tuple[float, float], times: np.ndarray,

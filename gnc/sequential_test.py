@@ -99,6 +99,8 @@ class ScanBuffer:
     r: list[float] = field(default_factory=list)
     sigma_e: list[float] = field(default_factory=list)
     sigma_b: list[float] = field(default_factory=list)
+    times: list[float] = field(default_factory=list)
+    """the images' times (s)"""
     last_t: float = -math.inf
     scored_t: float = -math.inf
 
@@ -108,6 +110,7 @@ class ScanBuffer:
         self.r = [*self.r[-keep:], r]
         self.sigma_e = [*self.sigma_e[-keep:], sigma_e]
         self.sigma_b = [*self.sigma_b[-keep:], sigma_b]
+        self.times = [*self.times[-keep:], t]
         self.last_t = self.scored_t = t
 
     def scan(self) -> ScanResult | None:

@@ -14,7 +14,7 @@ import logging
 from gnc.image_scan import Crossing
 from gnc.window_test import exceeded as window_exceeded
 from ground.fdir.constellation import ConstellationVerdict
-from ground.fdir.identify import Evidence, Tolerances, classify
+from ground.fdir.identify import Evidence, Tolerances, classify, classify_part
 from ground.fdir.information import Judgement
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, FdirWindow, Message
@@ -35,10 +35,19 @@ class Declarer:
         self._crossed_s: dict[int, float] = {}
         """observers declared by a scan, with the time it crossed (s), until a window that
         began at or after it is judged"""
+        self._change_s: dict[int, float] = {}
+        """observers declared by a scan and not yet identified, with the time the change
+        began as the scan estimated it (s)"""
 
     def identifying(self, sc: int) -> bool:
         """Whether observer ``sc``'s declared fault still has no class."""
         return sc in self._unidentified
+
+    def change_s(self, sc: int) -> float | None:
+        """When observer ``sc``'s fault still without a class began, as the scan that declared
+        it estimated (s; ``gnc.image_scan.Crossing.change_s``); None: not declared by a scan,
+        or identified."""
+        return self._change_s.get(sc) if sc in self._unidentified else None
 
     def naming(self, sc: int) -> bool:
         """Whether a failed window of ``sc`` would have to name a class (no fault declared, or
@@ -55,21 +64,51 @@ class Declarer:
         out: list[Message] = [w]
         counted = None if self._before_crossing(sc, w.t_start_s) and not exceeded else exceeded
         if self.persistence.update(sc, counted):
-            cls = classify(j.evidence, self.tol, failed)
+            self._change_s.pop(sc, None)  # declared by the windows: a scan's estimate is old
+            cls, ev = self._classify(j, failed)
             self.log.warning("FDIR: fault declared on sc%d at %.0f s (failed %s; H_m %s, τ %s, "
                              "%s): %s", sc, w.t_end_s, "+".join(failed), _g(w.metric),
                              _g(w.threshold), w.direction, cls or "unidentified")
-            out.append(self._report(sc, cls, w, j.evidence))
+            out.append(self._report(sc, cls, w, ev))
             if cls is None:
                 self._unidentified.add(sc)
         elif sc in self._unidentified:
-            cls = classify(j.evidence, self.tol, failed)
+            cls, ev = self._classify(j, failed)
             if cls is not None or counted is False:
                 self._unidentified.discard(sc)
             if cls is not None:
                 self.log.warning("FDIR: sc%d identified at %.0f s: %s", sc, w.t_end_s, cls)
-                out.append(self._report(sc, cls, w, j.evidence))
+                out.append(self._report(sc, cls, w, ev))
         return out
+
+    def identify_part(self, sc: int, j: Judgement, t_s: float, window_end_s: float
+                      ) -> FaultReport | None:
+        """Observer ``sc``'s declared fault, still without a class, classified on the part of
+        the window being collected (ending at ``window_end_s``) since its change, judged as a
+        window (``j``: the part's tests and evidence) at its last image's time ``t_s`` (s;
+        docs/fdir.md, "Identification after a crossing"): the report naming the class, or
+        None when the evidence names none yet."""
+        cls = classify_part(j.evidence, self.tol, j.window.failed)
+        if cls is None:
+            return None
+        self._unidentified.discard(sc)
+        self.log.warning("FDIR: sc%d identified at %.0f s on its images since %.0f s: %s", sc,
+                         t_s, j.window.t_start_s, cls)
+        w = j.window
+        return FaultReport(sender=self.node, t_sim=t_s, spacecraft=sc, fault_class=cls,
+                           direction=w.direction, metric=w.metric, threshold=w.threshold,
+                           window_end_s=window_end_s, detector="sequential",
+                           evidence={**j.evidence.as_dict(), "since_s": w.t_start_s})
+
+    def _classify(self, j: Judgement, failed: list[str]) -> tuple[str | None, Evidence]:
+        """The class ``j``'s evidence names, with ``failed`` its tests failed, and the evidence
+        that named it: its images since the change first (``classify_part``), else the whole
+        window's (``classify``)."""
+        if j.part is not None:
+            cls = classify_part(j.part, self.tol, failed)
+            if cls is not None:
+                return cls, j.part
+        return classify(j.evidence, self.tol, failed), j.evidence
 
     def _before_crossing(self, sc: int, t_start_s: float) -> bool:
         """Whether observer ``sc`` was declared by a scan crossing after ``t_start_s`` (s): a
@@ -95,6 +134,7 @@ class Declarer:
         self.persistence.declare(sc)
         self._unidentified.add(sc)
         self._crossed_s[sc] = crossing.image_t_s
+        self._change_s[sc] = crossing.change_s
         self.log.warning("FDIR: fault declared on sc%d at %.0f s (sequential, %s scan: |Z| "
                          "%.3g over %d, mean %.3g against %.3g%s)", sc, crossing.image_t_s,
                          crossing.test, crossing.scan.z, crossing.scan.span, crossing.shift,

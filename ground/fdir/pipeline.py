@@ -36,7 +36,7 @@ from gnc.twin import FlightPlan, Transfer, TwinModel
 from ground.fdir.declaration import Declarer
 from ground.fdir.fused_views import FusedViews
 from ground.fdir.global_check import GlobalCheck
-from ground.fdir.information import InformationTest, Judgement
+from ground.fdir.information import IDENTIFY_IMAGES, IDENTIFY_STEP, InformationTest, Judgement
 from ground.fdir.integrity import IntegrityCheck
 from ground.fdir.link_checks import LinkChecks
 from ground.fdir.neighbour_rulings import NeighbourRulings
@@ -93,6 +93,9 @@ class FdirPipeline:
                                           image_false_alarm(sc, self.information.tests))
                            if cfg.detector == "sequential" else None)
         """the sequential test on each image as it comes (None: the windows alone)"""
+        self._identify_tries: dict[int, tuple[float, int]] = {}
+        """each observer's last try at identifying on part of a window: its start (s) and the
+        images tried"""
         self._crossings: dict[int, Crossing] = {}
         """the sequential test's crossings waiting for the other observers' images"""
         self.global_check = GlobalCheck(cfg, self.information.q_window, node, log)
@@ -254,6 +257,7 @@ class FdirPipeline:
             self.next_window += 1  # first: a failing window is not retried forever
             out += self.evaluate(k)
         out += self._scan(self.next_window, final=False)
+        out += self._identify_part(self.next_window)
         return [m.model_copy(update={"declared_s": t}) if isinstance(m, FaultReport) else m
                 for m in out]
 
@@ -307,7 +311,8 @@ class FdirPipeline:
                 continue
             judged[sc] = self.information.judge(
                 ctx, obs, window.model_copy(update={"images": images}),
-                self.declarer.identifying(sc), self.declarer.naming(sc))
+                self.declarer.identifying(sc), self.declarer.naming(sc),
+                self.declarer.change_s(sc))
         common, messages = self.global_check.check(a, b, judged, self._cost())
         out += messages
         for sc, j in judged.items():
@@ -355,6 +360,48 @@ class FdirPipeline:
             else:  # the images after it are scored once it is decided
                 self._crossings[sc] = crossing
         return self._scan_nis(a, b) + self._decide_crossings(a, b, final)
+
+    def _identify_part(self, k: int) -> list[Message]:
+        """With the sequential test: each declared fault still without a class judged, as a
+        window of its own, on the newest ``IDENTIFY_IMAGES`` images of window k come so far
+        since its change (the scan's estimate, or the window's start), each time
+        ``IDENTIFY_STEP`` more have come (docs/fdir.md, "Identification after a crossing"):
+        its class as soon as the evidence names one, not at the window's end.  The newest,
+        not all since the change: a drift (a leak) is the farther off the later."""
+        if self.sequential is None:
+            return []
+        a, b = self.schedule.start(k), self.schedule.end(k)
+        out: list[Message] = []
+        for sc, obs in self.observers.items():
+            if not self.declarer.identifying(sc) or obs.plan_at(a) is None:
+                continue
+            since = max(self.declarer.change_s(sc) or a, a)
+            mine = sorted((m for m in self.pending
+                           if m.spacecraft == sc and since <= m.image_t_s < b),
+                          key=lambda m: m.image_t_s)
+            if not self._identify_due(sc, a, len(mine)):
+                continue
+            newest = mine[-IDENTIFY_IMAGES:]  # a drift shows most in the newest
+            ctx = window_context(sc, obs, newest, newest[0].image_t_s, newest[-1].image_t_s,
+                                 SettledMap.of(self.settled), self.n, self.settle_s)[0]
+            if ctx is None or len(ctx.times) < IDENTIFY_IMAGES:
+                continue
+            window = FdirWindow(sender=self.node, t_sim=ctx.b, spacecraft=sc, t_start_s=ctx.a,
+                                t_end_s=ctx.b, images=len(ctx.times))
+            j = self.information.judge(ctx, obs, window, True, True)
+            report = self.declarer.identify_part(sc, j, ctx.b, b)
+            out += [report] if report is not None else []
+        return out
+
+    def _identify_due(self, sc: int, a: float, images: int) -> bool:
+        """Whether observer ``sc``'s ``images`` since its change in the window starting at
+        ``a`` (s) are enough, and enough more than at the last try, for a try."""
+        held = self._identify_tries.get(sc)
+        tried = held[1] if held is not None and abs(held[0] - a) < TIME_TOL_S else 0
+        if images < max(IDENTIFY_IMAGES, tried + IDENTIFY_STEP):
+            return False
+        self._identify_tries[sc] = (a, images)
+        return True
 
     def _scan_nis(self, a: float, b: float) -> list[Message]:
         """With ``fdir.fuse_nis``: each observer's nav updates come since the last call and

@@ -44,6 +44,8 @@ class _NisScan:
     of the last update looked at."""
 
     values: list[float] = field(default_factory=list)
+    times: list[float] = field(default_factory=list)
+    """the values' times (s)"""
     last_t: float = -math.inf
     window: tuple[float, float] | None = None
     """the start of the window its last updates were scored in (s) and their largest z"""
@@ -89,11 +91,12 @@ class SequentialTest(ImageScans):
         if fresh:
             scan.last_t = fresh[-1][0]
         if not judged:
-            scan.values = []
+            scan.values, scan.times = [], []
             return None
         keep = max(SCAN_LENGTHS) - 1
         for t, v in fresh:
             scan.values = [*scan.values[-keep:], v]
+            scan.times = [*scan.times[-keep:], t]
             result = chi2_scan(scan.values, NIS_DOF)
             z = result.z if result is not None else 0.0
             held = scan.window if scan.window is not None and abs(scan.window[0] - a) <= \
@@ -102,9 +105,11 @@ class SequentialTest(ImageScans):
             if result is not None and result.z > self.c_nis:
                 n = result.span
                 mean = float(np.mean(scan.values[-n:])) / NIS_DOF
-                scan.values = []  # its evidence spent
+                since = scan.times[-n]
+                scan.values, scan.times = [], []  # its evidence spent
                 return Crossing(t, result, mean,
-                                chi2_span_limit(self.c_nis, NIS_DOF, n) / (n * NIS_DOF), "nis")
+                                chi2_span_limit(self.c_nis, NIS_DOF, n) / (n * NIS_DOF), "nis",
+                                since)
         return None
 
     def window_fields(self, spacecraft: int, a: float) -> dict[str, float]:

@@ -10,7 +10,7 @@ known plan covers (a transfer whose plan was lost is not).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -18,6 +18,7 @@ from gnc.poi_map import PoiMap
 from gnc.window_test import Observation, WindowPose
 from ground.fdir.observer import ObserverState
 from interfaces.contracts.messages import PoiObservations, Unjudged
+from interfaces.contracts.timing import TIME_TOL_S
 
 
 @dataclass(frozen=True)
@@ -77,6 +78,20 @@ class WindowContext:
         return WindowPose(self.planned, att[:, 4:7] if att is not None else None, self.nav,
                           self.nav_sigma, att[:, 3] if att is not None else None,
                           att[:, 7] if att is not None else None, self.moving)
+
+    def since(self, t: float) -> WindowContext:
+        """The same window's judged images taken at or after ``t`` (s), with their poses: the
+        part of the window a change that began at ``t`` shows in (the map still the one
+        settled at ``a``)."""
+        keep = self.times >= t - TIME_TOL_S
+        rows = np.flatnonzero(keep)
+        return replace(self, images=[m for m in self.images if m.image_t_s >= t - TIME_TOL_S],
+                       times=self.times[keep],
+                       planned=self.planned[keep],
+                       attitude=None if self.attitude is None else self.attitude[keep],
+                       nav=None if self.nav is None else self.nav[keep],
+                       nav_sigma=None if self.nav_sigma is None else self.nav_sigma[keep],
+                       seen=[self.seen[i] for i in rows])
 
 
 

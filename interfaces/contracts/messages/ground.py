@@ -128,6 +128,11 @@ class FdirWindow(Message):
         default=None, ge=0.0,
         description="one image's nominal relative 1σ √(σ_b² + σ_e²), RMS over the images "
                     "scored (the per-image divergence of a shift δ is δ² / 2σ²)")
+    evidence_since_s: float | None = Field(
+        default=None,
+        description="the evidence is of the window's images from this time on (s): the change "
+                    "the sequential test estimated, for a fault it declared within the window "
+                    "(docs/fdir.md, 'Identification after a crossing'); None: the whole window")
 
 
 class ConstellationWindow(Message):

@@ -1,12 +1,13 @@
 """The FDIR pipeline's sequential test (ground/fdir/sequential.py) on windows of images made
 by the twin's own camera model: a nominal camera (the sim's multiplicative noise) never
 crosses, a degraded one crosses on its first image, and the crossing declares a fault whose
-class the windows then look for."""
+class is then looked for on the images since the change the scan estimated."""
 
 from __future__ import annotations
 
 import logging
 import math
+from dataclasses import replace
 
 import numpy as np
 import pydantic
@@ -19,11 +20,12 @@ from gnc.poi_map import PoiMap
 from gnc.sequential_test import ScanResult
 from gnc.twin import TwinModel, centre_boresights
 from ground.fdir.declaration import Declarer
-from ground.fdir.identify import Evidence
-from ground.fdir.information import InformationTest, Judgement
+from ground.fdir.identify import Evidence, Tolerances, classify, classify_part
+from ground.fdir.information import IDENTIFY_IMAGES, InformationTest, Judgement, evidence_part
+from ground.fdir.observer import ObserverState
 from ground.fdir.sequential import SequentialTest, decided, image_false_alarm
 from ground.fdir.window import SettledMap, WindowContext
-from interfaces.contracts.messages import FdirWindow
+from interfaces.contracts.messages import FaultReport, FdirWindow
 from tests.conftest import small_scenario
 
 NOISE = 0.05
@@ -78,6 +80,7 @@ def test_a_degraded_camera_crosses_on_its_first_image() -> None:
     crossing = _score(test, _window(30.0, [1.0] * 10 + [0.8] * 20, rng))
     assert crossing is not None and crossing.image_t_s == 40.0
     assert crossing.direction == "degraded" and crossing.scan.span == 1
+    assert crossing.change_s == 40.0  # the span that crossed: this image alone
     assert crossing.shift == pytest.approx(-0.2, abs=0.02)
     assert crossing.scan.z > test.c and crossing.limit < abs(crossing.shift)
     assert test.window_fields(1, 30.0)["scan_z_max"] == crossing.scan.z
@@ -167,22 +170,69 @@ def test_the_nis_scan_of_a_declared_observer_starts_afresh() -> None:
     assert test.score_nis(2, updates, True, 0.0) is None  # one value held: no crossing
     crossing = SequentialTest(SCENARIO, TWIN, 1e-6).score_nis(2, updates, True, 0.0)
     assert crossing is not None and crossing.image_t_s == 3.0 and crossing.scan.span == 4
+    assert crossing.change_s == 0.0  # the growth began with the span's first update
 
 
-def test_a_scan_s_declaration_outlives_the_window_it_crossed_in() -> None:
-    """Declared by a crossing late in window [0, 30), which passes on the whole: the episode
-    and its identification go on; a passing window after the crossing ends them."""
+def test_a_change_late_in_a_window_is_identified_on_its_images_alone() -> None:
+    """A camera degraded to β = 0.75 for the last 12 images of a window: over the whole
+    window the 18 nominal images before it hold the median β̂ near 1, within its margin of
+    standard errors, and name nothing; the images since the change the scan estimated name
+    the camera (looked at first, the whole window's still judged), and the window records
+    where that evidence starts.  Fewer than ``IDENTIFY_IMAGES`` since the change: the whole
+    window alone, as before."""
+    ctx = _window(0.0, [1.0] * 18 + [0.75] * 12, np.random.default_rng(9))
+    test, tol = InformationTest(SCENARIO, TWIN), Tolerances.of(SCENARIO.fdir)
+    window = FdirWindow(sender="ground", t_sim=30.0, spacecraft=1, t_start_s=0.0, t_end_s=30.0,
+                        images=30)
+    whole = test.judge(ctx, ObserverState(), window, True, True)
+    assert whole.window.failed == ["information"] and whole.window.evidence_since_s is None
+    assert whole.part is None and classify(whole.evidence, tol, whole.window.failed) is None
+    j = test.judge(ctx, ObserverState(), window, True, True, since_s=18.0)
+    assert j.window.evidence_since_s == 18.0 and j.window.failed == ["information"]
+    assert j.evidence == whole.evidence and j.part is not None
+    assert j.part.beta_hat == pytest.approx(0.75, abs=0.05)
+    assert classify_part(j.part, tol, j.window.failed) == "camera"
+    declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
+    declarer.declare_crossing(1, _crossing(18.0, -8.0), 30.0)
+    (verdict, report) = declarer.declare(1, j, None)
+    assert isinstance(report, FaultReport) and report.fault_class == "camera"
+    assert report.evidence["beta_hat"] == j.part.beta_hat  # the part's evidence named it
+    assert evidence_part(ctx, 30.0 - IDENTIFY_IMAGES + 1.0) is None
+    assert evidence_part(ctx, 0.0) is None  # no change within the window
+    assert len(evidence_part(ctx, 18.0).times) == 12  # type: ignore[union-attr]
+
+
+def test_a_part_names_nothing_while_the_nav_walks_off_a_plan_the_camera_holds() -> None:
+    """A nav sensor's step being absorbed: the nav 0.46 m off the plan, the camera located
+    0.09 m off it with a standard error of 0.22 m, and a seen set not the reported pose's.
+    The whole window's rules would name the camera; a part names nothing until the camera is
+    off the plan beyond half the tolerance and three standard errors (then the spacecraft
+    moved: a state disturbance's jump, named ``actuator``)."""
+    tol = Tolerances.of(SCENARIO.fdir)
+    walking = Evidence(beta_hat=0.99, beta_se=0.03, camera_vs_nav_m=0.46, nav_vs_plan_m=0.46,
+                       camera_vs_plan_m=0.09, camera_se_m=0.22, seen_overlap=0.77)
+    assert classify(walking, tol) == "camera" and classify_part(walking, tol) is None
+    jumped = replace(walking, camera_vs_plan_m=1.6, camera_vs_nav_m=1.2, camera_se_m=0.09,
+                     offset_alignment=0.99)
+    assert classify_part(jumped, tol) == classify(jumped, tol) == "actuator"
+
+
+def test_a_part_of_a_window_names_the_class_at_its_last_image() -> None:
+    """A fault a scan declared at 27 s, judged on its images of 28-37 s in the next window
+    (``Declarer.identify_part``): evidence naming nothing keeps it unidentified; β̂ = 0.7 off
+    1 by many standard errors names the camera at 37 s, in the window ending at 60 s, with
+    where its evidence starts, and ends the identification (the windows look no further)."""
     declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
     declarer.declare_crossing(1, _crossing(27.0, -8.0), 30.0)
-    passing = Judgement(_judged_window(0.0), Evidence(), None)  # type: ignore[arg-type]
-    assert declarer.declare(1, passing, None) == [passing.window.model_copy(
-        update={"exceeded": False})]
-    assert declarer.declared(1) and declarer.identifying(1)
-    declarer.declare(1, Judgement(_judged_window(30.0), Evidence(), None), None)  # type: ignore[arg-type]
-    assert not declarer.declared(1) and not declarer.identifying(1)
+    assert declarer.change_s(1) == 27.0
+    part = FdirWindow(sender="ground", t_sim=37.0, spacecraft=1, t_start_s=28.0, t_end_s=37.0,
+                      images=10, failed=["information"])
+    nothing = Judgement(part, Evidence(beta_hat=0.99, beta_se=0.01), None)  # type: ignore[arg-type]
+    assert declarer.identify_part(1, nothing, 37.0, 60.0) is None and declarer.identifying(1)
+    camera = Judgement(part, Evidence(beta_hat=0.7, beta_se=0.01), None)  # type: ignore[arg-type]
+    report = declarer.identify_part(1, camera, 37.0, 60.0)
+    assert report is not None and report.fault_class == "camera" and report.t_sim == 37.0
+    assert report.window_end_s == 60.0 and report.evidence["since_s"] == 28.0
+    assert not declarer.identifying(1) and declarer.change_s(1) is None
+    assert declarer.declared(1)  # the episode goes on
 
-
-def _judged_window(a: float) -> FdirWindow:
-    """A window of observer 1 whose information test passed."""
-    return FdirWindow(sender="ground", t_sim=a + 30.0, spacecraft=1, t_start_s=a,
-                      t_end_s=a + 30.0, images=30, metric=0.001, threshold=0.01)
