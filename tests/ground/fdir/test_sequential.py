@@ -236,3 +236,19 @@ def test_a_part_of_a_window_names_the_class_at_its_last_image() -> None:
     assert not declarer.identifying(1) and declarer.change_s(1) is None
     assert declarer.declared(1)  # the episode goes on
 
+
+def test_a_model_drawn_before_the_plan_was_known_is_drawn_again_on_it() -> None:
+    """A window whose plan is not known over its whole span when its first images are scored
+    (a transfer planned after the window began): its ratio model is drawn on those images
+    alone and held only until the plan is known; then drawn on the plan, once."""
+    test = SequentialTest(SCENARIO, TWIN, 1e-6)
+    window = _window(0.0, [1.0] * 30, np.random.default_rng(10))
+    first = WindowContext(1, 0.0, 30.0, window.settled, [], window.times[:10],
+                          window.planned[:10], False, None, None, None, window.seen[:10], 0.0)
+    assert test.score(first, None) is None
+    assert not test.modelled(1, 0.0)  # drawn on ten images: held, but not the window's
+    later = WindowContext(1, 0.0, 30.0, window.settled, [], window.times[10:],
+                          window.planned[10:], False, None, None, None, window.seen[10:], 0.0)
+    assert test.score(later, _arc(test.plan_times(0.0, 30.0))) is None
+    assert test.modelled(1, 0.0)
+    assert test.window_fields(1, 0.0)["scan_z_max"] < test.c
