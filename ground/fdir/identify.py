@@ -308,21 +308,23 @@ def classify_part(ev: Evidence, tol: Tolerances, failed: Sequence[str] | None = 
                   ) -> str | None:
     """:func:`classify` for the evidence of part of a window (the images since a change the
     sequential test estimated; docs/fdir.md, "Identification after a crossing"), which names
-    nothing while the nav is off its plan by more than half ``position_tol_m`` unless the
-    located camera is off it too, beyond half of it and ``SE_MARGIN`` standard errors of
-    its fixes (the spacecraft moved, as after a state disturbance).  Otherwise it may be a
-    nav sensor's step being absorbed, the nav walking off the plan ahead of the spacecraft
-    it steers, and on ten images the fixes' standard error (0.15-0.25 m) is too wide for the
-    rules that tell it from a camera fault or a leak.  On the identify campaign's paper
-    set-up, replayed, 6 of 12 nav biases were named ``camera`` (a seen set not the reported
-    pose's) or ``actuator`` (the Δv of moving onto the biased orbit, or the nav off the
-    plan) 12-59 s after onset, with the nav 0.40-0.53 m off the plan and the camera
-    0.09-0.34 m at standard errors of 0.15-0.25 m.  The windows, or a later part, name it."""
+    no class but ``state_sensor`` while the nav is off its plan by more than half
+    ``position_tol_m`` unless the located camera is off it too, beyond half of it and
+    ``SE_MARGIN`` standard errors of its fixes (the spacecraft moved, as after a state
+    disturbance).  Otherwise it may be a nav sensor's step being absorbed, the nav walking
+    off the plan ahead of the spacecraft it steers, and on ten images the fixes' standard
+    error (0.15-0.25 m) is too wide for the rules that tell it from a camera fault or a
+    leak.  On the identify campaign's paper set-up, replayed, 6 of 12 nav biases were named
+    ``camera`` (a seen set not the reported pose's) or ``actuator`` (the Δv of moving onto
+    the biased orbit, or the nav off the plan) 12-59 s after onset, with the nav 0.40-0.53 m
+    off the plan and the camera 0.09-0.34 m at standard errors of 0.15-0.25 m.  The windows,
+    or a later part, name it."""
+    cls = classify(ev, tol, failed)
     half = tol.position_m / 2.0
     camera_moved = (ev.camera_vs_plan_m or 0.0) > half + SE_MARGIN * (ev.camera_se_m or 0.0)
-    if (ev.nav_vs_plan_m or 0.0) > half and not camera_moved:
+    if cls != "state_sensor" and (ev.nav_vs_plan_m or 0.0) > half and not camera_moved:
         return None
-    return classify(ev, tol, failed)
+    return cls
 
 
 def _evidence_class(ev: Evidence, tol: Tolerances, gap: bool = True) -> str | None:

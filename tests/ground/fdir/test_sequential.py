@@ -205,13 +205,16 @@ def test_a_change_late_in_a_window_is_identified_on_its_images_alone() -> None:
 def test_a_part_names_nothing_while_the_nav_walks_off_a_plan_the_camera_holds() -> None:
     """A nav sensor's step being absorbed: the nav 0.46 m off the plan, the camera located
     0.09 m off it with a standard error of 0.22 m, and a seen set not the reported pose's.
-    The whole window's rules would name the camera; a part names nothing until the camera is
-    off the plan beyond half the tolerance and three standard errors (then the spacecraft
-    moved: a state disturbance's jump, named ``actuator``)."""
+    The whole window's rules would name the camera; a part names nothing until the nav is
+    beyond the tolerance (the nav sensor, as the rules say) or the camera off the plan
+    beyond half the tolerance and three standard errors (then the spacecraft moved: a state
+    disturbance's jump, named ``actuator``)."""
     tol = Tolerances.of(SCENARIO.fdir)
     walking = Evidence(beta_hat=0.99, beta_se=0.03, camera_vs_nav_m=0.46, nav_vs_plan_m=0.46,
                        camera_vs_plan_m=0.09, camera_se_m=0.22, seen_overlap=0.77)
     assert classify(walking, tol) == "camera" and classify_part(walking, tol) is None
+    walked = replace(walking, nav_vs_plan_m=0.6, camera_vs_nav_m=0.6)  # beyond the tolerance
+    assert classify_part(walked, tol) == classify(walked, tol) == "state_sensor"
     jumped = replace(walking, camera_vs_plan_m=1.6, camera_vs_nav_m=1.2, camera_se_m=0.09,
                      offset_alignment=0.99)
     assert classify_part(jumped, tol) == classify(jumped, tol) == "actuator"
