@@ -14,7 +14,7 @@ import logging
 from gnc.image_scan import Crossing
 from gnc.window_test import exceeded as window_exceeded
 from ground.fdir.constellation import ConstellationVerdict
-from ground.fdir.identify import Evidence, Tolerances, classify, classify_part
+from ground.fdir.identify import STEP_SPAN, Evidence, Tolerances, classify, classify_part
 from ground.fdir.information import Judgement
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, FdirWindow, Message
@@ -35,6 +35,9 @@ class Declarer:
         self._crossed_s: dict[int, float] = {}
         """observers declared by a scan, with the time it crossed (s), until a window that
         began at or after it is judged"""
+        self._step: set[int] = set()
+        """observers declared by a step of the NIS scan and not yet identified
+        (``ground.fdir.identify.STEP_SPAN``)"""
         self._change_s: dict[int, float] = {}
         """observers declared by a scan and not yet identified, with the time the change
         began as the scan estimated it (s)"""
@@ -54,18 +57,23 @@ class Declarer:
         one still without a class)."""
         return sc in self._unidentified or not self.persistence.declared(sc)
 
-    def declare(self, sc: int, j: Judgement, common: ConstellationVerdict | None
-                ) -> list[Message]:
-        """The window's verdict (``exceeded`` set) and the fault reports it brings."""
-        failed = [f for f in j.window.failed
-                  if not (f == "information" and common is not None and common.common_mode)]
+    def declare(self, sc: int, j: Judgement, common: ConstellationVerdict | None,
+                common_way: str | None = None) -> list[Message]:
+        """The window's verdict (``exceeded`` set) and the fault reports it brings.  Its
+        information test failed is not held against the observer when the window's global
+        check found common mode (``common``), or the window went the way (``common_way``) of
+        a common-mode episode declared on the constellation and still going on."""
+        shared = (common is not None and common.common_mode) or (
+            common_way is not None and j.window.direction == common_way)
+        failed = [f for f in j.window.failed if not (f == "information" and shared)]
         exceeded = window_exceeded(failed, j.decided)
         w = j.window.model_copy(update={"exceeded": exceeded})
         out: list[Message] = [w]
         counted = None if self._before_crossing(sc, w.t_start_s) and not exceeded else exceeded
         if self.persistence.update(sc, counted):
             self._change_s.pop(sc, None)  # declared by the windows: a scan's estimate is old
-            cls, ev = self._classify(j, failed)
+            self._step.discard(sc)
+            cls, ev = self._classify(sc, j, failed)
             self.log.warning("FDIR: fault declared on sc%d at %.0f s (failed %s; H_m %s, τ %s, "
                              "%s): %s", sc, w.t_end_s, "+".join(failed), _g(w.metric),
                              _g(w.threshold), w.direction, cls or "unidentified")
@@ -73,7 +81,7 @@ class Declarer:
             if cls is None:
                 self._unidentified.add(sc)
         elif sc in self._unidentified:
-            cls, ev = self._classify(j, failed)
+            cls, ev = self._classify(sc, j, failed)
             if cls is not None or counted is False:
                 self._unidentified.discard(sc)
             if cls is not None:
@@ -88,7 +96,7 @@ class Declarer:
         window (``j``: the part's tests and evidence) at its last image's time ``t_s`` (s;
         docs/fdir.md, "Identification after a crossing"): the report naming the class, or
         None when the evidence names none yet."""
-        cls = classify_part(j.evidence, self.tol, j.window.failed)
+        cls = classify_part(j.evidence, self.tol, j.window.failed, sc in self._step)
         if cls is None:
             return None
         self._unidentified.discard(sc)
@@ -100,12 +108,13 @@ class Declarer:
                            window_end_s=window_end_s, detector="sequential",
                            evidence={**j.evidence.as_dict(), "since_s": w.t_start_s})
 
-    def _classify(self, j: Judgement, failed: list[str]) -> tuple[str | None, Evidence]:
-        """The class ``j``'s evidence names, with ``failed`` its tests failed, and the evidence
-        that named it: its images since the change first (``classify_part``), else the whole
-        window's (``classify``)."""
+    def _classify(self, sc: int, j: Judgement, failed: list[str]
+                  ) -> tuple[str | None, Evidence]:
+        """The class observer ``sc``'s ``j`` names, with ``failed`` its tests failed, and the
+        evidence that named it: its images since the change first (``classify_part``), else
+        the whole window's (``classify``)."""
         if j.part is not None:
-            cls = classify_part(j.part, self.tol, failed)
+            cls = classify_part(j.part, self.tol, failed, sc in self._step)
             if cls is not None:
                 return cls, j.part
         return classify(j.evidence, self.tol, failed), j.evidence
@@ -135,6 +144,9 @@ class Declarer:
         self._unidentified.add(sc)
         self._crossed_s[sc] = crossing.image_t_s
         self._change_s[sc] = crossing.change_s
+        self._step.discard(sc)
+        if crossing.test == "nis" and crossing.scan.span <= STEP_SPAN:
+            self._step.add(sc)
         self.log.warning("FDIR: fault declared on sc%d at %.0f s (sequential, %s scan: |Z| "
                          "%.3g over %d, mean %.3g against %.3g%s)", sc, crossing.image_t_s,
                          crossing.test, crossing.scan.z, crossing.scan.span, crossing.shift,

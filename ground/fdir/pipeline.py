@@ -316,7 +316,7 @@ class FdirPipeline:
         common, messages = self.global_check.check(a, b, judged, self._cost())
         out += messages
         for sc, j in judged.items():
-            out += self.declarer.declare(sc, j, common)
+            out += self.declarer.declare(sc, j, common, self.global_check.way)
         out += self.rulings.rule(b, {w.spacecraft: w.exceeded for w in out
                                      if isinstance(w, FdirWindow)})
         self._settle(inside, b)
@@ -424,17 +424,26 @@ class FdirPipeline:
 
     def _decide_crossings(self, a: float, b: float, final: bool) -> list[Message]:
         """The pending crossings of window [a, b) declared once decided
-        (:func:`ground.fdir.sequential.decided`; ``final``: the window's data is all in), or
-        dropped when common to every observer scored in it (the global check's, Eq. 6).  An
+        (:func:`ground.fdir.sequential.decided`; ``final``: the window's data is all in), or,
+        when common to every observer scored in it, declared on the constellation (the global
+        check's verdict, Eq. 6, reached at once: ``GlobalCheck.declare_crossings``); one the
+        way of a common-mode episode still declared is the constellation's, dropped.  An
         observer whose images were passed over (no plan, camera off) has no say."""
         if self.sequential is None:
             return []
         test = self.sequential
+        for sc in [sc for sc, c in self._crossings.items() if self.global_check.explains(c)]:
+            del self._crossings[sc]  # the constellation's declared common mode, not its own
+            test.reset(sc)
         scored = [sc for sc in self.observers
                   if test.evidence_since(sc, a) and not self.declarer.declared(sc)]
         now = decided(self._crossings, scored,
                       {sc: test.last_scored_s(sc) for sc in self.observers}, final)
         out: list[Message] = []
+        if now is None:  # every scored observer crossed the same way: the constellation's
+            together = [self._crossings[sc] for sc in scored]
+            out += self.global_check.declare_crossings(
+                together, max(c.image_t_s for c in together), b)
         for sc in list(self._crossings) if now is None else now:
             crossing = self._crossings.pop(sc)
             test.reset(sc)  # its evidence spent: a later crossing is a new one

@@ -24,6 +24,7 @@ from ground.fdir.identify import Evidence, Tolerances, classify, classify_part
 from ground.fdir.information import IDENTIFY_IMAGES, InformationTest, Judgement, evidence_part
 from ground.fdir.observer import ObserverState
 from ground.fdir.sequential import SequentialTest, decided, image_false_alarm
+from ground.fdir.threshold import WindowThreshold
 from ground.fdir.window import SettledMap, WindowContext
 from interfaces.contracts.messages import FaultReport, FdirWindow
 from tests.conftest import small_scenario
@@ -218,6 +219,43 @@ def test_a_part_names_nothing_while_the_nav_walks_off_a_plan_the_camera_holds() 
     jumped = replace(walking, camera_vs_plan_m=1.6, camera_vs_nav_m=1.2, camera_se_m=0.09,
                      offset_alignment=0.99)
     assert classify_part(jumped, tol) == classify(jumped, tol) == "actuator"
+
+
+def test_after_a_nis_step_a_nav_walking_off_a_plan_the_camera_holds_is_the_sensor() -> None:
+    """Declared on a NIS step (one update): with the NIS still failing, the nav 0.16 m off
+    the plan and the camera 0.12 m off it (identify campaign, paper-late-nav-bias-0004, 10 s
+    after its change) is the nav sensor; the truth's jump (the camera off by the step) or a
+    drift leading the nav (the camera the farther off) is not, and neither is a NIS passed,
+    a nav on its plan, or a crossing that was not a step."""
+    tol = Tolerances.of(SCENARIO.fdir)
+    early = Evidence(beta_hat=1.01, beta_se=0.03, camera_vs_nav_m=0.21, nav_vs_plan_m=0.16,
+                     camera_vs_plan_m=0.12, camera_se_m=0.21, seen_overlap=0.9)
+    assert classify_part(early, tol, ["nis"]) is None
+    assert classify_part(early, tol, ["nis"], step=True) == "state_sensor"
+    assert classify_part(early, tol, [], step=True) is None  # the NIS passes
+    on_plan = replace(early, nav_vs_plan_m=0.05)
+    assert classify_part(on_plan, tol, ["nis"], step=True) is None
+    leading = replace(early, camera_vs_plan_m=0.3)  # the truth ahead of the nav: a drift
+    assert classify_part(leading, tol, ["nis"], step=True) != "state_sensor"
+    jumped = replace(early, camera_vs_plan_m=2.4, camera_vs_nav_m=2.3, camera_se_m=0.1,
+                     offset_alignment=0.99)
+    assert classify_part(jumped, tol, ["nis"], step=True) == "actuator"
+    declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
+    step = Crossing(12.0, ScanResult(20.0, 20.0, 1), 80.0, 7.0, test="nis")
+    declarer.declare_crossing(1, step, 30.0)
+    part = _part_judgement(1, early)
+    report = declarer.identify_part(1, part, 22.0, 30.0)
+    assert report is not None and report.fault_class == "state_sensor"
+    drift = Crossing(12.0, ScanResult(7.0, 7.0, 8), 3.0, 2.0, test="nis")
+    declarer.declare_crossing(2, drift, 30.0)  # not a step: the part waits
+    assert declarer.identify_part(2, _part_judgement(2, early), 22.0, 30.0) is None
+
+
+def _part_judgement(sc: int, evidence: Evidence) -> Judgement:
+    """A part of a window, judged: its NIS test failed, the evidence given."""
+    window = FdirWindow(sender="ground", t_sim=22.0, spacecraft=sc, t_start_s=12.0,
+                        t_end_s=22.0, images=10, failed=["nis"])
+    return Judgement(window, evidence, WindowThreshold(None, None, None, 0.1, "model"))
 
 
 def test_a_part_of_a_window_names_the_class_at_its_last_image() -> None:

@@ -13,8 +13,10 @@ import numpy as np
 import pytest
 
 from gnc.hardware_threshold import RatioModel
+from gnc.image_scan import Crossing
 from gnc.poi_map import PoiMap
 from gnc.pro import Pro
+from gnc.sequential_test import ScanResult
 from gnc.twin import FlightPlan
 from ground.fdir.constellation import ConstellationVerdict
 from ground.fdir.declaration import Declarer
@@ -251,6 +253,31 @@ def test_a_ratio_every_observer_shares_is_common_mode_declared_once() -> None:
     assert verdict is None and out[0].observers == 1  # too few observers to judge
 
 
+def test_scans_crossing_together_declare_common_mode_at_once_then_are_its() -> None:
+    """Every scored observer's scan crossed the same way: the constellation's common mode,
+    declared at the latest crossing, once; while its episode goes on a crossing the same way
+    is its, the other way an observer's own; a window not common ends the episode."""
+    check = GlobalCheck(small_scenario().fdir, 1e-3, "ground", LOG)
+    down = [Crossing(12.0, ScanResult(8.0, -8.0, 1), -0.08, 0.05),
+            Crossing(13.0, ScanResult(9.0, -9.0, 2), -0.12, 0.05)]
+    (report,) = check.declare_crossings(down, 13.0, 30.0)
+    assert report.spacecraft == 0 and report.fault_class == "common_mode"
+    assert report.t_sim == 13.0 and report.direction == "degraded"
+    assert report.detector == "sequential" and report.metric == pytest.approx(0.12)
+    assert check.declare_crossings(down, 14.0, 30.0) == []  # once per episode
+    up = Crossing(20.0, ScanResult(8.0, 8.0, 1), 0.08, 0.05)
+    assert check.explains(down[0]) and not check.explains(up)
+    model = RatioModel(1.0, 0.01, 0.01, 0.0)
+    same = {sc: _judgement(sc, 0.5, Evidence(), model) for sc in (1, 2, 3)}
+    healthy = {sc: _judgement(sc, 0.0, Evidence(), model, dh=1.0) for sc in (1, 2, 3)}
+    check.check(0.0, 30.0, healthy, cost=7.0)  # the change began late in it: not counted
+    assert check.explains(down[0])
+    _, out = check.check(30.0, 60.0, same, cost=7.0)
+    assert len(out) == 1 and check.explains(down[0])  # the same episode, not again
+    check.check(60.0, 90.0, healthy, cost=7.0)
+    assert not check.explains(down[0])  # the episode ended
+
+
 def test_declaration_after_persistence_with_the_class_the_evidence_shows() -> None:
     declarer = Declarer(small_scenario(fdir={"persistence": 2}).fdir, "ground", LOG)
     camera = Evidence(beta_hat=0.5)  # half the nominal health: a camera fault
@@ -272,6 +299,11 @@ def test_a_class_found_on_a_later_window_and_common_mode_not_held_against_one() 
     common = ConstellationVerdict(0.5, RatioModel(1.0, 0.01, 0.01, 0.0), 0.05, True, None)
     out = declarer.declare(3, _judgement(3, 0.5, Evidence(beta_hat=0.5)), common)
     assert out[0].exceeded is False and len(out) == 1
+    # no verdict this window, but a common-mode episode the same way goes on: not its own
+    out = declarer.declare(4, _judgement(4, 0.5, Evidence(beta_hat=0.5)), None, "degraded")
+    assert out[0].exceeded is False and len(out) == 1
+    out = declarer.declare(4, _judgement(4, 0.5, Evidence(beta_hat=0.5)), None, "improved")
+    assert out[0].exceeded is True and out[1].fault_class == "camera"
 
 
 def _integrity_over_two_boundaries(observers: dict[int, ObserverState],
