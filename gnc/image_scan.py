@@ -70,8 +70,11 @@ class _WindowStats:
     z_max: float = 0.0
     var_sum: float = 0.0
     images: int = 0
+    latest: tuple[float, float] = (-math.inf, 0.0)
+    """the newest image's time (s) and the scan statistic at it"""
 
-    def add(self, z: float, sigma_e: float, sigma_b: float) -> None:
+    def add(self, t: float, z: float, sigma_e: float, sigma_b: float) -> None:
+        self.latest = (t, z)
         self.z_max = max(self.z_max, z)
         self.var_sum += sigma_e * sigma_e + sigma_b * sigma_b
         self.images += 1
@@ -114,6 +117,12 @@ class ImageScans:
             return {}
         return {"scan_z_max": stats.z_max, "scan_threshold": self.c,
                 "image_sigma": math.sqrt(stats.var_sum / stats.images)}
+
+    def latest(self, observer: int) -> tuple[float, float] | None:
+        """``observer``'s newest scored image: its time (s) and the scan statistic
+        max_n |Z_n| at it; None: none scored."""
+        stats = self._stats.get(observer)
+        return stats.latest if stats is not None and stats.images else None
 
     def last_scored_s(self, observer: int) -> float:
         """The time of ``observer``'s last image looked at (scored or passed over), s."""
@@ -184,7 +193,7 @@ class ImageScans:
         for t, rk, ek, bk in zip(at, evidence.residuals, evidence.sigma_e, sigma_b, strict=True):
             scan.push(float(rk), float(ek), float(bk), float(t))
             result = scan.scan()
-            stats.add(result.z if result is not None else 0.0, float(ek), float(bk))
+            stats.add(float(t), result.z if result is not None else 0.0, float(ek), float(bk))
             if result is not None and result.z > self.c:
                 shift = float(np.mean(scan.r[-result.span:]))
                 return Crossing(float(t), result, shift, self.c * abs(shift) / result.z,

@@ -126,13 +126,13 @@ def _metric_plot(mission: str, i: int) -> dict[str, Any]:
 
 
 def _scan_plot(mission: str, i: int) -> dict[str, Any]:
-    window = f"{cat.FDIR_WINDOW.key(mission)}{{spacecraft=={i}}}"
-    return _plot(f"sc{i}: the sequential test's largest scan statistics in each window "
+    scan = f"{cat.SCAN_STATUS.key(mission)}{{spacecraft=={i}}}"
+    return _plot(f"sc{i}: the sequential test's scan statistics as they are scored "
                  f"(images, NIS) against their thresholds",
-                 [_series(f"{window}.scan_z_max", "images: max |Z|", METRIC_COLOUR),
-                  _series(f"{window}.scan_threshold", "c", THRESHOLD_COLOUR),
-                  _series(f"{window}.nis_scan_z_max", "NIS: max z"),
-                  _series(f"{window}.nis_scan_threshold", "c NIS")])
+                 [_series(f"{scan}.image_z", "images: max_n |Z_n|", METRIC_COLOUR),
+                  _series(f"{scan}.image_threshold", "c", THRESHOLD_COLOUR),
+                  _series(f"{scan}.nis_z", "NIS: max_n z_n"),
+                  _series(f"{scan}.nis_threshold", "c NIS")])
 
 
 def _fault_panels(scenario: Scenario, mission: str) -> Panels:

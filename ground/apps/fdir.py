@@ -10,8 +10,10 @@ observer's onboard store lost to overflow, and sent again after a loss), and the
 observers' neighbours declared aboard, which it rules on (``NeighbourRuling`` on
 ``ground/fdir/ruling``). Outputs: one ``FdirWindow`` per observer and FDI window on
 ``ground/fdir/window``, one ``ConstellationWindow`` per FDI window on
-``ground/fdir/constellation``, and a ``FaultReport``
-on ``ground/fdir/report`` for each fault declared or identified. Each window is judged
+``ground/fdir/constellation``, a ``FaultReport``
+on ``ground/fdir/report`` for each fault declared or identified, and with the sequential
+test each observer's newest scan statistics as they are scored (``ScanStatus`` on
+``ground/fdir/scan``). Each window is judged
 ``fdir.latency_s`` after it closes."""
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from interfaces.contracts.messages import (
     FdirWindow,
     Message,
     NeighbourRuling,
+    ScanStatus,
 )
 from interfaces.runtime.app import App, AppContext, Input, Output
 
@@ -45,11 +48,11 @@ class FdirApp(App):
     )
     OUTPUTS = (Output("window", cat.FDIR_WINDOW), Output("report", cat.FAULT_REPORT),
                Output("constellation", cat.CONSTELLATION_WINDOW),
-               Output("ruling", cat.NEIGHBOUR_RULING))
+               Output("ruling", cat.NEIGHBOUR_RULING), Output("scan", cat.SCAN_STATUS))
     CRITICAL = ("pipeline",)
     PORTS: dict[type[Message], str] = {FdirWindow: "window", FaultReport: "report",
                                         ConstellationWindow: "constellation",
-                                        NeighbourRuling: "ruling"}
+                                        NeighbourRuling: "ruling", ScanStatus: "scan"}
     """the output each of the pipeline's messages goes out on"""
 
     def __init__(self, ctx: AppContext) -> None:

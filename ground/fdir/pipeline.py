@@ -57,6 +57,7 @@ from interfaces.contracts.messages import (
     OnboardFdirEvent,
     PoiObservations,
     ProAssignments,
+    ScanStatus,
     StateEstimate,
     TransferPlanMsg,
     Unjudged,
@@ -96,6 +97,8 @@ class FdirPipeline:
         self._identify_tries: dict[int, tuple[float, int]] = {}
         """each observer's last try at identifying on part of a window: its start (s) and the
         images tried"""
+        self._status_s: dict[int, float] = {}
+        """each observer's time of the newest statistics sent out (``ScanStatus``), s"""
         self._crossings: dict[int, Crossing] = {}
         """the sequential test's crossings waiting for the other observers' images"""
         self.global_check = GlobalCheck(cfg, self.information.q_window, node, log)
@@ -359,7 +362,7 @@ class FdirPipeline:
                 self.sequential.passed(sc, mine[-1].image_t_s)
             else:  # the images after it are scored once it is decided
                 self._crossings[sc] = crossing
-        return self._scan_nis(a, b) + self._decide_crossings(a, b, final)
+        return self._scan_nis(a, b) + self._decide_crossings(a, b, final) + self._statuses()
 
     def _identify_part(self, k: int) -> list[Message]:
         """With the sequential test: each declared fault still without a class judged, as a
@@ -402,6 +405,20 @@ class FdirPipeline:
             return False
         self._identify_tries[sc] = (a, images)
         return True
+
+    def _statuses(self) -> list[Message]:
+        """Each observer's newest scan statistics, where something was scored since the last
+        (``ScanStatus``: the operator sees evidence build before a declaration)."""
+        assert self.sequential is not None
+        out: list[Message] = []
+        for sc in self.observers:
+            fields = self.sequential.status(sc)
+            t = fields.pop("t_s", None)
+            if t is None or t <= self._status_s.get(sc, -math.inf) + TIME_TOL_S:
+                continue
+            self._status_s[sc] = t
+            out.append(ScanStatus(sender=self.node, t_sim=t, spacecraft=sc, **fields))
+        return out
 
     def _scan_nis(self, a: float, b: float) -> list[Message]:
         """With ``fdir.fuse_nis``: each observer's nav updates come since the last call and

@@ -49,6 +49,8 @@ class _NisScan:
     last_t: float = -math.inf
     window: tuple[float, float] | None = None
     """the start of the window its last updates were scored in (s) and their largest z"""
+    latest: tuple[float, float] | None = None
+    """the newest update scored: its time (s) and the scan statistic at it"""
 
 
 def image_false_alarm(scenario: Scenario, tests: int) -> float:
@@ -102,6 +104,7 @@ class SequentialTest(ImageScans):
             held = scan.window if scan.window is not None and abs(scan.window[0] - a) <= \
                 TIME_TOL_S else (a, 0.0)
             scan.window = (a, max(held[1], z))
+            scan.latest = (t, z)
             if result is not None and result.z > self.c_nis:
                 n = result.span
                 mean = float(np.mean(scan.values[-n:])) / NIS_DOF
@@ -111,6 +114,19 @@ class SequentialTest(ImageScans):
                                 chi2_span_limit(self.c_nis, NIS_DOF, n) / (n * NIS_DOF), "nis",
                                 since)
         return None
+
+    def status(self, spacecraft: int) -> dict[str, float]:
+        """The scans' newest statistics of observer ``spacecraft``, as ``ScanStatus``'s
+        fields, with ``t_s`` the time of the newer (empty: nothing scored yet)."""
+        out: dict[str, float] = {}
+        image = self.latest(spacecraft)
+        if image is not None:
+            out |= {"t_s": image[0], "image_z": image[1], "image_threshold": self.c}
+        nis = self._nis.get(spacecraft)
+        if nis is not None and nis.latest is not None:
+            out |= {"t_s": max(out.get("t_s", -math.inf), nis.latest[0]),
+                    "nis_z": nis.latest[1], "nis_threshold": self.c_nis}
+        return out
 
     def window_fields(self, spacecraft: int, a: float) -> dict[str, float]:
         """The scans' record of observer ``spacecraft``'s window starting at ``a`` (s), the

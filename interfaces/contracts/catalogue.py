@@ -149,6 +149,8 @@ FDIR_WINDOW = Topic(Space.GROUND, "fdir", "window", m.FdirWindow, "one FDI windo
 FAULT_REPORT = Topic(Space.GROUND, "fdir", "report", m.FaultReport, "declared faults")
 CONSTELLATION_WINDOW = Topic(Space.GROUND, "fdir", "constellation", m.ConstellationWindow,
                              "the global check (Eq. 6) of one FDI window")
+SCAN_STATUS = Topic(Space.GROUND, "fdir", "scan", m.ScanStatus,
+                    "the sequential test's statistics per observer, as scored")
 BASELINE = Topic(Space.GROUND, "fdir", "baseline", m.BaselineVerdict, "baseline detectors")
 NEIGHBOUR_RULING = Topic(Space.GROUND, "fdir", "ruling", m.NeighbourRuling,
                          "the ground's ruling on a fault the neighbours declared")
@@ -160,8 +162,8 @@ ALL: tuple[Topic[m.Message], ...] = (
     GUIDANCE_STATUS, INFO_COST, FDIR_COMMAND, FDIR_EVENT, NEIGHBOUR_JUDGEMENT,
     NEIGHBOUR_DECLARATION,
     TICK_DONE, HEARTBEAT, EXEC_STATS, LINK_STATS,
-    ASSIGNMENTS, DECISIONS, FDIR_WINDOW, FAULT_REPORT, CONSTELLATION_WINDOW, BASELINE,
-    NEIGHBOUR_RULING, TLM_STATUS,
+    ASSIGNMENTS, DECISIONS, FDIR_WINDOW, FAULT_REPORT, CONSTELLATION_WINDOW, SCAN_STATUS,
+    BASELINE, NEIGHBOUR_RULING, TLM_STATUS,
 )
 
 

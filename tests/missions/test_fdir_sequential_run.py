@@ -2,9 +2,10 @@
 camera is declared within seconds of its onset, on its observer only and by the sequential
 test, and named a camera fault on its images since the change, before the window's end; a
 thruster leak by the NIS scan, within seconds, and named an actuator fault; a calibration
-error common to every camera
-is still the constellation's alone (the window's global check, Eq. 6), not each observer's;
-and the replay of the archive gives the live declarations, at the same times."""
+error common to every camera is the constellation's alone (Eq. 6), declared within seconds
+when every observer's scan crosses the same way, not each observer's; the scans' statistics
+go out image by image; and the replay of the archive gives the live declarations, at the
+same times."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ import pytest
 
 from harness.replay import replay_run
 from harness.summary import RunSummary
-from interfaces.contracts.messages import FaultReport
+from interfaces.contracts.messages import FaultReport, ScanStatus
 from interfaces.contracts.scenario import Scenario
 from tests.conftest import recorded_run, small_scenario
 
@@ -33,8 +34,14 @@ def _scenario(fault: dict[str, object]) -> Scenario:
 
 
 def _run(tmp: Path, fault: dict[str, object]) -> tuple[list[FaultReport], RunSummary]:
-    got, summary = recorded_run(_scenario(fault), tmp, FaultReport)
-    return got["FaultReport"], summary
+    reports, _, summary = _run_with_scans(tmp, fault)
+    return reports, summary
+
+
+def _run_with_scans(tmp: Path, fault: dict[str, object]
+                    ) -> tuple[list[FaultReport], list[ScanStatus], RunSummary]:
+    got, summary = recorded_run(_scenario(fault), tmp, FaultReport, ScanStatus)
+    return got["FaultReport"], got["ScanStatus"], summary
 
 
 DEGRADED = {"spacecraft": 2, "kind": "camera_degradation", "start_s": ONSET_S,
@@ -42,14 +49,15 @@ DEGRADED = {"spacecraft": 2, "kind": "camera_degradation", "start_s": ONSET_S,
 
 
 @pytest.fixture(scope="module")
-def degraded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[FaultReport],
-                                                                  RunSummary]:
+def degraded(tmp_path_factory: pytest.TempPathFactory
+             ) -> tuple[Path, list[FaultReport], RunSummary, list[ScanStatus]]:
     out = tmp_path_factory.mktemp("seq_degraded")
-    return out, *_run(out, DEGRADED)
+    reports, scans, summary = _run_with_scans(out, DEGRADED)
+    return out, reports, summary, scans
 
 
 def test_a_degraded_camera_is_declared_within_seconds(degraded: Any) -> None:
-    _, reports, summary = degraded
+    _, reports, summary, _ = degraded
     first = reports[0]
     assert first.spacecraft == 2 and first.detector == "sequential"
     assert first.fault_class is None and first.direction == "degraded"
@@ -77,9 +85,26 @@ def _declarations(reports: list[FaultReport]) -> int:
 
 
 def test_the_replay_declares_as_the_live_run(degraded: Any) -> None:
-    out, _, _ = degraded
+    out, _, _, _ = degraded
     replay = replay_run(out, scenario=_scenario(DEGRADED))
     assert replay.matches_live()
+
+
+def test_the_statistics_go_out_as_they_are_scored(degraded: Any) -> None:
+    """``ScanStatus``: every observer's image and NIS scan statistics, image by image, held
+    under their thresholds on the healthy observers throughout and on sc2 until its onset;
+    the image that crossed on sc2 shows its statistic beyond c."""
+    _, reports, _, scans = degraded
+    for sc in (1, 2, 3, 4):
+        mine = [m for m in scans if m.spacecraft == sc]
+        times = [m.t_sim for m in mine]
+        assert len(mine) > 100 and times == sorted(times) and len(set(times)) == len(times)
+        healthy = [m for m in mine if sc != 2 or m.t_sim < ONSET_S]
+        assert all(m.image_z is None or m.image_z < m.image_threshold for m in healthy)
+        assert all(m.nis_z is None or m.nis_z < m.nis_threshold for m in healthy)
+        assert any(m.image_z is not None for m in mine) and any(m.nis_z for m in mine)
+    crossed = [m for m in scans if m.spacecraft == 2 and m.t_sim == reports[0].t_sim]
+    assert crossed and crossed[0].image_z > crossed[0].image_threshold
 
 
 def test_a_thruster_leak_is_declared_by_the_nav_s_nis_within_seconds(
@@ -109,3 +134,5 @@ def test_a_common_mode_fault_stays_the_constellations(
                       {"spacecraft": 0, "kind": "camera_calibration", "start_s": ONSET_S,
                        "magnitude": 0.6})
     assert [(r.spacecraft, r.fault_class) for r in reports] == [(0, "common_mode")]
+    # every observer's scan crossed the same way: declared at once, not at the window's end
+    assert reports[0].detector == "sequential" and reports[0].t_sim <= ONSET_S + 5.0

@@ -74,6 +74,7 @@ from interfaces.contracts.messages.ground import (
     ProAssignment,
     ProAssignments,
     ProElements,
+    ScanStatus,
     TelemetryStatus,
     WindowTest,
 )
@@ -163,6 +164,7 @@ __all__ = [
     "ProAssignments",
     "FdirWindow",
     "ConstellationWindow",
+    "ScanStatus",
     "FaultReport",
     "BaselineVerdict",
     "AssignmentDecision",
@@ -188,6 +190,7 @@ ALL_MESSAGES: tuple[type[Message], ...] = (
     FdirWindow,
     FaultReport,
     ConstellationWindow,
+    ScanStatus,
     BaselineVerdict,
     TransferPlanMsg,
     GuidanceStatus,

@@ -135,6 +135,21 @@ class FdirWindow(Message):
                     "(docs/fdir.md, 'Identification after a crossing'); None: the whole window")
 
 
+class ScanStatus(Message):
+    """The sequential test's evidence on one observer as it is scored (docs/fdir.md, "What
+    the operator sees"), one at most per observer and ground step with something new: at
+    ``t_sim`` (the newest image or nav update scored, s), the image scan's statistic
+    max_n |Z_n| at its newest image and its threshold c, and the NIS scan's max_n z_n at its
+    newest update and its threshold c_nis.  A fault is declared when either crosses (None:
+    not scored yet in the window being collected)."""
+
+    spacecraft: int = Field(ge=1)
+    image_z: float | None = Field(default=None, ge=0.0)
+    image_threshold: float | None = Field(default=None, gt=0.0)
+    nis_z: float | None = Field(default=None)
+    nis_threshold: float | None = Field(default=None, gt=0.0)
+
+
 class ConstellationWindow(Message):
     """The global check (Eq. 6) over one FDI window (ground/fdir/constellation.py): the
     constellation ratio ΣΔH_i / ΣΔH_i^pred of the judged observers, its nominal mean and 1σ,
