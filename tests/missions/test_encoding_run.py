@@ -12,6 +12,7 @@ from interfaces.contracts.messages import (
     NeighbourRuling,
     OnboardCommand,
     OnboardFdirEvent,
+    ScanStatus,
     registry,
 )
 from interfaces.runtime.encoding import encode
@@ -24,7 +25,7 @@ def test_every_message_type_of_a_run_is_encoded_as_pydantic_does() -> None:
     """A short run with faults, FDIR windows and the neighbours' FDIR (its judgements, and the
     pose with every observation): every message it publishes, then the types it does not (a
     fault report, an assignment decision, the onboard FDIR's command and event, a neighbours'
-    declaration and the ground's ruling)."""
+    declaration, the ground's ruling and the sequential test's statistics)."""
     scenario = small_scenario(
         "enc", duration_s=100.0, rates={"fdi_period_s": 10.0}, neighbours={"enabled": True},
         faults=[{"spacecraft": 1, "kind": "pointing_actuator", "start_s": 5.0, "magnitude": 20.0},
@@ -49,6 +50,8 @@ def test_every_message_type_of_a_run_is_encoded_as_pydantic_does() -> None:
                              t_end_s=60.0, judges=[1, 3], decided=[1, 3, 4]),
         NeighbourRuling(sender="ground", t_sim=90.0, subject=2, window_end_s=60.0,
                         verdict="upheld"),
+        ScanStatus(sender="ground", t_sim=41.0, spacecraft=2, image_z=3.2, image_threshold=5.3,
+                   nis_z=None, nis_threshold=5.17),
     ]
     messages = [s.message for s in samples if s.message is not None] + extra
     assert {type(m).__name__ for m in messages} == set(registry())  # every type is here

@@ -47,6 +47,13 @@ class Attitude(Section):
         return self
 
 
+STAR_TRACKER_MIN_ARCSEC = 0.1
+"""The finest star tracker noise a scenario may declare (1σ, arcsec): the best trackers flown
+are near 1 arcsec.  Far below it the attitude filter's covariance, its variance next to the
+gyro's, is no longer positive definite in floating point (8.8e-206 arcsec stopped the
+attitude app)."""
+
+
 class Sensors(Section):
     relnav_sigma_r_m: float = Field(default=0.1, gt=0.0, le=100.0,
                                     description="1σ position noise, m (at most 100)")
@@ -62,10 +69,12 @@ class Sensors(Section):
     gyro_bias_sigma_radps: float = Field(default=1e-4, gt=0.0, le=0.1,
                                          description="1σ initial gyro bias, rad/s (at most 0.1)")
     star_tracker_hz: float = Field(default=1.0, gt=0.0)
-    star_tracker_cross_arcsec: float = Field(default=10.0, gt=0.0, le=3600.0,
-                                             description="1σ, at most 1°")
-    star_tracker_roll_arcsec: float = Field(default=60.0, gt=0.0, le=3600.0,
-                                            description="1σ, about boresight, at most 1°")
+    star_tracker_cross_arcsec: float = Field(
+        default=10.0, ge=STAR_TRACKER_MIN_ARCSEC, le=3600.0,
+        description="1σ, at least 0.1 arcsec, at most 1°")
+    star_tracker_roll_arcsec: float = Field(
+        default=60.0, ge=STAR_TRACKER_MIN_ARCSEC, le=3600.0,
+        description="1σ, about boresight, at least 0.1 arcsec, at most 1°")
 
 
 class Nav(Section):
