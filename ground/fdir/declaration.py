@@ -19,7 +19,6 @@ from ground.fdir.information import Judgement
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, FdirWindow, Message
 from interfaces.contracts.scenario import FdirSettings
-from interfaces.contracts.timing import TIME_TOL_S
 
 
 class Declarer:
@@ -32,9 +31,6 @@ class Declarer:
         self.node = node
         self.log = log
         self._unidentified: set[int] = set()
-        self._crossed_s: dict[int, float] = {}
-        """observers declared by a scan, with the time it crossed (s), until a window that
-        began at or after it is judged"""
         self._step: set[int] = set()
         """observers declared by a step of the NIS scan and not yet identified
         (``ground.fdir.identify.STEP_SPAN``)"""
@@ -69,7 +65,7 @@ class Declarer:
         exceeded = window_exceeded(failed, j.decided)
         w = j.window.model_copy(update={"exceeded": exceeded})
         out: list[Message] = [w]
-        counted = None if self._before_crossing(sc, w.t_start_s) and not exceeded else exceeded
+        counted = self.persistence.counted(sc, exceeded, w.t_start_s)
         if self.persistence.update(sc, counted):
             self._change_s.pop(sc, None)  # declared by the windows: a scan's estimate is old
             self._step.discard(sc)
@@ -119,18 +115,6 @@ class Declarer:
                 return cls, j.part
         return classify(j.evidence, self.tol, failed), j.evidence
 
-    def _before_crossing(self, sc: int, t_start_s: float) -> bool:
-        """Whether observer ``sc`` was declared by a scan crossing after ``t_start_s`` (s): a
-        window that began before the crossing, passed on the whole, neither ends the episode
-        nor its identification (the fault may have begun late in it)."""
-        crossed = self._crossed_s.get(sc)
-        if crossed is None:
-            return False
-        if t_start_s >= crossed - TIME_TOL_S:
-            del self._crossed_s[sc]
-            return False
-        return True
-
     def declared(self, sc: int) -> bool:
         """Whether observer ``sc``'s declared fault's episode is going on."""
         return self.persistence.declared(sc)
@@ -140,9 +124,8 @@ class Declarer:
         """A fault declared by the sequential test at an image (docs/fdir.md, "The sequential
         test"), in the window ending at ``window_end_s``: without a class, which the windows
         of its episode then look for."""
-        self.persistence.declare(sc)
+        self.persistence.declare(sc, crossing.image_t_s)
         self._unidentified.add(sc)
-        self._crossed_s[sc] = crossing.image_t_s
         self._change_s[sc] = crossing.change_s
         self._step.discard(sc)
         if crossing.test == "nis" and crossing.scan.span <= STEP_SPAN:

@@ -17,7 +17,6 @@ from ground.fdir.information import Judgement
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import ConstellationWindow, FaultReport, Message
 from interfaces.contracts.scenario import FdirSettings
-from interfaces.contracts.timing import TIME_TOL_S
 
 
 class GlobalCheck:
@@ -32,8 +31,6 @@ class GlobalCheck:
         self.log = log
         self.way: str | None = None
         """the direction of the common-mode episode declared (None: none declared)"""
-        self._crossed_s: float | None = None
-        """when the scans declared the episode (s), until a window that began after it"""
         self.shortfall = 0.0
         """Σ over judged windows of (ΔH^pred − ΔH) over the constellation: the running
         integral of Eq. 6's H − H_nom to first order"""
@@ -58,7 +55,8 @@ class GlobalCheck:
             explained_by=verdict.explained_by if verdict else None,
             common_mode=verdict.common_mode if verdict else None,
             cost=cost, shortfall=self.shortfall)]
-        declared = self.persistence.update(0, self._counted(a, verdict))
+        declared = self.persistence.update(
+            0, self.persistence.counted(0, verdict.common_mode if verdict else None, a))
         self.way = self.way if self.persistence.declared(0) else None
         if declared and verdict:
             self.way = "degraded" if verdict.ratio < verdict.model.mean else "improved"
@@ -80,9 +78,8 @@ class GlobalCheck:
         the episode on (docs/fdir.md, "The sequential test")."""
         if self.persistence.declared(0) or not crossings:
             return []
-        self.persistence.declare(0)
+        self.persistence.declare(0, t_s)
         way = self.way = crossings[0].direction
-        self._crossed_s = t_s
         self.log.warning("FDIR: constellation fault at %.0f s: the scans of %d observers crossed "
                          "together (%s): common mode", t_s, len(crossings), way)
         return [FaultReport(
@@ -97,12 +94,3 @@ class GlobalCheck:
         model is off by the common factor until the episode ends): not the observer's own."""
         return self.way is not None and crossing.direction == self.way
 
-    def _counted(self, a: float, verdict: ConstellationVerdict | None) -> bool | None:
-        """What the window starting at ``a`` (s) counts for the episode: its verdict, except
-        that a window begun before the scans declared the episode, not common on the whole
-        (the change began late in it), neither ends the episode nor counts (None)."""
-        common = verdict.common_mode if verdict else None
-        if self._crossed_s is not None and a < self._crossed_s - TIME_TOL_S:
-            return common or None
-        self._crossed_s = None
-        return common

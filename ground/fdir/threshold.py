@@ -16,6 +16,7 @@ from gnc.fdi_metric import metric
 from gnc.hardware_threshold import RatioModel
 from gnc.twin import TwinModel, perturbed_boresights, sample_stride
 from gnc.window_test import HardwareThreshold, floor_guard
+from interfaces.contracts.timing import TIME_TOL_S
 
 
 def adaptive_threshold(dh_samples: Sequence[float], dh_pred: float, h_prev: float = 0.0,
@@ -65,22 +66,41 @@ class Persistence:
     """Exceedance counter per spacecraft: ``update`` returns True on the window that brings the
     exceedances among the last ``window`` decided windows to ``count``, itself exceeding (None:
     ``count`` in a row), once per episode: the episode ends when that no longer holds.  A
-    window without a decision (None: missing or degenerate) neither counts nor resets."""
+    window without a decision (None: missing or degenerate) neither counts nor resets.  An
+    episode declared at a time (``declare(at_s=...)``: the sequential test's crossing) is not
+    ended by a window that began before it and passed on the whole (:meth:`counted`)."""
 
     count: int = 3
     window: int | None = None
     _hits: dict[int, list[bool]] = field(default_factory=dict)
     _declared: set[int] = field(default_factory=set)
+    _crossed_s: dict[int, float] = field(default_factory=dict)
+    """episodes declared at a time (s), until a window that began at or after it"""
 
     def declared(self, spacecraft: int) -> bool:
         """Whether a fault of ``spacecraft`` is declared and its episode still going on."""
         return spacecraft in self._declared
 
-    def declare(self, spacecraft: int) -> None:
-        """A fault of ``spacecraft`` declared on other grounds (one decisive window): its
-        episode goes on while its windows keep exceeding, without another declaration."""
+    def declare(self, spacecraft: int, at_s: float | None = None) -> None:
+        """A fault of ``spacecraft`` declared on other grounds (one decisive window, or a
+        scan's crossing at ``at_s``, s): its episode goes on while its windows keep exceeding,
+        without another declaration."""
         self._declared.add(spacecraft)
         self._hits[spacecraft] = [True] * (self.window or self.count)
+        if at_s is not None:
+            self._crossed_s[spacecraft] = at_s
+
+    def counted(self, spacecraft: int, exceeded: bool | None, window_start_s: float
+                ) -> bool | None:
+        """What a window of ``spacecraft`` starting at ``window_start_s`` (s) with verdict
+        ``exceeded`` counts: its verdict, except that one begun before the crossing that
+        declared the episode, not exceeded on the whole (the change began late in it),
+        counts as no decision (None)."""
+        crossed = self._crossed_s.get(spacecraft)
+        if crossed is not None and window_start_s < crossed - TIME_TOL_S:
+            return exceeded or None
+        self._crossed_s.pop(spacecraft, None)
+        return exceeded
 
     def update(self, spacecraft: int, exceeded: bool | None) -> bool:
         if exceeded is None:

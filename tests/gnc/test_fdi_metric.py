@@ -118,3 +118,18 @@ def test_m_of_n_persistence_against_its_definition() -> None:
             assert [i for i, h in enumerate(hits) if p.update(1, bool(h))] == expected, (m, n)
     with pytest.raises(ValueError, match="persistence_window"):
         FdirSettings(persistence=3, persistence_window=2)
+
+
+def test_a_window_begun_before_the_crossing_that_declared_does_not_end_its_episode() -> None:
+    """Declared by a scan at 45 s: the window [30, 60) passing on the whole counts as no
+    decision (the change began late in it); one that exceeds counts; the window [60, 90)
+    passing ends the episode."""
+    p = Persistence(count=1)
+    p.declare(2, at_s=45.0)
+    assert p.counted(2, False, 30.0) is None and p.counted(2, None, 30.0) is None
+    assert p.counted(2, True, 30.0) is True
+    assert p.update(2, p.counted(2, False, 30.0)) is False and p.declared(2)
+    assert p.counted(2, False, 60.0) is False  # after the crossing: its verdict
+    p.update(2, False)
+    assert not p.declared(2)
+    assert p.counted(2, False, 30.0) is False  # the crossing is spent
