@@ -33,16 +33,18 @@ Seen = list[tuple[np.ndarray, np.ndarray]]
 @dataclass(frozen=True)
 class Crossing:
     """A scan crossing its threshold: at an image (the information scan: the image's time,
-    s; the span's mean relative shift and the shift it had to exceed) or at a nav update (the
+    s; the span's mean relative shift and the shift it had to exceed), at a nav update (the
     NIS scan, ``test = "nis"``: the update's time; the span's mean NIS per degree of freedom
-    and the mean it had to exceed); ``since_s``, the time of the span's first image or update
-    (s; None: the crossing's own)."""
+    and the mean it had to exceed), or at the last of ``POINTING_RUN`` images in a row whose
+    reported pointing error exceeds the tolerance (``test = "pointing"``: their median error
+    and the tolerance, deg); ``since_s``, the time of the span's first image or update (s;
+    None: the crossing's own)."""
 
     image_t_s: float
     scan: ScanResult
     shift: float
     limit: float
-    test: Literal["information", "nis"] = "information"
+    test: Literal["information", "nis", "pointing"] = "information"
     since_s: float | None = None
 
     @property
@@ -55,8 +57,8 @@ class Crossing:
     @property
     def direction(self) -> Direction | None:
         """Table 3's direction: the gain below the prediction is degraded (None: the NIS
-        scan, which judges no gain)."""
-        if self.test == "nis":
+        scan and the pointing run, which judge no gain)."""
+        if self.test != "information":
             return None
         return "degraded" if self.scan.signed < 0.0 else "improved"
 
@@ -85,6 +87,24 @@ def step_false_alarm(per_hour: float, tests: int, rate_hz: float) -> float:
     ``tests`` fused tests, of the budget ``per_hour`` false alarms per observer-hour over the
     steps of an hour (one every ω_mid period, ``rate_hz``)."""
     return min(per_hour / max(tests, 1) / (3600.0 * rate_hz), 0.5)
+
+
+POINTING_RUN = 5
+"""Scored images in a row whose reported pointing error exceeds ``pointing_tol_deg`` that
+declare a pointing fault at once (the window test's pointing test, image by image; with
+``fdir.fuse_guidance``).  A persistence rule on a tolerance, not a model: five seconds at
+1 Hz, against the window's median over half its 30 images.  An image is scored only
+``fdir.settle_s`` after its slew ended (a slew's overshoot exceeds the tolerance for up to
+25 s after it); then the reported error of a healthy attitude loop stays within a tenth of
+the tolerance."""
+
+
+def pointing_beyond(pose: WindowPose, tol_rad: float) -> np.ndarray | None:
+    """Which of the pose's images report a pointing error beyond ``tol_rad`` (None: none
+    reported)."""
+    if pose.pointing_error_rad is None:
+        return None
+    return np.asarray(pose.pointing_error_rad) > tol_rad
 
 
 class ImageScans:
@@ -175,30 +195,51 @@ class ImageScans:
         gains = np.array([delta_h(psi[poi], phi[poi], p) for poi, p in seen])
         evidence = image_evidence(gains, prec * (phi * psi), model.mean, self.noise_var)
         at = times[evidence.kept]
+        beyond = (pointing_beyond(pose, self.settings.pointing_tol_rad)
+                  if self.settings.fuse_pose else None)
         crossing = self._push(observer, window[0], at, evidence,
-                              pose_spreads_at(model, model_times, at))
+                              pose_spreads_at(model, model_times, at),
+                              None if beyond is None else beyond[evidence.kept],
+                              None if pose.pointing_error_rad is None
+                              else np.degrees(pose.pointing_error_rad)[evidence.kept])
         if crossing is None:
             scan.last_t = float(times[-1])
         return crossing
 
     def _push(self, observer: int, a: float, at: np.ndarray, evidence: ImageEvidence,
-              sigma_b: np.ndarray) -> Crossing | None:
+              sigma_b: np.ndarray, beyond: np.ndarray | None, pointing_deg: np.ndarray | None
+              ) -> Crossing | None:
         """The images at ``at`` (s) pushed onto the observer's scan one by one until the scan
-        crosses c (that image's crossing), each counted in the record of the window starting
-        at ``a`` (s)."""
+        crosses c or ``POINTING_RUN`` images in a row report their pointing beyond the
+        tolerance (``beyond``; their errors ``pointing_deg``): that image's crossing; each
+        counted in the record of the window starting at ``a`` (s)."""
         scan = self._scans[observer]
         stats = self._stats.get(observer)
         if stats is None or abs(stats.a - a) > TIME_TOL_S:
             stats = self._stats[observer] = _WindowStats(a)
-        for t, rk, ek, bk in zip(at, evidence.residuals, evidence.sigma_e, sigma_b, strict=True):
-            scan.push(float(rk), float(ek), float(bk), float(t))
+        for i, (t, rk, ek, bk) in enumerate(zip(at, evidence.residuals, evidence.sigma_e,
+                                                sigma_b, strict=True)):
+            scan.push(float(rk), float(ek), float(bk), float(t),
+                      beyond is not None and bool(beyond[i]))
             result = scan.scan()
             stats.add(float(t), result.z if result is not None else 0.0, float(ek), float(bk))
             if result is not None and result.z > self.c:
                 shift = float(np.mean(scan.r[-result.span:]))
                 return Crossing(float(t), result, shift, self.c * abs(shift) / result.z,
                                 since_s=scan.times[-result.span])
+            if scan.beyond_run >= POINTING_RUN and pointing_deg is not None:
+                return self._pointing_crossing(scan, pointing_deg[max(0, i + 1 - POINTING_RUN):
+                                                                  i + 1])
         return None
+
+    def _pointing_crossing(self, scan: ScanBuffer, run_deg: np.ndarray) -> Crossing:
+        """The pointing run's crossing at the scan's newest image: the run's median reported
+        error against the tolerance (deg), its ratio to it as the statistic."""
+        tol = math.degrees(self.settings.pointing_tol_rad)
+        error = float(np.median(run_deg))
+        run = scan.beyond_run
+        return Crossing(scan.times[-1], ScanResult(error / tol, error / tol, run), error, tol,
+                        "pointing", scan.times[-run])
 
     def _model(self, observer: int, window: tuple[float, float], times: np.ndarray,
                pose: WindowPose, psi: np.ndarray, phi: np.ndarray, plan: np.ndarray | None

@@ -103,9 +103,14 @@ class ScanBuffer:
     """the images' times (s)"""
     last_t: float = -math.inf
     scored_t: float = -math.inf
+    beyond_run: int = 0
+    """how many of the newest images in a row reported a pose beyond its tolerance"""
 
-    def push(self, r: float, sigma_e: float, sigma_b: float, t: float) -> None:
-        """An image of time ``t`` (s) scored: its residual and 1σ parts."""
+    def push(self, r: float, sigma_e: float, sigma_b: float, t: float,
+             beyond: bool = False) -> None:
+        """An image of time ``t`` (s) scored: its residual and 1σ parts, and whether it
+        reported a pose beyond its tolerance (``beyond``)."""
+        self.beyond_run = self.beyond_run + 1 if beyond else 0
         keep = max(SCAN_LENGTHS) - 1
         self.r = [*self.r[-keep:], r]
         self.sigma_e = [*self.sigma_e[-keep:], sigma_e]

@@ -14,7 +14,7 @@ import logging
 from gnc.image_scan import Crossing
 from gnc.window_test import exceeded as window_exceeded
 from ground.fdir.constellation import ConstellationVerdict
-from ground.fdir.identify import STEP_SPAN, Evidence, Tolerances, classify, classify_part
+from ground.fdir.identify import Evidence, Tolerances, classify, classify_part
 from ground.fdir.information import Judgement
 from ground.fdir.threshold import Persistence
 from interfaces.contracts.messages import FaultReport, FdirWindow, Message
@@ -31,9 +31,9 @@ class Declarer:
         self.node = node
         self.log = log
         self._unidentified: set[int] = set()
-        self._step: set[int] = set()
-        """observers declared by a step of the NIS scan and not yet identified
-        (``ground.fdir.identify.STEP_SPAN``)"""
+        self._nis_span: dict[int, int] = {}
+        """observers declared by the NIS scan and not yet identified, with the number of nav
+        updates its crossing spanned (``ground.fdir.identify.classify_part``)"""
         self._change_s: dict[int, float] = {}
         """observers declared by a scan and not yet identified, with the time the change
         began as the scan estimated it (s)"""
@@ -68,7 +68,7 @@ class Declarer:
         counted = self.persistence.counted(sc, exceeded, w.t_start_s)
         if self.persistence.update(sc, counted):
             self._change_s.pop(sc, None)  # declared by the windows: a scan's estimate is old
-            self._step.discard(sc)
+            self._nis_span.pop(sc, None)
             cls, ev = self._classify(sc, j, failed)
             self.log.warning("FDIR: fault declared on sc%d at %.0f s (failed %s; H_m %s, τ %s, "
                              "%s): %s", sc, w.t_end_s, "+".join(failed), _g(w.metric),
@@ -92,7 +92,7 @@ class Declarer:
         window (``j``: the part's tests and evidence) at its last image's time ``t_s`` (s;
         docs/fdir.md, "Identification after a crossing"): the report naming the class, or
         None when the evidence names none yet."""
-        cls = classify_part(j.evidence, self.tol, j.window.failed, sc in self._step)
+        cls = classify_part(j.evidence, self.tol, j.window.failed, self._nis_span.get(sc))
         if cls is None:
             return None
         self._unidentified.discard(sc)
@@ -110,7 +110,7 @@ class Declarer:
         evidence that named it: its images since the change first (``classify_part``), else
         the whole window's (``classify``)."""
         if j.part is not None:
-            cls = classify_part(j.part, self.tol, failed, sc in self._step)
+            cls = classify_part(j.part, self.tol, failed, self._nis_span.get(sc))
             if cls is not None:
                 return cls, j.part
         return classify(j.evidence, self.tol, failed), j.evidence
@@ -127,20 +127,20 @@ class Declarer:
         self.persistence.declare(sc, crossing.image_t_s)
         self._unidentified.add(sc)
         self._change_s[sc] = crossing.change_s
-        self._step.discard(sc)
-        if crossing.test == "nis" and crossing.scan.span <= STEP_SPAN:
-            self._step.add(sc)
+        self._nis_span.pop(sc, None)
+        if crossing.test == "nis":
+            self._nis_span[sc] = crossing.scan.span
         self.log.warning("FDIR: fault declared on sc%d at %.0f s (sequential, %s scan: |Z| "
                          "%.3g over %d, mean %.3g against %.3g%s)", sc, crossing.image_t_s,
                          crossing.test, crossing.scan.z, crossing.scan.span, crossing.shift,
                          crossing.limit, f", {crossing.direction}" if crossing.direction else "")
-        nis = {"nis_scan": 1.0} if crossing.test == "nis" else {}
+        which = {f"{crossing.test}_scan": 1.0} if crossing.test != "information" else {}
         return FaultReport(sender=self.node, t_sim=crossing.image_t_s, spacecraft=sc,
                            fault_class=None, direction=crossing.direction,
                            metric=abs(crossing.shift), threshold=crossing.limit,
                            window_end_s=window_end_s, detector="sequential",
                            evidence={"z": crossing.scan.z, "span": float(crossing.scan.span),
-                                     **nis})
+                                     **which})
 
     def _report(self, sc: int, cls: str | None, w: FdirWindow, ev: Evidence) -> FaultReport:
         return FaultReport(sender=self.node, t_sim=w.t_end_s, spacecraft=sc, fault_class=cls,

@@ -338,6 +338,7 @@ class FdirPipeline:
             return []
         a, b = self.schedule.start(k), self.schedule.end(k)
         settled: SettledMap | None = None
+        own: list[Message] = []
         for sc, obs in self.observers.items():
             if self.declarer.declared(sc):  # scored afresh once its episode ends
                 self.sequential.reset(sc)
@@ -360,9 +361,13 @@ class FdirPipeline:
                         if ctx is not None else None)
             if crossing is None:
                 self.sequential.passed(sc, mine[-1].image_t_s)
+            elif crossing.test == "pointing":  # its own attitude: declared at once
+                self.sequential.reset(sc)
+                own.append(self.declarer.declare_crossing(sc, crossing, b))
             else:  # the images after it are scored once it is decided
                 self._crossings[sc] = crossing
-        return self._scan_nis(a, b) + self._decide_crossings(a, b, final) + self._statuses()
+        return (own + self._scan_nis(a, b) + self._decide_crossings(a, b, final)
+                + self._statuses())
 
     def _identify_part(self, k: int) -> list[Message]:
         """With the sequential test: each declared fault still without a class judged, as a

@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 WITHIN = 2.0
 """The factor of the bound a delay is judged against (issue 41: "within 2×")."""
 
-MARKERS = {"sequential": ("o", "C0"), "nis_scan": ("s", "C2")}
+MARKERS = {"sequential": ("o", "C0"), "nis_scan": ("s", "C2"), "pointing_scan": ("D", "C3")}
 """The plot's marker and colour by what declared a fault (a window's tests: a triangle)."""
 
 
@@ -43,6 +43,7 @@ def kind_figures(rows: list[dict[str, Any]]) -> dict[str, Any]:
     return {"faults": len(rows),
             "scan": sum(r.get("declaring_test") == "sequential" for r in rows),
             "nis_scan": sum(r.get("declaring_test") == "nis_scan" for r in rows),
+            "pointing_scan": sum(r.get("declaring_test") == "pointing_scan" for r in rows),
             "delay": float(np.median(delay)), "bound": float(np.median(bound)),
             "divergence": float(np.median([r["image_divergence"] for r in rows])),
             "nis": float(np.median(nis)) if nis else None,
@@ -66,14 +67,16 @@ def bound_lines(out: Path, rows: list[dict[str, Any]]) -> list[str]:
              "judgeable window (from onset for a fault that starts while its observer is "
              "judged) to the first isolating alarm, by any test. Medians.", "",
              "![bound](bound.png)", "",
-             f"| kind | faults | declared by the image scan / NIS scan / a window | delay (s) | "
+             f"| kind | faults | declared by the image scan / NIS scan / pointing run / a "
+             f"window | delay (s) | "
              f"bound (s) | D ratio (nats) | D NIS (nats) | within {WITHIN:.0f}× |",
              "|---|---|---|---|---|---|---|---|"]
     for kind in kinds:
         st = kind_figures([r for r in bounded if r["kind"] == kind])
         nis = "-" if st["nis"] is None else f"{st['nis']:.3g}"
-        windows = st["faults"] - st["scan"] - st["nis_scan"]
-        lines.append(f"| {kind} | {st['faults']} | {st['scan']} / {st['nis_scan']} / {windows} | "
+        windows = st["faults"] - st["scan"] - st["nis_scan"] - st["pointing_scan"]
+        lines.append(f"| {kind} | {st['faults']} | {st['scan']} / {st['nis_scan']} / "
+                     f"{st['pointing_scan']} / {windows} | "
                      f"{st['delay']:.0f} | "
                      f"{st['bound']:.1f} | {st['divergence']:.3g} | {nis} | "
                      f"{st['within']} of {st['faults']} |")
@@ -97,7 +100,8 @@ def _bound_plot(out: Path, rows: list[dict[str, Any]], kinds: list[str]) -> None
         ax.set_title(kind, fontsize=9)
         ax.set_xlabel("magnitude")
         ax.grid(True, alpha=0.3, which="both")
-    axes[0][0].set_ylabel("delay (s): o image scan, s NIS scan, ^ window; x bound")
+    axes[0][0].set_ylabel("delay (s): o image scan, s NIS scan, ◆ pointing run, ^ window; "
+                          "x bound")
     fig.suptitle("delay against the information bound, per fault kind")
     fig.tight_layout()
     fig.savefig(out / "bound.png", dpi=100)

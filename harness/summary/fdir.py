@@ -15,7 +15,15 @@ from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
 from harness.archive.reader import RunArchive
 from harness.summary.delay_bound import NisSeries, nis_series, with_delay_bounds
 from harness.summary.records import SummaryRecord
-from harness.summary.scoring import Alarm, FaultClass, Judged, Scores, overlaps_fault, score
+from harness.summary.scoring import (
+    Alarm,
+    DeclaringTest,
+    FaultClass,
+    Judged,
+    Scores,
+    overlaps_fault,
+    score,
+)
 from harness.summary.series import FdirSeries, MainWindow, SeriesWindow
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import (
@@ -267,10 +275,13 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
             {"fdi_period_s": scenario.rates.fdi_period_s, **scenario.fdir.model_dump()}))
 
 
-def _declaring_test(report: FaultReport) -> Literal["window", "sequential", "nis_scan"]:
-    """What declared ``report``: a window's tests, the image scan or the NIS scan."""
-    if report.detector == "sequential" and report.evidence.get("nis_scan"):
-        return "nis_scan"
+def _declaring_test(report: FaultReport) -> DeclaringTest:
+    """What declared ``report``: a window's tests, the image scan, the NIS scan or the
+    pointing run."""
+    if report.detector == "sequential":
+        for test in ("nis_scan", "pointing_scan"):
+            if report.evidence.get(test):
+                return test  # type: ignore[return-value]
     return report.detector
 
 

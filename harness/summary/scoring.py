@@ -30,6 +30,10 @@ from pydantic import Field
 from harness.summary.records import Figure, SummaryRecord
 from interfaces.contracts.scenario import Fault, FaultKind
 
+DeclaringTest = Literal["window", "sequential", "nis_scan", "pointing_scan"]
+"""What declared a fault: a window's tests, the image scan, the NIS scan or the pointing run
+(``gnc.image_scan.POINTING_RUN``)."""
+
 EXPECTED_CLASS: dict[str, FaultClass] = {
     "thruster_bias": "actuator", "pointing_actuator": "actuator",
     "camera_degradation": "camera", "camera_misalignment": "camera",
@@ -49,9 +53,9 @@ class Alarm:
     fault_class: FaultClass | None
     declared_s: float | None = None
     """when it was declared (s; None: not known)"""
-    detector: Literal["window", "sequential", "nis_scan"] | None = None
-    """what declared it, where the sequential test runs: a window's tests, the image scan or
-    the NIS scan (None: the window test alone)"""
+    detector: DeclaringTest | None = None
+    """what declared it, where the sequential test runs: a window's tests, the image scan,
+    the NIS scan or the pointing run (None: the window test alone)"""
 
     @property
     def at_s(self) -> float:
@@ -151,10 +155,10 @@ class FaultScore(SummaryRecord):
         default=None, description="onset to the first (isolating) alarm's declaration, s: "
                                   "what the ground knew when (with ground passes, the gap "
                                   "to the pass is in it)")
-    detector: Literal["window", "sequential", "nis_scan"] | None = Field(
+    detector: DeclaringTest | None = Field(
         default=None, description="what declared the first (isolating) alarm, where the "
                                   "sequential test runs: a window's tests, the image scan "
-                                  "(sequential) or the NIS scan")
+                                  "(sequential), the NIS scan or the pointing run")
     image_divergence: float | None = Field(
         default=None, ge=0.0,
         description="where the sequential test runs: the fault's per-image Kullback-Leibler "

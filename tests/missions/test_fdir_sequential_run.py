@@ -107,25 +107,54 @@ def test_the_statistics_go_out_as_they_are_scored(degraded: Any) -> None:
     assert crossed and crossed[0].image_z > crossed[0].image_threshold
 
 
-def test_a_thruster_leak_is_declared_by_the_nav_s_nis_within_seconds(
-        tmp_path_factory: pytest.TempPathFactory) -> None:
+LEAK = {"spacecraft": 3, "kind": "thruster_bias", "start_s": ONSET_S, "magnitude": 0.5}
+POINTING = {"spacecraft": 1, "kind": "pointing_actuator", "start_s": ONSET_S,
+            "magnitude": 3.0}
+
+
+@pytest.fixture(scope="module")
+def actuators(tmp_path_factory: pytest.TempPathFactory
+              ) -> tuple[list[FaultReport], RunSummary]:
+    """A thruster leak on sc3 and a pointing fault on sc1, at once."""
+    got, summary = recorded_run(small_scenario("seq", **SETTINGS, faults=[LEAK, POINTING]),
+                                tmp_path_factory.mktemp("seq_actuators"), FaultReport)
+    return got["FaultReport"], summary
+
+
+def test_a_thruster_leak_is_declared_by_the_nav_s_nis_within_seconds(actuators: Any) -> None:
     """An unmodelled force: the nav's innovations grow at once, the information later; the
     NIS scan declares it on its observer, once, well before the window's end (the window
-    test's NIS test waits for it: 37 s here)."""
-    reports, summary = _run(tmp_path_factory.mktemp("seq_thruster"),
-                            {"spacecraft": 3, "kind": "thruster_bias", "start_s": ONSET_S,
-                             "magnitude": 0.5})
+    test's NIS test waits for it: 37 s here), and its ramp names the actuator."""
+    reports = [r for r in actuators[0] if r.spacecraft == 3]
     first = reports[0]
-    assert first.spacecraft == 3 and first.detector == "sequential"
+    assert first.detector == "sequential"
     assert first.evidence.get("nis_scan") == 1.0 and first.direction is None
     assert first.metric > first.threshold > 1.0  # mean NIS per degree beyond its limit
     assert ONSET_S < first.t_sim <= ONSET_S + 20.0
-    assert {r.spacecraft for r in reports} == {3}
+    assert first.evidence["span"] > 2  # a ramp, not a step
     assert _declarations(reports) == 1
-    (f,) = summary.scores.per_fault
+    (f,) = [f for f in actuators[1].scores.per_fault if f.spacecraft == 3]
     assert f.isolated and f.detector == "nis_scan"
     assert f.identified_class == "actuator"
     assert f.nis_divergence is not None and f.nis_divergence > 0.0
+
+
+def test_a_pointing_fault_is_declared_by_its_pointing_run_within_seconds(
+        actuators: Any) -> None:
+    """A pointing fault of 3°: its attitude loop reports the error beyond the 1° tolerance
+    image after image, and the fifth in a row declares it (``gnc.image_scan.POINTING_RUN``),
+    named an actuator fault on its images since then, where the window's pointing test
+    waits for the window's end (37 s here)."""
+    reports = [r for r in actuators[0] if r.spacecraft == 1]
+    first = reports[0]
+    assert first.detector == "sequential" and first.evidence.get("pointing_scan") == 1.0
+    assert ONSET_S < first.t_sim <= ONSET_S + 15.0  # the loop's error builds over 8 s here
+    assert first.metric > first.threshold == pytest.approx(1.0)  # deg
+    assert _declarations(reports) == 1
+    (f,) = [f for f in actuators[1].scores.per_fault if f.spacecraft == 1]
+    assert f.isolated and f.detector == "pointing_scan"
+    assert f.identified_class == "actuator" and f.identification_latency_s <= 20.0
+    assert {r.spacecraft for r in actuators[0]} == {1, 3}
 
 
 def test_a_common_mode_fault_stays_the_constellations(

@@ -87,6 +87,35 @@ def test_a_degraded_camera_crosses_on_its_first_image() -> None:
     assert test.window_fields(1, 30.0)["scan_z_max"] == crossing.scan.z
 
 
+def _pointing(ctx: WindowContext, error_deg: list[float]) -> WindowContext:
+    """``ctx`` with the attitude reports of a loop aimed at the target's centre whose reported
+    pointing error is ``error_deg`` at each image."""
+    k = len(ctx.times)
+    bore = centre_boresights(ctx.planned)
+    att = np.column_stack([bore, np.radians(error_deg), np.zeros((k, 3)), np.full(k, 1e-4)])
+    return replace(ctx, attitude=att)
+
+
+def test_five_images_in_a_row_pointing_beyond_the_tolerance_declare_at_once() -> None:
+    """The window test's pointing test image by image (``gnc.image_scan.POINTING_RUN``): a
+    loop reporting 0.1° never crosses, nor four images at 3° then one back within 1°; from
+    the image where 3° begins, the fifth crosses, its change at the first.  The pipeline
+    declares it at once (the observer's own attitude), named for the pointing run."""
+    test = SequentialTest(SCENARIO, TWIN, 1e-6)
+    rng = np.random.default_rng(9)
+    assert _score(test, _pointing(_window(0.0, [1.0] * 30, rng), [0.1] * 30)) is None
+    broken = [0.1] * 10 + [3.0] * 4 + [0.5] + [3.0] * 4 + [0.1] * 11
+    assert _score(test, _pointing(_window(30.0, [1.0] * 30, rng), broken)) is None
+    crossing = _score(test, _pointing(_window(60.0, [1.0] * 30, rng), [0.1] * 12 + [3.0] * 18))
+    assert crossing is not None and crossing.test == "pointing"
+    assert crossing.image_t_s == 76.0 and crossing.change_s == 72.0
+    assert crossing.direction is None and crossing.scan.span == 5
+    assert crossing.shift == pytest.approx(3.0) and crossing.limit == pytest.approx(1.0)
+    declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
+    report = declarer.declare_crossing(1, crossing, 90.0)
+    assert report.evidence["pointing_scan"] == 1.0 and declarer.change_s(1) == 72.0
+
+
 def test_a_crossing_declares_a_fault_the_windows_then_name() -> None:
     declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
     test = SequentialTest(SCENARIO, TWIN, 1e-6)
@@ -231,15 +260,15 @@ def test_after_a_nis_step_a_nav_walking_off_a_plan_the_camera_holds_is_the_senso
     early = Evidence(beta_hat=1.01, beta_se=0.03, camera_vs_nav_m=0.21, nav_vs_plan_m=0.16,
                      camera_vs_plan_m=0.12, camera_se_m=0.21, seen_overlap=0.9)
     assert classify_part(early, tol, ["nis"]) is None
-    assert classify_part(early, tol, ["nis"], step=True) == "state_sensor"
-    assert classify_part(early, tol, [], step=True) is None  # the NIS passes
+    assert classify_part(early, tol, ["nis"], nis_span=1) == "state_sensor"
+    assert classify_part(early, tol, [], nis_span=1) is None  # the NIS passes
     on_plan = replace(early, nav_vs_plan_m=0.05)
-    assert classify_part(on_plan, tol, ["nis"], step=True) is None
+    assert classify_part(on_plan, tol, ["nis"], nis_span=1) is None
     leading = replace(early, camera_vs_plan_m=0.3)  # the truth ahead of the nav: a drift
-    assert classify_part(leading, tol, ["nis"], step=True) != "state_sensor"
+    assert classify_part(leading, tol, ["nis"], nis_span=1) != "state_sensor"
     jumped = replace(early, camera_vs_plan_m=2.4, camera_vs_nav_m=2.3, camera_se_m=0.1,
                      offset_alignment=0.99)
-    assert classify_part(jumped, tol, ["nis"], step=True) == "actuator"
+    assert classify_part(jumped, tol, ["nis"], nis_span=1) == "actuator"
     declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
     step = Crossing(12.0, ScanResult(20.0, 20.0, 1), 80.0, 7.0, test="nis")
     declarer.declare_crossing(1, step, 30.0)
@@ -249,6 +278,27 @@ def test_after_a_nis_step_a_nav_walking_off_a_plan_the_camera_holds_is_the_senso
     drift = Crossing(12.0, ScanResult(7.0, 7.0, 8), 3.0, 2.0, test="nis")
     declarer.declare_crossing(2, drift, 30.0)  # not a step: the part waits
     assert declarer.identify_part(2, _part_judgement(2, early), 22.0, 30.0) is None
+
+
+def test_after_a_nis_ramp_a_nav_holding_its_plan_with_the_nis_failing_is_a_force() -> None:
+    """Declared by the NIS scan over 32 updates (hard campaign, late-thruster-0000: a leak of
+    14% of the maximum thrust, crossing 29 s after its onset): 4 s later the nav is 0.02 m off
+    the plan and the camera located 0.14 m off it, too little for the window's rules.  The
+    ramp names the actuator; a step, a NIS passed, or a nav walked off its plan does not."""
+    tol = Tolerances.of(SCENARIO.fdir)
+    leak = Evidence(beta_hat=0.99, beta_se=0.004, camera_vs_nav_m=0.13, nav_vs_plan_m=0.02,
+                    camera_vs_plan_m=0.14, camera_se_m=0.03, seen_overlap=0.99)
+    assert classify(leak, tol, ["nis"]) is None
+    assert classify_part(leak, tol, ["nis"], nis_span=32) == "actuator"
+    assert classify_part(leak, tol, ["nis"], nis_span=1) is None  # a step
+    assert classify_part(leak, tol, [], nis_span=32) is None  # the NIS passes
+    walked = replace(leak, nav_vs_plan_m=0.3)
+    assert classify_part(walked, tol, ["nis"], nis_span=32) is None
+    declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
+    declarer.declare_crossing(1, Crossing(12.0, ScanResult(7.0, 7.0, 32), 3.0, 2.0,
+                                          test="nis"), 30.0)
+    report = declarer.identify_part(1, _part_judgement(1, leak), 22.0, 30.0)
+    assert report is not None and report.fault_class == "actuator"
 
 
 def _part_judgement(sc: int, evidence: Evidence) -> Judgement:
