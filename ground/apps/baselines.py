@@ -6,7 +6,11 @@ detector, observer and FDI window on ``ground/fdir/baseline``; ``alarm`` marks t
 declares a fault (``chi2_nis`` and ``fixed_threshold`` after ``fdir.persistence`` exceedances
 in a row for the first, at once for the second, as a plain limit check; ``cusum`` when its sum
 first crosses ``fdir.cusum_threshold``, once per episode).  summary.json scores each like the
-main detector.
+main detector.  With the sequential test as the main detector (``fdir.detector``), the window
+test alone is one more baseline, ``window``: the FDIR's own window verdicts (Eq. 9 and its
+fused tests, at the budget share the sequential test leaves it), declared after
+``fdir.persistence`` failed windows, without the scans: the chapter's detector beside the one
+that replaced it.
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import BaselineVerdict, FdirWindow, StateEstimate
 from interfaces.runtime.app import App, AppContext, Input, Output
 
-Detector = Literal["chi2_nis", "cusum", "fixed_threshold"]
+Detector = Literal["chi2_nis", "cusum", "fixed_threshold", "window"]
 
 
 class BaselinesApp(App):
@@ -30,7 +34,8 @@ class BaselinesApp(App):
         Input(cat.NAV_ESTIMATE, "on_nav", every_spacecraft=True),
     )
     OUTPUTS = (Output("verdict", cat.BASELINE),)
-    CRITICAL = ("nis", "windows", "cusum", "chi2_persistence", "fixed_persistence")
+    CRITICAL = ("nis", "windows", "cusum", "chi2_persistence", "fixed_persistence",
+                "window_persistence")
 
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
@@ -41,6 +46,8 @@ class BaselinesApp(App):
         self.cusum = Cusum(self.cfg.cusum_drift, self.cfg.cusum_threshold)
         self.chi2_persistence = Persistence(self.cfg.persistence)
         self.fixed_persistence = Persistence(1)
+        self.window_persistence = (Persistence(self.cfg.persistence, self.cfg.persistence_window)
+                                   if self.cfg.detector == "sequential" else None)
 
     def on_nav(self, msg: StateEstimate) -> None:
         if msg.nis is not None and 1 <= msg.spacecraft <= self.count:
@@ -58,6 +65,7 @@ class BaselinesApp(App):
                 continue
             self._chi2(w)
             self._information(w)
+            self._window(w)
 
     def _verdict(self, detector: Detector, w: FdirWindow, statistic: float | None,
                  threshold: float | None, exceeded: bool | None, alarm: bool) -> None:
@@ -94,3 +102,10 @@ class BaselinesApp(App):
         exceeded = w.metric > self.cfg.fixed_threshold
         alarm = self.fixed_persistence.update(w.spacecraft, exceeded)
         self._verdict("fixed_threshold", w, w.metric, self.cfg.fixed_threshold, exceeded, alarm)
+
+    def _window(self, w: FdirWindow) -> None:
+        """The window test's own verdict on the window, where the scans declare too."""
+        if self.window_persistence is None:
+            return
+        alarm = self.window_persistence.update(w.spacecraft, w.exceeded)
+        self._verdict("window", w, w.metric, w.threshold, w.exceeded, alarm)

@@ -357,12 +357,13 @@ def window_margins(runs: list[CampaignRun]) -> dict[str, np.ndarray]:
 
 def persistence_of(summary: RunSummary, detector: str) -> tuple[int, int]:
     """The persistence rule (m exceedances among the last n windows) the detector used in
-    that run, from its settings as summary.json records them: the main detector m of
-    ``persistence_window`` (or in a row), chi2_nis ``persistence`` in a row, the plain limit
-    checks one.  A summary without settings: 2 in a row."""
+    that run, from its settings as summary.json records them: the main detector and the
+    window test beside the sequential one (``window``) m of ``persistence_window`` (or in a
+    row), chi2_nis ``persistence`` in a row, the plain limit checks one.  A summary without
+    settings: 2 in a row."""
     cfg = summary.fdir_settings
     m = cfg.persistence if cfg else 2
-    if detector == "main":
+    if detector in ("main", "window"):
         return m, (cfg.persistence_window if cfg else None) or m
     return (m, m) if detector == "chi2_nis" else (1, 1)
 

@@ -77,6 +77,9 @@ def test_a_degraded_camera_is_declared_within_seconds(degraded: Any) -> None:
     assert f.detector == "sequential" and f.image_divergence > 50.0
     assert f.delay_bound_s == 1.0 and f.latency_s <= 2.0 * f.delay_bound_s + 1.0
     assert summary.detections[0].detector == "sequential"
+    # the window test alone, scored beside it, waits for its window's end (250 s)
+    (w,) = summary.baselines["window"].per_fault
+    assert w.isolated and w.latency_s >= 250.0 - ONSET_S > f.latency_s
 
 
 def _declarations(reports: list[FaultReport]) -> int:

@@ -202,9 +202,11 @@ class FaultReport(Message):
 class BaselineVerdict(Message):
     """A baseline detector's verdict on one observer over one FDI window [t_start_s, t_end_s)
     (ground/fdir/baselines.py): its statistic against its threshold, whether that was exceeded
-    (None: no decision) and whether this window declared a fault (``alarm``)."""
+    (None: no decision) and whether this window declared a fault (``alarm``).  ``window``: the
+    window test alone (Eq. 9 per window, with its fused tests), published where the sequential
+    test is the main detector."""
 
-    detector: Literal["chi2_nis", "cusum", "fixed_threshold"]
+    detector: Literal["chi2_nis", "cusum", "fixed_threshold", "window"]
     spacecraft: int = Field(ge=1)
     t_start_s: Time
     t_end_s: Time
