@@ -23,10 +23,10 @@ from tests.conftest import REPO, small_scenario
 M = "fox"
 PASSES = load_scenario(REPO / "deploy" / "scenarios" / "passes.toml")
 """Five observers, ground passes, a thruster fault on observer 2."""
-PLAIN = small_scenario(M, observers={"count": 3})
-"""Three observers heard continuously, no fault."""
-SEQUENTIAL = small_scenario(M, observers={"count": 3}, fdir={"detector": "sequential"})
-"""The same, judged by the sequential test."""
+PLAIN = small_scenario(M, observers={"count": 3}, fdir={"detector": "window"})
+"""Three observers heard continuously, no fault, judged by the window test alone."""
+SEQUENTIAL = small_scenario(M, observers={"count": 3})
+"""The same, judged by the sequential test (the default)."""
 
 _TOKEN = re.compile(r"\.(\w+)|\[(-?\d+|:)\]|\{(\w+)==('[^']*'|-?\d+|true|false)\}")
 

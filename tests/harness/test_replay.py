@@ -16,7 +16,9 @@ from tests.conftest import small_scenario
 
 def _scenario(**fdir: object) -> Scenario:
     """The scenario the replays fly (tests/missions/test_replay.py): lossy, range-limited and cut
-    links and three faults, with ``fdir`` settings."""
+    links and three faults, judged by the window test (whose persistence a replay varies;
+    the sequential test's replay: tests/missions/test_fdir_sequential_run.py), with ``fdir``
+    settings."""
     return small_scenario(
         "replay", duration_s=400.0, target={"pois": 1000},
         rates={"high_hz": 5.0, "fdi_period_s": 50.0},
@@ -26,7 +28,7 @@ def _scenario(**fdir: object) -> Scenario:
         faults=[{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0, "magnitude": 0.5},
                 {"spacecraft": 1, "kind": "faulty_data", "start_s": 150.0, "magnitude": 2.0},
                 {"spacecraft": 3, "kind": "link_loss", "start_s": 250.0, "end_s": 330.0}],
-        fdir=fdir)
+        fdir={"detector": "window", **fdir})
 
 
 def test_what_a_replay_drops_unread_no_ground_app_reads() -> None:

@@ -22,8 +22,10 @@ FDIR_FIELDS = tuple(FdirResults.model_fields)
 
 
 def _campaign(tmp: Path) -> Path:
-    """test_campaign's campaign, long enough (150 s) for the camera faults to be declared."""
-    (tmp / "base.toml").write_text(BASE.replace("duration_s = 60.0", "duration_s = 150.0"))
+    """test_campaign's campaign, long enough (150 s) for the camera faults to be declared,
+    judged by the window test (whose persistence the sweep varies)."""
+    (tmp / "base.toml").write_text(BASE.replace("duration_s = 60.0", "duration_s = 150.0")
+                                   + '[fdir]\ndetector = "window"\n')
     path = tmp / "c.toml"
     path.write_text(CAMPAIGN.format(seeds=2))
     return path

@@ -1,4 +1,4 @@
-"""The nav's NIS test in the main detector, in a real (in-process) run: a thruster leak is an
+"""The nav's NIS test in the window test, in a real (in-process) run: a thruster leak is an
 unmodelled force in the nav filter, so the window after its onset fails on the NIS before the
 information metric or the Δv spent show it; the fault is declared unidentified on that window
 and identified as an actuator fault on a later one, while the healthy observers' NIS stays
@@ -19,7 +19,7 @@ ONSET_S = 50.0
 @pytest.fixture(scope="module")
 def run() -> tuple[list[FdirWindow], list[FaultReport]]:
     sc = small_scenario("nis", duration_s=180.0, target={"pois": 500},
-                        rates={"fdi_period_s": 20.0},
+                        rates={"fdi_period_s": 20.0}, fdir={"detector": "window"},
                         faults=[{"spacecraft": 1, "kind": "thruster_bias", "start_s": ONSET_S,
                                  "magnitude": 0.2}])
     tap, got = collector(FdirWindow, FaultReport)

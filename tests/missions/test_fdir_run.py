@@ -1,4 +1,5 @@
-"""The ground FDIR in a real (in-process) run: a degraded camera is detected and isolated with
+"""The ground FDIR's window test in a real (in-process) run (the sequential test, the default:
+tests/missions/test_fdir_sequential_run.py): a degraded camera is detected and isolated with
 the metric at 1 − β (Eq. 21), the healthy observers stay far below the threshold, a
 spacecraft whose link is cut is reported as a link fault, not as a performance fault, and one
 that reports a corrupted H_i as a data-integrity fault."""
@@ -21,7 +22,7 @@ def fdir_run(tmp_path_factory: pytest.TempPathFactory
              ) -> tuple[list[FdirWindow], list[FaultReport], RunSummary]:
     sc = small_scenario(
         "fd", duration_s=400.0, target={"pois": 1000},
-        rates={"high_hz": 5.0, "fdi_period_s": 50.0},
+        rates={"high_hz": 5.0, "fdi_period_s": 50.0}, fdir={"detector": "window"},
         observers={"count": 3, "initial_attitude": "lvlh"},
         faults=[{"spacecraft": 2, "kind": "camera_degradation", "start_s": 0.0,
                  "magnitude": 0.5},

@@ -1,6 +1,6 @@
 """The onboard FDIR flown (fsw/apps/fdir.py, issue 28): the paper's set-up with three observers
 and a 5° pointing fault on observer 2 once its tracking has settled.  Onboard, the pointing
-watchpoint trips within 10 s of the onset, before the ground declares the fault; the ground's
+watchpoint trips within 10 s of the onset, as the ground declares the fault; the ground's
 declaration reaches the spacecraft and starts safe hold in the same tick; in safe hold it fires
 no thruster until the ground's re-plan reaches it, which ends it; the healthy observers trip
 nothing; and summary.json and report.md tell the story with the times."""
@@ -35,13 +35,16 @@ def flown(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out / "runs" / "onboard"
 
 
-def test_the_pointing_watchpoint_trips_within_10_s_before_the_ground_declares(flown: Path) -> None:
+def test_the_pointing_watchpoint_trips_within_10_s_as_the_ground_declares(flown: Path) -> None:
+    """Both read the pointing error the attitude loop reports: the watchpoint aboard and the
+    ground's pointing run (``gnc.image_scan.POINTING_RUN``) trip within a second of each
+    other (the window test's ground declared at its window's end, 20 s later here)."""
     ob = RunSummary.read(flown / "summary.json").onboard_fdir
     assert ob is not None
     (fault,) = ob.per_fault
     assert fault.trip == "pointing_deg" and fault.trip_action == "request_plan"
     assert fault.trip_s is not None and fault.trip_s - ONSET_S <= 10.0
-    assert fault.detected_s is not None and fault.trip_s < fault.detected_s
+    assert fault.detected_s is not None and abs(fault.trip_s - fault.detected_s) <= 1.0
     assert {e.spacecraft for e in ob.events if e.event == "trip"} == {2}
 
 

@@ -50,7 +50,7 @@ class FdirSettings(Section):
         description="the threshold that decides: the quantile of the hardware's nominal ratio "
                     "distribution, or Eq. 11-12's ε-sampling (both are computed and archived)")
     detector: Literal["window", "sequential"] = Field(
-        default="window",
+        default="sequential",
         description="what declares an observer's information fault: the window test alone "
                     "(Eq. 9 per FDI window), or also the sequential test on each image as it "
                     "arrives (gnc/sequential_test.py), the budget split between them")

@@ -32,7 +32,8 @@ from tests.conftest import app_alone, small_scenario
 
 SC = small_scenario("nb", target={"radius_m": 5.0, "pois": 1000},
                     camera={"half_angle_deg": 12.0}, rates={"fdi_period_s": 30.0},
-                    neighbours={"enabled": True})
+                    neighbours={"enabled": True}, fdir={"detector": "window"})
+"""The window test (Eq. 9 per window) aboard; ``SEQ``: the sequential test, the default."""
 PROS = {2: Pro(10.0, 0.3, 0.0, 15.0, 1.1), 3: Pro(10.0, 2.4, 0.0, 15.0, 3.2)}
 
 

@@ -135,7 +135,9 @@ def test_the_budget_is_shared_image_by_image() -> None:
     assert tests == 4 and image_false_alarm(SCENARIO, tests) == pytest.approx(0.01 / 4 / 3600)
     assert InformationTest(small_scenario(fdir={"detector": "sequential", "fuse_nis": False},
                                           camera={"noise_frac": NOISE}), TWIN).tests == 2
-    assert InformationTest(small_scenario(), TWIN).tests == 2  # the window and NIS tests
+    assert InformationTest(small_scenario(), TWIN).tests == 4  # the default: sequential
+    window = small_scenario(fdir={"detector": "window"})
+    assert InformationTest(window, TWIN).tests == 2  # the window and NIS tests
 
 
 def test_an_unknown_detector_is_refused_naming_the_key() -> None:
