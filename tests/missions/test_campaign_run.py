@@ -41,7 +41,8 @@ def test_local_pool_and_dask_cluster_agree(tmp_path: Path) -> None:
     assert list(local) == ["cam-0000", "cam-0001", "nom-0000"]
     assert local == dask
     rows = list(csv.DictReader(open(tmp_path / "dask" / "results.csv")))
-    assert {r["detector"] for r in rows} == {"main", "chi2_nis", "cusum", "fixed_threshold"}
+    assert {r["detector"] for r in rows} == {"main", "chi2_nis", "cusum", "fixed_threshold",
+                                             "window"}
     assert len([r for r in rows if r["detector"] == "main"]) == 3
 
 

@@ -53,9 +53,9 @@ def test_each_fault_identified_on_its_spacecraft(run: Run) -> None:
 
 def test_baselines_scored_beside(run: Run) -> None:
     _, verdicts, summary = run
-    assert {v.detector for v in verdicts} == {"chi2_nis", "cusum", "fixed_threshold"}
+    assert {v.detector for v in verdicts} == {"chi2_nis", "cusum", "fixed_threshold", "window"}
     base = summary.baselines or {}
-    assert set(base) == {"chi2_nis", "cusum", "fixed_threshold"}
+    assert set(base) == {"chi2_nis", "cusum", "fixed_threshold", "window"}
     for scores in base.values():
         assert len(scores.per_fault) == 3
     # The nav filter's consistency test sees the sensor bias step (two windows: persistence),

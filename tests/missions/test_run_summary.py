@@ -64,7 +64,7 @@ def test_window_series_are_named_in_memory_and_positional_on_disk(
     on_disk = json.loads(path.read_text())["fdir_series"]
     assert summary.fdir_series is not None
     assert list(on_disk) == summary.fdir_series.detectors() == [
-        "main", "chi2_nis", "cusum", "fixed_threshold"]
+        "main", "chi2_nis", "cusum", "fixed_threshold", "window"]
     main = summary.fdir_series.main
     assert [len(r) for r in on_disk["main"]] == [6] * len(main) and len(main) >= 10
     for row, w in zip(on_disk["main"], main, strict=True):

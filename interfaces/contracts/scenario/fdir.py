@@ -51,9 +51,10 @@ class FdirSettings(Section):
                     "distribution, or Eq. 11-12's ε-sampling (both are computed and archived)")
     detector: Literal["window", "sequential"] = Field(
         default="sequential",
-        description="what declares an observer's information fault: the window test alone "
-                    "(Eq. 9 per FDI window), or also the sequential test on each image as it "
-                    "arrives (gnc/sequential_test.py), the budget split between them")
+        description="what declares an observer's information fault: the sequential test on "
+                    "each image and nav update as they arrive (gnc/sequential_test.py, "
+                    "gnc/image_scan.py) beside the window test, the budget split between them "
+                    "(the default), or the window test alone (Eq. 9 per FDI window)")
     false_alarms_per_observer_hour: float = Field(
         default=0.01, gt=0.0, le=100.0,
         description="false-alarm budget of the hardware threshold, per observer-hour")
