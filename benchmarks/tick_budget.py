@@ -17,13 +17,16 @@ with the default mission's work, by rate group.
 
 * **the slower work per call**, in the same run: the sim's camera images (one call images
   every observer), the nav step, the infocost fusion of one observations message, the ground
-  FDIR's work per observer-window (hardware threshold and identification evidence included)
-  and an MPC solve.  Each is timed around the real call (the method wrapped for the run,
-  restored after).
+  FDIR's work per observer-window (hardware threshold and identification evidence included;
+  with the sequential test, each part of a window judged for its class too), the sequential
+  test's image scan and NIS scan per call (an observer's images or nav updates come since the
+  last, the window's ratio model drawn on the first) and an MPC solve.  Each is timed around
+  the real call (the method wrapped for the run, restored after).
 
 Targets (issue 25): bare ≤ 50 µs, 10 Hz-only ≤ 0.5 ms, a 1 Hz tick adds
 ≤ 3 ms, a 0.1 Hz tick adds ≤ 10 ms; per call: camera image ≤ 0.3 ms, fusion ≤ 0.3 ms, nav
-≤ 0.1 ms, FDIR ≤ 5 ms per observer-window, MPC solve ≤ 1 ms.
+≤ 0.1 ms, FDIR ≤ 5 ms per observer-window, image scan ≤ 0.3 ms and NIS scan ≤ 0.1 ms a
+call, MPC solve ≤ 1 ms.
 """
 
 from __future__ import annotations
@@ -65,6 +68,10 @@ CALLS: tuple[tuple[str, str, str, float], ...] = (
     ("fsw.apps.infocost", "InfoCostApp.on_observations", "infocost fusion, one image", 0.3),
     ("ground.fdir.information", "InformationTest.judge", "ground FDIR, one observer-window",
      5.0),
+    ("ground.fdir.sequential", "SequentialTest.score",
+     "ground image scan, per call", 0.3),
+    ("ground.fdir.sequential", "SequentialTest.score_nis",
+     "ground NIS scan, per call", 0.1),
     ("fsw.lib.mpc", "MpcTracker.solve", "MPC solve", 1.0),
 )
 """The slower work timed per call, with its target per call (ms)."""

@@ -65,7 +65,6 @@ INDIRECT: dict[str, str] = {
     **{f"harness.summary.{m}": _SUMMARY
        for m in ("access", "document", "execution", "fault_events", "recovery", "records",
                  "series")},
-    "ground.apps.baselines": _APP.format("tests/ground/fdir/test_baselines.py"),
     "harness.archive.__main__": (
         "``python -m harness.archive``, two lines handing over to harness/archive/cli.py's main "
         "(tests/harness/archive/test_cli.py, tests/missions/test_archive_cli_run.py)"),
