@@ -4,13 +4,17 @@
 A declaration (``NeighbourDeclaration``; every observer that applied the agreement rule sends
 one, the same subject and window) is ruled on the first window of its subject, ending at or
 after the declared window's end, on which the ground's own information test decided:
-``upheld`` if that window failed, ``overruled`` if it passed (the observers then fuse the
-subject again).  Each (subject, window) is ruled once.
+``upheld`` if that window failed or the ground's own declaration of the subject stands at its
+end (the sequential test declares between windows: a pointing fault that began late in a
+window is declared by the ground's scan while that window, a median, passes), ``overruled``
+if it passed (the observers then fuse the subject again).  Each (subject, window) is ruled
+once.
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Collection
 
 from interfaces.contracts.messages import NeighbourDeclaration, NeighbourRuling
 from interfaces.contracts.timing import TIME_TOL_S
@@ -38,13 +42,17 @@ class NeighbourRulings:
         """Whether ``observer`` leaves a declared neighbour out of its fusion."""
         return bool(self.excluding.get(observer))
 
-    def rule(self, b: float, exceeded: dict[int, bool | None]) -> list[NeighbourRuling]:
+    def rule(self, b: float, exceeded: dict[int, bool | None], declared: Collection[int] = ()
+             ) -> list[NeighbourRuling]:
         """Rulings on the declarations whose subject the ground judged in the window ending at
-        ``b`` (s): ``exceeded`` by observer, None where it did not decide."""
+        ``b`` (s): ``exceeded`` by observer, None where it did not decide; ``declared``: the
+        observers whose fault the ground itself holds declared at ``b``."""
         out = []
         for key in sorted(self.pending):
             subject, t_end = key
             verdict = exceeded.get(subject)
+            if verdict is not None and subject in declared:
+                verdict = True
             if t_end > b + TIME_TOL_S or verdict is None:
                 continue
             del self.pending[key]

@@ -321,7 +321,8 @@ class FdirPipeline:
         for sc, j in judged.items():
             out += self.declarer.declare(sc, j, common, self.global_check.way)
         out += self.rulings.rule(b, {w.spacecraft: w.exceeded for w in out
-                                     if isinstance(w, FdirWindow)})
+                                     if isinstance(w, FdirWindow)},
+                                 [sc for sc in judged if self.declarer.declared(sc)])
         self._settle(inside, b)
         reports, unjudged = self.integrity.check(k + 1, b, self.settled, self.views,
                                                  self.observers, self.rulings.excludes)

@@ -38,3 +38,16 @@ def test_an_overruled_subject_is_fused_again_by_everyone() -> None:
     (ruling,) = r.rule(90.0, {3: False})
     assert ruling.verdict == "overruled"
     assert not r.excludes(1) and not r.excludes(2)
+
+
+def test_a_subject_the_ground_holds_declared_is_upheld_though_its_window_passed() -> None:
+    """The ground's scan declared the subject inside the window (a pointing fault begun late
+    in it), whose median test passed: the ground's own declaration upholds the neighbours'
+    (passes campaign, pointing-neighbours-0000: overruled before, and the subject fused
+    again)."""
+    r = NeighbourRulings("ground", logging.getLogger("t"))
+    r.declaration(_declaration(1, 2, 540.0))
+    (ruling,) = r.rule(540.0, {2: False}, declared={2})
+    assert ruling.verdict == "upheld" and r.excludes(1)
+    r.declaration(_declaration(1, 3, 540.0))
+    assert r.rule(540.0, {3: None}, declared={3}) == []  # undecided: no ruling yet
