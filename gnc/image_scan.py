@@ -99,12 +99,14 @@ declare a pointing fault at once (the window test's pointing test, image by imag
 the tolerance."""
 
 
-def pointing_beyond(pose: WindowPose, tol_rad: float) -> np.ndarray | None:
-    """Which of the pose's images report a pointing error beyond ``tol_rad`` (None: none
-    reported)."""
-    if pose.pointing_error_rad is None:
-        return None
-    return np.asarray(pose.pointing_error_rad) > tol_rad
+def _pointing_crossing(scan: ScanBuffer, run_rad: np.ndarray, tol_rad: float) -> Crossing:
+    """The pointing run's crossing at the scan's newest image: the run's median reported
+    error against the tolerance (deg), their ratio as the statistic, its change at the run's
+    first image."""
+    error, tol = math.degrees(float(np.median(run_rad))), math.degrees(tol_rad)
+    run = scan.beyond_run
+    return Crossing(scan.times[-1], ScanResult(error / tol, error / tol, run), error, tol,
+                    "pointing", scan.times[-run])
 
 
 class ImageScans:
@@ -195,24 +197,22 @@ class ImageScans:
         gains = np.array([delta_h(psi[poi], phi[poi], p) for poi, p in seen])
         evidence = image_evidence(gains, prec * (phi * psi), model.mean, self.noise_var)
         at = times[evidence.kept]
-        beyond = (pointing_beyond(pose, self.settings.pointing_tol_rad)
-                  if self.settings.fuse_pose else None)
+        pointing = (np.asarray(pose.pointing_error_rad)[evidence.kept]
+                    if self.settings.fuse_pose and pose.pointing_error_rad is not None
+                    else None)
         crossing = self._push(observer, window[0], at, evidence,
-                              pose_spreads_at(model, model_times, at),
-                              None if beyond is None else beyond[evidence.kept],
-                              None if pose.pointing_error_rad is None
-                              else np.degrees(pose.pointing_error_rad)[evidence.kept])
+                              pose_spreads_at(model, model_times, at), pointing)
         if crossing is None:
             scan.last_t = float(times[-1])
         return crossing
 
     def _push(self, observer: int, a: float, at: np.ndarray, evidence: ImageEvidence,
-              sigma_b: np.ndarray, beyond: np.ndarray | None, pointing_deg: np.ndarray | None
-              ) -> Crossing | None:
+              sigma_b: np.ndarray, pointing_rad: np.ndarray | None) -> Crossing | None:
         """The images at ``at`` (s) pushed onto the observer's scan one by one until the scan
-        crosses c or ``POINTING_RUN`` images in a row report their pointing beyond the
-        tolerance (``beyond``; their errors ``pointing_deg``): that image's crossing; each
-        counted in the record of the window starting at ``a`` (s)."""
+        crosses c or ``POINTING_RUN`` images in a row report their pointing error
+        (``pointing_rad``; None: not judged) beyond the tolerance: that image's crossing;
+        each counted in the record of the window starting at ``a`` (s)."""
+        tol = self.settings.pointing_tol_rad
         scan = self._scans[observer]
         stats = self._stats.get(observer)
         if stats is None or abs(stats.a - a) > TIME_TOL_S:
@@ -220,26 +220,18 @@ class ImageScans:
         for i, (t, rk, ek, bk) in enumerate(zip(at, evidence.residuals, evidence.sigma_e,
                                                 sigma_b, strict=True)):
             scan.push(float(rk), float(ek), float(bk), float(t),
-                      beyond is not None and bool(beyond[i]))
+                      pointing_rad is not None and bool(pointing_rad[i] > tol))
             result = scan.scan()
             stats.add(float(t), result.z if result is not None else 0.0, float(ek), float(bk))
             if result is not None and result.z > self.c:
                 shift = float(np.mean(scan.r[-result.span:]))
                 return Crossing(float(t), result, shift, self.c * abs(shift) / result.z,
                                 since_s=scan.times[-result.span])
-            if scan.beyond_run >= POINTING_RUN and pointing_deg is not None:
-                return self._pointing_crossing(scan, pointing_deg[max(0, i + 1 - POINTING_RUN):
-                                                                  i + 1])
+            if pointing_rad is not None and scan.beyond_run >= POINTING_RUN:
+                run = pointing_rad[max(0, i + 1 - POINTING_RUN):i + 1]  # of this call's
+                return _pointing_crossing(scan, run, tol)
         return None
 
-    def _pointing_crossing(self, scan: ScanBuffer, run_deg: np.ndarray) -> Crossing:
-        """The pointing run's crossing at the scan's newest image: the run's median reported
-        error against the tolerance (deg), its ratio to it as the statistic."""
-        tol = math.degrees(self.settings.pointing_tol_rad)
-        error = float(np.median(run_deg))
-        run = scan.beyond_run
-        return Crossing(scan.times[-1], ScanResult(error / tol, error / tol, run), error, tol,
-                        "pointing", scan.times[-run])
 
     def _model(self, observer: int, window: tuple[float, float], times: np.ndarray,
                pose: WindowPose, psi: np.ndarray, phi: np.ndarray, plan: np.ndarray | None

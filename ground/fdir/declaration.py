@@ -32,8 +32,9 @@ class Declarer:
         self.log = log
         self._unidentified: set[int] = set()
         self._nis_span: dict[int, int] = {}
-        """observers declared by the NIS scan and not yet identified, with the number of nav
-        updates its crossing spanned (``ground.fdir.identify.classify_part``)"""
+        """observers whose latest episode the NIS scan declared, with the number of nav
+        updates its crossing spanned (``ground.fdir.identify.classify_part``; read while the
+        fault has no class)"""
         self._change_s: dict[int, float] = {}
         """observers declared by a scan and not yet identified, with the time the change
         began as the scan estimated it (s)"""
@@ -128,7 +129,7 @@ class Declarer:
         self._unidentified.add(sc)
         self._change_s[sc] = crossing.change_s
         self._nis_span.pop(sc, None)
-        if crossing.test == "nis":
+        if crossing.test == "nis":  # the crossing's shape: a step or a ramp
             self._nis_span[sc] = crossing.scan.span
         self.log.warning("FDIR: fault declared on sc%d at %.0f s (sequential, %s scan: |Z| "
                          "%.3g over %d, mean %.3g against %.3g%s)", sc, crossing.image_t_s,

@@ -114,6 +114,12 @@ def test_five_images_in_a_row_pointing_beyond_the_tolerance_declare_at_once() ->
     declarer = Declarer(SCENARIO.fdir, "ground", logging.getLogger("test"))
     report = declarer.declare_crossing(1, crossing, 90.0)
     assert report.evidence["pointing_scan"] == 1.0 and declarer.change_s(1) == 72.0
+    split = SequentialTest(SCENARIO, TWIN, 1e-6)  # a run across two windows' scoring
+    assert _score(split, _pointing(_window(0.0, [1.0] * 30, rng), [0.1] * 27 + [3.0] * 3)) \
+        is None
+    across = _score(split, _pointing(_window(30.0, [1.0] * 30, rng), [3.0] * 30))
+    assert across is not None and (across.image_t_s, across.change_s) == (31.0, 27.0)
+    assert across.shift == pytest.approx(3.0)
 
 
 def test_a_crossing_declares_a_fault_the_windows_then_name() -> None:
