@@ -5,13 +5,15 @@ results.csv's rows of the main detector and the runs' neighbours sections:
   observer's windows after the onset reached the ground in the run) and those none could,
   apart, by where the onset fell (in contact, between passes);
 * of the judgeable: detected and isolated (≥ 98%), identified per expected class (≥ 95%
-  each), latency from the first judgeable window (median ≤ 30 s, p90 ≤ 60 s); from onset as
-  well, both stamped at the window's end and when the ground declared it (with passes, after
-  the data came down);
+  each); of those that began after their observer's first judgeable image
+  (``judgeable_s`` ≤ onset), the latency from onset (median ≤ 10 s, p90 ≤ 30 s; issue 41)
+  and each class's identification latency from onset (median ≤ 30 s); the latency from the
+  first judgeable window, and from onset to when the ground declared it (with passes, after
+  the data came down), without a target;
 * false alarms per nominal observer-window (the ground) and per nominal neighbour-window (the
   neighbours aboard), 95% upper bound ≤ 1e-3;
 * faults between passes in runs with the neighbours on: the first declaration, by the
-  neighbours aboard or the ground, from onset (median ≤ 60 s).
+  neighbours aboard or the ground, from onset (median ≤ 20 s).
 
 Each figure is a :class:`Figure`: what it is, its value as text, the target as text, and
 whether the target is met (None: nothing to judge it on).
@@ -33,12 +35,14 @@ from harness.campaign.rescore import (
     spread,
     values,
 )
+from interfaces.contracts.timing import TIME_TOL_S
 
 DETECTED_MIN = 0.98
 IDENTIFIED_MIN = 0.95
-WINDOW_MEDIAN_S, WINDOW_P90_S = 30.0, 60.0
+ONSET_MEDIAN_S, ONSET_P90_S = 10.0, 30.0
+IDENTIFIED_MEDIAN_S = 30.0
 FALSE_ALARMS_MAX = 1e-3
-OUT_OF_CONTACT_MEDIAN_S = 60.0
+OUT_OF_CONTACT_MEDIAN_S = 20.0
 
 
 @dataclass(frozen=True)
@@ -85,7 +89,7 @@ def target_figures(rows: Sequence[dict[str, Any]], runs: Sequence[CampaignRun]
     fa, windows = sum(r["false_alarms"] for r in nominal), sum(r["nominal_cycles"]
                                                                 for r in nominal)
     nfa, nwin = neighbour_false_alarms(runs)
-    window_lat = values(judged, "window_latency_s")
+    after = [r for r in judged if r["judgeable_s"] <= r["start_s"] + TIME_TOL_S]
     with_neighbours = {r.id for r in runs if r.summary.neighbours is not None}
     between = [r for r in faults if r["contact"] == "between_passes"
                and r["run"] in with_neighbours]
@@ -96,11 +100,15 @@ def target_figures(rows: Sequence[dict[str, Any]], runs: Sequence[CampaignRun]
            Figure("detected and isolated, of the judgeable", share(isolated, len(judged)),
                   f"≥ {DETECTED_MIN:.0%}",
                   None if not judged else isolated >= DETECTED_MIN * len(judged))]
-    out += _identified_figures(judged)
-    out += [Figure("latency from the first judgeable window, median / p90 / max (s)",
-                   spread(window_lat), f"≤ {WINDOW_MEDIAN_S:g} / ≤ {WINDOW_P90_S:g}",
-                   _quantiles_met(window_lat, WINDOW_MEDIAN_S, WINDOW_P90_S)),
-            Figure("latency from onset, at the window's end (s)", latency_summary(judged)),
+    out += _identified_figures(judged, after)
+    onset = [r["latency_s"] for r in after if r["isolated"] and r["latency_s"] is not None]
+    out += [Figure(f"latency from onset, the {len(after)} faults after their observer's first "
+                   "judgeable image, median / p90 / max (s)", spread(onset),
+                   f"≤ {ONSET_MEDIAN_S:g} / ≤ {ONSET_P90_S:g}",
+                   _quantiles_met(onset, ONSET_MEDIAN_S, ONSET_P90_S)),
+            Figure("latency from the first judgeable window (s)",
+                   spread(values(judged, "window_latency_s"))),
+            Figure("latency from onset, all judgeable (s)", latency_summary(judged)),
             Figure("latency from onset, when the ground declared it (s)",
                    spread(values(judged, "declared_latency_s"))),
             Figure("false alarms per nominal observer-window (ground)", rate(fa, windows),
@@ -114,14 +122,24 @@ def target_figures(rows: Sequence[dict[str, Any]], runs: Sequence[CampaignRun]
     return out
 
 
-def _identified_figures(judged: Sequence[dict[str, Any]]) -> list[Figure]:
-    """Identified, of the judgeable faults, per expected class."""
+def _identified_figures(judged: Sequence[dict[str, Any]], after: Sequence[dict[str, Any]]
+                        ) -> list[Figure]:
+    """Identified, of the judgeable faults, per expected class; and the class's
+    identification latency from onset, of those ``after`` their observer's first judgeable
+    image."""
     out = []
     for cls in sorted({r["expected_class"] for r in judged if r["expected_class"]}):
         mine = [r for r in judged if r["expected_class"] == cls]
         right = sum(r.get("identified_class") == cls for r in mine)
-        out.append(Figure(f"identified as {cls}", share(right, len(mine)),
-                          f"≥ {IDENTIFIED_MIN:.0%}", right >= IDENTIFIED_MIN * len(mine)))
+        named = [r["identification_latency_s"] for r in after
+                 if r["expected_class"] == cls and r.get("identified_class") == cls
+                 and r.get("identification_latency_s") is not None]
+        out += [Figure(f"identified as {cls}", share(right, len(mine)),
+                       f"≥ {IDENTIFIED_MIN:.0%}", right >= IDENTIFIED_MIN * len(mine)),
+                Figure(f"{cls} named, from onset ({len(named)} after the first judgeable "
+                       "image), median / p90 / max (s)", spread(named),
+                       f"median ≤ {IDENTIFIED_MEDIAN_S:g}",
+                       _quantiles_met(named, IDENTIFIED_MEDIAN_S, None))]
     return out
 
 

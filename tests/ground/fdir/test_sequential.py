@@ -151,6 +151,14 @@ def test_an_unknown_detector_is_refused_naming_the_key() -> None:
         small_scenario(fdir={"detector": "cusum"})
 
 
+@pytest.mark.parametrize("budget", [0.0, -0.01, 101.0, math.nan])
+def test_a_false_alarm_budget_out_of_range_is_refused_naming_the_key(budget: float) -> None:
+    """The budget is per observer-hour, in (0, 100]: at 100 an image's share of it is still a
+    probability (``image_false_alarm``), below 0 or at 0 no threshold exists."""
+    with pytest.raises(pydantic.ValidationError, match="false_alarms_per_observer_hour"):
+        small_scenario(fdir={"false_alarms_per_observer_hour": budget})
+
+
 def _crossing(t: float, signed: float) -> Crossing:
     return Crossing(t, ScanResult(abs(signed), signed, 1), signed / 100.0, 0.05)
 
