@@ -2,7 +2,8 @@
 node of the declared topology (``interfaces/contracts/topology.py``) and the sim.
 
 Same apps, messages, channel model and lockstep as the multi-process run; ticks run
-synchronously inside the sim's publish, so no threads are involved.  The lean runtime: routes
+synchronously inside the sim's publish, so no threads are involved, and the spacecraft step
+together as one fleet (``interfaces/runtime/fleet.py``).  The lean runtime: routes
 resolved once per key, messages made in this process not re-admitted, one truth feed for every
 node's channel stage, no barrier wait (every announced message was delivered before the tick).
 """
@@ -18,6 +19,7 @@ from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import Executive, TickClient
+from interfaces.runtime.fleet import fleets_of
 from interfaces.runtime.transport import InprocNetwork, RawHandler, SampleHandler
 from links.channel import ChannelModel
 from links.truth import history_for
@@ -31,12 +33,14 @@ def run_inproc(
     ground: bool = True,
     sample_tap: SampleHandler | None = None,
     stop: threading.Event | None = None,
+    fleet: bool = True,
 ) -> tuple[SimNode, dict[str, Executive]]:
     """Run ``scenario`` to the end in this process.  ``tap`` receives every message raw (key,
     type, payload), as the recorder does; ``sample_tap`` every message as a Sample (the
     message object with its JSON bytes encoded on demand, once: the recorder's fast path).
     ``stop``, set, stops the run at the next tick boundary (``SimNode.completed`` stays
-    False).  Returns the sim and the executives by node."""
+    False).  ``fleet``: the spacecraft step together (False: each alone, as it would in a
+    process of its own).  Returns the sim and the executives by node."""
     mission = mission or scenario.name
     net = InprocNetwork()
     if tap is not None:
@@ -50,7 +54,12 @@ def run_inproc(
         bus = Bus(node.name, mission, net.endpoint(),
                   channel=ChannelModel.of(node.name, scenario, truth))
         executives[node.name] = executive_of(node, bus, scenario)
-        TickClient(executives[node.name], synchronous=True)
+    fleets = fleets_of([n for n in topo.nodes if fleet and n.spacecraft is not None],
+                       executives)
+    for node in topo.nodes:  # the spacecraft step together (interfaces/runtime/fleet.py)
+        fleet = fleets.get(node.name)
+        TickClient(executives[node.name], synchronous=True,
+                   fleet=fleet.take if fleet is not None else None)
     sim = SimNode(Bus(topics.SIM, mission, net.endpoint()), scenario, topo.participants,
                   log=logging.getLogger("insp.sim"), stop=stop or threading.Event())
     sim.run()

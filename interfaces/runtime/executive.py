@@ -28,6 +28,7 @@ from interfaces.contracts.messages import (
     GroupStats,
     Heartbeat,
     LinkStats,
+    RateGroupName,
     SimStatus,
     Tick,
     TickDone,
@@ -102,22 +103,59 @@ class Executive:
         first for the messages the tick announces (not needed when the tick runs inside the
         sim's publish on the in-process transport: every message was delivered as it was
         published)."""
-        t, k = tick.t_sim, tick.k
-        if self.last_done is not None and k == self.last_done.k:
-            self._answer_again()
+        if not self.begin_tick(tick, barrier):
             return
+        for g in self.due_groups(tick.k):
+            self.bus.dispatch(tick.t_sim)
+            start = time.perf_counter()
+            for app in self.groups[g]:
+                self.run_app(app, tick.t_sim)
+            self.count_group(g, 1e3 * (time.perf_counter() - start))
+        self.end_tick(tick)
+
+    def begin_tick(self, tick: Tick, barrier: bool) -> bool:
+        """The start of ``tick``: False when this node ran it already (its answer is then sent
+        again); otherwise, with ``barrier``, wait for the messages the tick announces."""
+        if self.last_done is not None and tick.k == self.last_done.k:
+            self._answer_again()
+            return False
         missing = self._barrier(tick) if barrier else []
         if missing:
             self.barrier_timeouts += 1
             self.log.warning("%s tick %d: announced messages missing after %.1f s: %s",
-                             self.bus.node, k, self.barrier_timeout_s, ", ".join(sorted(missing)))
-        for g in RATE_GROUPS:
-            if k % self.period[g] == 0:
-                self._run_group(g, t)
+                             self.bus.node, tick.k, self.barrier_timeout_s,
+                             ", ".join(sorted(missing)))
+        return True
+
+    def due_groups(self, k: int) -> list[RateGroupName]:
+        """The rate groups due at tick ``k``, in the order they run (high, mid, low)."""
+        return [g for g in RATE_GROUPS if k % self.period[g] == 0]
+
+    def run_app(self, app: App, t: float) -> None:
+        """One app's step at ``t`` (s); a failure is counted and logged, never raised."""
+        try:
+            app.step(t)
+        except Exception:  # noqa: BLE001 - one app's failure must not stop the node
+            self.app_errors += 1
+            if self.app_errors <= 5 or self.app_errors % 100 == 0:
+                self.log.exception("%s: app %s failed at t=%.3f s (error #%d)",
+                                   self.bus.node, app.NAME, t, self.app_errors)
+
+    def count_group(self, g: RateGroupName, ms: float) -> None:
+        """Group ``g`` ran for ``ms`` (wall): counted, and a cycle slip beyond its budget."""
+        s = self.stats[g]
+        s.runs += 1
+        s.max_exec_ms = max(s.max_exec_ms, ms)
+        if ms > s.budget_ms:
+            s.cycle_slips += 1
+
+    def end_tick(self, tick: Tick) -> None:
+        """The end of ``tick``: housekeeping at ω_mid, the answer (TickDone), the
+        critical-data store."""
         self.ticks += 1
-        if k % self.period["mid"] == 0:
-            self._publish_housekeeping(t, k)
-        self.last_done = TickDone(sender=self.bus.node, t_sim=t, k=k,
+        if tick.k % self.period["mid"] == 0:
+            self._publish_housekeeping(tick.t_sim, tick.k)
+        self.last_done = TickDone(sender=self.bus.node, t_sim=tick.t_sim, k=tick.k,
                                   published=self.bus.published_since_last())
         self.bus.publish(self._keys["done"], self.last_done, announce=False)
         if self.at_tick_end is not None:
@@ -155,24 +193,6 @@ class Executive:
             recover(self.bus, missing)
             missing = self.bus.wait_for(tick.expect, self.barrier_timeout_s)
         return missing
-
-    def _run_group(self, g: str, t: float) -> None:
-        self.bus.dispatch(t)
-        start = time.perf_counter()
-        for app in self.groups[g]:
-            try:
-                app.step(t)
-            except Exception:  # noqa: BLE001 - one app's failure must not stop the node
-                self.app_errors += 1
-                if self.app_errors <= 5 or self.app_errors % 100 == 0:
-                    self.log.exception("%s: app %s failed at t=%.3f s (error #%d)",
-                                       self.bus.node, app.NAME, t, self.app_errors)
-        ms = 1e3 * (time.perf_counter() - start)
-        s = self.stats[g]
-        s.runs += 1
-        s.max_exec_ms = max(s.max_exec_ms, ms)
-        if ms > s.budget_ms:
-            s.cycle_slips += 1
 
     def _publish_housekeeping(self, t: float, k: int) -> None:
         node = self.bus.node
@@ -217,6 +237,10 @@ class TickClient:
 
     executive: Executive
     synchronous: bool = False
+    fleet: Callable[[Executive, Tick, bool], None] | None = None
+    """Synchronous only: how a tick this node took is run when it steps with other nodes
+    (``interfaces.runtime.fleet.Fleet.take``: once every member has taken it); None: at once,
+    alone."""
     _ticks: queue.Queue[tuple[int, Tick] | None] = field(default_factory=queue.Queue)
     """(epoch, tick) to run; None wakes the serving thread."""
     finished: threading.Event = field(default_factory=threading.Event)
@@ -277,7 +301,11 @@ class TickClient:
     def _take(self, tick: Tick) -> None:
         """Run ``tick`` now (synchronous) or queue it for ``serve``."""
         if self.synchronous:
-            self.executive.run_tick(tick, barrier=not self.executive.bus.transport.synchronous)
+            barrier = not self.executive.bus.transport.synchronous
+            if self.fleet is not None:
+                self.fleet(self.executive, tick, barrier)
+            else:
+                self.executive.run_tick(tick, barrier=barrier)
         else:
             self._ticks.put((self._epoch, tick))
 

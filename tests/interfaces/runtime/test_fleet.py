@@ -1,0 +1,109 @@
+"""Spacecraft that share a process step together (interfaces/runtime/fleet.py): what each
+spacecraft's apps see and publish is the same whether it steps in a fleet or alone."""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import replace
+from typing import Any
+
+import pytest
+
+from deploy.inproc import run_inproc
+from interfaces.contracts import catalogue as cat
+from interfaces.contracts import topics
+from interfaces.contracts.messages import Message, Tick
+from interfaces.contracts.scenario import Scenario
+from interfaces.contracts.topology import Node, topology
+from interfaces.runtime.app import App
+from interfaces.runtime.assembly import build_executive
+from interfaces.runtime.bus import Bus
+from interfaces.runtime.executive import Executive
+from interfaces.runtime.fleet import Fleet, fleets_of
+from interfaces.runtime.transport import InprocNetwork, Sample
+from tests.conftest import small_scenario
+
+
+def _what_each_key_carries(scenario: Scenario, fleet: bool) -> dict[str, list[dict[str, Any]]]:
+    """Every message of an in-process run by key, in order, without its wall-clock fields
+    (and without the executives' own statistics, which are wall times)."""
+    out: dict[str, list[dict[str, Any]]] = defaultdict(list)
+
+    def tap(sample: Sample) -> None:
+        msg = sample.message
+        assert msg is not None
+        if cat.topic_of(sample.key) is not cat.EXEC_STATS:
+            out[sample.key].append(_timeless(msg))
+
+    run_inproc(scenario, sample_tap=tap, fleet=fleet)
+    return out
+
+
+def _timeless(msg: Message) -> dict[str, Any]:
+    return msg.model_dump(exclude={"t_wall", *getattr(msg, "WALL_CLOCK_FIELDS", ())})
+
+
+def test_a_fleet_changes_no_message_any_spacecraft_sees_or_publishes() -> None:
+    """The same run with the spacecraft stepping together and each alone: every key carries
+    the same messages in the same order (only their interleaving across keys differs)."""
+    scenario = small_scenario("fleet", duration_s=40.0)
+    together = _what_each_key_carries(scenario, fleet=True)
+    alone = _what_each_key_carries(scenario, fleet=False)
+    assert together.keys() == alone.keys()
+    assert any(k.endswith("/camera/observations") for k in together)
+    for key in together:
+        assert together[key] == alone[key], key
+
+
+class _Count(App):
+    NAME = "count"
+    RATE = "high"
+
+    def __init__(self, ctx: Any) -> None:
+        super().__init__(ctx)
+        self.steps: list[float] = []
+
+    def step(self, t: float) -> None:
+        self.steps.append(t)
+
+
+def _executive(net: InprocNetwork, node: str, scenario: Scenario) -> Executive:
+    """An executive of node ``node`` running one ``_Count`` app."""
+    return build_executive(Node(node, (f"{__name__}:_Count",), "", ("t", 0), "", spacecraft=1),
+                           Bus(node, "m", net.endpoint()), scenario)
+
+
+def _tick(k: int, scenario: Scenario) -> Tick:
+    dt = scenario.rates.dt_s
+    return Tick(sender=topics.SIM, t_sim=k * dt, k=k, dt_s=dt, expect={}, final=False)
+
+
+def test_a_tick_runs_once_every_member_took_it_and_an_old_one_is_answered_again() -> None:
+    scenario = small_scenario("f")
+    net = InprocNetwork()
+    a, b = (_executive(net, n, scenario) for n in ("sc1", "sc2"))
+    fleet = Fleet([a, b])
+    fleet.take(a, _tick(0, scenario), barrier=False)
+    assert a.apps[0].steps == [] and a.last_done is None  # waits for sc2
+    fleet.take(b, _tick(0, scenario), barrier=False)
+    assert a.apps[0].steps == b.apps[0].steps == [0.0]
+    assert a.last_done is not None and a.last_done.k == b.last_done.k == 0
+    fleet.take(a, _tick(0, scenario), barrier=False)  # the open tick sent again: answered
+    assert a.apps[0].steps == [0.0] and a.ticks == 1
+    fleet.take(a, _tick(1, scenario), barrier=False)  # sc2 refuses tick 1: run at tick 2
+    fleet.take(a, _tick(2, scenario), barrier=False)
+    assert a.apps[0].steps == [0.0, 0.5] and b.apps[0].steps == [0.0]
+
+
+def test_spacecraft_whose_software_differs_form_fleets_apart() -> None:
+    """An agent-level FDIR aboard one spacecraft only: it steps apart from the others."""
+    scenario = small_scenario("f", observers={"count": 3})
+    net = InprocNetwork()
+    nodes = [n for n in topology(scenario).nodes if n.spacecraft is not None]
+    executives = {n.name: _executive(net, n.name, scenario) for n in nodes}
+    assert len({id(f) for f in fleets_of(nodes, executives).values()}) == 1
+    odd = replace(nodes[2], apps=(*nodes[2].apps, "fsw.apps.fdir:OnboardFdirApp"))
+    assert len({id(f) for f in fleets_of([*nodes[:2], odd], executives).values()}) == 2
+    with pytest.raises(ValueError, match="same apps"):
+        Fleet([executives[nodes[0].name], Executive(Bus("sc9", "m", net.endpoint()),
+                                                      scenario, [])])
