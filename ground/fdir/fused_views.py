@@ -71,9 +71,11 @@ class FusedViews:
         diag = np.diag(self.images)
         held = np.divide(self.images, diag[None, :], out=np.zeros_like(self.images),
                          where=diag > 0)
-        parts = self.by_source + (held * extra[None, :])[:, :, None] * settled.F[None, :, :]
         share = np.ones_like(counted) if shared is None else fused_shares(counted, shared)
-        view = np.einsum("ij,ijm->im", share, parts)
+        # Σ_j share_ij (by_source_ijm + held_ij extra_j F_jm), without an (N, N, M) temporary:
+        # one row-by-matrix product per view, and the lost shares as one (N, N) @ (N, M)
+        view = (np.matmul(share[:, None, :], self.by_source)[:, 0, :]
+                + (share * held * extra[None, :]) @ settled.F)
         psi = 1.0 / (settled.w_inv[None, :] + view) ** 2
         own = settled.F * (1.0 + extra)[:, None]
         return np.einsum("im,im->i", own, psi * settled.phi[None, :])
