@@ -1,18 +1,16 @@
-"""Spacecraft that share a process step together (interfaces/runtime/fleet.py): what each
-spacecraft's apps see and publish is the same whether it steps in a fleet or alone."""
+"""Spacecraft that share a process step together (interfaces/runtime/fleet.py): a tick runs
+once every member has taken it, and spacecraft whose software differs step apart.  That a
+fleet changes no message is flown in tests/missions/test_fleet_run.py."""
 
 from __future__ import annotations
 
-from collections import defaultdict
 from dataclasses import replace
 from typing import Any
 
 import pytest
 
-from deploy.inproc import run_inproc
-from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
-from interfaces.contracts.messages import Message, Tick
+from interfaces.contracts.messages import Tick
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import Node, topology
 from interfaces.runtime.app import App
@@ -20,39 +18,8 @@ from interfaces.runtime.assembly import build_executive
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import Executive
 from interfaces.runtime.fleet import Fleet, fleets_of
-from interfaces.runtime.transport import InprocNetwork, Sample
+from interfaces.runtime.transport import InprocNetwork
 from tests.conftest import small_scenario
-
-
-def _what_each_key_carries(scenario: Scenario, fleet: bool) -> dict[str, list[dict[str, Any]]]:
-    """Every message of an in-process run by key, in order, without its wall-clock fields
-    (and without the executives' own statistics, which are wall times)."""
-    out: dict[str, list[dict[str, Any]]] = defaultdict(list)
-
-    def tap(sample: Sample) -> None:
-        msg = sample.message
-        assert msg is not None
-        if cat.topic_of(sample.key) is not cat.EXEC_STATS:
-            out[sample.key].append(_timeless(msg))
-
-    run_inproc(scenario, sample_tap=tap, fleet=fleet)
-    return out
-
-
-def _timeless(msg: Message) -> dict[str, Any]:
-    return msg.model_dump(exclude={"t_wall", *getattr(msg, "WALL_CLOCK_FIELDS", ())})
-
-
-def test_a_fleet_changes_no_message_any_spacecraft_sees_or_publishes() -> None:
-    """The same run with the spacecraft stepping together and each alone: every key carries
-    the same messages in the same order (only their interleaving across keys differs)."""
-    scenario = small_scenario("fleet", duration_s=40.0)
-    together = _what_each_key_carries(scenario, fleet=True)
-    alone = _what_each_key_carries(scenario, fleet=False)
-    assert together.keys() == alone.keys()
-    assert any(k.endswith("/camera/observations") for k in together)
-    for key in together:
-        assert together[key] == alone[key], key
 
 
 class _Count(App):
