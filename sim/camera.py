@@ -5,11 +5,10 @@ An image of observer i sees the POIs visible from its true position along its tr
 (``gnc.infocost.visibility``: inside the field-of-view cone, within range, front-facing on
 the convex target) and measures each with precision σ⁻¹ = 1/(k d²) (Eq. 5), scaled by the
 camera's health β and perturbed by multiplicative noise: σ⁻¹_meas = β σ⁻¹ max(0, 1 + ν ε),
-ε ~ N(0, 1) from the observer's own generator, and quantised to ``SIGNIFICANT_DIGITS``
-significant digits (far below the noise; it halves the images' JSON on the bus and in the
-archive, where 17-digit floats dominated).  Fault hooks (issue 5): ``beta`` (camera
-degradation, information scaled by β ∈ (0, 1]) and ``misalignment`` (a rotation of the
-boresight in body axes: other POIs, or none, are seen).
+ε ~ N(0, 1) from the observer's own generator, and quantised to the significant digits the
+message carries (``interfaces.contracts.messages.poi_packing.quantise``).  Fault hooks
+(issue 5): ``beta`` (camera degradation, information scaled by β ∈ (0, 1]) and
+``misalignment`` (a rotation of the boresight in body axes: other POIs, or none, are seen).
 
 The precision of every camera-POI pair is computed by the compiled kernel
 (``gnc.infocost_kernels.precision``, ``compiled=True``, the default) or by the numpy
@@ -29,26 +28,10 @@ import numpy.typing as npt
 from gnc import infocost, infocost_kernels, quat
 from gnc.checks import finite_array
 from gnc.infocost import Camera
+from interfaces.contracts.messages.poi_packing import quantise
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
-
-SIGNIFICANT_DIGITS = 6
-"""Precision of a measured σ⁻¹ (the camera noise is 5% by default)."""
-
-
-def quantise(values: FloatArray, digits: int = SIGNIFICANT_DIGITS) -> FloatArray:
-    """Round positive ``values`` to ``digits`` significant digits, as the nearest doubles of the
-    rounded decimals (n / 10^k with an exact power of ten), so their shortest decimal form has
-    at most ``digits`` digits.  Zeros stay zero."""
-    out = np.zeros_like(values)
-    pos = values > 0.0
-    k = digits - 1 - np.floor(np.log10(values[pos]))
-    scale = 10.0 ** np.abs(k)
-    v = values[pos]
-    out[pos] = np.where(k >= 0, np.round(v * scale) / scale, np.round(v / scale) * scale)
-    return out
-
 
 @dataclass(frozen=True)
 class Image:
