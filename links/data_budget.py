@@ -34,6 +34,7 @@ import numpy as np
 from gnc.passes import ContactPlan
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import PoiObservations
+from interfaces.contracts.messages.poi_packing import quantise
 from interfaces.contracts.scenario import Scenario
 from links.onboard_store import message_bytes
 
@@ -96,11 +97,12 @@ def mean_visible_fraction(scenario: Scenario, rho: tuple[float, float, float]) -
 
 def observation_bytes(entries: int, pois: int) -> int:
     """JSON bytes of an image's observations with ``entries`` POIs of ``pois`` (indices spread
-    over the target, precisions of a 20-30 m image), as the store counts them."""
+    over the target, precisions of a 20-30 m image with the camera's digits, packed), as the
+    store counts them."""
     idx = np.linspace(0, pois - 1, max(entries, 0)).astype(int)
-    prec = 1.0 / (np.linspace(20.0, 30.0, len(idx)) ** 2 * np.pi)
+    prec = quantise(1.0 / (np.linspace(20.0, 30.0, len(idx)) ** 2 * np.pi))
     msg = PoiObservations(sender="sc1", t_sim=1234.5, spacecraft=1, image_t_s=1234.5,
-                          poi=idx.tolist(), precision=prec.tolist())
+                          poi=idx, precision=prec)
     return message_bytes(msg)
 
 

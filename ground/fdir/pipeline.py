@@ -118,7 +118,8 @@ class FdirPipeline:
     def observations(self, msg: PoiObservations) -> None:
         if msg.spacecraft not in self.observers:
             return
-        if msg.poi and (min(msg.poi) < 0 or max(msg.poi) >= len(self.twin.poi_pos)):
+        poi = msg.poi
+        if len(poi) and int(poi.max()) >= len(self.twin.poi_pos):
             self.rejected += 1
             self.log.error("FDIR: dropped observations of sc%d with POI indices outside the "
                            "%d of the target (%d dropped)", msg.spacecraft, len(self.twin.poi_pos),

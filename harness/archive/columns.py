@@ -7,9 +7,11 @@ The convention (the DataFrames and Parquet files of ``harness.archive.frame``):
 * a list whose length the model fixes (``min_length == max_length``: Position, Quat, State6,
   Mat6...) becomes one column per element, the index appended: ``x.0`` ... ``x.5``,
   ``P.0.0`` ... ``P.5.5``, ``q_lvlh_body.3``;
-* any other list (its length varies with the message: ``poi``, ``t_s``, ``assignments``,
+* any other list (its length varies with the message: ``t_s``, ``assignments``,
   TruthState's ``r_lvlh_m``) stays one column holding the whole list, as plain Python values
   (nested models as dicts);
+* the packed POI set and precisions of an image or its observations (``poi_packed``,
+  ``precision_packed``) are the lists they pack, in columns ``poi`` and ``precision``;
 * anything else (numbers, strings, None) is a column of its own;
 * an optional model or fixed-length list left out (None) gives None in each of its columns.
 
@@ -27,6 +29,8 @@ from typing import Annotated, Any, Union, get_args, get_origin
 from annotated_types import MaxLen, MinLen
 from pydantic import BaseModel
 from pydantic.fields import FieldInfo
+
+from interfaces.contracts.messages.base import PoiPrecisions
 
 
 @dataclass(frozen=True, slots=True)
@@ -147,7 +151,17 @@ class RowFlattener:
             shape = self._shapes[model] = model_shape(model)
         row: dict[str, Any] = {}
         flatten_into(message.model_dump(), shape, "", row)
+        if isinstance(message, PoiPrecisions):
+            return _unpacked(row, message)
         return row
+
+
+def _unpacked(row: dict[str, Any], message: PoiPrecisions) -> dict[str, Any]:
+    """``row`` with the packed POI set and precisions as the lists they pack, in their place
+    (``poi``, ``precision``)."""
+    lists = {"poi_packed": ("poi", message.poi.tolist()),
+             "precision_packed": ("precision", message.precision.tolist())}
+    return dict(lists.get(name, (name, value)) for name, value in row.items())
 
 
 __all__ = ["Fields", "Fixed", "Keyed", "Leaf", "RowFlattener", "Shape", "flatten_into",

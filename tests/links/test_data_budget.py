@@ -57,7 +57,7 @@ def test_the_store_fills_out_of_contact_and_drains_in_a_pass() -> None:
 def test_an_observations_bytes_are_the_stores_count_of_such_a_message() -> None:
     small, large = observation_bytes(100, 5000), observation_bytes(1100, 5000)
     per_entry = (large - small) / 1000
-    assert 15.0 < per_entry < 30.0  # an index and a float, in JSON
+    assert 7.0 < per_entry < 9.0  # an index step (2 bytes) and a decimal (4 bytes), in base64
     msg = PoiObservations(sender="sc1", t_sim=1234.5, spacecraft=1, image_t_s=1234.5,
                           poi=[0], precision=[1e-3])
     assert abs(observation_bytes(1, 5000) - message_bytes(msg)) < 30

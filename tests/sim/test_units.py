@@ -134,7 +134,7 @@ def test_camera_publishes_the_images_its_cameras_take_of_the_true_pose() -> None
     sim._publish_hardware(0, 0.0)
     msgs = _of(kept, CameraImage)
     assert [m.spacecraft for m in msgs] == sim.ids
-    assert [(m.poi, m.precision) for m in msgs] == [
+    assert [(m.poi.tolist(), m.precision.tolist()) for m in msgs] == [
         (img.poi.tolist(), img.precision.tolist()) for img in images]
 
 

@@ -14,6 +14,14 @@ import numpy as np
 import numpy.typing as npt
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
+from interfaces.contracts.messages.poi_packing import (
+    pack_poi,
+    pack_precision,
+    packed_length,
+    unpack_poi,
+    unpack_precision,
+)
+
 # What a message may carry, far beyond anything the mission flies and far below what breaks a
 # filter: a value outside is refused where it enters (an invalid message, dropped and counted).
 MAX_RANGE_M = 1.0e5
@@ -144,44 +152,115 @@ def header_ok(sender: object, t_sim: object) -> bool:
 
 
 class PoiPrecisions(Message):
-    """POI indices (into the target's POI list) and the precision σ⁻¹ measured on each."""
+    """POI indices (into the target's POI list) and the precision σ⁻¹ measured on each, packed
+    (:mod:`interfaces.contracts.messages.poi_packing`: exact to the bit, a third of the JSON
+    lists' size).
+
+    Build it with the lists or arrays as ``poi=`` and ``precision=`` (packed on the way in, as
+    are the lists of archives written before the packing) or with the packed strings; read them
+    as arrays with :attr:`poi`, :attr:`precision` or :meth:`arrays` (unpacked once per message).
+    """
 
     spacecraft: int = Field(ge=1)
-    poi: list[Annotated[int, Field(ge=0)]] = Field(max_length=MAX_POIS)
-    precision: list[Annotated[float, Field(ge=0.0, le=MAX_PRECISION)]] = Field(
-        max_length=MAX_POIS)
+    poi_packed: str = Field(max_length=packed_length(MAX_POIS),
+                            description="POI indices, packed: 'd16:' or 'i64:' and base64 "
+                                        "(interfaces.contracts.messages.poi_packing)")
+    precision_packed: str = Field(max_length=packed_length(MAX_POIS),
+                                  description="precision of each POI σ⁻¹, 1/m², packed: 'dec:' "
+                                              "or 'f64:' and base64 (same module)")
 
-    _arrays: tuple[list[int], np.ndarray, np.ndarray] | None = PrivateAttr(default=None)
+    _arrays: tuple[str, str, np.ndarray, np.ndarray] | None = PrivateAttr(default=None)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _pack_lists(cls, data: object) -> object:
+        """``poi`` and ``precision`` given as lists or arrays, packed."""
+        if not isinstance(data, dict) or not ("poi" in data or "precision" in data):
+            return data
+        out = {k: v for k, v in data.items() if k not in ("poi", "precision")}
+        if "poi" in data:
+            out["poi_packed"] = pack_poi(_numbers("poi", data["poi"], "iu"))
+        if "precision" in data:
+            out["precision_packed"] = pack_precision(
+                _numbers("precision", data["precision"], "iuf"))
+        return out
 
     @model_validator(mode="after")
-    def _same_length(self) -> PoiPrecisions:
-        if len(self.poi) != len(self.precision):
-            raise ValueError("poi and precision must have the same length")
+    def _unpacked(self) -> PoiPrecisions:
+        """The packed lists hold the same number of valid values (POIs ≥ 0, precisions in
+        [0, MAX_PRECISION]); their arrays are kept."""
+        idx = unpack_poi(self.poi_packed)
+        prec = unpack_precision(self.precision_packed)
+        if len(idx) != len(prec):
+            raise ValueError(f"{len(idx)} POIs but {len(prec)} precisions")
+        if len(idx) > MAX_POIS:
+            raise ValueError(f"{len(idx)} POIs, more than {MAX_POIS}")
+        if not bool((idx >= 0).all()):
+            raise ValueError("POI indices must be ≥ 0")
+        if not bool(((prec >= 0.0) & (prec <= MAX_PRECISION)).all()):
+            raise ValueError(f"precisions must be finite, in [0, {MAX_PRECISION:g}]")
+        self._keep_arrays(idx, prec)
         return self
 
+    def __eq__(self, other: object) -> bool:
+        """Equal fields (the unpacked arrays are a cache of two of them)."""
+        if not isinstance(other, PoiPrecisions):
+            return NotImplemented
+        return type(self) is type(other) and self.__dict__ == other.__dict__
+
+    def __hash__(self) -> int:
+        return hash((type(self), self.t_sim, self.seq, self.poi_packed))
+
+    @property
+    def poi(self) -> np.ndarray:
+        """POI indices (int64, read-only)."""
+        return self.arrays()[0]
+
+    @property
+    def precision(self) -> np.ndarray:
+        """Precision σ⁻¹ of each POI, 1/m² (float64, read-only)."""
+        return self.arrays()[1]
+
     def arrays(self) -> tuple[np.ndarray, np.ndarray]:
-        """``poi`` (int64) and ``precision`` (float64) as read-only numpy arrays, converted once
-        per message: in one process every subscriber of the same message shares them."""
+        """(POI indices int64, precisions float64) as read-only numpy arrays, unpacked once per
+        message: in one process every subscriber of the same message shares them."""
         cached = self._arrays
-        if cached is None or cached[0] is not self.poi:  # a model_copy may carry another list
-            self._keep_arrays(self.poi, self.precision)
+        if (cached is None or cached[0] is not self.poi_packed
+                or cached[1] is not self.precision_packed):  # a model_copy may carry others
+            self._keep_arrays(unpack_poi(self.poi_packed),
+                              unpack_precision(self.precision_packed))
             cached = self._arrays
             assert cached is not None
-        return cached[1], cached[2]
+        return cached[2], cached[3]
 
     def share_arrays(self, other: PoiPrecisions) -> None:
-        """Take ``other``'s converted arrays, as they are (None: not converted yet): this
-        message holds ``other``'s own lists."""
+        """Take ``other``'s unpacked arrays, as they are (None: not unpacked yet): this
+        message holds ``other``'s own packed strings."""
         self.__pydantic_private__["_arrays"] = other._arrays  # type: ignore[index]
 
     def _keep_arrays(self, poi: npt.ArrayLike, precision: npt.ArrayLike) -> None:
-        """Keep read-only copies of ``poi`` (int64) and ``precision`` (float64), equal to the
-        lists, as what :meth:`arrays` returns."""
+        """Keep read-only copies of ``poi`` (int64) and ``precision`` (float64), the values of
+        the packed strings, as what :meth:`arrays` returns."""
         idx = np.array(poi, dtype=np.int64)
         prec = np.array(precision, dtype=np.float64)
         idx.setflags(write=False)
         prec.setflags(write=False)
-        self.__pydantic_private__["_arrays"] = (self.poi, idx, prec)  # type: ignore[index]
+        self.__pydantic_private__["_arrays"] = (  # type: ignore[index]
+            self.poi_packed, self.precision_packed, idx, prec)
+
+
+def _numbers(name: str, values: object, kinds: str) -> np.ndarray:
+    """``values`` (a list or array of numbers of the numpy ``kinds``) as a 1-D array.  Raises
+    ValueError for anything else (strings, booleans, nesting, objects)."""
+    try:
+        arr = np.asarray(values)
+    except (ValueError, TypeError) as exc:
+        raise ValueError(f"{name} must be a list of numbers: {exc}") from exc
+    if arr.ndim != 1 or (arr.size and arr.dtype.kind not in kinds):
+        raise ValueError(f"{name} must be a flat list of numbers, got {arr.dtype} {arr.shape}")
+    if arr.size and arr.dtype.kind == "f" and not bool(np.isfinite(arr).all()):
+        raise ValueError(f"{name} must be finite")
+    return arr
 
 
 Unjudged = Literal["store_overflow", "aboard", "lost", "not_heard", "lossy", "crosslink_loss",

@@ -155,7 +155,8 @@ class PoiObservations(PoiPrecisions):
         a 2,500-POI image's lists cost ~0.1 ms to validate).  A header outside the rules goes
         to pydantic, which raises."""
         fields = {"sender": sender, "t_sim": t_sim, "spacecraft": image.spacecraft,
-                  "image_t_s": image.t_sim, "poi": image.poi, "precision": image.precision}
+                  "image_t_s": image.t_sim, "poi_packed": image.poi_packed,
+                  "precision_packed": image.precision_packed}
         if pose is not None:
             fields["pose"] = pose
         msg = cls.model_construct(**fields) if header_ok(sender, t_sim) else cls(**fields)

@@ -21,6 +21,7 @@ from interfaces.contracts.messages.base import (
     Velocity,
     header_ok,
 )
+from interfaces.contracts.messages.poi_packing import pack_poi, pack_precision
 
 
 class TruthState(Message):
@@ -80,8 +81,8 @@ class CameraImage(PoiPrecisions):
     @classmethod
     def of_arrays(cls, sender: str, t_sim: float, spacecraft: int, poi: np.ndarray,
                   precision: np.ndarray) -> CameraImage:
-        """The image of ``poi`` (int) and ``precision`` (float) arrays, which keeps copies of
-        them as :meth:`arrays` (the same values: its subscribers convert no list back).
+        """The image of ``poi`` (int) and ``precision`` (float) arrays, packed, which keeps
+        copies of them as :meth:`arrays` (the same values: its subscribers unpack nothing).
 
         Validated on the arrays: the schema's rules checked with numpy (POIs integers ≥ 0,
         precisions finite in [0, MAX_PRECISION], equal lengths within the bound, the header's
@@ -89,14 +90,16 @@ class CameraImage(PoiPrecisions):
         pass is validated by pydantic, which raises
         (``tests/interfaces/runtime/test_encoding.py``)."""
         idx, prec = np.asarray(poi), np.asarray(precision)
-        fields = {"sender": sender, "t_sim": t_sim, "spacecraft": spacecraft,
-                  "poi": idx.tolist(), "precision": prec.tolist()}
         ok = (header_ok(sender, t_sim) and type(spacecraft) is int and spacecraft >= 1
               and idx.ndim == prec.ndim == 1 and len(idx) == len(prec) <= MAX_POIS
               and np.issubdtype(idx.dtype, np.integer) and bool((idx >= 0).all())
               and np.issubdtype(prec.dtype, np.floating) and bool(np.isfinite(prec).all())
               and bool(((prec >= 0.0) & (prec <= MAX_PRECISION)).all()))
-        msg = cls.model_construct(**fields) if ok else cls(**fields)
+        if not ok:
+            return cls(sender=sender, t_sim=t_sim, spacecraft=spacecraft, poi=idx,
+                       precision=prec)
+        msg = cls.model_construct(sender=sender, t_sim=t_sim, spacecraft=spacecraft,
+                                  poi_packed=pack_poi(idx), precision_packed=pack_precision(prec))
         msg._keep_arrays(idx, prec)
         return msg
 

@@ -13,6 +13,7 @@ from interfaces.contracts.messages import (
     ExecStats,
     FaultReport,
     GroupStats,
+    PoiObservations,
     StateEstimate,
     TruthState,
 )
@@ -81,3 +82,12 @@ def test_lists_of_varying_length_stay_whole() -> None:
     assert row["spacecraft"] == [1, 2]
     assert row["r_lvlh_m"] == [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0]]
     assert not any(k.startswith("r_lvlh_m.") for k in row)
+
+
+def test_packed_poi_sets_and_precisions_are_their_lists_in_place() -> None:
+    obs = PoiObservations(sender="sc2", seq=3, t_sim=4.0, spacecraft=2, image_t_s=3.5,
+                          poi=[7, 9, 400], precision=[0.25, 1e-3, 3.0])
+    row = RowFlattener().row(obs)
+    assert list(row)[:8] == [*HEADER, "spacecraft", "poi", "precision", "image_t_s"]
+    assert row["poi"] == [7, 9, 400] and row["precision"] == [0.25, 1e-3, 3.0]
+    assert type(row["poi"][0]) is int and type(row["precision"][0]) is float

@@ -9,6 +9,7 @@ import pytest
 from pydantic import ValidationError
 
 from interfaces.contracts.messages import CameraImage, Message, PoiObservations, SimStatus
+from interfaces.contracts.messages.poi_packing import pack_poi, unpack_poi
 from interfaces.runtime.encoding import encode
 
 
@@ -16,19 +17,26 @@ def _pydantic(msg: Message) -> bytes:
     return msg.model_dump_json().encode()
 
 
+class _Numbers(Message):
+    """A message of free-form numbers (floats across the whole exponent range, big ints)."""
+
+    items: list[int]
+    values: list[float]
+
+
 def test_floats_strings_and_fallback() -> None:
     rng = np.random.default_rng(5)
     values = [0.0, -0.0, 5e-324, 1.7976931348623157e308, 1e15, 1e16, 1e21, 1e22, 1e-5, 1e-7,
               0.1, 1.0 / 3.0, 123456789012345678.0]
     values += (rng.standard_normal(20_000) * 10.0 ** rng.uniform(-300, 300, 20_000)).tolist()
-    image = CameraImage.model_construct(sender="sim", seq=1, t_sim=1.0, t_wall=0.0, spacecraft=1,
-                                        poi=list(range(len(values))), precision=values)
-    assert encode(image) == _pydantic(image)
+    numbers = _Numbers.model_construct(sender="sim", seq=1, t_sim=1.0, t_wall=0.0,
+                                       items=list(range(len(values))), values=values)
+    assert encode(numbers) == _pydantic(numbers)
     text = "".join(chr(i) for i in range(300)) + "é漢字\u2028\u2029😀\x7f"
     status = SimStatus(sender="sim", t_sim=0.0, state="aborted", k=0, reason=text)
     assert encode(status) == _pydantic(status)
-    huge = CameraImage.model_construct(sender="sim", seq=1, t_sim=1.0, t_wall=0.0, spacecraft=1,
-                                       poi=[2**70], precision=[1.0])  # beyond orjson's ints
+    huge = _Numbers.model_construct(sender="sim", seq=1, t_sim=1.0, t_wall=0.0,
+                                    items=[2**70], values=[1.0])  # beyond orjson's ints
     assert encode(huge) == _pydantic(huge)
 
 
@@ -47,19 +55,21 @@ def test_observations_of_an_image_are_the_validated_message() -> None:
 
 
 def test_an_image_of_arrays_keeps_them_for_its_subscribers() -> None:
-    """The sim's image keeps copies of its arrays (equal to its lists, read-only), and the
-    observations shared from it carry the same arrays; a copy with other lists converts its
-    own."""
+    """The sim's image keeps copies of its arrays (equal to its packed lists, read-only), and
+    the observations shared from it carry the same arrays; a copy with other packed lists
+    unpacks its own."""
     poi, precision = np.array([1, 5, 9]), np.array([0.5, 1e-3, 2.0])
     image = CameraImage.of_arrays("sim", 3.0, 2, poi, precision)
     poi[0] = 7  # the caller's array may change afterwards
     idx, prec = image.arrays()
-    assert idx.tolist() == image.poi == [1, 5, 9] and prec.tolist() == image.precision
+    assert idx.tolist() == [1, 5, 9] and prec.tolist() == [0.5, 1e-3, 2.0]
+    assert image.poi is idx and image.precision is prec
+    assert unpack_poi(image.poi_packed).tolist() == [1, 5, 9]
     assert not idx.flags.writeable and not prec.flags.writeable
     shared = PoiObservations.of_image(image, "sc2", 3.0)
     assert shared.arrays()[0] is idx and shared.arrays()[1] is prec
-    other = image.model_copy(update={"poi": [2, 3, 4]})
-    assert other.arrays()[0].tolist() == [2, 3, 4]
+    other = image.model_copy(update={"poi_packed": pack_poi([2, 3, 4])})
+    assert other.arrays()[0].tolist() == [2, 3, 4] and other.arrays()[1].tolist() == prec.tolist()
 
 
 def test_an_image_of_arrays_is_checked_as_pydantic_would() -> None:
@@ -72,7 +82,7 @@ def test_an_image_of_arrays_is_checked_as_pydantic_would() -> None:
     checked = CameraImage(sender="sim", t_sim=12.5, spacecraft=3, poi=poi.tolist(),
                           precision=precision.tolist())
     assert fast.model_dump() == checked.model_dump() and encode(fast) == _pydantic(checked)
-    assert type(fast.poi[0]) is int and type(fast.precision[0]) is float
+    assert fast.poi.dtype == np.int64 and fast.precision.dtype == np.float64
     bad_precision = [np.nan, -1.0, 2e12, np.inf]
     for value in bad_precision:
         p = precision.copy()
