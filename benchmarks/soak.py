@@ -23,6 +23,7 @@ lost; 1 otherwise.  About twice the reference mission's Zenoh wall time (two run
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import re
@@ -173,18 +174,23 @@ def _join(out: Path) -> ZenohTransport:
 
 
 def _pid_of(victim: str, out: Path) -> int | None:
-    """The pid of this run's process ``victim`` (sc<N>, ground, recorder, router)."""
+    """The pid of this run's process ``victim`` (sc<N>: the flight process hosting it, ground,
+    recorder, router)."""
     parts = {"ground": ["-m", "ground", "--scenario"],
              "recorder": ["-m", "ground.archive.record"],
              "router": ["-m", "deploy.router", "--config", str(out / "access" / "router.json5")]}
-    want = parts.get(victim, ["-m", "fsw", "--spacecraft", victim[2:]])
+    want = parts.get(victim, ["-m", "fsw", "--spacecraft"])
     for pid in filter(str.isdigit, os.listdir("/proc")):
         try:
             cmd = [c.decode() for c in Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")]
         except OSError:
             continue
         ours = victim == "router" or str(out / "access") in " ".join(cmd)
-        if ours and any(cmd[i:i + len(want)] == want for i in range(len(cmd))):
+        at = [i for i in range(len(cmd)) if cmd[i:i + len(want)] == want]
+        if not ours or not at:
+            continue
+        hosted = itertools.takewhile(str.isdigit, cmd[at[0] + len(want):])
+        if victim in parts or victim[2:] in hosted:
             return int(pid)
     return None
 

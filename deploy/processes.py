@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import os
 import signal
 import subprocess
 import sys
@@ -146,3 +147,11 @@ class Supervisor:
         for c in sorted(self.children, key=lambda c: rank.get(c.name, len(rank))):
             if c.name not in (exclude or set()):
                 c.stop(timeout_s)
+
+
+def host_cores() -> int:
+    """The cores this process may run on (its CPU affinity; the machine's count elsewhere)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1

@@ -54,7 +54,7 @@ from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
 from deploy.interrupts import Interrupts  # noqa: E402
 from deploy.out_folder import OutFolderError, written  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
-from deploy.processes import Child, Incident, Supervisor  # noqa: E402
+from deploy.processes import Child, Incident, Supervisor, host_cores  # noqa: E402
 from deploy.router import address_taken  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
@@ -69,7 +69,14 @@ from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario  # noqa: E402
-from interfaces.contracts.topology import RECORDER, ROUTER, SIM, topology  # noqa: E402
+from interfaces.contracts.topology import (  # noqa: E402
+    RECORDER,
+    ROUTER,
+    SIM,
+    Host,
+    hosting,
+    topology,
+)
 from interfaces.runtime.arguments import add_log_level, endpoint, mission_name  # noqa: E402
 from interfaces.runtime.cds import read_starts, write_run_key  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
@@ -112,6 +119,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--advertise", metavar="ENDPOINT", type=endpoint,
                    help="endpoint the clients connect to (default: --endpoint); for nodes on "
                         "other hosts")
+    p.add_argument("--hosting", choices=("packed", "one-per-process"), default="packed",
+                   help="packed: the spacecraft share as many processes as this host has "
+                        "cores, stepping together (default); one-per-process: a process per "
+                        "node, as on separate computers (interfaces/contracts/topology.py)")
     p.add_argument("--external", action="append", default=[], metavar="NODE",
                    help="a node (sc<N> or ground) started by hand on another host; repeatable")
     p.add_argument("--tls-host", action="append", default=[], metavar="NAME",
@@ -384,7 +395,14 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     if args.duration is not None:
         common += ["--duration", str(args.duration)]
 
-    def account(name: str) -> list[str]:
+    def account(who: str | Host) -> list[str]:
+        """The account options of a service, a node or a host (each of its nodes its own:
+        ``{node}`` in the path)."""
+        if isinstance(who, Host) and len(who.nodes) > 1:
+            for n in who.nodes:
+                access.client_config(n.name)  # a clear error for a missing account
+            return [*common, "--zenoh-config", str(access.directory / "{node}.json5")]
+        name = who.name if isinstance(who, Host) else who
         return [*common, "--zenoh-config", str(access.client_config(name))]
 
     logs = out / "logs"
@@ -405,16 +423,19 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     sup.start(Child(SIM.name, sim_argv, logs / "sim.log"))
     topo = topology(scenario)
     cds = _store_args(out, args.restart_on_crash)
-    commands = {n.name: [*n.command, *account(n.name), *cds] for n in topo.nodes}
-    for node, argv in commands.items():
-        if node in args.external:
-            config = access.client_config(node)
-            there = [config.name if a == str(config) else a for a in argv]
+    hosts = hosting(topo, args.hosting, host_cores(), alone=args.external)
+    for host in hosts:
+        if host.name in args.external:
+            config = access.client_config(host.name)
+            there = [config.name if a == str(config) else a
+                     for a in [*host.command, *account(host.name), *cds]]
             log.info("%s runs elsewhere: on its host, with this run's scenario and %s there, "
-                     "run: python %s", node, config, " ".join(there))
+                     "run: python %s", host.name, config, " ".join(there))
         else:
-            sup.start(Child(node, argv, logs / f"{node}.log"))
-    watch = _Watch(sup, progress, flight=[n for n in topo.participants if n not in args.external],
+            sup.start(Child(host.name, [*host.command, *account(host), *cds],
+                            logs / f"{host.name}.log"))
+    watch = _Watch(sup, progress, flight={h.name: [n.name for n in h.nodes] for h in hosts
+                                          if h.name not in args.external},
                    restart=args.restart_on_crash, recorder_up=recorder_up.count,
                    sim_up=_Appearances(hub, topics.alive_token(mission, SIM.name)).count,
                    stop=stop)
@@ -422,7 +443,8 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     progress.report(final=True)
     watch.read_restores(out / "cds")
     # Stop the flight side first, then the recorder, so the archive holds everything sent.
-    sup.stop_all(order=[SIM.name, *topo.participants], exclude={RECORDER.name, ROUTER.name})
+    sup.stop_all(order=[SIM.name, *(h.name for h in hosts)],
+                 exclude={RECORDER.name, ROUTER.name})
     time.sleep(0.2)
     recorder = sup.named(RECORDER.name)
     if recorder.returncode is None:
@@ -487,11 +509,12 @@ class _Watch:
     back ``SERVICE_READY_S`` after a restart (the count of appearances of its token,
     ``recorder_up``, or of the sim's through it, ``sim_up``, not grown)."""
 
-    def __init__(self, sup: Supervisor, progress: _Progress, flight: list[str],
+    def __init__(self, sup: Supervisor, progress: _Progress, flight: dict[str, list[str]],
                  restart: bool, recorder_up: Callable[[], int] = lambda: 0,
                  sim_up: Callable[[], int] = lambda: 0,
                  stop: threading.Event | None = None) -> None:
         self.sup, self.progress, self.flight, self.restart = sup, progress, flight, restart
+        """``flight``: the flight and ground processes, each with the nodes it hosts"""
         self.recorder_up, self.sim_up = recorder_up, sim_up
         self.stop = stop or threading.Event()
         """set by SIGINT or SIGTERM: the watch ends at its next look"""
@@ -622,17 +645,20 @@ class _Watch:
         return None
 
     def _flight_stopped(self, sim_done: bool) -> None:
-        for name in self.flight:
+        """A flight or ground process stopped early: each node it hosted is an incident (see
+        the class docstring)."""
+        for name, nodes in self.flight.items():
             child = self.sup.named(name)
             if name in self.down or child.returncode is None:
                 continue
             if sim_done and child.returncode == 0:
                 continue
             again = self.restart and not sim_done and not self._looping(name)
-            incident = Incident(name, child.describe_exit(), self.progress.t_sim, again)
-            self.incidents.append(incident)
-            log.error("%s; %s", incident, "starting it again" if again else
-                      "the constellation flies on without it")
+            for node in nodes:
+                incident = Incident(node, child.describe_exit(), self.progress.t_sim, again)
+                self.incidents.append(incident)
+                log.error("%s; %s", incident, "starting it again" if again else
+                          "the constellation flies on without it")
             if again:
                 self._restart(child)
             else:

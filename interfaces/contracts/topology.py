@@ -21,8 +21,10 @@ from __future__ import annotations
 
 import argparse
 import importlib
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 from interfaces.contracts import dataflow, topics
 from interfaces.contracts.apps import (
@@ -119,6 +121,59 @@ def topology(scenario: Scenario, ground: bool = True) -> Topology:
     nodes = [spacecraft_node(i, onboard, neighbours)
              for i in range(1, scenario.observers.count + 1)]
     return Topology(tuple(nodes + ([GROUND] if ground else [])))
+
+
+Hosting = Literal["packed", "one-per-process"]
+"""How a multi-process run puts its lockstep nodes in processes: ``packed`` (the default on
+one host) shares the spacecraft among as many processes as the host has cores, stepping
+together (``interfaces/runtime/fleet.py``); ``one-per-process``, every node alone, as on
+separate computers.  The ground is always alone."""
+
+
+@dataclass(frozen=True)
+class Host:
+    """One process of a multi-process run and the lockstep nodes it hosts (one account, bus
+    and Zenoh session each): named for its node when alone, else for them all
+    (``sc1+sc2+sc3``)."""
+
+    nodes: tuple[Node, ...]
+
+    def __post_init__(self) -> None:
+        if not self.nodes:
+            raise ValueError("a host needs at least one node")
+        if len({(n.module, n.args[:1]) for n in self.nodes}) != 1:
+            raise ValueError("the nodes of one host must start the same way, got "
+                             + ", ".join(" ".join(n.command) for n in self.nodes))
+
+    @property
+    def name(self) -> str:
+        return "+".join(n.name for n in self.nodes)
+
+    @property
+    def command(self) -> list[str]:
+        """The Python arguments starting it: its nodes' module, and their values of its one
+        option together (``-m fsw --spacecraft 1 2 3``)."""
+        first = self.nodes[0]
+        if len(self.nodes) == 1:
+            return first.command
+        return ["-m", first.module, *first.args[:1], *(n.args[1] for n in self.nodes)]
+
+
+def hosting(topo: Topology, mode: Hosting, processes: int,
+            alone: Collection[str] = ()) -> tuple[Host, ...]:
+    """The processes of a multi-process run of ``topo`` (:data:`Hosting`): ``packed``, the
+    spacecraft in ``processes`` processes of consecutive ids (sizes differing by one at most),
+    the nodes named in ``alone`` (run elsewhere) and the ground each alone."""
+    if processes < 1:
+        raise ValueError(f"processes must be at least 1, got {processes}")
+    packable = [n for n in topo.nodes if n.spacecraft is not None and n.name not in alone]
+    singles = [Host((n,)) for n in topo.nodes if n not in packable]
+    if mode == "one-per-process" or not packable:
+        return tuple(Host((n,)) for n in topo.nodes)
+    count = min(processes, len(packable))
+    ends = [round(len(packable) * (i + 1) / count) for i in range(count)]
+    blocks = [Host(tuple(packable[a:b])) for a, b in zip([0, *ends], ends, strict=False)]
+    return tuple(blocks + singles)
 
 
 def describe(topo: Topology) -> str:

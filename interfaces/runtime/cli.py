@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import queue
 import signal
 import threading
 from collections.abc import Callable
@@ -11,12 +12,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from interfaces.contracts import topics
+from interfaces.contracts.messages import Tick
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.contracts.topology import topology
 from interfaces.runtime.arguments import add_log_level, endpoint, mission_name
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore
-from interfaces.runtime.executive import Executive, TickClient
+from interfaces.runtime.executive import Executive, TickClient, serve_together
+from interfaces.runtime.fleet import fleets_of
 from interfaces.runtime.link_stage import LinkStageFactory
 from interfaces.runtime.recent import depth_for
 from interfaces.runtime.restart import resume
@@ -31,7 +34,10 @@ def add_node_args(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--duration", type=float, help="override duration_s (s)")
     parser.add_argument("--connect", default=DEFAULT_ENDPOINT, type=endpoint,
                         help=f"Zenoh endpoint to join (default {DEFAULT_ENDPOINT})")
-    parser.add_argument("--zenoh-config", help="Zenoh JSON5 config file (overrides --connect)")
+    parser.add_argument("--zenoh-config",
+                        help="Zenoh JSON5 config file (overrides --connect); in a process "
+                             "hosting several nodes, '{node}' in it is each node's name "
+                             "(its account: access/{node}.json5)")
     add_log_level(parser)
     parser.add_argument("--cds", type=Path, metavar="DIR",
                         help="keep this node's critical-data store in DIR (made by the launcher "
@@ -51,13 +57,18 @@ def mission_of(args: argparse.Namespace, scenario: Scenario) -> str:
     return str(args.mission or scenario.name)
 
 
-def open_zenoh(args: argparse.Namespace) -> ZenohTransport:
-    return ZenohTransport(ZenohSettings(connect=(args.connect,), config_file=args.zenoh_config))
+def open_zenoh(args: argparse.Namespace, node: str = "") -> ZenohTransport:
+    """A Zenoh session of ``node`` (its own account: ``{node}`` in ``--zenoh-config``)."""
+    config = args.zenoh_config.replace("{node}", node) if args.zenoh_config else None
+    return ZenohTransport(ZenohSettings(connect=(args.connect,), config_file=config))
 
 
 def setup_logging(level: str, name: str) -> logging.Logger:
+    """Logging of process ``name``; a process hosting several nodes (``sc1+sc2``) names each
+    line's logger (``insp.sc2.guidance``)."""
+    which = "[%(name)s] " if "+" in name else ""
     logging.basicConfig(level=getattr(logging, level.upper(), logging.INFO),
-                        format=f"%(asctime)s {name:>7} %(levelname)s %(message)s",
+                        format=f"%(asctime)s {name:>7} %(levelname)s {which}%(message)s",
                         datefmt="%H:%M:%S")
     return logging.getLogger(f"insp.{name}")
 
@@ -99,33 +110,74 @@ def run_participant(
     build: Callable[[Bus, Scenario], Executive],
     links: LinkStageFactory,
 ) -> int:
-    """Main loop of a lockstep node process (a spacecraft or the ground) over Zenoh.
+    """Main loop of a process hosting the one lockstep node ``node`` (:func:`run_participants`)."""
+    return run_participants(args, [node], build, links)
 
-    Joins the network, wires the executive (with the link stage ``links(node, scenario)``),
-    restores it from its critical-data store when started again (``--cds``), serves the message
-    schemas and what it sent lately, announces itself, and runs ticks until the sim finishes
-    (exit 0), the sim disappears (exit 3) or a signal stops it (exit 0).  The Zenoh session is
-    always closed."""
-    start = start_node(args, node)
-    bus = Bus(node, start.mission, open_zenoh(args),
-              channel=links(node, start.scenario),
-              recent_ticks=depth_for(start.scenario.rates.ticks_per("mid")))
+
+def run_participants(
+    args: argparse.Namespace,
+    nodes: list[str],
+    build: Callable[[Bus, Scenario], Executive],
+    links: LinkStageFactory,
+) -> int:
+    """Main loop of a process hosting the lockstep nodes ``nodes`` (spacecraft or the ground)
+    over Zenoh.
+
+    Each node joins the network with its own account and session, and its executive is wired
+    on its own bus (``build(bus, scenario)``, with the link stage ``links(node, scenario)``);
+    nodes running the same apps step together (``interfaces/runtime/fleet.py``).  Each is
+    restored from its critical-data store when started again (``--cds``), serves the message
+    schemas and what it sent lately, and announces itself.  Ticks run until the sim finishes
+    (exit 0), the sim disappears (exit 3) or a signal stops the process (exit 0).  Every Zenoh
+    session is always closed."""
+    start = start_node(args, "+".join(nodes))
+    buses: list[Bus] = []
     try:
-        client = TickClient(build(bus, start.scenario))
-        if args.cds is not None:
-            others = [topics.SIM, *(n for n in topology(start.scenario).participants
-                                    if n != node)]
-            resume(client, CriticalDataStore.open(args.cds, start.mission, node, start.scenario),
-                   others, start.log)
-        bus.watch_alive(client.on_liveness)
-        bus.serve_schemas()
-        bus.serve_recent()
-        bus.declare_alive()
+        for node in nodes:
+            buses.append(Bus(node, start.mission, open_zenoh(args, node),
+                             channel=links(node, start.scenario),
+                             recent_ticks=depth_for(start.scenario.rates.ticks_per("mid"))))
+        shared: queue.Queue[tuple[TickClient, int, Tick] | None] = queue.Queue()
+        clients = [TickClient(build(bus, start.scenario), tick_queue=shared) for bus in buses]
+        _step_together(clients, start.scenario)
+        for client in clients:
+            _join(client, args, start)
         start.log.info("ready")
-        client.serve(start.stop)
-        if client.sim_lost and not client.finished.is_set():
-            start.log.error("sim lost before the end of the run")
+        serve_together(clients, start.stop)
+        lost = [c.executive.bus.node for c in clients if c.sim_lost and not c.finished.is_set()]
+        if lost:
+            start.log.error("sim lost before the end of the run (%s)", ", ".join(lost))
             return 3
         return 0
     finally:
-        bus.close()
+        for bus in buses:
+            bus.close()
+
+
+def _step_together(clients: list[TickClient], scenario: Scenario) -> None:
+    """The clients of one process whose nodes run the same apps step together."""
+    if len(clients) < 2:
+        return
+    topo = topology(scenario)
+    executives = {c.executive.bus.node: c.executive for c in clients}
+    fleets = fleets_of([topo.node(n) for n in executives], executives)
+    for client in clients:
+        fleet = fleets[client.executive.bus.node]
+        if len(fleet.members) > 1:
+            client.fleet = fleet.take
+
+
+def _join(client: TickClient, args: argparse.Namespace, start: NodeStart) -> None:
+    """``client``'s node restored from its critical-data store (``--cds``, when started
+    again), watching the others' liveliness, serving its schemas and recent messages, and
+    announced."""
+    bus = client.executive.bus
+    if args.cds is not None:
+        others = [topics.SIM, *(n for n in topology(start.scenario).participants
+                                if n != bus.node)]
+        resume(client, CriticalDataStore.open(args.cds, start.mission, bus.node,
+                                              start.scenario), others, start.log)
+    bus.watch_alive(client.on_liveness)
+    bus.serve_schemas()
+    bus.serve_recent()
+    bus.declare_alive()

@@ -16,7 +16,7 @@ import logging
 import queue
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -209,6 +209,25 @@ class Executive:
                 sender=node, t_sim=t, node=node, links=self.bus.channel.counters()))
 
 
+def serve_together(clients: Sequence[TickClient], stop: threading.Event | None = None) -> None:
+    """Run the ticks of ``clients``, the nodes one process hosts (sharing one ``tick_queue``),
+    on the calling thread until every one is done (``TickClient.done``) or ``stop`` is set.
+    Every tick queued before the end is run."""
+    ticks = clients[0].tick_queue
+    if any(c.tick_queue is not ticks for c in clients):
+        raise ValueError("clients served together must share one tick queue")
+    while not (stop is not None and stop.is_set()):
+        try:
+            item = ticks.get(timeout=0.5)
+        except queue.Empty:
+            item = None
+        if item is not None:
+            client, epoch, tick = item
+            client._run(epoch, tick)
+        elif all(c.done for c in clients):
+            return
+
+
 MAX_TICK_GAP = 100
 """Most ticks a node may find skipped between two it receives (none are, on a reliable link);
 fewer when they span more than ``admission.MAX_AHEAD_S`` of simulated time."""
@@ -238,11 +257,13 @@ class TickClient:
     executive: Executive
     synchronous: bool = False
     fleet: Callable[[Executive, Tick, bool], None] | None = None
-    """Synchronous only: how a tick this node took is run when it steps with other nodes
+    """How a tick this node took is run when it steps with other nodes of its process
     (``interfaces.runtime.fleet.Fleet.take``: once every member has taken it); None: at once,
     alone."""
-    _ticks: queue.Queue[tuple[int, Tick] | None] = field(default_factory=queue.Queue)
-    """(epoch, tick) to run; None wakes the serving thread."""
+    tick_queue: queue.Queue[tuple[TickClient, int, Tick] | None] = field(
+        default_factory=queue.Queue)
+    """(client, epoch, tick) to run, shared by the clients one serving thread runs
+    (:func:`serve_together`); None wakes that thread."""
     finished: threading.Event = field(default_factory=threading.Event)
     sim_lost: bool = False
     rejoin_grace_s: float = 60.0
@@ -301,13 +322,16 @@ class TickClient:
     def _take(self, tick: Tick) -> None:
         """Run ``tick`` now (synchronous) or queue it for ``serve``."""
         if self.synchronous:
-            barrier = not self.executive.bus.transport.synchronous
-            if self.fleet is not None:
-                self.fleet(self.executive, tick, barrier)
-            else:
-                self.executive.run_tick(tick, barrier=barrier)
+            self._step(tick, barrier=not self.executive.bus.transport.synchronous)
         else:
-            self._ticks.put((self._epoch, tick))
+            self.tick_queue.put((self, self._epoch, tick))
+
+    def _step(self, tick: Tick, barrier: bool) -> None:
+        """Run ``tick``: alone, or with the nodes this one steps with (``fleet``)."""
+        if self.fleet is not None:
+            self.fleet(self.executive, tick, barrier)
+        else:
+            self.executive.run_tick(tick, barrier=barrier)
 
     def _implausible(self, tick: Tick) -> str:
         """Why ``tick`` cannot be the sim's next tick ("" if it can): tick numbers only increase,
@@ -327,7 +351,7 @@ class TickClient:
     def _on_status(self, status: SimStatus) -> None:
         if status.state in ("finished", "aborted"):
             self.finished.set()
-            self._ticks.put(None)
+            self.tick_queue.put(None)
 
     def on_liveness(self, node: str, alive: bool) -> None:
         """Liveliness handler: the sim lost (see the class docstring), the sim back (rejoin),
@@ -335,7 +359,7 @@ class TickClient:
         bus = self.executive.bus
         if node == topics.SIM and not alive:
             self.sim_lost, self._lost_at = True, time.monotonic()
-            self._ticks.put(None)
+            self.tick_queue.put(None)
         elif node == topics.SIM and self.sim_lost:
             self.sim_lost, self._sim_back = False, True
             self.executive.log.warning("%s: the sim is back", self.executive.bus.node)
@@ -352,21 +376,19 @@ class TickClient:
             self.executive.bus.admission.forget()
             self._served_epoch = self._epoch
         else:
-            self._ticks.put(None)  # wakes the serving thread
+            self.tick_queue.put(None)  # wakes the serving thread
         self.executive.log.warning("%s: %s; rejoining the lockstep", self.executive.bus.node,
                                    why)
 
     def serve(self, stop: threading.Event | None = None) -> None:
         """Run ticks until finished, the sim is lost for good, or ``stop`` is set."""
-        while not (stop is not None and stop.is_set()):
-            try:
-                item = self._ticks.get(timeout=0.5)
-            except queue.Empty:
-                item = None
-            if item is not None:  # every tick queued before the end is run
-                self._run(*item)
-            elif self.finished.is_set() or self._gone():
-                return
+        serve_together([self], stop)
+
+    @property
+    def done(self) -> bool:
+        """Whether this node runs no more ticks: the run finished, or the sim was lost for
+        longer than ``rejoin_grace_s``."""
+        return self.finished.is_set() or self._gone()
 
     def _run(self, epoch: int, tick: Tick) -> None:
         """Run a queued tick unless its epoch was lost.  The first tick of a new epoch first
@@ -380,7 +402,7 @@ class TickClient:
             self.executive.bus.admission.forget()
             self.executive.bus.admission.advance(tick.t_sim)
             self._served_epoch = epoch
-        self.executive.run_tick(tick)
+        self._step(tick, barrier=True)
 
     def _gone(self) -> bool:
         """Whether the sim has been lost for longer than ``rejoin_grace_s``."""

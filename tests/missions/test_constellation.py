@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import signal
@@ -15,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 from mcap.reader import make_reader
 
 from deploy.inproc import run_inproc
@@ -119,7 +121,8 @@ def test_dead_and_stalled_processes_are_faults_not_the_end(tmp_path: Path, free_
     sc = small_scenario("dead", duration_s=400.0)
     path = write_scenario(tmp_path / "dead.toml", sc)
     out = tmp_path / "out"
-    p = _launch(path, out, free_port, "--realtime", "10")  # 40 s of wall time if undisturbed
+    p = _launch(path, out, free_port, "--realtime", "10",  # 40 s of wall time if undisturbed
+                "--hosting", "one-per-process")
     try:
         _under_way(out, "dead")
         os.kill(_wait_pid(["fsw", "--spacecraft", "2", "--scenario", str(path)], 10.0),
@@ -151,26 +154,37 @@ def test_dead_and_stalled_processes_are_faults_not_the_end(tmp_path: Path, free_
     assert not load_run(archive).truncated
 
 
-def test_restart_on_crash_rejoins_the_lockstep(tmp_path: Path, free_port: int) -> None:
+@pytest.mark.parametrize("hosting", ["one-per-process", "packed"])
+def test_restart_on_crash_rejoins_the_lockstep(tmp_path: Path, free_port: int,
+                                               hosting: str) -> None:
+    """The process of sc2 killed: every spacecraft it hosts (sc2 alone, or sc2 and those
+    packed with it, stepping together) is lost, restarted from its critical-data store and
+    back in the lockstep while the sim holds the clock."""
     sc = small_scenario("again", duration_s=200.0)
     path = write_scenario(tmp_path / "again.toml", sc)
     out = tmp_path / "out"
-    p = _launch(path, out, free_port, "--realtime", "10", "--restart-on-crash")
+    p = _launch(path, out, free_port, "--realtime", "10", "--restart-on-crash",
+                "--hosting", hosting)
     try:
         _under_way(out, "again")
-        os.kill(_wait_pid(["fsw", "--spacecraft", "2", "--scenario", str(path)], 10.0),
-                signal.SIGKILL)
+        pid, hosted = _fsw_pid(path, 2, 10.0)
+        os.kill(pid, signal.SIGKILL)
     finally:
         stdout, stderr = p.communicate(timeout=120)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "degraded" and "(restarted: restored after tick" in \
         summary["error"], stderr
-    assert [e["what"] for e in summary["sim"]["participants"]["sc2"]] == ["lost", "rejoined"]
-    t_lost, t_back = (e["t_sim"] for e in summary["sim"]["participants"]["sc2"])
-    assert t_back - t_lost <= sc.rates.dt_s  # the sim held the clock while sc2 restarted
-    sc2_t = _times(out / "run.mcap", topics.key("again", "sc2", "nav", "estimate"))
-    assert sc2_t[-1] >= 199.0 and (sc2_t < t_lost).any()  # before the crash, and to the end
-    assert (out / "logs" / "sc2.restart1.log").is_file()
+    assert (hosting == "packed") == (len(hosted) > 1) and 2 in hosted
+    participants = summary["sim"]["participants"]
+    assert sorted(participants) == [f"sc{i}" for i in hosted]
+    for i in hosted:
+        assert [e["what"] for e in participants[f"sc{i}"]] == ["lost", "rejoined"]
+        t_lost, t_back = (e["t_sim"] for e in participants[f"sc{i}"])
+        assert t_back - t_lost <= sc.rates.dt_s  # the sim held the clock while it restarted
+        t = _times(out / "run.mcap", topics.key("again", f"sc{i}", "nav", "estimate"))
+        assert t[-1] >= 199.0 and (t < t_lost).any()  # before the crash, and to the end
+    host = "+".join(f"sc{i}" for i in hosted)
+    assert (out / "logs" / f"{host}.restart1.log").is_file()
 
 
 def _killed_mid_run(tmp_path: Path, port: int, name: str,
@@ -274,7 +288,7 @@ def test_malformed_messages_are_dropped_and_the_app_goes_on(tmp_path: Path, free
     path = write_scenario(tmp_path / "bad.toml", sc)
     out = tmp_path / "out"
     p = _launch(path, out, free_port, "--realtime", "20")
-    _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
+    _fsw_pid(path, 1, timeout_s=30.0)
     # the sim's own account (a compromised sim): the router lets it publish on sc1's sensor keys
     hostile = _join(out, "sim")
     key = cat.RELNAV.key("bad", "sc1")  # what sc1's nav app subscribes to
@@ -357,7 +371,7 @@ def test_terminated_launcher_stops_every_process(tmp_path: Path, free_port: int)
     out = tmp_path / "out"
     p = _launch(path, out, free_port, "--realtime", "20")
     try:
-        _wait_pid(["fsw", "--spacecraft", "1", "--scenario", str(path)], timeout_s=30.0)
+        _fsw_pid(path, 1, timeout_s=30.0)
         watcher = _join(out, "tlm")
         seen = threading.Semaphore(0)
         try:
@@ -379,6 +393,26 @@ def test_terminated_launcher_stops_every_process(tmp_path: Path, free_port: int)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "interrupted"  # deploy/interrupts.py
     assert not load_run(out / "run.mcap").truncated
+
+
+def _fsw_pid(path: Path, spacecraft: int, timeout_s: float) -> tuple[int, list[int]]:
+    """PID of the flight process of a run of ``path`` hosting ``spacecraft``, and the ids of
+    the spacecraft it hosts."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        for pid in filter(str.isdigit, os.listdir("/proc")):
+            try:
+                cmd = Path(f"/proc/{pid}/cmdline").read_bytes().decode().split("\0")
+            except OSError:
+                continue
+            if cmd[1:3] != ["-m", "fsw"] or str(path) not in cmd or "--spacecraft" not in cmd:
+                continue
+            i = cmd.index("--spacecraft") + 1
+            hosted = [int(a) for a in itertools.takewhile(str.isdigit, cmd[i:])]
+            if spacecraft in hosted:
+                return int(pid), hosted
+        time.sleep(0.1)
+    raise TimeoutError(f"no flight process hosting sc{spacecraft}")
 
 
 def _wait_pid(argv_parts: list[str], timeout_s: float) -> int:

@@ -20,7 +20,7 @@ def _watch(tmp_path: Path, recorder_code: str, recorder_up: int = 0) -> launcher
     sup = launcher.Supervisor(REPO)
     sup.start(launcher.Child(RECORDER.name, ["-c", recorder_code], tmp_path / "recorder.log"))
     sup.start(launcher.Child(SIM.name, ["-c", "import time; time.sleep(60)"], tmp_path / "sim.log"))
-    return launcher._Watch(sup, launcher._Progress(small_scenario("sup")), flight=[],
+    return launcher._Watch(sup, launcher._Progress(small_scenario("sup")), flight={},
                            restart=True, recorder_up=lambda: recorder_up)
 
 

@@ -20,7 +20,7 @@ from interfaces.contracts import topics
 from interfaces.contracts.messages import StateEstimate, registry
 from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
 from tests.conftest import small_scenario, write_scenario
-from tests.missions.test_constellation import _launch, _wait_pid
+from tests.missions.test_constellation import _fsw_pid, _launch, _wait_pid
 
 M = "chaos"
 SC = small_scenario(
@@ -37,24 +37,34 @@ answered again), the sim's status (it names the participants lost and back) and 
 executives' statistics (wall-clock execution times)."""
 
 
-def _run(tmp_path: Path, port: int, name: str, kills: list[tuple[float, list[str]]]
+def _run(tmp_path: Path, port: int, name: str, kills: list[tuple[float, str]]
          ) -> tuple[dict[str, Any], Path]:
-    """Fly SC with --restart-on-crash, killing at each sim time (s) the process whose command
-    line holds the given parts; the summary and the run's folder."""
+    """Fly SC with --restart-on-crash (the default hosting: spacecraft packed in processes),
+    killing at each sim time (s) the process of the node named (``sc<N>``: the flight process
+    hosting it); the summary and the run's folder."""
     path = write_scenario(tmp_path / f"{M}.toml", SC)
     out = tmp_path / name
     p = _launch(path, out, port, "--realtime", "20", "--restart-on-crash")
     try:
-        for t_kill, argv in kills:
+        for t_kill, victim in kills:
             _until(out, t_kill)
-            own = (["--config", str(out / "access" / "router.json5")]
-                   if argv == ["deploy.router"] else ["--scenario", str(path)])
-            os.kill(_wait_pid([*argv, *own], 10.0), signal.SIGKILL)
+            os.kill(_pid_of(victim, path, out), signal.SIGKILL)
     finally:
         stdout, stderr = p.communicate(timeout=240)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["t_sim_final_s"] == SC.duration_s, stderr
     return summary, out
+
+
+def _pid_of(victim: str, path: Path, out: Path) -> int:
+    """The pid of the process of ``victim`` (sc<N>, ground, router, recorder) in the run of
+    scenario ``path`` writing to ``out``."""
+    if victim.startswith("sc"):
+        return _fsw_pid(path, int(victim[2:]), 10.0)[0]
+    argv = {"ground": ["ground", "--scenario", str(path)],
+            "router": ["deploy.router", "--config", str(out / "access" / "router.json5")],
+            "recorder": ["ground.archive.record", "--scenario", str(path)]}[victim]
+    return _wait_pid(argv, 10.0)
 
 
 def _until(out: Path, t_sim: float) -> None:
@@ -93,8 +103,7 @@ def _messages(out: Path) -> dict[tuple[str, int], dict[str, Any]]:
 def test_killed_and_restarted_processes_change_no_result(tmp_path: Path, free_port: int) -> None:
     clean, clean_out = _run(tmp_path, free_port, "clean", [])
     assert clean["status"] == "completed"
-    kills = [(60.0, ["fsw", "--spacecraft", "2"]), (110.0, ["ground"]),
-             (160.0, ["deploy.router"]), (210.0, ["ground.archive.record"])]
+    kills = [(60.0, "sc2"), (110.0, "ground"), (160.0, "router"), (210.0, "recorder")]
     chaos, chaos_out = _run(tmp_path, free_port, "chaos", kills)
     assert chaos["status"] == "degraded"
     for name in ("sc2", "ground", "router", "recorder"):

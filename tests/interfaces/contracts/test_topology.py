@@ -14,8 +14,10 @@ from fsw.apps.infocost import InfoCostApp
 from interfaces.contracts import topics
 from interfaces.contracts.apps import GROUND_APPS, ONBOARD_FDIR_APPS, SPACECRAFT_APPS
 from interfaces.contracts.topology import (
+    Host,
     Node,
     describe,
+    hosting,
     topology,
 )
 from interfaces.runtime.app import App
@@ -87,3 +89,33 @@ def test_a_missing_node_or_name_is_a_clear_error() -> None:
                ("fsw", 1), "fsw")
     with pytest.raises(ValueError, match="fsw.apps.nowhere"):
         executive_of(bad, Bus("sc1", "topo", InprocNetwork().endpoint()), small_scenario())
+
+
+@pytest.mark.parametrize(("observers", "processes", "expected"), [
+    (5, 2, ["sc1+sc2", "sc3+sc4+sc5", "ground"]),
+    (5, 1, ["sc1+sc2+sc3+sc4+sc5", "ground"]),
+    (3, 8, ["sc1", "sc2", "sc3", "ground"]),
+    (20, 3, ["+".join(f"sc{i}" for i in range(a, b)) for a, b in ((1, 8), (8, 14), (14, 21))]
+     + ["ground"]),
+])
+def test_packed_hosting_shares_the_spacecraft_among_the_cores(
+        observers: int, processes: int, expected: list[str]) -> None:
+    """Consecutive spacecraft, as many processes as cores (sizes within one), every node
+    hosted once, the ground alone."""
+    topo = topology(small_scenario(observers={"count": observers}))
+    hosts = hosting(topo, "packed", processes)
+    assert [h.name for h in hosts] == expected
+    assert sorted(n.name for h in hosts for n in h.nodes) == sorted(topo.participants)
+
+
+def test_a_packed_host_starts_its_spacecraft_together_and_one_alone_as_before() -> None:
+    topo = topology(small_scenario(observers={"count": 4}))
+    packed = hosting(topo, "packed", 2)
+    assert packed[0].command == ["-m", "fsw", "--spacecraft", "1", "2"]
+    assert hosting(topo, "one-per-process", 2)[1].command == topo.node("sc2").command
+    assert [h.name for h in hosting(topo, "packed", 2, alone={"sc2"})] == [
+        "sc1+sc3", "sc4", "sc2", "ground"]
+    with pytest.raises(ValueError, match="at least 1"):
+        hosting(topo, "packed", 0)
+    with pytest.raises(ValueError, match="start the same way"):
+        Host((topo.node("sc1"), topo.node(topics.GROUND)))

@@ -4,19 +4,21 @@ fleet changes no message is flown in tests/missions/test_fleet_run.py."""
 
 from __future__ import annotations
 
+import queue
 from dataclasses import replace
 from typing import Any
 
 import pytest
 
+from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
-from interfaces.contracts.messages import Tick
+from interfaces.contracts.messages import SimStatus, Tick, TickDone
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import Node, topology
 from interfaces.runtime.app import App
 from interfaces.runtime.assembly import build_executive
 from interfaces.runtime.bus import Bus
-from interfaces.runtime.executive import Executive
+from interfaces.runtime.executive import Executive, TickClient, serve_together
 from interfaces.runtime.fleet import Fleet, fleets_of
 from interfaces.runtime.transport import InprocNetwork
 from tests.conftest import small_scenario
@@ -74,3 +76,30 @@ def test_spacecraft_whose_software_differs_form_fleets_apart() -> None:
     with pytest.raises(ValueError, match="same apps"):
         Fleet([executives[nodes[0].name], Executive(Bus("sc9", "m", net.endpoint()),
                                                       scenario, [])])
+
+
+def test_nodes_of_one_process_served_together_step_as_a_fleet() -> None:
+    """Ticks queued by the clients of one process (as over Zenoh) run on the serving thread,
+    each once every member has it, until the sim says the run is finished; clients that do
+    not share their queue are refused."""
+    scenario = small_scenario("f")
+    net = InprocNetwork()
+    a, b = (_executive(net, n, scenario) for n in ("sc1", "sc2"))
+    fleet = Fleet([a, b])
+    shared: queue.Queue[Any] = queue.Queue()
+    clients = [TickClient(e, tick_queue=shared, fleet=fleet.take) for e in (a, b)]
+    sim = Bus(topics.SIM, "m", net.endpoint())
+    answers: list[tuple[str, int]] = []
+    for node in ("sc1", "sc2"):
+        sim.subscribe(cat.TICK_DONE.key("m", node), TickDone,
+                      lambda m: answers.append((m.sender, m.k)), immediate=True)
+    for k in range(3):
+        sim.publish(cat.TICK.key("m"), _tick(k, scenario), announce=False)
+    assert a.apps[0].steps == [] and shared.qsize() == 6  # queued, not run
+    sim.publish(cat.SIM_STATUS.key("m"), SimStatus(sender=topics.SIM, t_sim=1.0, state="finished",
+                                                   k=2))
+    serve_together(clients)
+    assert a.apps[0].steps == b.apps[0].steps == [0.0, 0.5, 1.0]
+    assert answers == [("sc1", 0), ("sc2", 0), ("sc1", 1), ("sc2", 1), ("sc1", 2), ("sc2", 2)]
+    with pytest.raises(ValueError, match="share one tick queue"):
+        serve_together([clients[0], TickClient(_executive(net, "sc3", scenario))])

@@ -243,7 +243,7 @@ def test_a_node_the_sim_names_rejoining_takes_the_sims_present() -> None:
 
     def served(ticks: int) -> None:
         deadline = time.monotonic() + 5.0
-        while (client.executive.ticks < ticks or not client._ticks.empty()) \
+        while (client.executive.ticks < ticks or not client.tick_queue.empty()) \
                 and time.monotonic() < deadline:
             time.sleep(0.01)
 
