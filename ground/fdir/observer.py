@@ -27,11 +27,14 @@ class TimeSeries:
     def __init__(self) -> None:
         self.t: list[float] = []
         self.v: list[np.ndarray] = []
+        self._arrays: tuple[np.ndarray, np.ndarray] | None = None
+        """``t`` and ``v`` as arrays, made at the first read after a change."""
 
     def add(self, t: float, value: np.ndarray) -> None:
         i = bisect.bisect_right(self.t, t)
         self.t.insert(i, t)
         self.v.insert(i, value)
+        self._arrays = None
 
     def at(self, times: np.ndarray) -> np.ndarray | None:
         """Values (K, d) at ``times`` (K,), or None unless every time is within ``MAX_GAP_S``
@@ -44,11 +47,12 @@ class TimeSeries:
         every sample; None without any sample."""
         if not self.t:
             return None
-        t = np.array(self.t)
+        if self._arrays is None:
+            self._arrays = np.array(self.t), np.array(self.v)
+        t, v = self._arrays
         j = np.searchsorted(t, times)
         before = np.abs(times - t[np.clip(j - 1, 0, len(t) - 1)])
         after = np.abs(t[np.clip(j, 0, len(t) - 1)] - times)
-        v = np.array(self.v)
         out = np.stack([np.interp(times, t, v[:, j]) for j in range(v.shape[1])], axis=1)
         out[np.minimum(before, after) > self.MAX_GAP_S] = np.nan
         return out
@@ -56,7 +60,9 @@ class TimeSeries:
     def forget_before(self, t: float) -> None:
         """Drop samples no later window needs (keep the last one before t)."""
         i = max(bisect.bisect_left(self.t, t) - 1, 0)
-        del self.t[:i], self.v[:i]
+        if i:
+            del self.t[:i], self.v[:i]
+            self._arrays = None
 
 
 @dataclass

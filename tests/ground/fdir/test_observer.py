@@ -60,6 +60,10 @@ def test_a_series_is_nan_where_it_is_stale_and_none_where_any_is() -> None:
     assert series.at(np.array([1.0, 10.0])) is None
     assert series.at(np.array([1.0, 21.0])).tolist() == [[1.0, -1.0], [20.0, -20.0]]
     assert TimeSeries().at_each(np.array([1.0])) is None
+    series.add(10.0, np.array([10.0, -10.0]))  # read after a change: the new sample counts
+    assert series.at(np.array([9.0])).tolist() == [[9.0, -9.0]]
+    series.forget_before(15.0)  # and after forgetting: the samples before 10 s are gone
+    assert series.t == [10.0, 20.0] and np.isnan(series.at_each(np.array([1.0]))).all()
 
 
 def test_twin_points_at_the_reported_aim_or_the_centre() -> None:
