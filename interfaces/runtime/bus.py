@@ -360,8 +360,8 @@ class Bus:
         state (highest numbers seen, clock, counts), the messages waiting in the inbox (their
         subscribers by key expression and place) and the channel stage's (the truth it judges
         ranges on from the oldest message waiting or the clock, whichever is earlier: nothing
-        sent before either is still to come).  The values are the Bus's own: pickle them at
-        once."""
+        sent before either is still to come), and what it sent in its last ticks (``recent``).
+        The values are the Bus's own: pickle them at once."""
         index = {id(s): (e, i) for e, group in self.table.groups.items()
                  for i, s in enumerate(group)}
         with self.inbox.lock:  # the receiving threads queue and admit under it: copies
@@ -372,7 +372,7 @@ class Bus:
         channel = (None if self.channel is None else
                    self.channel.checkpoint(since, lambda e: _pack(e, index)))
         return {"seq": dict(self._seq), "stats": stats, "admission": admission,
-                "pending": pending, "channel": channel}
+                "pending": pending, "channel": channel, "recent": self.recent.checkpoint()}
 
     def restore(self, saved: dict[str, Any]) -> None:
         """Take back a ``checkpoint`` into a Bus wired as the one that took it."""
@@ -385,6 +385,7 @@ class Bus:
             self.inbox.pending = [_unpack(p, groups) for p in saved["pending"]]
         if self.channel is not None:
             self.channel.restore(saved["channel"], lambda p: _unpack(p, groups))
+        self.recent.restore(saved["recent"])
 
     # --- services --------------------------------------------------------------------------
 

@@ -22,7 +22,7 @@ from interfaces.runtime.executive import Executive, TickClient, serve_together
 from interfaces.runtime.fleet import fleets_of
 from interfaces.runtime.link_stage import LinkStageFactory
 from interfaces.runtime.recent import depth_for
-from interfaces.runtime.restart import resume
+from interfaces.runtime.restart import resume_together
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
 
 
@@ -141,7 +141,11 @@ def run_participants(
         clients = [TickClient(build(bus, start.scenario), tick_queue=shared) for bus in buses]
         _step_together(clients, start.scenario)
         for client in clients:
-            _join(client, args, start)
+            client.executive.bus.serve_recent()
+        if args.cds is not None:
+            _restore(clients, args.cds, start)
+        for client in clients:
+            _join(client)
         start.log.info("ready")
         serve_together(clients, start.stop)
         lost = [c.executive.bus.node for c in clients if c.sim_lost and not c.finished.is_set()]
@@ -167,17 +171,18 @@ def _step_together(clients: list[TickClient], scenario: Scenario) -> None:
             client.fleet = fleet.take
 
 
-def _join(client: TickClient, args: argparse.Namespace, start: NodeStart) -> None:
-    """``client``'s node restored from its critical-data store (``--cds``, when started
-    again), watching the others' liveliness, serving its schemas and recent messages, and
+def _restore(clients: list[TickClient], cds: Path, start: NodeStart) -> None:
+    """The process's nodes restored together from their critical-data stores in ``cds``,
+    when started again (``interfaces.runtime.restart.resume_together``)."""
+    resume_together([(c, CriticalDataStore.open(cds, start.mission, c.executive.bus.node,
+                                                start.scenario)) for c in clients],
+                    [topics.SIM, *topology(start.scenario).participants], start.log)
+
+
+def _join(client: TickClient) -> None:
+    """``client``'s node watching the others' liveliness, serving its schemas, and
     announced."""
     bus = client.executive.bus
-    if args.cds is not None:
-        others = [topics.SIM, *(n for n in topology(start.scenario).participants
-                                if n != bus.node)]
-        resume(client, CriticalDataStore.open(args.cds, start.mission, bus.node,
-                                              start.scenario), others, start.log)
     bus.watch_alive(client.on_liveness)
     bus.serve_schemas()
-    bus.serve_recent()
     bus.declare_alive()

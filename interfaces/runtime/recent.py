@@ -56,6 +56,17 @@ class RecentSent:
         """The current tick has ended (the oldest kept is forgotten)."""
         self._ticks.append([])
 
+    def checkpoint(self) -> list[list[tuple[str, str, bytes]]]:
+        """The kept samples, tick by tick, as (key, type name, payload) for the node's
+        critical-data store: restored with the node, it can send them again to the nodes
+        restarted with it (``interfaces.runtime.restart.resume_together``)."""
+        return [[(s.key, s.type_name, s.payload) for s in tick] for tick in self._ticks]
+
+    def restore(self, saved: list[list[tuple[str, str, bytes]]]) -> None:
+        """Take back a :meth:`checkpoint`."""
+        self._ticks = deque([[Sample(k, t, payload=p) for k, t, p in tick] for tick in saved],
+                            maxlen=self._ticks.maxlen)
+
     def reply(self, _key: str = "") -> bytes:
         """Every kept sample, oldest first, as the query's JSON reply."""
         return json.dumps([[s.key, s.type_name, s.payload.decode()]

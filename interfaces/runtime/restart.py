@@ -14,6 +14,7 @@ and its start record says why: the mission goes on, no longer as if nothing happ
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import pickle
 import time
@@ -34,10 +35,41 @@ def resume(client: TickClient, store: CriticalDataStore, others: list[str],
     """Restore the node of ``client`` from ``store`` if this process is a restart and run
     again the ticks since (from the sim and the ``others`` nodes), or start cold (logged with
     the reason); record how it started; write the store at every ω_mid boundary from now on.
-    Call before the node announces itself."""
+    Call before the node announces itself, its recent ticks served (``Bus.serve_recent``)."""
+    return resume_together([(client, store)], others, log)[0]
+
+
+def resume_together(members: list[tuple[TickClient, CriticalDataStore]], nodes: list[str],
+                    log: logging.Logger) -> list[StartRecord]:
+    """:func:`resume` for the nodes one process hosts (``members``, each with its store), which
+    stopped and start again together.  Each is restored first, with what it sent in its last
+    ticks (served to the others restarted with it); each then takes in what the sim and the
+    other ``nodes`` sent lately; and the ticks since are run again tick by tick across the
+    members, so that what one sends again in a tick reaches the others before their next, as
+    in flight."""
+    records = [_start(client, store, log) for client, store in members]
+    for client, store in members:
+        _keep(client, store, log)
+    runs = [_recent_ticks(client, [n for n in nodes if n != client.executive.bus.node],
+                          record, log) if record.outcome == "restored" else ({}, record)
+            for (client, _), record in zip(members, records, strict=True)]
+    for k in sorted({k for ticks, _ in runs for k in ticks}):
+        for (client, _), (ticks, _) in zip(members, runs, strict=True):
+            if k in ticks:
+                client.catch_up(ticks[k])
+    out = []
+    for (client, store), (ticks, record) in zip(members, runs, strict=True):
+        if record.outcome == "restored":
+            record = _ran_again(client, ticks, record, log)
+        store.record_start(record)
+        out.append(record)
+    return out
+
+
+def _keep(client: TickClient, store: CriticalDataStore, log: logging.Logger) -> None:
+    """Write ``store`` at every ω_mid boundary of ``client``'s node from now on."""
     ex = client.executive
     every = ex.period["mid"]
-
     failed: list[int] = [0]
 
     def save() -> None:
@@ -54,11 +86,6 @@ def resume(client: TickClient, store: CriticalDataStore, others: list[str],
                           e, failed[0])
 
     ex.at_tick_end = save
-    record = _start(client, store, log)
-    if record.outcome == "restored":
-        record = _catch_up(client, others, record, log)
-    store.record_start(record)
-    return record
 
 
 def _start(client: TickClient, store: CriticalDataStore, log: logging.Logger) -> StartRecord:
@@ -77,10 +104,11 @@ def _start(client: TickClient, store: CriticalDataStore, log: logging.Logger) ->
     return StartRecord("restored", tick=tick, t_sim=t_sim, wall_time=time.time())
 
 
-def _catch_up(client: TickClient, others: list[str], record: StartRecord,
-              log: logging.Logger) -> StartRecord:
-    """Take in what the sim and ``others`` sent lately and run the sim's ticks after the
-    restored one, in order; the record says how far it got (and why not further)."""
+def _recent_ticks(client: TickClient, others: list[str], record: StartRecord,
+                  log: logging.Logger) -> tuple[dict[int, Tick], StartRecord]:
+    """Take in what the sim and ``others`` sent lately; the sim's ticks after the restored one
+    to run again, in order (none when some are no longer kept: the node then goes on from
+    where it is, numbering afresh), and the record saying why not, if so."""
     bus = client.executive.bus
     tick_key = cat.TICK.key(bus.mission)
     ticks: dict[int, Tick] = {}
@@ -105,11 +133,16 @@ def _catch_up(client: TickClient, others: list[str], record: StartRecord,
     if gap:  # go on from where it is, numbering afresh: its receivers saw higher numbers
         log.error("%s: %s; rejoining with the state of tick %d", bus.node, gap, record.tick)
         bus.number_afresh()
-        run = []
-    for k in run:
-        client.catch_up(ticks[k])
-    log.warning("%s: ran again ticks %s since the store", bus.node,
+        return {}, dataclasses.replace(record, reason=gap)
+    return {k: ticks[k] for k in run}, record
+
+
+def _ran_again(client: TickClient, ticks: dict[int, Tick], record: StartRecord,
+               log: logging.Logger) -> StartRecord:
+    """The record of a restored node that ran ``ticks`` again since its store."""
+    run = sorted(ticks)
+    log.warning("%s: ran again ticks %s since the store", client.executive.bus.node,
                 f"{run[0]}-{run[-1]}" if run else "(none)")
-    return StartRecord("restored", reason=gap, tick=run[-1] if run else record.tick,
+    return StartRecord("restored", reason=record.reason, tick=run[-1] if run else record.tick,
                        t_sim=ticks[run[-1]].t_sim if run else record.t_sim,
                        wall_time=record.wall_time)

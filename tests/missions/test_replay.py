@@ -1,8 +1,9 @@
 """Replay (harness/replay.py): the live ground re-run on a recorded run reproduces the live
 detections, windows and verdicts exactly -- with lossy, range-limited and cut links and three
 faults -- and, under another setting, what the live run with that setting declared, up to the
-first uplink the two runs differ in.  An archive that lost its second half (cut at half its
-bytes) or holds less than its run says where it ends, and nothing past that is judged."""
+first uplink the two runs differ in.  An archive that lost its last quarter (cut at three
+quarters of its bytes) or holds less than its run says where it ends, and nothing past that is
+judged."""
 
 from __future__ import annotations
 
@@ -42,13 +43,14 @@ def live(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, RunSummary]:
 
 @pytest.fixture(scope="module")
 def cut(live: tuple[Path, RunSummary], tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The live run's folder with its archive cut at half its bytes (no summary section, no
-    footer, a chunk torn), and its summary.json (of the whole run)."""
+    """The live run's folder with its archive cut at three quarters of its bytes (no summary
+    section, no footer, a chunk torn: its data ends after the first declarations, before the
+    last), and its summary.json (of the whole run)."""
     out, _ = live
     folder = tmp_path_factory.mktemp("replay") / "cut"
     folder.mkdir()
     data = (out / "run.mcap").read_bytes()
-    (folder / "run.mcap").write_bytes(data[:len(data) // 2])
+    (folder / "run.mcap").write_bytes(data[:len(data) * 3 // 4])
     shutil.copyfile(out / "summary.json", folder / "summary.json")
     return folder
 

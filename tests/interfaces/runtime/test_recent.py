@@ -4,6 +4,7 @@ the request itself is tested on both transports in test_bus.py."""
 from __future__ import annotations
 
 import json
+import pickle
 
 import pytest
 
@@ -21,6 +22,20 @@ def test_the_last_ticks_are_kept_oldest_first() -> None:
     assert [s.key for s in got] == ["k/2", "k/3", "k/4"]
     assert json.loads(got[0].payload) == {"k": 2}
     assert depth_for(10) > 10
+
+
+def test_what_was_kept_comes_back_with_the_node_from_its_store() -> None:
+    """Restored from the node's critical-data store, the last ticks are sent again as they
+    were kept, and the depth stays the one the node was built with."""
+    recent = RecentSent(depth=2)
+    for k in range(3):
+        recent.add(Sample(f"k/{k}", "T", payload=f'{{"k": {k}}}'.encode()))
+        recent.next_tick()
+    again = RecentSent(depth=2)
+    again.restore(pickle.loads(pickle.dumps(recent.checkpoint())))
+    assert again.reply() == recent.reply()
+    again.next_tick()
+    assert [s.key for s in parse_reply(again.reply())] == ["k/2"]
 
 
 @pytest.mark.parametrize("reply", [b"{}", b'[["a", "b"]]', b'[[1, "b", "c"]]', b"not json",
