@@ -99,12 +99,10 @@ def unpack_precision(packed: str) -> FloatArray:
     """The precisions of a packed string (float64).  Raises ValueError if it is not one."""
     codec, raw = _split(packed)
     if codec == "dec":
-        planes = _whole(raw, 4)
+        planes = np.frombuffer(_whole(raw, 4), dtype=np.uint8)
         n = len(planes) // 4
-        mantissa = np.frombuffer(planes[:3 * n] + bytes(n), dtype=np.uint8)
-        m = mantissa.reshape(4, n).T.copy().view("<u4").reshape(-1)
-        k = np.frombuffer(planes[3 * n:], dtype=np.int8)
-        return _from_decimal(m, k)
+        low, mid, high = planes[:3 * n].reshape(3, n).astype(np.uint32)
+        return _from_decimal(low | (mid << 8) | (high << 16), planes[3 * n:].view(np.int8))
     if codec == "f64":
         return _unplanes(raw, np.dtype("<f8")).astype(np.float64)
     raise ValueError(f"unknown precision codec {codec!r} (dec or f64)")
@@ -121,7 +119,8 @@ def _decimal(values: FloatArray) -> str | None:
     if bool((np.abs(k) > _MAX_POW10).any()):
         return None
     scale = _POW10[np.abs(k)]
-    m = np.round(np.where(k >= 0, values * scale, values / scale))
+    m = np.round(values * scale if k.min(initial=0) >= 0 else
+                 np.where(k >= 0, values * scale, values / scale))
     if bool((m >= _MAX_MANTISSA).any()):
         return None
     m = m.astype("<u4")
@@ -135,6 +134,8 @@ def _decimal(values: FloatArray) -> str | None:
 def _from_decimal(m: npt.NDArray[np.uint32], k: npt.NDArray[np.int8]) -> FloatArray:
     """n / 10^k (n · 10^-k for k < 0), as :func:`quantise` rounds."""
     n = m.astype(np.float64)
+    if k.min(initial=0) >= 0:  # every precision below 10^6: one division
+        return n / _POW10[k]
     scale = _POW10[np.abs(k.astype(np.int64))]
     return np.where(k >= 0, n / scale, n * scale)
 
