@@ -123,6 +123,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                    help="packed: the spacecraft share as many processes as this host has "
                         "cores, stepping together (default); one-per-process: a process per "
                         "node, as on separate computers (interfaces/contracts/topology.py)")
+    p.add_argument("--processes", type=int, metavar="N",
+                   help="with --hosting packed: the processes the spacecraft share (default: "
+                        "this host's cores)")
     p.add_argument("--external", action="append", default=[], metavar="NODE",
                    help="a node (sc<N> or ground) started by hand on another host; repeatable")
     p.add_argument("--tls-host", action="append", default=[], metavar="NAME",
@@ -159,6 +162,10 @@ def main(argv: list[str] | None = None) -> int:
     data_budget = budget(scenario)
     for warning in data_budget.warnings() if data_budget is not None else []:
         log.warning("%s", warning)
+    if args.processes is not None and args.processes < 1:
+        print(f"error: --processes takes a count of at least 1, not {args.processes}",
+              file=sys.stderr)
+        return 2
     zenoh_only = _zenoh_only(args)
     if args.transport == "inproc" and zenoh_only:
         print(f"error: {', '.join(zenoh_only)} apply only to --transport zenoh",
@@ -222,7 +229,8 @@ def _zenoh_only(args: argparse.Namespace) -> list[str]:
     """The options given that only a Zenoh run uses."""
     given = {"--endpoint": args.endpoint != DEFAULT_ENDPOINT, "--advertise": args.advertise,
              "--tls-host": args.tls_host, "--restart-on-crash": args.restart_on_crash,
-             "--audit-access": args.audit_access}
+             "--audit-access": args.audit_access, "--processes": args.processes is not None,
+             "--hosting": args.hosting != "packed"}
     return [name for name, on in given.items() if on]
 
 
@@ -423,7 +431,7 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     sup.start(Child(SIM.name, sim_argv, logs / "sim.log"))
     topo = topology(scenario)
     cds = _store_args(out, args.restart_on_crash)
-    hosts = hosting(topo, args.hosting, host_cores(), alone=args.external)
+    hosts = hosting(topo, args.hosting, args.processes or host_cores(), alone=args.external)
     for host in hosts:
         if host.name in args.external:
             config = access.client_config(host.name)

@@ -54,6 +54,10 @@ CASES = [
      "--endpoint apply only to --transport zenoh"),
     ("restarts in process", ["run", "--restart-on-crash", "--audit-access"], None,
      "--restart-on-crash, --audit-access apply only"),
+    ("hosting in process", ["run", "--hosting", "one-per-process", "--processes", "2"], None,
+     "--processes, --hosting apply only"),
+    ("no processes", ["run", "--processes", "0"], None,
+     "--processes takes a count of at least 1, not 0"),
 ]
 
 RUN = {"run.mcap": b"\x89MCAP0\r\nold", "summary.json": b"{}", "report.md": b"# old"}

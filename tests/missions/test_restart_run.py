@@ -39,12 +39,12 @@ executives' statistics (wall-clock execution times)."""
 
 def _run(tmp_path: Path, port: int, name: str, kills: list[tuple[float, str]]
          ) -> tuple[dict[str, Any], Path]:
-    """Fly SC with --restart-on-crash (the default hosting: spacecraft packed in processes),
+    """Fly SC with --restart-on-crash (the default hosting, 2 processes: sc1 and sc2 share one),
     killing at each sim time (s) the process of the node named (``sc<N>``: the flight process
     hosting it); the summary and the run's folder."""
     path = write_scenario(tmp_path / f"{M}.toml", SC)
     out = tmp_path / name
-    p = _launch(path, out, port, "--realtime", "20", "--restart-on-crash")
+    p = _launch(path, out, port, "--realtime", "20", "--restart-on-crash", "--processes", "2")
     try:
         for t_kill, victim in kills:
             _until(out, t_kill)
