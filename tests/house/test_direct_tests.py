@@ -48,7 +48,6 @@ INDIRECT: dict[str, str] = {
     "gnc.attitude_gains": (
         "the gain design the flight tracking law re-exports (fsw/lib/attitude_control.py): "
         "tests/fsw/lib/test_attitude.py checks it against the closed loop's response"),
-    "fsw.__main__": _NODE_MAIN,
     "fsw.spacecraft": (
         "a spacecraft's executive, built by name from the topology: "
         "tests/interfaces/contracts/test_topology.py runs its apps and its software-fault hook"),
