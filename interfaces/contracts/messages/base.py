@@ -199,7 +199,7 @@ class PoiPrecisions(Message):
             raise ValueError("POI indices must be ≥ 0")
         if not bool(((prec >= 0.0) & (prec <= MAX_PRECISION)).all()):
             raise ValueError(f"precisions must be finite, in [0, {MAX_PRECISION:g}]")
-        self._keep_arrays(idx, prec)
+        self._keep_arrays(idx, prec, copy=False)  # unpacked afresh: no one else holds them
         return self
 
     def __eq__(self, other: object) -> bool:
@@ -228,7 +228,7 @@ class PoiPrecisions(Message):
         if (cached is None or cached[0] is not self.poi_packed
                 or cached[1] is not self.precision_packed):  # a model_copy may carry others
             self._keep_arrays(unpack_poi(self.poi_packed),
-                              unpack_precision(self.precision_packed))
+                              unpack_precision(self.precision_packed), copy=False)
             cached = self._arrays
             assert cached is not None
         return cached[2], cached[3]
@@ -238,11 +238,13 @@ class PoiPrecisions(Message):
         message holds ``other``'s own packed strings."""
         self.__pydantic_private__["_arrays"] = other._arrays  # type: ignore[index]
 
-    def _keep_arrays(self, poi: npt.ArrayLike, precision: npt.ArrayLike) -> None:
-        """Keep read-only copies of ``poi`` (int64) and ``precision`` (float64), the values of
-        the packed strings, as what :meth:`arrays` returns."""
-        idx = np.array(poi, dtype=np.int64)
-        prec = np.array(precision, dtype=np.float64)
+    def _keep_arrays(self, poi: npt.ArrayLike, precision: npt.ArrayLike,
+                     copy: bool = True) -> None:
+        """Keep read-only ``poi`` (int64) and ``precision`` (float64), the values of the packed
+        strings, as what :meth:`arrays` returns: copies, unless ``copy`` is False (arrays of
+        the right types that nobody else holds)."""
+        idx = np.array(poi, dtype=np.int64, copy=copy)
+        prec = np.array(precision, dtype=np.float64, copy=copy)
         idx.setflags(write=False)
         prec.setflags(write=False)
         self.__pydantic_private__["_arrays"] = (  # type: ignore[index]
