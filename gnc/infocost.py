@@ -144,25 +144,48 @@ TINY = float(np.finfo(np.float64).tiny)
 """The smallest squared distance a precision divides by (m²): a camera on a POI stays finite."""
 
 
-def checked_inputs(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.ArrayLike,
-                   poi_normal: npt.ArrayLike | None, camera: Camera,
-                   ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray | None]:
-    """Validated camera positions p (N, 3), unit boresights b (N, 3), POIs s (M, 3), normals.
+@dataclass(frozen=True)
+class PoiSet:
+    """POIs validated once, for the many calls that image the same target: positions s
+    (M, 3), m, and outward normals (M, 3) or None (no horizon test).  Build with
+    :meth:`of`."""
 
-    Normals are only used through the sign of n·(p − s), so they are not normalised; zero rows
-    are rejected.
-    """
+    pos: FloatArray
+    normal: FloatArray | None
+
+    @classmethod
+    def of(cls, poi_pos: npt.ArrayLike, poi_normal: npt.ArrayLike | None) -> PoiSet:
+        """Validated POIs: finite (M, 3) positions (M ≥ 1) and normals of the same shape.
+
+        Normals are only used through the sign of n·(p − s), so they are not normalised; zero
+        rows are rejected.
+        """
+        s = _rows3("poi_pos", poi_pos)
+        n = None
+        if poi_normal is not None:
+            n = finite_array("poi_normal", poi_normal, s.shape)
+            if not np.all((n * n) @ np.ones(3) > 0.0):  # a matrix-vector product: row sums
+                raise ValueError("poi_normal has a zero-length row; expected outward normals")
+        return cls(s, n)
+
+
+def checked_cameras(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, camera: Camera
+                    ) -> tuple[FloatArray, FloatArray]:
+    """Validated camera positions p (N, 3) and unit boresights b (N, 3) of a ``camera``."""
     if not isinstance(camera, Camera):
         raise ValueError(f"camera must be a Camera, got {type(camera).__name__}")
     p = _rows3("cam_pos", cam_pos)
-    s = _rows3("poi_pos", poi_pos)
-    b = _unit_rows("boresight", boresight, p.shape[0])
-    n = None
-    if poi_normal is not None:
-        n = finite_array("poi_normal", poi_normal, s.shape)
-        if not np.all((n * n) @ np.ones(3) > 0.0):  # a matrix-vector product: fast row sums
-            raise ValueError("poi_normal has a zero-length row; expected outward normals")
-    return p, b, s, n
+    return p, _unit_rows("boresight", boresight, p.shape[0])
+
+
+def checked_inputs(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.ArrayLike,
+                   poi_normal: npt.ArrayLike | None, camera: Camera,
+                   ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray | None]:
+    """Validated camera positions p (N, 3), unit boresights b (N, 3), POIs s (M, 3), normals
+    (:class:`PoiSet`)."""
+    p, b = checked_cameras(cam_pos, boresight, camera)
+    pois = PoiSet.of(poi_pos, poi_normal)
+    return p, b, pois.pos, pois.normal
 
 
 def _blocks(p: FloatArray, b: FloatArray, s: FloatArray, n: FloatArray | None, camera: Camera,

@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from gnc.infocost import TINY, Camera, checked_inputs
+from gnc.infocost import TINY, Camera, PoiSet, checked_cameras
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -53,7 +53,19 @@ def precision(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.Arr
               poi_normal: npt.ArrayLike | None, camera: Camera) -> FloatArray:
     """σ⁻¹ (N, M) = 1/(k d²) where visible, else 0: :func:`gnc.infocost.precision`
     compiled (same arguments, same validation and errors)."""
-    p, b, s, n = checked_inputs(cam_pos, boresight, poi_pos, poi_normal, camera)
+    p, b = checked_cameras(cam_pos, boresight, camera)
+    return _precision(p, b, PoiSet.of(poi_pos, poi_normal), camera)
+
+
+def precision_on(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, pois: PoiSet,
+                 camera: Camera) -> FloatArray:
+    """:func:`precision` of POIs validated once (``pois``): only the cameras are checked."""
+    p, b = checked_cameras(cam_pos, boresight, camera)
+    return _precision(p, b, pois, camera)
+
+
+def _precision(p: FloatArray, b: FloatArray, pois: PoiSet, camera: Camera) -> FloatArray:
+    s, n = pois.pos, pois.normal
     out = np.empty((p.shape[0], s.shape[0]))
     _fill(p, b, s, s if n is None else n, n is not None, float(np.cos(camera.half_angle_rad)) ** 2,
           camera.max_range_m ** 2, 1.0 / camera.k, out)

@@ -19,15 +19,15 @@ Pure functions and frozen dataclasses; the FDIR app holds the state.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
-from dataclasses import dataclass
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
 
 from gnc.hcw import zoh_matrices
-from gnc.infocost import Camera
-from gnc.infocost_kernels import precision
+from gnc.infocost import Camera, PoiSet
+from gnc.infocost_kernels import precision, precision_on
 from gnc.pro import Pro
 from interfaces.contracts.messages import ProAssignment
 
@@ -199,16 +199,35 @@ class TwinModel:
     camera: Camera
     radius_m: float
     noise_frac: float = 0.0
+    pois: PoiSet = field(init=False, repr=False, compare=False)
+    """the POIs validated once (the twin images them thousands of times a window)"""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "pois", PoiSet.of(self.poi_pos, self.poi_normal))
 
     def precision(self, positions: npt.ArrayLike, boresights: npt.ArrayLike) -> FloatArray:
         """σ⁻¹ (K, M) of nominal images taken from ``positions`` along ``boresights``."""
-        return precision(positions, boresights, self.poi_pos, self.poi_normal, self.camera)
+        return precision_on(positions, boresights, self.pois, self.camera)
 
     def predicted(self, positions: npt.ArrayLike, boresights: npt.ArrayLike,
                   psi: npt.ArrayLike, phi: npt.ArrayLike) -> float:
-        """ΔH_i^pred of images taken from ``positions`` along ``boresights``."""
-        return predicted_delta_h(positions, boresights, self.poi_pos, self.poi_normal,
-                                 self.camera, psi, phi)
+        """ΔH_i^pred of images taken from ``positions`` along ``boresights``
+        (:func:`predicted_delta_h`)."""
+        if np.shape(positions)[0] == 0:
+            return 0.0
+        return delta_h(psi, phi, self.precision(positions, boresights))
+
+    def predicted_each(self, positions: npt.ArrayLike, boresights: Sequence[FloatArray],
+                       psi: npt.ArrayLike, phi: npt.ArrayLike) -> list[float]:
+        """:meth:`predicted` of the images taken from ``positions`` (K, 3) along each set of
+        ``boresights`` (each (K, 3)), imaged in one call."""
+        pos = np.asarray(positions, dtype=float)
+        if pos.shape[0] == 0:
+            return [0.0] * len(boresights)
+        if not boresights:
+            return []
+        prec = self.precision(np.tile(pos, (len(boresights), 1)), np.concatenate(boresights))
+        return [delta_h(psi, phi, block) for block in np.split(prec, len(boresights))]
 
 
 SAMPLED_IMAGES = 20

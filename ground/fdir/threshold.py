@@ -127,8 +127,8 @@ def sampled_threshold(twin: TwinModel, positions: np.ndarray, boresights: np.nda
     k = sample_stride(len(positions))
     pos, bore = positions[::k], boresights[::k]
     ref = twin.predicted(pos, bore, psi, phi)
-    draws = [twin.predicted(pos, perturbed_boresights(bore, eps_rad, len(bore), rng), psi, phi)
-             for _ in range(samples)]
+    tilted = [perturbed_boresights(bore, eps_rad, len(bore), rng) for _ in range(samples)]
+    draws = twin.predicted_each(pos, tilted, psi, phi)
     # the subset holds about 1/k of the window's gain
     return adaptive_threshold(draws, ref, h_prev / k, floor)
 

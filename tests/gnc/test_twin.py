@@ -16,6 +16,7 @@ from gnc.pro import Pro
 from gnc.twin import (
     FlightPlan,
     Transfer,
+    TwinModel,
     centre_boresights,
     delta_h,
     held_over,
@@ -64,6 +65,34 @@ def test_delta_h_is_the_change_of_the_contribution_with_psi_held() -> None:
                              psi, phi) == pytest.approx(direct[1], rel=1e-12)
     assert predicted_delta_h(np.zeros((0, 3)), np.zeros((0, 3)), pos, nor, ic.Camera(), psi,
                              phi) == 0.0
+
+
+def test_the_twin_images_many_pointings_in_one_call_as_one_by_one() -> None:
+    """``TwinModel.predicted_each`` (the threshold's draws imaged together) gives, bit for bit,
+    what ``predicted`` gives each draw alone, and that is ``predicted_delta_h`` with the POIs
+    validated at every call."""
+    rng = np.random.default_rng(5)
+    pos, nor = sphere_pois(400, 5.0)
+    twin = TwinModel(pos, nor, ic.Camera(), 5.0)
+    psi, phi = rng.uniform(0.1, 1.0, 400), np.full(400, 1 / 400)
+    cams = np.array([[0.0, 0.0, -20.0], [15.0, 0.0, 5.0], [0.0, -18.0, 3.0]])
+    tilted = [perturbed_boresights(centre_boresights(cams), 0.1, 3, rng) for _ in range(4)]
+    each = twin.predicted_each(cams, tilted, psi, phi)
+    assert each == [twin.predicted(cams, b, psi, phi) for b in tilted]
+    assert each[0] == predicted_delta_h(cams, tilted[0], pos, nor, ic.Camera(), psi, phi)
+    assert len(set(each)) == 4 and min(each) > 0.0  # four pointings, four gains
+    assert twin.predicted_each(np.zeros((0, 3)), [np.zeros((0, 3))] * 2, psi, phi) == [0.0, 0.0]
+    assert twin.predicted_each(cams, [], psi, phi) == []
+
+
+def test_the_twin_refuses_pois_it_cannot_image_when_built() -> None:
+    pos, nor = sphere_pois(10, 5.0)
+    nor[3] = 0.0
+    with pytest.raises(ValueError, match="poi_normal has a zero-length row"):
+        TwinModel(pos, nor, ic.Camera(), 5.0)
+    pos[2, 1] = np.nan
+    with pytest.raises(ValueError, match="poi_pos contains NaN"):
+        TwinModel(pos, nor, ic.Camera(), 5.0)
 
 
 def test_perturbed_boresights_are_uniform_in_the_cone() -> None:
