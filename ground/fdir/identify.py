@@ -117,6 +117,7 @@ from gnc.infocost import visibility
 from gnc.twin import TwinModel, sample_stride
 from gnc.window_test import Observation, WindowPose
 from ground.fdir.boresight import boresight_offset
+from ground.fdir.trilateration import least_squares
 from interfaces.contracts.scenario import FdirSettings
 
 FloatArray = npt.NDArray[np.float64]
@@ -156,7 +157,8 @@ class CameraFix:
 
 
 def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
-                  radius_m: float, noise_frac: float = 0.0) -> CameraFix | None:
+                  radius_m: float, noise_frac: float = 0.0,
+                  seen: npt.ArrayLike | None = None) -> CameraFix | None:
     """Trilaterate the camera from one image of a spherical target (module docstring).
 
     The measured σ⁻¹_j = β w_j / (k d_j²) carries the camera's multiplicative noise
@@ -167,28 +169,35 @@ def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
     f = E[w] / E[w²] (errors in variables); dividing it out leaves β unbiased, and the
     position, which is a ratio of the fitted terms, does not depend on it.
 
+    The least squares are solved by their normal equations
+    (``ground.fdir.trilateration.least_squares``).
+
     Args:
         poi_pos: positions (n, 3) of the POIs the image saw, target frame (LVLH), m, on the
-            sphere of radius ``radius_m`` about the origin.
+            sphere of radius ``radius_m`` about the origin; with ``seen``, every POI's (M, 3).
         precision: their measured σ⁻¹ (n,), > 0.
         k: the camera's variance coefficient (σ = k d², Eq. 5), m⁻².
         radius_m: the target's radius R, m.
         noise_frac: ν, the 1σ multiplicative noise of a measured precision (the camera's
             spec, ``[camera] noise_frac``).
+        seen: the indices (n,) into ``poi_pos`` of the POIs the image saw (None: ``poi_pos``
+            are they).
 
     Returns:
         The fix, or None when the image saw fewer than ``MIN_POIS`` POIs or the fit is
-        degenerate (POIs on a plane, no root outside the sphere).
+        degenerate (POIs near a plane, no root outside the sphere).
+
+    Raises:
+        ValueError: when the positions, indices and precisions do not go together.
     """
-    s = np.asarray(poi_pos, dtype=float)
-    p = np.asarray(precision, dtype=float)
-    good = p > 0.0
-    if good.sum() < MIN_POIS:
-        return None
-    s, kp = s[good], k * p[good]
-    coef, _, rank, _ = np.linalg.lstsq(kp[:, None] * np.c_[np.ones(len(kp)), s],
-                                       np.ones(len(kp)), rcond=None)
-    if rank < 4:
+    s = np.ascontiguousarray(poi_pos, dtype=float)
+    p = np.ascontiguousarray(precision, dtype=float)
+    index = np.arange(len(s)) if seen is None else np.ascontiguousarray(seen, dtype=np.int64)
+    if s.ndim != 2 or s.shape[1] != 3 or len(index) != len(p) or (
+            len(index) and not 0 <= index.min() <= index.max() < len(s)):
+        raise ValueError(f"{len(p)} precisions for POIs {s.shape} seen at {len(index)} indices")
+    coef = least_squares(s, index, k * p, MIN_POIS)
+    if coef is None:
         return None
     m1, var = clipped_noise_moments(noise_frac)
     coef = coef * (m1 * m1 + var) / m1
@@ -451,8 +460,8 @@ def located_cameras(twin: TwinModel, images: Sequence[Observation]
                     ) -> list[tuple[int, CameraFix]]:
     """The camera located from each image that allows it (:func:`locate_camera`), by image
     index; none when fewer than ``MIN_FIXES`` images do."""
-    fixes = [locate_camera(twin.poi_pos[poi], prec, twin.camera.k, twin.radius_m,
-                           twin.noise_frac) for poi, prec in images]
+    fixes = [locate_camera(twin.poi_pos, prec, twin.camera.k, twin.radius_m, twin.noise_frac,
+                           poi) for poi, prec in images]
     located = [(i, f) for i, f in enumerate(fixes) if f is not None]
     return located if len(located) >= MIN_FIXES else []
 

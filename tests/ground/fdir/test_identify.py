@@ -113,6 +113,23 @@ def test_too_few_pois_give_no_fix() -> None:
     assert locate_camera(s, np.zeros_like(p), 1.0, R) is None
 
 
+def test_an_image_is_located_from_its_indices_as_from_its_positions() -> None:
+    """``seen``: the indices into the whole table (no gathered copy) give the same fix;
+    indices, positions and precisions that do not go together are refused."""
+    c = np.array([9.0, 14.0, -11.0])
+    s, p = _image(c, 0.8)
+    seen = np.flatnonzero(np.isin(POS[:, 0], s[:, 0]))
+    direct = locate_camera(s, p, 1.0, R)
+    indexed = locate_camera(POS, p, 1.0, R, seen=seen)
+    assert direct is not None and indexed is not None
+    assert np.array_equal(direct.position_m, indexed.position_m)
+    assert direct.beta == indexed.beta
+    with pytest.raises(ValueError, match="precisions for POIs"):
+        locate_camera(POS, p[:-1], 1.0, R, seen=seen)
+    with pytest.raises(ValueError, match="precisions for POIs"):
+        locate_camera(POS, p, 1.0, R, seen=seen + len(POS))
+
+
 def test_explained_fraction() -> None:
     assert explained_fraction(0.5, 1.0, 0.5) == pytest.approx(1.0)  # the pose explains it all
     assert explained_fraction(0.5, 1.0, 1.0) == pytest.approx(0.0)  # nothing
