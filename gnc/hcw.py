@@ -103,13 +103,23 @@ def hcw_stm(n: float, t: float | npt.ArrayLike) -> FloatArray:
     """
     _check_n(n)
     tt = np.asarray(t, dtype=float)
+    if tt.size == 1:  # one time: Python floats, the same operations (sin, cos: libm's)
+        nt = n * float(tt.reshape(()))
+        return _matrix(_stm_rows(n, nt, math.sin(nt), math.cos(nt), 0.0, 1.0), tt.shape)
     nt = n * tt
-    s = np.sin(nt)
-    c = np.cos(nt)
-    zero = np.zeros_like(nt)
-    one = np.ones_like(nt)
+    return _stacked(_stm_rows(n, nt, np.sin(nt), np.cos(nt), np.zeros_like(nt),
+                              np.ones_like(nt)))
+
+
+Scalar = float | FloatArray
+"""A float, or an array of them: the matrices' entries are built by one expression for both."""
+
+
+def _stm_rows(n: float, nt: Scalar, s: Scalar, c: Scalar, zero: Scalar, one: Scalar
+              ) -> tuple[tuple[Scalar, ...], ...]:
+    """The entries of Phi(t) (:func:`hcw_stm`) from n t, sin n t and cos n t."""
     inv_n = 1.0 / n
-    rows = (
+    return (
         (4.0 - 3.0 * c, zero, zero, s * inv_n, 2.0 * (1.0 - c) * inv_n, zero),
         (6.0 * (s - nt), one, zero, 2.0 * (c - 1.0) * inv_n, (4.0 * s - 3.0 * nt) * inv_n, zero),
         (zero, zero, c, zero, zero, s * inv_n),
@@ -117,7 +127,19 @@ def hcw_stm(n: float, t: float | npt.ArrayLike) -> FloatArray:
         (6.0 * n * (c - 1.0), zero, zero, -2.0 * s, 4.0 * c - 3.0, zero),
         (zero, zero, -n * s, zero, zero, c),
     )
+
+
+def _stacked(rows: tuple[tuple[Scalar, ...], ...]) -> FloatArray:
+    """A matrix per time, shape ``S + (rows, columns)``, of entries that are arrays of
+    shape ``S``."""
     return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
+def _matrix(rows: tuple[tuple[Scalar, ...], ...], shape: tuple[int, ...]) -> FloatArray:
+    """The matrix of float entries, shaped ``shape + (rows, columns)`` (``shape``: one
+    time's, () or (1,) ...)."""
+    m = np.array(rows, dtype=float)
+    return m.reshape(shape + m.shape)
 
 
 def discretize(n: float, dt: float) -> tuple[FloatArray, FloatArray]:
@@ -275,12 +297,22 @@ def zoh_matrices(n: float, tau: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
     """
     tt = np.asarray(tau, dtype=float)
     phi = hcw_stm(n, tt)
+    if tt.size == 1:  # one time: Python floats, as in hcw_stm
+        th = n * float(tt.reshape(()))
+        half = math.sin(0.5 * th)
+        return phi, _matrix(_gamma_rows(n, th, math.sin(th), 2.0 * (half * half), 0.0),
+                            tt.shape)
     th = n * tt
-    s = np.sin(th)
-    c1 = 2.0 * np.sin(0.5 * th) ** 2
-    zero = np.zeros_like(th)
+    return phi, _stacked(_gamma_rows(n, th, np.sin(th), 2.0 * np.sin(0.5 * th) ** 2,
+                                     np.zeros_like(th)))
+
+
+def _gamma_rows(n: float, th: Scalar, s: Scalar, c1: Scalar, zero: Scalar
+                ) -> tuple[tuple[Scalar, ...], ...]:
+    """The entries of Gamma(tau) (:func:`zoh_matrices`) from th = n tau, sin th and
+    C1 = 2 sin²(th/2)."""
     n2 = n * n
-    rows = (
+    return (
         (c1 / n2, 2.0 * (th - s) / n2, zero),
         (2.0 * (s - th) / n2, (4.0 * c1 - 1.5 * th * th) / n2, zero),
         (zero, zero, c1 / n2),
@@ -288,5 +320,3 @@ def zoh_matrices(n: float, tau: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
         (-2.0 * c1 / n, (4.0 * s - 3.0 * th) / n, zero),
         (zero, zero, s / n),
     )
-    gam = np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
-    return phi, gam

@@ -27,14 +27,43 @@ class TimeSeries:
     def __init__(self) -> None:
         self.t: list[float] = []
         self.v: list[np.ndarray] = []
-        self._arrays: tuple[np.ndarray, np.ndarray] | None = None
-        """``t`` and ``v`` as arrays, made at the first read after a change."""
+        self._arrays: tuple[np.ndarray, np.ndarray, int] | None = None
+        """``t`` (capacity,) and ``v`` by column (d, capacity) as arrays, of which the first
+        (count) hold the samples: extended in place by a sample after the last (the usual
+        case: reports come in time order), made afresh at the first read after any other
+        change."""
 
     def add(self, t: float, value: np.ndarray) -> None:
         i = bisect.bisect_right(self.t, t)
         self.t.insert(i, t)
         self.v.insert(i, value)
-        self._arrays = None
+        if self._arrays is not None and i == self._arrays[2] == len(self.t) - 1:
+            self._append(t, value)
+        else:
+            self._arrays = None
+
+    def _append(self, t: float, value: np.ndarray) -> None:
+        """Extend the arrays by a last sample (their capacity doubled when full)."""
+        assert self._arrays is not None
+        times, columns, count = self._arrays
+        if np.shape(value) != columns.shape[:1]:
+            self._arrays = None
+            return
+        if count == len(times):
+            times = np.resize(times, 2 * count + 8)
+            grown = np.empty((columns.shape[0], len(times)))
+            grown[:, :count] = columns[:, :count]
+            columns = grown
+        times[count] = t
+        columns[:, count] = value
+        self._arrays = times, columns, count + 1
+
+    def _current(self) -> tuple[np.ndarray, np.ndarray]:
+        """The sample times (N,) and values by column (d, N)."""
+        if self._arrays is None or self._arrays[2] != len(self.t):
+            self._arrays = np.array(self.t), np.array(self.v).T.copy(), len(self.t)
+        times, columns, count = self._arrays
+        return times[:count], columns[:, :count]
 
     def at(self, times: np.ndarray) -> np.ndarray | None:
         """Values (K, d) at ``times`` (K,), or None unless every time is within ``MAX_GAP_S``
@@ -47,13 +76,11 @@ class TimeSeries:
         every sample; None without any sample."""
         if not self.t:
             return None
-        if self._arrays is None:
-            self._arrays = np.array(self.t), np.array(self.v)
-        t, v = self._arrays
+        t, columns = self._current()
         j = np.searchsorted(t, times)
         before = np.abs(times - t[np.clip(j - 1, 0, len(t) - 1)])
         after = np.abs(t[np.clip(j, 0, len(t) - 1)] - times)
-        out = np.stack([np.interp(times, t, v[:, j]) for j in range(v.shape[1])], axis=1)
+        out = np.stack([np.interp(times, t, column) for column in columns], axis=1)
         out[np.minimum(before, after) > self.MAX_GAP_S] = np.nan
         return out
 

@@ -24,6 +24,7 @@ from gnc.hcw import (
     mean_motion,
     pro_state,
     process_noise,
+    zoh_matrices,
 )
 
 # Vallado uses mu = 398600.4415 km^3/s^2 in Example 6-14.
@@ -119,6 +120,21 @@ def test_stm_vectorised_over_time() -> None:
     assert phis.shape == (3, 6, 6)
     for k, t in enumerate(ts):
         np.testing.assert_array_equal(phis[k], hcw_stm(N_500, float(t)))
+
+
+def test_one_time_gives_the_matrices_of_many_bit_for_bit() -> None:
+    """One time is computed with Python floats (math.sin, math.cos), many with numpy's: the
+    same operations in the same order, so the same bits, whatever the shape of the time."""
+    rng = np.random.default_rng(7)
+    ts = np.r_[rng.uniform(0.0, 12000.0, 400), rng.uniform(0.0, 1.0, 50), 0.0, 1e-9, -30.0]
+    phis, gams = zoh_matrices(N_500, ts)
+    np.testing.assert_array_equal(phis, hcw_stm(N_500, ts))
+    for k, t in enumerate(ts):
+        for arg in (float(t), np.array(t), np.array([t]), np.array([[t]])):
+            phi, gam = zoh_matrices(N_500, arg)
+            assert phi.shape == np.shape(arg) + (6, 6) and gam.shape == np.shape(arg) + (6, 3)
+            np.testing.assert_array_equal(phi.reshape(6, 6), phis[k])
+            np.testing.assert_array_equal(gam.reshape(6, 3), gams[k])
 
 
 def test_stm_matches_numerical_integration() -> None:

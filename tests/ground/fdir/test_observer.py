@@ -66,6 +66,29 @@ def test_a_series_is_nan_where_it_is_stale_and_none_where_any_is() -> None:
     assert series.t == [10.0, 20.0] and np.isnan(series.at_each(np.array([1.0]))).all()
 
 
+def test_a_series_read_while_it_grows_reads_as_one_built_at_once() -> None:
+    """Samples after the last extend the arrays in place (grown as they fill); one out of
+    order, a forgotten start or a sample of another width makes them afresh: every read equals
+    a series given the same samples at once, bit for bit."""
+    rng = np.random.default_rng(4)
+    grown = TimeSeries()
+    times = np.cumsum(rng.uniform(0.5, 1.5, 60))
+    for k, t in enumerate(times):
+        grown.add(float(t), rng.standard_normal(3))
+        if k == 30:
+            grown.add(float(t) - 0.2, rng.standard_normal(3))  # out of order
+        if k == 45:
+            grown.forget_before(float(times[20]))
+        fresh = TimeSeries()
+        for u, v in zip(grown.t, grown.v, strict=True):
+            fresh.add(u, v)
+        at = np.sort(rng.uniform(grown.t[0] - 1.0, t + 1.0, 5))
+        assert np.array_equal(grown.at_each(at), fresh.at_each(at), equal_nan=True)
+    grown.add(float(times[-1]) + 1.0, np.ones(2))  # another width: refused by the reader
+    with pytest.raises(ValueError):
+        grown.at_each(np.array([times[-1]]))
+
+
 def test_twin_points_at_the_reported_aim_or_the_centre() -> None:
     pos = np.array([[30.0, 0.0, 0.0], [0.0, 40.0, 0.0]])
     assert planned_boresights(None, pos) == pytest.approx(centre_boresights(pos))
