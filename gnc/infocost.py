@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -152,6 +152,16 @@ class PoiSet:
 
     pos: FloatArray
     normal: FloatArray | None
+    columns: tuple[FloatArray, ...] = field(init=False, repr=False, compare=False)
+    """what the compiled kernel reads (``gnc.infocost_kernels``), contiguous (M,) each: the
+    positions' x, y, z and |s|², the normals' x, y, z and n·s (zeros without normals)"""
+
+    def __post_init__(self) -> None:
+        sx, sy, sz = (np.ascontiguousarray(self.pos[:, k]) for k in range(3))
+        n = np.zeros_like(self.pos) if self.normal is None else self.normal
+        nx, ny, nz = (np.ascontiguousarray(n[:, k]) for k in range(3))
+        object.__setattr__(self, "columns", (sx, sy, sz, sx * sx + sy * sy + sz * sz,
+                                             nx, ny, nz, nx * sx + ny * sy + nz * sz))
 
     @classmethod
     def of(cls, poi_pos: npt.ArrayLike, poi_normal: npt.ArrayLike | None) -> PoiSet:

@@ -27,7 +27,7 @@ import numpy.typing as npt
 
 from gnc import infocost, infocost_kernels, quat
 from gnc.checks import finite_array
-from gnc.infocost import Camera
+from gnc.infocost import Camera, PoiSet
 from interfaces.contracts.messages.poi_packing import quantise
 
 FloatArray = npt.NDArray[np.float64]
@@ -67,11 +67,14 @@ class TruthCameras:
     compiled: bool = True
     beta: FloatArray = field(init=False)
     misalignment: FloatArray = field(init=False)
+    pois: PoiSet = field(init=False)
+    """the POIs validated once, for the compiled kernel"""
 
     def __post_init__(self) -> None:
         m = len(self.poi_pos)
         self.poi_pos = finite_array("poi_pos", self.poi_pos, (m, 3))
         self.poi_normal = finite_array("poi_normal", self.poi_normal, (m, 3))
+        self.pois = PoiSet.of(self.poi_pos, self.poi_normal)
         b = finite_array("boresight_body", self.boresight_body, (3,))
         if not np.linalg.norm(b) > 0.0 or not self.noise_frac >= 0.0:
             raise ValueError("need a non-zero boresight and a non-negative noise fraction")
@@ -91,9 +94,9 @@ class TruthCameras:
         """One image per observer at true positions (N, 3) m and attitudes (N, 4)."""
         n = len(self.rngs)
         r = finite_array("r_lvlh_m", r_lvlh_m, (n, 3))
-        precision = infocost_kernels.precision if self.compiled else infocost.precision
-        prec = precision(r, self.boresights_lvlh(q_lvlh_body), self.poi_pos, self.poi_normal,
-                         self.camera)
+        bore = self.boresights_lvlh(q_lvlh_body)
+        prec = (infocost_kernels.precision_on(r, bore, self.pois, self.camera) if self.compiled
+                else infocost.precision(r, bore, self.poi_pos, self.poi_normal, self.camera))
         out = []
         for i in range(n):
             seen = np.flatnonzero(prec[i]).astype(np.int64)

@@ -52,3 +52,20 @@ def test_kernel_refuses_what_the_reference_refuses() -> None:
     for f in (infocost.precision, infocost_kernels.precision):
         with pytest.raises(ValueError):
             f(p, b, s, nrm, CAM)
+
+
+def test_pois_validated_once_give_the_same_bits() -> None:
+    """``precision_on`` (a ``PoiSet`` made once, as the twin and the sim's cameras hold it)
+    is ``precision`` bit for bit; its columns are the POIs' own."""
+    s, nrm = sphere_pois(2000, 5.0)
+    p, b = _poses(np.random.default_rng(6), 40)
+    for n in (nrm, None):
+        pois = infocost.PoiSet.of(s, n)
+        assert np.array_equal(infocost_kernels.precision_on(p, b, pois, CAM),
+                              infocost_kernels.precision(p, b, s, n, CAM))
+    sx, sy, sz, ss, nx, ny, nz, ns = infocost.PoiSet.of(s, nrm).columns
+    assert np.array_equal(np.c_[sx, sy, sz], s) and np.array_equal(np.c_[nx, ny, nz], nrm)
+    np.testing.assert_allclose(ss, np.sum(s * s, axis=1), rtol=1e-15)
+    np.testing.assert_allclose(ns, np.sum(s * nrm, axis=1), rtol=1e-15)
+    with pytest.raises(ValueError, match="zero-length row"):
+        infocost.PoiSet.of(s, np.zeros_like(s))
