@@ -107,8 +107,8 @@ class FlightPlan:
             return out
         inside = self.on_transfer(tt)
         if inside.any():
-            k = np.clip(np.searchsorted(tr.t_s, tt[inside], side="right") - 1, 0,
-                        len(tr.u) - 1)
+            k = np.minimum(np.maximum(np.searchsorted(tr.t_s, tt[inside], side="right") - 1, 0),
+                           len(tr.u) - 1)
             phi, gam = zoh_matrices(n, tt[inside] - tr.t_s[k])
             x = np.einsum("tij,tj->ti", phi, tr.x[k]) + np.einsum("tij,tj->ti", gam, tr.u[k])
             out[inside] = x[:, :3]
@@ -165,10 +165,12 @@ def predicted_delta_h(positions: npt.ArrayLike, boresights: npt.ArrayLike,
 
 
 def perturbed_boresights(boresight: npt.ArrayLike, eps_rad: float, count: int,
-                         rng: np.random.Generator) -> FloatArray:
+                         rng: np.random.Generator, draws: int = 1) -> FloatArray:
     """Unit directions drawn uniformly (in solid angle) within ``eps_rad`` of a boresight: the
     ε-neighbourhood pointings of the adaptive threshold (Eq. 11).  ``boresight`` (3,) gives
-    ``count`` draws about it; (K, 3) gives one draw about each row (``count`` must be K)."""
+    ``count`` draws about it; (K, 3) gives one draw about each row (``count`` must be K).
+    ``draws`` > 1 repeats that ``draws`` times, stacked (draws·count, 3): the same directions,
+    bit for bit, as that many calls one after the other on ``rng``."""
     b = np.atleast_2d(np.asarray(boresight, dtype=float))
     b = b / np.linalg.norm(b, axis=1, keepdims=True)
     if b.shape[0] == 1:
@@ -177,13 +179,15 @@ def perturbed_boresights(boresight: npt.ArrayLike, eps_rad: float, count: int,
         raise ValueError(f"{b.shape[0]} boresights for {count} draws")
     if not (math.isfinite(eps_rad) and 0.0 < eps_rad < math.pi / 2):
         raise ValueError(f"eps_rad must be in (0, pi/2), got {eps_rad!r}")
-    cos_t = 1.0 - rng.random(count) * (1.0 - math.cos(eps_rad))
+    uniform = [(rng.random(count), rng.random(count)) for _ in range(draws)]  # a call's order
+    cos_t = 1.0 - np.concatenate([u for u, _ in uniform]) * (1.0 - math.cos(eps_rad))
     sin_t = np.sqrt(1.0 - cos_t**2)
-    az = rng.random(count) * 2.0 * math.pi
+    az = np.concatenate([v for _, v in uniform]) * 2.0 * math.pi
     helper = np.where((np.abs(b[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     e1 = np.cross(b, helper)
     e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
     e2 = np.cross(b, e1)
+    b, e1, e2 = (np.tile(v, (draws, 1)) for v in (b, e1, e2))
     return (cos_t[:, None] * b + sin_t[:, None] * (np.cos(az)[:, None] * e1
                                                   + np.sin(az)[:, None] * e2))
 

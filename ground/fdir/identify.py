@@ -117,7 +117,7 @@ from gnc.infocost import visibility
 from gnc.twin import TwinModel, sample_stride
 from gnc.window_test import Observation, WindowPose
 from ground.fdir.boresight import boresight_offset
-from ground.fdir.trilateration import least_squares
+from ground.fdir.trilateration import least_squares, least_squares_each
 from interfaces.contracts.scenario import FdirSettings
 
 FloatArray = npt.NDArray[np.float64]
@@ -196,7 +196,14 @@ def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
     if s.ndim != 2 or s.shape[1] != 3 or len(index) != len(p) or (
             len(index) and not 0 <= index.min() <= index.max() < len(s)):
         raise ValueError(f"{len(p)} precisions for POIs {s.shape} seen at {len(index)} indices")
-    coef = least_squares(s, index, k * p, MIN_POIS)
+    return camera_fix(least_squares(s, index, k * p, MIN_POIS), radius_m, noise_frac)
+
+
+def camera_fix(coef: npt.NDArray[np.float64] | None, radius_m: float, noise_frac: float
+               ) -> CameraFix | None:
+    """The camera fix of the trilateration's fitted θ = [a, g] (:func:`locate_camera`; None:
+    no fit): its errors-in-variables shrinkage divided out, the root outside the sphere of
+    radius ``radius_m`` (m).  None when there is no such root."""
     if coef is None:
         return None
     m1, var = clipped_noise_moments(noise_frac)
@@ -458,10 +465,20 @@ def _alignment(ev: Evidence) -> float | None:
 
 def located_cameras(twin: TwinModel, images: Sequence[Observation]
                     ) -> list[tuple[int, CameraFix]]:
-    """The camera located from each image that allows it (:func:`locate_camera`), by image
-    index; none when fewer than ``MIN_FIXES`` images do."""
-    fixes = [locate_camera(twin.poi_pos, prec, twin.camera.k, twin.radius_m, twin.noise_frac,
-                           poi) for poi, prec in images]
+    """The camera located from each image that allows it (:func:`locate_camera`, the images
+    fitted together: ``ground.fdir.trilateration.least_squares_each``), by image index; none
+    when fewer than ``MIN_FIXES`` images do."""
+    if not images:
+        return []
+    seen = np.concatenate([poi for poi, _ in images]).astype(np.int64, copy=False)
+    kp = twin.camera.k * np.concatenate([prec for _, prec in images])
+    starts = np.cumsum([0] + [len(poi) for poi, _ in images], dtype=np.int64)
+    if len(kp) != len(seen) or (len(seen) and not 0 <= seen.min() <= seen.max()
+                                < len(twin.pois.pos)):
+        raise ValueError(f"images of {len(seen)} POI indices and {len(kp)} precisions, "
+                         f"not all of the target's {len(twin.pois.pos)} POIs")
+    fixes = [camera_fix(coef, twin.radius_m, twin.noise_frac)
+             for coef in least_squares_each(twin.pois.pos, seen, kp, starts, MIN_POIS)]
     located = [(i, f) for i, f in enumerate(fixes) if f is not None]
     return located if len(located) >= MIN_FIXES else []
 

@@ -77,10 +77,12 @@ class TimeSeries:
         if not self.t:
             return None
         t, columns = self._current()
-        j = np.searchsorted(t, times)
-        before = np.abs(times - t[np.clip(j - 1, 0, len(t) - 1)])
-        after = np.abs(t[np.clip(j, 0, len(t) - 1)] - times)
-        out = np.stack([np.interp(times, t, column) for column in columns], axis=1)
+        j = np.searchsorted(t, times)  # in [0, N]
+        before = np.abs(times - t[np.maximum(j - 1, 0)])
+        after = np.abs(t[np.minimum(j, len(t) - 1)] - times)
+        out = np.empty((len(times), len(columns)))
+        for c, column in enumerate(columns):
+            out[:, c] = np.interp(times, t, column)
         out[np.minimum(before, after) > self.MAX_GAP_S] = np.nan
         return out
 

@@ -127,8 +127,8 @@ def sampled_threshold(twin: TwinModel, positions: np.ndarray, boresights: np.nda
     k = sample_stride(len(positions))
     pos, bore = positions[::k], boresights[::k]
     ref = twin.predicted(pos, bore, psi, phi)
-    tilted = [perturbed_boresights(bore, eps_rad, len(bore), rng) for _ in range(samples)]
-    draws = twin.predicted_each(pos, tilted, psi, phi)
+    tilted = perturbed_boresights(bore, eps_rad, len(bore), rng, draws=samples)
+    draws = twin.predicted_each(pos, np.split(tilted, samples), psi, phi)
     # the subset holds about 1/k of the window's gain
     return adaptive_threshold(draws, ref, h_prev / k, floor)
 

@@ -66,16 +66,46 @@ def normal_equations(s: FloatArray, seen: npt.NDArray[np.int64], kp: FloatArray
     return ata, atb, rows
 
 
+@njit(cache=True)
+def normal_equations_each(s: FloatArray, seen: npt.NDArray[np.int64], kp: FloatArray,
+                          starts: npt.NDArray[np.int64]
+                          ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.int64]]:
+    """:func:`normal_equations` of several images at once, their seen POIs and ``kp``
+    concatenated, image i's from ``starts[i]`` to ``starts[i + 1]``: AᵀA (n, 4, 4), Aᵀ1
+    (n, 4), rows (n,), each summed as the image alone."""
+    n = starts.shape[0] - 1
+    ata = np.empty((n, 4, 4))
+    atb = np.empty((n, 4))
+    rows = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        a, b = starts[i], starts[i + 1]
+        ata[i], atb[i], rows[i] = normal_equations(s, seen[a:b], kp[a:b])
+    return ata, atb, rows
+
+
 def least_squares(s: FloatArray, seen: npt.NDArray[np.int64], kp: FloatArray, min_rows: int
                   ) -> FloatArray | None:
     """θ (4,) minimising |A θ − 1| for the rows kp_j [1, s_j] of the POIs ``seen`` (indices
     into ``s`` (M, 3), m) with a positive ``kp`` (one per seen POI); None with fewer than
     ``min_rows`` such rows, or when κ(A) exceeds ``MAX_CONDITION``."""
-    ata, atb, rows = normal_equations(s, seen, kp)
-    if rows < min_rows:
-        return None
-    eig = np.linalg.eigvalsh(ata)  # ascending; κ(A)² = λ_max / λ_min
-    if not eig[0] > eig[-1] / MAX_CONDITION**2:
-        return None
-    coef: FloatArray = np.linalg.solve(ata, atb)
-    return coef
+    starts = np.array([0, len(seen)], dtype=np.int64)
+    return least_squares_each(s, seen, kp, starts, min_rows)[0]
+
+
+def least_squares_each(s: FloatArray, seen: npt.NDArray[np.int64], kp: FloatArray,
+                       starts: npt.NDArray[np.int64], min_rows: int) -> list[FloatArray | None]:
+    """:func:`least_squares` of each image, the images' ``seen`` and ``kp`` concatenated
+    (image i's from ``starts[i]`` to ``starts[i + 1]``): one compiled pass and one batched
+    solve, the same values as image by image."""
+    ata, atb, rows = normal_equations_each(s, seen, kp, starts)
+    ok = rows >= min_rows
+    out: list[FloatArray | None] = [None] * len(rows)
+    if not ok.any():
+        return out
+    eig = np.linalg.eigvalsh(ata[ok])  # ascending; κ(A)² = λ_max / λ_min
+    ok[ok] = eig[:, 0] > eig[:, -1] / MAX_CONDITION**2
+    if ok.any():
+        coef = np.linalg.solve(ata[ok], atb[ok][:, :, None])[:, :, 0]
+        for i, c in zip(np.flatnonzero(ok), coef, strict=True):
+            out[i] = c
+    return out

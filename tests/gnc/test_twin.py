@@ -85,6 +85,16 @@ def test_the_twin_images_many_pointings_in_one_call_as_one_by_one() -> None:
     assert twin.predicted_each(cams, [], psi, phi) == []
 
 
+def test_stacked_draws_are_the_draws_one_after_the_other() -> None:
+    rows = centre_boresights(np.array([[0.0, 0.0, -20.0], [15.0, 0.0, 5.0], [1.0, -18.0, 0.0]]))
+    stacked = perturbed_boresights(rows, 0.05, 3, np.random.default_rng(9), draws=4)
+    rng = np.random.default_rng(9)
+    one_by_one = [perturbed_boresights(rows, 0.05, 3, rng) for _ in range(4)]
+    assert np.array_equal(stacked, np.concatenate(one_by_one))
+    single = perturbed_boresights(rows[0], 0.05, 5, np.random.default_rng(2), draws=2)
+    assert single.shape == (10, 3) and np.allclose(np.linalg.norm(single, axis=1), 1.0)
+
+
 def test_the_twin_refuses_pois_it_cannot_image_when_built() -> None:
     pos, nor = sphere_pois(10, 5.0)
     nor[3] = 0.0

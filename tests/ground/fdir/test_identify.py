@@ -12,12 +12,14 @@ from scipy.stats import median_abs_deviation
 
 from gnc.infocost import Camera, precision
 from gnc.poi import sphere_pois
+from gnc.twin import TwinModel
 from ground.fdir.identify import (
     Evidence,
     Tolerances,
     classify,
     explained_fraction,
     locate_camera,
+    located_cameras,
     median_se,
     offset_alignment,
     seen_overlap,
@@ -128,6 +130,31 @@ def test_an_image_is_located_from_its_indices_as_from_its_positions() -> None:
         locate_camera(POS, p[:-1], 1.0, R, seen=seen)
     with pytest.raises(ValueError, match="precisions for POIs"):
         locate_camera(POS, p, 1.0, R, seen=seen + len(POS))
+
+
+def test_a_window_s_images_located_together_as_one_by_one() -> None:
+    """``located_cameras`` fits a window's images in one pass: the fixes are those of
+    ``locate_camera`` image by image, bit for bit; an image of too few POIs has none; indices
+    beyond the target's POIs are refused."""
+    rng = np.random.default_rng(12)
+    twin = TwinModel(POS, NORMAL, Camera(), R, 0.05)
+    images = []
+    for _ in range(8):
+        c = rng.standard_normal(3)
+        c *= rng.uniform(15.0, 40.0) / np.linalg.norm(c)
+        s, p = _image(c, 0.9, noise=0.05, rng=rng)
+        images.append((np.flatnonzero(np.isin(POS[:, 0], s[:, 0])), p))
+    images[3] = (images[3][0][:6], images[3][1][:6])  # too few POIs: no fix
+    located = dict(located_cameras(twin, images))
+    assert sorted(located) == [0, 1, 2, 4, 5, 6, 7]
+    for i, (seen, p) in enumerate(images):
+        alone = locate_camera(POS, p, 1.0, R, 0.05, seen=seen)
+        assert (alone is None) == (i not in located)
+        if alone is not None:
+            assert np.array_equal(alone.position_m, located[i].position_m)
+            assert alone.beta == located[i].beta
+    with pytest.raises(ValueError, match="not all of the target"):
+        located_cameras(twin, [(images[0][0] + len(POS), images[0][1])])
 
 
 def test_explained_fraction() -> None:
