@@ -103,8 +103,8 @@ def hcw_stm(n: float, t: float | npt.ArrayLike) -> FloatArray:
     """
     _check_n(n)
     tt = np.asarray(t, dtype=float)
-    if tt.size == 1:  # one time: Python floats, the same operations (sin, cos: libm's)
-        nt = n * float(tt.reshape(()))
+    if tt.size == 1 and math.isfinite(nt := n * float(tt.reshape(()))):
+        # one time: Python floats, the same operations (sin, cos: libm's, as numpy's here)
         return _matrix(_stm_rows(n, nt, math.sin(nt), math.cos(nt), 0.0, 1.0), tt.shape)
     nt = n * tt
     return _stacked(_stm_rows(n, nt, np.sin(nt), np.cos(nt), np.zeros_like(nt),
@@ -117,7 +117,8 @@ Scalar = float | FloatArray
 
 def _stm_rows(n: float, nt: Scalar, s: Scalar, c: Scalar, zero: Scalar, one: Scalar
               ) -> tuple[tuple[Scalar, ...], ...]:
-    """The entries of Phi(t) (:func:`hcw_stm`) from n t, sin n t and cos n t."""
+    """The entries of Phi(t) (:func:`hcw_stm`) from n (rad/s), n t (rad) and its sine and
+    cosine; ``zero``, ``one``: those constants in the entries' type."""
     inv_n = 1.0 / n
     return (
         (4.0 - 3.0 * c, zero, zero, s * inv_n, 2.0 * (1.0 - c) * inv_n, zero),
@@ -297,11 +298,12 @@ def zoh_matrices(n: float, tau: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
     """
     tt = np.asarray(tau, dtype=float)
     phi = hcw_stm(n, tt)
-    if tt.size == 1:  # one time: Python floats, as in hcw_stm
-        th = n * float(tt.reshape(()))
+    if tt.size == 1 and math.isfinite(th := n * float(tt.reshape(()))):
+        # one time: Python floats, as in hcw_stm.  sin² as numpy squares it: a scalar's
+        # ** 2 is pow(), an array's is x·x (they differ in the last bit for some x)
         half = math.sin(0.5 * th)
-        return phi, _matrix(_gamma_rows(n, th, math.sin(th), 2.0 * (half * half), 0.0),
-                            tt.shape)
+        c1 = 2.0 * (half**2 if tt.ndim == 0 else half * half)
+        return phi, _matrix(_gamma_rows(n, th, math.sin(th), c1, 0.0), tt.shape)
     th = n * tt
     return phi, _stacked(_gamma_rows(n, th, np.sin(th), 2.0 * np.sin(0.5 * th) ** 2,
                                      np.zeros_like(th)))
@@ -309,8 +311,8 @@ def zoh_matrices(n: float, tau: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
 
 def _gamma_rows(n: float, th: Scalar, s: Scalar, c1: Scalar, zero: Scalar
                 ) -> tuple[tuple[Scalar, ...], ...]:
-    """The entries of Gamma(tau) (:func:`zoh_matrices`) from th = n tau, sin th and
-    C1 = 2 sin²(th/2)."""
+    """The entries of Gamma(tau) (:func:`zoh_matrices`, s², s) from n (rad/s), th = n tau
+    (rad), sin th and C1 = 2 sin²(th/2); ``zero``: 0 in the entries' type."""
     n2 = n * n
     return (
         (c1 / n2, 2.0 * (th - s) / n2, zero),

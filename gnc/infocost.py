@@ -30,7 +30,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import numpy.typing as npt
@@ -147,36 +148,39 @@ TINY = float(np.finfo(np.float64).tiny)
 @dataclass(frozen=True)
 class PoiSet:
     """POIs validated once, for the many calls that image the same target: positions s
-    (M, 3), m, and outward normals (M, 3) or None (no horizon test).  Build with
-    :meth:`of`."""
+    (M, 3), m, and outward normals (M, 3) or None (no horizon test), both copied read-only
+    when made.  Positions must be finite (M ≥ 1), normals finite and of the same shape.
+    Normals are only used through the sign of n·(p − s), so they are not normalised; zero rows
+    are rejected."""
 
     pos: FloatArray
     normal: FloatArray | None
-    columns: tuple[FloatArray, ...] = field(init=False, repr=False, compare=False)
-    """what the compiled kernel reads (``gnc.infocost_kernels``), contiguous (M,) each: the
-    positions' x, y, z and |s|², the normals' x, y, z and n·s (zeros without normals)"""
 
     def __post_init__(self) -> None:
+        s = _read_only(_rows3("poi_pos", self.pos))
+        object.__setattr__(self, "pos", s)
+        if self.normal is not None:
+            n = finite_array("poi_normal", self.normal, s.shape)
+            if not np.all((n * n) @ np.ones(3) > 0.0):  # a matrix-vector product: row sums
+                raise ValueError("poi_normal has a zero-length row; expected outward normals")
+            object.__setattr__(self, "normal", _read_only(n))
+
+    @cached_property
+    def columns(self) -> tuple[FloatArray, ...]:
+        """What the compiled kernel reads (``gnc.infocost_kernels``), contiguous (M,) each:
+        the positions' x, y, z (m) and |s|² (m²), the normals' x, y, z and n·s (m; zeros
+        without normals)."""
         sx, sy, sz = (np.ascontiguousarray(self.pos[:, k]) for k in range(3))
         n = np.zeros_like(self.pos) if self.normal is None else self.normal
         nx, ny, nz = (np.ascontiguousarray(n[:, k]) for k in range(3))
-        object.__setattr__(self, "columns", (sx, sy, sz, sx * sx + sy * sy + sz * sz,
-                                             nx, ny, nz, nx * sx + ny * sy + nz * sz))
+        return sx, sy, sz, sx * sx + sy * sy + sz * sz, nx, ny, nz, nx * sx + ny * sy + nz * sz
 
-    @classmethod
-    def of(cls, poi_pos: npt.ArrayLike, poi_normal: npt.ArrayLike | None) -> PoiSet:
-        """Validated POIs: finite (M, 3) positions (M ≥ 1) and normals of the same shape.
 
-        Normals are only used through the sign of n·(p − s), so they are not normalised; zero
-        rows are rejected.
-        """
-        s = _rows3("poi_pos", poi_pos)
-        n = None
-        if poi_normal is not None:
-            n = finite_array("poi_normal", poi_normal, s.shape)
-            if not np.all((n * n) @ np.ones(3) > 0.0):  # a matrix-vector product: row sums
-                raise ValueError("poi_normal has a zero-length row; expected outward normals")
-        return cls(s, n)
+def _read_only(a: FloatArray) -> FloatArray:
+    """A read-only copy of ``a``."""
+    out = np.array(a, dtype=float)
+    out.setflags(write=False)
+    return out
 
 
 def checked_cameras(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, camera: Camera
@@ -194,7 +198,7 @@ def checked_inputs(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: np
     """Validated camera positions p (N, 3), unit boresights b (N, 3), POIs s (M, 3), normals
     (:class:`PoiSet`)."""
     p, b = checked_cameras(cam_pos, boresight, camera)
-    pois = PoiSet.of(poi_pos, poi_normal)
+    pois = PoiSet(poi_pos, poi_normal)  # type: ignore[arg-type]
     return p, b, pois.pos, pois.normal
 
 

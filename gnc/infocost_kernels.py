@@ -54,7 +54,7 @@ def precision(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: npt.Arr
     """σ⁻¹ (N, M) = 1/(k d²) where visible, else 0: :func:`gnc.infocost.precision`
     compiled (same arguments, same validation and errors)."""
     p, b = checked_cameras(cam_pos, boresight, camera)
-    return _precision(p, b, PoiSet.of(poi_pos, poi_normal), camera)
+    return _precision(p, b, PoiSet(poi_pos, poi_normal), camera)
 
 
 def precision_on(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, pois: PoiSet,
@@ -65,6 +65,7 @@ def precision_on(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, pois: PoiSet,
 
 
 def _precision(p: FloatArray, b: FloatArray, pois: PoiSet, camera: Camera) -> FloatArray:
+    """σ⁻¹ (N, M) of validated cameras p (N, 3), m, and unit boresights b (N, 3)."""
     out = np.empty((p.shape[0], pois.pos.shape[0]))
     _fill(p, b, *pois.columns, pois.normal is not None,
           float(np.cos(camera.half_angle_rad)) ** 2, camera.max_range_m ** 2, 1.0 / camera.k,

@@ -27,7 +27,7 @@ import numpy.typing as npt
 
 from gnc.hcw import zoh_matrices
 from gnc.infocost import Camera, PoiSet
-from gnc.infocost_kernels import precision, precision_on
+from gnc.infocost_kernels import precision_on
 from gnc.pro import Pro
 from interfaces.contracts.messages import ProAssignment
 
@@ -158,10 +158,16 @@ def predicted_delta_h(positions: npt.ArrayLike, boresights: npt.ArrayLike,
                       psi: npt.ArrayLike, phi: npt.ArrayLike) -> float:
     """ΔH_i^pred of images taken at ``positions`` (K, 3) along ``boresights`` (K, 3) with the
     nominal camera (β = 1, no noise)."""
+    return predicted_on(positions, boresights, PoiSet(poi_pos, poi_normal),  # type: ignore[arg-type]
+                        camera, psi, phi)
+
+
+def predicted_on(positions: npt.ArrayLike, boresights: npt.ArrayLike, pois: PoiSet,
+                 camera: Camera, psi: npt.ArrayLike, phi: npt.ArrayLike) -> float:
+    """:func:`predicted_delta_h` of POIs validated once (``pois``)."""
     if np.shape(positions)[0] == 0:
         return 0.0
-    prec = precision(positions, boresights, poi_pos, poi_normal, camera)
-    return delta_h(psi, phi, prec)
+    return delta_h(psi, phi, precision_on(positions, boresights, pois, camera))
 
 
 def perturbed_boresights(boresight: npt.ArrayLike, eps_rad: float, count: int,
@@ -179,6 +185,8 @@ def perturbed_boresights(boresight: npt.ArrayLike, eps_rad: float, count: int,
         raise ValueError(f"{b.shape[0]} boresights for {count} draws")
     if not (math.isfinite(eps_rad) and 0.0 < eps_rad < math.pi / 2):
         raise ValueError(f"eps_rad must be in (0, pi/2), got {eps_rad!r}")
+    if draws < 1:
+        raise ValueError(f"draws must be at least 1, got {draws!r}")
     uniform = [(rng.random(count), rng.random(count)) for _ in range(draws)]  # a call's order
     cos_t = 1.0 - np.concatenate([u for u, _ in uniform]) * (1.0 - math.cos(eps_rad))
     sin_t = np.sqrt(1.0 - cos_t**2)
@@ -207,7 +215,7 @@ class TwinModel:
     """the POIs validated once (the twin images them thousands of times a window)"""
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "pois", PoiSet.of(self.poi_pos, self.poi_normal))
+        object.__setattr__(self, "pois", PoiSet(self.poi_pos, self.poi_normal))
 
     def precision(self, positions: npt.ArrayLike, boresights: npt.ArrayLike) -> FloatArray:
         """σ⁻¹ (K, M) of nominal images taken from ``positions`` along ``boresights``."""
@@ -217,21 +225,29 @@ class TwinModel:
                   psi: npt.ArrayLike, phi: npt.ArrayLike) -> float:
         """ΔH_i^pred of images taken from ``positions`` along ``boresights``
         (:func:`predicted_delta_h`)."""
-        if np.shape(positions)[0] == 0:
-            return 0.0
-        return delta_h(psi, phi, self.precision(positions, boresights))
+        return predicted_on(positions, boresights, self.pois, self.camera, psi, phi)
 
     def predicted_each(self, positions: npt.ArrayLike, boresights: Sequence[FloatArray],
                        psi: npt.ArrayLike, phi: npt.ArrayLike) -> list[float]:
         """:meth:`predicted` of the images taken from ``positions`` (K, 3) along each set of
-        ``boresights`` (each (K, 3)), imaged in one call."""
+        ``boresights`` (each (K, 3)), imaged together: as many sets a call as
+        ``IMAGED_BYTES`` of precisions hold."""
         pos = np.asarray(positions, dtype=float)
         if pos.shape[0] == 0:
             return [0.0] * len(boresights)
-        if not boresights:
-            return []
-        prec = self.precision(np.tile(pos, (len(boresights), 1)), np.concatenate(boresights))
-        return [delta_h(psi, phi, block) for block in np.split(prec, len(boresights))]
+        step = max(1, IMAGED_BYTES // (8 * pos.shape[0] * len(self.pois.pos)))
+        out: list[float] = []
+        for i in range(0, len(boresights), step):
+            part = boresights[i:i + step]
+            prec = self.precision(np.tile(pos, (len(part), 1)), np.concatenate(part))
+            out += [delta_h(psi, phi, block) for block in np.split(prec, len(part))]
+        return out
+
+
+IMAGED_BYTES = 16 * 2**20
+"""The most precisions (bytes) :meth:`TwinModel.predicted_each` makes at once: the default
+threshold's 10 draws of 20 images of 5,000 POIs (8 MB) in one call, 1,000 draws of 200,000
+POIs not all at once."""
 
 
 SAMPLED_IMAGES = 20

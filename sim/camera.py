@@ -67,14 +67,14 @@ class TruthCameras:
     compiled: bool = True
     beta: FloatArray = field(init=False)
     misalignment: FloatArray = field(init=False)
-    pois: PoiSet = field(init=False)
+    pois: PoiSet = field(init=False, repr=False, compare=False)
     """the POIs validated once, for the compiled kernel"""
 
     def __post_init__(self) -> None:
         m = len(self.poi_pos)
         self.poi_pos = finite_array("poi_pos", self.poi_pos, (m, 3))
         self.poi_normal = finite_array("poi_normal", self.poi_normal, (m, 3))
-        self.pois = PoiSet.of(self.poi_pos, self.poi_normal)
+        self.pois = PoiSet(self.poi_pos, self.poi_normal)
         b = finite_array("boresight_body", self.boresight_body, (3,))
         if not np.linalg.norm(b) > 0.0 or not self.noise_frac >= 0.0:
             raise ValueError("need a non-zero boresight and a non-negative noise fraction")

@@ -190,12 +190,11 @@ def locate_camera(poi_pos: npt.ArrayLike, precision: npt.ArrayLike, k: float,
     Raises:
         ValueError: when the positions, indices and precisions do not go together.
     """
-    s = np.ascontiguousarray(poi_pos, dtype=float)
     p = np.ascontiguousarray(precision, dtype=float)
-    index = np.arange(len(s)) if seen is None else np.ascontiguousarray(seen, dtype=np.int64)
-    if s.ndim != 2 or s.shape[1] != 3 or len(index) != len(p) or (
-            len(index) and not 0 <= index.min() <= index.max() < len(s)):
-        raise ValueError(f"{len(p)} precisions for POIs {s.shape} seen at {len(index)} indices")
+    if p.ndim == 1 and len(p) < MIN_POIS:
+        return None
+    s = np.ascontiguousarray(poi_pos, dtype=float)
+    index = np.arange(len(s)) if seen is None else np.ascontiguousarray(seen)
     return camera_fix(least_squares(s, index, k * p, MIN_POIS), radius_m, noise_frac)
 
 
@@ -470,13 +469,11 @@ def located_cameras(twin: TwinModel, images: Sequence[Observation]
     when fewer than ``MIN_FIXES`` images do."""
     if not images:
         return []
-    seen = np.concatenate([poi for poi, _ in images]).astype(np.int64, copy=False)
+    if any(len(poi) != len(prec) for poi, prec in images):
+        raise ValueError("an image's POI indices and precisions differ in number")
+    seen = np.concatenate([poi for poi, _ in images])
     kp = twin.camera.k * np.concatenate([prec for _, prec in images])
     starts = np.cumsum([0] + [len(poi) for poi, _ in images], dtype=np.int64)
-    if len(kp) != len(seen) or (len(seen) and not 0 <= seen.min() <= seen.max()
-                                < len(twin.pois.pos)):
-        raise ValueError(f"images of {len(seen)} POI indices and {len(kp)} precisions, "
-                         f"not all of the target's {len(twin.pois.pos)} POIs")
     fixes = [camera_fix(coef, twin.radius_m, twin.noise_frac)
              for coef in least_squares_each(twin.pois.pos, seen, kp, starts, MIN_POIS)]
     located = [(i, f) for i, f in enumerate(fixes) if f is not None]

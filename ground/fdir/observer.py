@@ -34,6 +34,7 @@ class TimeSeries:
         change."""
 
     def add(self, t: float, value: np.ndarray) -> None:
+        """A sample ``value`` (d,) at time ``t`` (s), in time order among the others."""
         i = bisect.bisect_right(self.t, t)
         self.t.insert(i, t)
         self.v.insert(i, value)
@@ -43,8 +44,10 @@ class TimeSeries:
             self._arrays = None
 
     def _append(self, t: float, value: np.ndarray) -> None:
-        """Extend the arrays by a last sample (their capacity doubled when full)."""
-        assert self._arrays is not None
+        """Extend the arrays (made: ``_arrays``) by a last sample (their capacity doubled
+        when full)."""
+        if self._arrays is None:
+            return
         times, columns, count = self._arrays
         if np.shape(value) != columns.shape[:1]:
             self._arrays = None
@@ -61,7 +64,8 @@ class TimeSeries:
     def _current(self) -> tuple[np.ndarray, np.ndarray]:
         """The sample times (N,) and values by column (d, N)."""
         if self._arrays is None or self._arrays[2] != len(self.t):
-            self._arrays = np.array(self.t), np.array(self.v).T.copy(), len(self.t)
+            self._arrays = (np.array(self.t, dtype=float), np.array(self.v, dtype=float).T.copy(),
+                            len(self.t))
         times, columns, count = self._arrays
         return times[:count], columns[:, :count]
 

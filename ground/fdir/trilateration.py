@@ -92,11 +92,29 @@ def least_squares(s: FloatArray, seen: npt.NDArray[np.int64], kp: FloatArray, mi
     return least_squares_each(s, seen, kp, starts, min_rows)[0]
 
 
+def _check(s: FloatArray, seen: npt.NDArray[np.int64], kp: FloatArray,
+           starts: npt.NDArray[np.int64]) -> None:
+    """Refuse what the compiled pass, which checks no index, cannot read safely: positions not
+    (M, 3) float, indices not integers in [0, M), a ``kp`` per index missing, image bounds
+    ``starts`` not from 0 to the end, ascending."""
+    if not (s.ndim == 2 and s.shape[1] == 3 and s.dtype == np.float64):
+        raise ValueError(f"POI positions must be an (M, 3) float array, got {s.shape} {s.dtype}")
+    if not (seen.ndim == 1 and np.issubdtype(seen.dtype, np.integer)
+            and kp.ndim == 1 and len(kp) == len(seen)):
+        raise ValueError(f"{kp.shape} precisions for {seen.shape} {seen.dtype} POI indices")
+    if len(seen) and not 0 <= seen.min() <= seen.max() < len(s):
+        raise ValueError(f"POI indices beyond the target's {len(s)} POIs")
+    if not (starts.ndim == 1 and len(starts) >= 1 and starts[0] == 0
+            and starts[-1] == len(seen) and np.all(np.diff(starts) >= 0)):
+        raise ValueError(f"image bounds must run from 0 to {len(seen)}, ascending")
+
+
 def least_squares_each(s: FloatArray, seen: npt.NDArray[np.int64], kp: FloatArray,
                        starts: npt.NDArray[np.int64], min_rows: int) -> list[FloatArray | None]:
     """:func:`least_squares` of each image, the images' ``seen`` and ``kp`` concatenated
     (image i's from ``starts[i]`` to ``starts[i + 1]``): one compiled pass and one batched
     solve, the same values as image by image."""
+    _check(s, seen, kp, starts)
     ata, atb, rows = normal_equations_each(s, seen, kp, starts)
     ok = rows >= min_rows
     out: list[FloatArray | None] = [None] * len(rows)

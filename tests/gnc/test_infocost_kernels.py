@@ -60,12 +60,17 @@ def test_pois_validated_once_give_the_same_bits() -> None:
     s, nrm = sphere_pois(2000, 5.0)
     p, b = _poses(np.random.default_rng(6), 40)
     for n in (nrm, None):
-        pois = infocost.PoiSet.of(s, n)
+        pois = infocost.PoiSet(s, n)
         assert np.array_equal(infocost_kernels.precision_on(p, b, pois, CAM),
                               infocost_kernels.precision(p, b, s, n, CAM))
-    sx, sy, sz, ss, nx, ny, nz, ns = infocost.PoiSet.of(s, nrm).columns
+    sx, sy, sz, ss, nx, ny, nz, ns = infocost.PoiSet(s, nrm).columns
     assert np.array_equal(np.c_[sx, sy, sz], s) and np.array_equal(np.c_[nx, ny, nz], nrm)
     np.testing.assert_allclose(ss, np.sum(s * s, axis=1), rtol=1e-15)
     np.testing.assert_allclose(ns, np.sum(s * nrm, axis=1), rtol=1e-15)
     with pytest.raises(ValueError, match="zero-length row"):
-        infocost.PoiSet.of(s, np.zeros_like(s))
+        infocost.PoiSet(s, np.zeros_like(s))
+    with pytest.raises(ValueError, match="poi_normal must have shape"):
+        infocost.PoiSet(s, nrm[:1])  # the kernel would read past the normals
+    pois = infocost.PoiSet(s, nrm)
+    s[0] = 99.0  # the set holds its own read-only copy
+    assert not np.array_equal(pois.pos[0], s[0]) and not pois.pos.flags.writeable

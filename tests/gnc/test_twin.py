@@ -10,6 +10,7 @@ import pytest
 
 from fsw.lib.scp import plan_transfer
 from gnc import infocost as ic
+from gnc import twin as twin_module
 from gnc.hcw import mean_motion
 from gnc.poi import sphere_pois
 from gnc.pro import Pro
@@ -83,6 +84,22 @@ def test_the_twin_images_many_pointings_in_one_call_as_one_by_one() -> None:
     assert len(set(each)) == 4 and min(each) > 0.0  # four pointings, four gains
     assert twin.predicted_each(np.zeros((0, 3)), [np.zeros((0, 3))] * 2, psi, phi) == [0.0, 0.0]
     assert twin.predicted_each(cams, [], psi, phi) == []
+
+
+def test_many_draws_are_imaged_a_few_at_a_time_with_the_same_gains(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    rng = np.random.default_rng(8)
+    pos, nor = sphere_pois(300, 5.0)
+    twin = TwinModel(pos, nor, ic.Camera(), 5.0)
+    psi, phi = rng.uniform(0.1, 1.0, 300), np.full(300, 1 / 300)
+    cams = np.array([[0.0, 0.0, -20.0], [15.0, 0.0, 5.0]])
+    tilted = list(np.split(perturbed_boresights(centre_boresights(cams), 0.1, 2, rng, draws=7),
+                           7))
+    together = twin.predicted_each(cams, tilted, psi, phi)
+    monkeypatch.setattr(twin_module, "IMAGED_BYTES", 3 * 8 * 2 * 300)  # 3 draws a call
+    assert twin.predicted_each(cams, tilted, psi, phi) == together
+    with pytest.raises(ValueError, match="draws must be at least 1"):
+        perturbed_boresights(centre_boresights(cams), 0.1, 2, rng, draws=0)
 
 
 def test_stacked_draws_are_the_draws_one_after_the_other() -> None:

@@ -126,10 +126,17 @@ def test_an_image_is_located_from_its_indices_as_from_its_positions() -> None:
     assert direct is not None and indexed is not None
     assert np.array_equal(direct.position_m, indexed.position_m)
     assert direct.beta == indexed.beta
-    with pytest.raises(ValueError, match="precisions for POIs"):
+    with pytest.raises(ValueError, match="precisions for"):
         locate_camera(POS, p[:-1], 1.0, R, seen=seen)
-    with pytest.raises(ValueError, match="precisions for POIs"):
+    with pytest.raises(ValueError, match="precisions for"):
+        locate_camera(POS, p, 1.0, R, seen=seen + 0.5)  # not indices
+    with pytest.raises(ValueError, match="precisions for"):
+        locate_camera(POS, p[:, None], 1.0, R, seen=seen)
+    with pytest.raises(ValueError, match="beyond the target's"):
         locate_camera(POS, p, 1.0, R, seen=seen + len(POS))
+    with pytest.raises(ValueError, match="beyond the target's"):
+        locate_camera(POS, p, 1.0, R, seen=seen - len(POS))
+    assert locate_camera([], [], 1.0, R) is None  # no POIs seen: no fix
 
 
 def test_a_window_s_images_located_together_as_one_by_one() -> None:
@@ -153,8 +160,10 @@ def test_a_window_s_images_located_together_as_one_by_one() -> None:
         if alone is not None:
             assert np.array_equal(alone.position_m, located[i].position_m)
             assert alone.beta == located[i].beta
-    with pytest.raises(ValueError, match="not all of the target"):
+    with pytest.raises(ValueError, match="beyond the target's"):
         located_cameras(twin, [(images[0][0] + len(POS), images[0][1])])
+    with pytest.raises(ValueError, match="differ in number"):  # not paired across images
+        located_cameras(twin, [(images[0][0], images[1][1]), (images[1][0], images[0][1])])
 
 
 def test_explained_fraction() -> None:
