@@ -165,6 +165,11 @@ class PoiSet:
                 raise ValueError("poi_normal has a zero-length row; expected outward normals")
             object.__setattr__(self, "normal", _read_only(n))
 
+    def __getstate__(self) -> dict[str, object]:
+        """The POIs without the columns made from them (a cache: a pickled set is the same
+        set whether or not it has been imaged yet)."""
+        return {k: v for k, v in self.__dict__.items() if k != "columns"}
+
     @cached_property
     def columns(self) -> tuple[FloatArray, ...]:
         """What the compiled kernel reads (``gnc.infocost_kernels``), contiguous (M,) each:

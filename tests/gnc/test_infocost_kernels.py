@@ -5,6 +5,7 @@ rounding of a boundary, the same errors on bad input."""
 from __future__ import annotations
 
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -72,5 +73,9 @@ def test_pois_validated_once_give_the_same_bits() -> None:
     with pytest.raises(ValueError, match="poi_normal must have shape"):
         infocost.PoiSet(s, nrm[:1])  # the kernel would read past the normals
     pois = infocost.PoiSet(s, nrm)
+    before = pickle.dumps(pois)
+    infocost_kernels.precision_on(p, b, pois, CAM)  # its columns made: a cache, not state
+    assert pickle.dumps(pois) == before
+    assert np.array_equal(pickle.loads(before).columns[0], pois.columns[0])
     s[0] = 99.0  # the set holds its own read-only copy
     assert not np.array_equal(pois.pos[0], s[0]) and not pois.pos.flags.writeable
