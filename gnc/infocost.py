@@ -157,13 +157,9 @@ class PoiSet:
     normal: FloatArray | None
 
     def __post_init__(self) -> None:
-        s = _read_only(_rows3("poi_pos", self.pos))
-        object.__setattr__(self, "pos", s)
-        if self.normal is not None:
-            n = finite_array("poi_normal", self.normal, s.shape)
-            if not np.all((n * n) @ np.ones(3) > 0.0):  # a matrix-vector product: row sums
-                raise ValueError("poi_normal has a zero-length row; expected outward normals")
-            object.__setattr__(self, "normal", _read_only(n))
+        s, n = checked_pois(self.pos, self.normal)
+        object.__setattr__(self, "pos", _read_only(s))
+        object.__setattr__(self, "normal", None if n is None else _read_only(n))
 
     def __getstate__(self) -> dict[str, object]:
         """The POIs without the columns made from them (a cache: a pickled set is the same
@@ -179,6 +175,19 @@ class PoiSet:
         n = np.zeros_like(self.pos) if self.normal is None else self.normal
         nx, ny, nz = (np.ascontiguousarray(n[:, k]) for k in range(3))
         return sx, sy, sz, sx * sx + sy * sy + sz * sz, nx, ny, nz, nx * sx + ny * sy + nz * sz
+
+
+def checked_pois(poi_pos: npt.ArrayLike, poi_normal: npt.ArrayLike | None
+                 ) -> tuple[FloatArray, FloatArray | None]:
+    """Validated POI positions s (M, 3), m, finite (M ≥ 1), and outward normals of the same
+    shape or None (:class:`PoiSet`'s rules)."""
+    s = _rows3("poi_pos", poi_pos)
+    if poi_normal is None:
+        return s, None
+    n = finite_array("poi_normal", poi_normal, s.shape)
+    if not np.all((n * n) @ np.ones(3) > 0.0):  # a matrix-vector product: fast row sums
+        raise ValueError("poi_normal has a zero-length row; expected outward normals")
+    return s, n
 
 
 def _read_only(a: FloatArray) -> FloatArray:
@@ -203,8 +212,7 @@ def checked_inputs(cam_pos: npt.ArrayLike, boresight: npt.ArrayLike, poi_pos: np
     """Validated camera positions p (N, 3), unit boresights b (N, 3), POIs s (M, 3), normals
     (:class:`PoiSet`)."""
     p, b = checked_cameras(cam_pos, boresight, camera)
-    pois = PoiSet(poi_pos, poi_normal)  # type: ignore[arg-type]
-    return p, b, pois.pos, pois.normal
+    return (p, b, *checked_pois(poi_pos, poi_normal))
 
 
 def _blocks(p: FloatArray, b: FloatArray, s: FloatArray, n: FloatArray | None, camera: Camera,

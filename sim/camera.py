@@ -11,7 +11,7 @@ message carries (``interfaces.contracts.messages.poi_packing.quantise``).  Fault
 ``misalignment`` (a rotation of the boresight in body axes: other POIs, or none, are seen).
 
 The precision of every camera-POI pair is computed by the compiled kernel
-(``gnc.infocost_kernels.precision``, ``compiled=True``, the default) or by the numpy
+(``gnc.infocost_kernels.precision_on``, ``compiled=True``, the default) or by the numpy
 reference (``gnc.infocost.precision``).  They agree to rounding; after quantisation the
 images are the same unless a pair lies within rounding of the cone, range or horizon boundary
 or a value within rounding of a quantisation step (``tests/sim/test_truth_camera.py``).
