@@ -265,6 +265,8 @@ class Bus:
             except ValidationError as e:
                 self.drop_invalid(key, f"not a valid {msg_type.__name__}: {_first_error(e)}")
                 return None
+            if sample.message is None:  # the other nodes of this process handed the same
+                sample.message = msg  # sample take it as it is (``SharedReceiver``)
         refusal = self.admission.check(key, msg, len(self.inbox.pending))
         if refusal is not None:
             self.refuse(key, *refusal)

@@ -23,7 +23,12 @@ from interfaces.runtime.fleet import fleets_of
 from interfaces.runtime.link_stage import LinkStageFactory
 from interfaces.runtime.recent import depth_for
 from interfaces.runtime.restart import resume_together
-from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
+from interfaces.runtime.zenoh_transport import (
+    DEFAULT_ENDPOINT,
+    SharedReceiver,
+    ZenohSettings,
+    ZenohTransport,
+)
 
 
 def add_node_args(parser: argparse.ArgumentParser) -> None:
@@ -57,10 +62,13 @@ def mission_of(args: argparse.Namespace, scenario: Scenario) -> str:
     return str(args.mission or scenario.name)
 
 
-def open_zenoh(args: argparse.Namespace, node: str = "") -> ZenohTransport:
-    """A Zenoh session of ``node`` (its own account: ``{node}`` in ``--zenoh-config``)."""
+def open_zenoh(args: argparse.Namespace, node: str = "",
+               shared: SharedReceiver | None = None) -> ZenohTransport:
+    """A Zenoh session of ``node`` (its own account: ``{node}`` in ``--zenoh-config``),
+    receiving through ``shared`` if given (the nodes of one process)."""
     config = args.zenoh_config.replace("{node}", node) if args.zenoh_config else None
-    return ZenohTransport(ZenohSettings(connect=(args.connect,), config_file=config))
+    return ZenohTransport(ZenohSettings(connect=(args.connect,), config_file=config),
+                          shared=shared, node=node)
 
 
 def setup_logging(level: str, name: str) -> logging.Logger:
@@ -123,7 +131,8 @@ def run_participants(
     """Main loop of a process hosting the lockstep nodes ``nodes`` (spacecraft or the ground)
     over Zenoh.
 
-    Each node joins the network with its own account and session, and its executive is wired
+    Each node joins the network with its own account and session (they receive through one
+    ``SharedReceiver``: what several of them read comes once), and its executive is wired
     on its own bus (``build(bus, scenario)``, with the link stage ``links(node, scenario)``);
     nodes running the same apps step together (``interfaces/runtime/fleet.py``).  Each is
     restored from its critical-data store when started again (``--cds``), serves the message
@@ -132,9 +141,10 @@ def run_participants(
     session is always closed."""
     start = start_node(args, "+".join(nodes))
     buses: list[Bus] = []
+    receiver = SharedReceiver() if len(nodes) > 1 else None
     try:
         for node in nodes:
-            buses.append(Bus(node, start.mission, open_zenoh(args, node),
+            buses.append(Bus(node, start.mission, open_zenoh(args, node, receiver),
                              channel=links(node, start.scenario),
                              recent_ticks=depth_for(start.scenario.rates.ticks_per("mid"))))
         shared: queue.Queue[tuple[TickClient, int, Tick] | None] = queue.Queue()

@@ -11,12 +11,19 @@ Messages are JSON with encoding ``application/json;<MessageType>``; publications
 congestion control so that nothing is dropped under pressure (the channel model, not the
 middleware, decides what is lost).  Zenoh sessions must be closed explicitly: an open session
 keeps the interpreter from exiting.
+
+The nodes one process hosts (issue 42; docs/architecture.md, "Hosting") each publish on their
+own session, with their own account, but receive through one :class:`SharedReceiver`: a key
+expression several of them subscribe to (the tick, the truth, every observer's images) is
+declared once, and what arrives is handed to each of them but its publisher, one sample whose
+message the first Bus to take it decodes for all.
 """
 
 from __future__ import annotations
 
 import json
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -78,6 +85,12 @@ class ZenohTransport:
     _closed: bool = False
     synchronous: bool = False
     """Delivery happens on Zenoh's threads, after ``send`` returns."""
+    shared: SharedReceiver | None = None
+    """The receiver this session's node shares with the other nodes of its process (None: it
+    subscribes on its own session)."""
+    node: str = ""
+    """The node whose session this is (needed with ``shared``: it is not handed its own
+    messages)."""
 
     def __post_init__(self) -> None:
         self._session = zenoh.open(self.settings.config())
@@ -97,7 +110,8 @@ class ZenohTransport:
                     key,
                     encoding=zenoh.Encoding.APPLICATION_JSON.with_schema(type_name),
                     congestion_control=zenoh.CongestionControl.BLOCK,
-                    allowed_destination=zenoh.Locality.REMOTE,
+                    allowed_destination=(zenoh.Locality.REMOTE if self.shared is None
+                                         else zenoh.Locality.ANY),  # its process's receiver
                 )
                 self._publishers[(key, type_name)] = pub
         pub.put(payload)
@@ -107,15 +121,21 @@ class ZenohTransport:
             handler(str(sample.key_expr), type_of_encoding(sample.encoding),
                     sample.payload.to_bytes())
 
-        sub = self._session.declare_subscriber(
-            key_expr, on_sample, allowed_origin=zenoh.Locality.REMOTE
-        )
-        self._entities.append(sub)
+        self.declare_subscriber(key_expr, on_sample, zenoh.Locality.REMOTE)
+
+    def declare_subscriber(self, key_expr: str, callback: Callable[[zenoh.Sample], None],
+                           origin: zenoh.Locality) -> None:
+        """A Zenoh subscriber on this session, undeclared when it closes."""
+        self._entities.append(
+            self._session.declare_subscriber(key_expr, callback, allowed_origin=origin))
 
     def subscribe_samples(self, key_expr: str, handler: SampleHandler,
                           made_here: MadeHereHandler | None = None) -> None:
-        """Every sample comes from another process: bytes, validated and admitted by the Bus
-        (``made_here`` is never called)."""
+        """Every sample comes as bytes, to be validated and admitted by the Bus (``made_here``
+        is never called); through the process's ``shared`` receiver, if it has one."""
+        if self.shared is not None:
+            self.shared.subscribe(self, key_expr, handler)
+            return
         self.subscribe(key_expr, lambda k, t, p: handler(Sample(k, t, payload=p)))
 
     def serve(self, key_expr: str, responder: Responder) -> None:
@@ -163,6 +183,44 @@ class ZenohTransport:
             except Exception:  # noqa: BLE001
                 pass
         self._session.close()
+
+
+@dataclass(eq=False)
+class SharedReceiver:
+    """What the nodes one process hosts receive, taken from Zenoh once (module docstring).
+
+    Each key expression is declared once, on the session of the first node that subscribes to
+    it, with samples of any origin: the process's own nodes publish on their own sessions, so a
+    message one of them sends reaches the others through it (from that very session without
+    the router).  A sample is handed to every node subscribed to the expression except the
+    owner of its key, the node that published it (a Bus delivers its own messages itself), as
+    one :class:`Sample`: the first Bus to validate it keeps the message on it and the others
+    take that (``Bus._admitted``), each admitting it by its own rules."""
+
+    _receivers: dict[str, tuple[tuple[str, SampleHandler], ...]] = field(default_factory=dict)
+    """By key expression: (node, handler) of each node subscribed to it."""
+    _lock: threading.Lock = field(default_factory=threading.Lock)
+
+    def subscribe(self, transport: ZenohTransport, key_expr: str,
+                  handler: SampleHandler) -> None:
+        """``handler`` of ``transport``'s node receives what arrives on ``key_expr``."""
+        if not transport.node:
+            raise ValueError("a session sharing its process's receiver must name its node")
+        with self._lock:
+            known = self._receivers.get(key_expr)
+            self._receivers[key_expr] = (*(known or ()), (transport.node, handler))
+            if known is None:
+                transport.declare_subscriber(
+                    key_expr, lambda s, e=key_expr: self._on_sample(e, s), zenoh.Locality.ANY)
+
+    def _on_sample(self, key_expr: str, zsample: zenoh.Sample) -> None:
+        key = str(zsample.key_expr)
+        sample = Sample(key, type_of_encoding(zsample.encoding),
+                        payload=zsample.payload.to_bytes())
+        publisher = topics.node_of_key(key)
+        for node, handler in self._receivers[key_expr]:
+            if node != publisher:
+                handler(sample)
 
 
 def _node_from_token(token_key: str) -> str | None:
