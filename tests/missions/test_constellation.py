@@ -120,7 +120,7 @@ def test_dead_and_stalled_processes_are_faults_not_the_end(tmp_path: Path, free_
     sc = small_scenario("dead", duration_s=400.0)
     path = write_scenario(tmp_path / "dead.toml", sc)
     out = tmp_path / "out"
-    p = _launch(path, out, free_port, "--realtime", "10",  # 40 s of wall time if undisturbed
+    p = _launch(path, out, free_port, "--realtime", "20",  # 20 s of wall time if undisturbed
                 "--hosting", "one-per-process")
     try:
         _under_way(out, "dead")
@@ -161,7 +161,7 @@ def test_restart_on_crash_rejoins_the_lockstep(tmp_path: Path, free_port: int) -
     sc = small_scenario("again", duration_s=200.0)
     path = write_scenario(tmp_path / "again.toml", sc)
     out = tmp_path / "out"
-    p = _launch(path, out, free_port, "--realtime", "10", "--restart-on-crash",
+    p = _launch(path, out, free_port, "--realtime", "20", "--restart-on-crash",
                 "--processes", "2")
     try:
         _under_way(out, "again")

@@ -41,10 +41,14 @@ def _run(tmp_path: Path, port: int, name: str, kills: list[tuple[float, str]]
          ) -> tuple[dict[str, Any], Path]:
     """Fly SC with --restart-on-crash (the default hosting, 2 processes: sc1 and sc2 share one),
     killing at each sim time (s) the process of the node named (``sc<N>``: the flight process
-    hosting it); the summary and the run's folder."""
+    hosting it); with no kills, the clean run, in one process (the same messages as over Zenoh:
+    ``test_constellation.test_same_seed_same_messages_on_zenoh_and_inproc``).  The summary and
+    the run's folder."""
     path = write_scenario(tmp_path / f"{M}.toml", SC)
     out = tmp_path / name
-    p = _launch(path, out, port, "--realtime", "20", "--restart-on-crash", "--processes", "2")
+    how = (["--realtime", "20", "--restart-on-crash", "--processes", "2"] if kills else
+           ["--transport", "inproc"])
+    p = _launch(path, out, port, *how)
     try:
         for t_kill, victim in kills:
             _until(out, t_kill)
@@ -113,7 +117,7 @@ def test_killed_and_restarted_processes_change_no_result(tmp_path: Path, free_po
     assert len(chaos["archive"]["segments"]) == 2
     assert _messages(chaos_out) == _messages(clean_out)
     volatile = {"status", "error", "wall_s", "real_time_factor", "archive", "messages", "sim",
-                "exec", "ticks"}
+                "exec", "ticks", "transport"}
     assert {k: v for k, v in chaos.items() if k not in volatile} == \
         {k: v for k, v in clean.items() if k not in volatile}
     assert {(d["spacecraft"], d["class"]) for d in clean["detections"]} >= {(3, "camera")}
