@@ -17,6 +17,7 @@ from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
+from interfaces.runtime.blas_threads import one_blas_thread
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.fleet import fleets_of
@@ -40,7 +41,9 @@ def run_inproc(
     message object with its JSON bytes encoded on demand, once: the recorder's fast path).
     ``stop``, set, stops the run at the next tick boundary (``SimNode.completed`` stays
     False).  ``fleet``: the spacecraft step together (False: each alone, as it would in a
-    process of its own).  Returns the sim and the executives by node."""
+    process of its own).  Returns the sim and the executives by node.  This process's BLAS
+    runs on one thread from then on (``interfaces.runtime.blas_threads``)."""
+    one_blas_thread()
     mission = mission or scenario.name
     net = InprocNetwork()
     if tap is not None:

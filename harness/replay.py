@@ -70,6 +70,7 @@ from interfaces.contracts.scenario import Scenario, ScenarioError
 from interfaces.contracts.topology import topology
 from interfaces.runtime.arguments import prog_name
 from interfaces.runtime.assembly import executive_of
+from interfaces.runtime.blas_threads import one_blas_thread
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import TickClient
 from interfaces.runtime.transport import InprocNetwork, Sample
@@ -240,7 +241,9 @@ def replay_run(path: Path, settings: dict[str, str] | None = None,
     """Replay the ground of the run archived at ``path`` (its archive or its folder; module
     docstring), judging nothing past the archive's end.  ``scenario``: the run's scenario when
     its archive carries none; ``settings``: detector settings changed from the run's.
-    Raises ArchiveError (ArchivePathError for a path naming no archive), ScenarioError."""
+    Raises ArchiveError (ArchivePathError for a path naming no archive), ScenarioError.  This
+    process's BLAS runs on one thread from then on (``interfaces.runtime.blas_threads``)."""
+    one_blas_thread()
     start = time.perf_counter()
     archive = load_run(archive_file(path), stream={t.any_mission(): _drop for t in UNREAD})
     flown = scenario or scenario_of(archive)

@@ -16,6 +16,7 @@ from interfaces.contracts.messages import Tick
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.contracts.topology import topology
 from interfaces.runtime.arguments import add_log_level, endpoint, mission_name
+from interfaces.runtime.blas_threads import one_blas_thread
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore
 from interfaces.runtime.executive import Executive, TickClient, serve_together
@@ -94,7 +95,9 @@ class NodeStart:
 
 def start_node(args: argparse.Namespace, name: str) -> NodeStart:
     """Logging as ``name``, the scenario (exits with a readable message if invalid), the mission
-    name and the stop event of a node process started with :func:`add_node_args`'s options."""
+    name and the stop event of a node process started with :func:`add_node_args`'s options;
+    its BLAS on one thread (``interfaces.runtime.blas_threads``)."""
+    one_blas_thread()
     log = setup_logging(args.log_level, name)
     scenario = load_node_scenario(args)
     return NodeStart(log, scenario, mission_of(args, scenario), stop_on_signals())

@@ -161,7 +161,7 @@ def test_restart_on_crash_rejoins_the_lockstep(tmp_path: Path, free_port: int) -
     sc = small_scenario("again", duration_s=200.0)
     path = write_scenario(tmp_path / "again.toml", sc)
     out = tmp_path / "out"
-    p = _launch(path, out, free_port, "--realtime", "20", "--restart-on-crash",
+    p = _launch(path, out, free_port, "--realtime", "10", "--restart-on-crash",
                 "--processes", "2")
     try:
         _under_way(out, "again")
