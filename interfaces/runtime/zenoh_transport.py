@@ -22,6 +22,7 @@ message the first Bus to take it decodes for all.
 from __future__ import annotations
 
 import json
+import logging
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -220,7 +221,11 @@ class SharedReceiver:
         publisher = topics.node_of_key(key)
         for node, handler in self._receivers[key_expr]:
             if node != publisher:
-                handler(sample)
+                try:
+                    handler(sample)
+                except Exception:  # noqa: BLE001 - one node's failure is not the others'
+                    logging.getLogger(f"insp.bus.{node}").exception(
+                        "%s: taking in a sample on %s failed", node, key)
 
 
 def _node_from_token(token_key: str) -> str | None:

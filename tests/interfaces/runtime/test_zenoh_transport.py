@@ -114,3 +114,18 @@ def test_a_shared_session_must_name_its_node(free_port: int) -> None:
             t.subscribe_samples(EVERY_HEARTBEAT, lambda s: None)
     finally:
         t.close()
+
+
+def test_a_node_whose_intake_fails_does_not_deprive_the_others(process: Process) -> None:
+    got: list[str] = []
+
+    def broken(_sample: object) -> None:
+        raise RuntimeError("a bug in sc1's intake")
+
+    process.sc1.transport.subscribe_samples(EVERY_HEARTBEAT, broken)
+    process.sc2.transport.subscribe_samples(EVERY_HEARTBEAT, lambda s: got.append(s.key))
+    time.sleep(0.3)
+    key = topics.key(M, "sc3", "exec", "heartbeat")
+    process.sc3.publish(key, _hb("sc3"))
+    settle(lambda: got == [key])
+    assert got == [key]
