@@ -85,12 +85,33 @@ def publishers(n_observers: int) -> list[str]:
     return [topics.SIM, *(topics.sc_node(i) for i in range(1, n_observers + 1)), topics.GROUND]
 
 
-def access_control(mission: str, n_observers: int) -> dict[str, Any]:
+def own_keys(mission: str, account: str) -> list[str]:
+    """The key expressions ``account`` (a node, or the recorder) may publish on."""
+    if account == RECORDER_ACCOUNT:
+        return [topics.recorder_token(mission)]
+    return [f"{topics.node_prefix(mission, account)}/**"]
+
+
+EVERY_MESSAGE = ["put", "delete", "reply", "liveliness_token", "declare_subscriber",
+                 "declare_liveliness_subscriber", "declare_queryable", "query",
+                 "liveliness_query"]
+"""Every message kind the access rules name."""
+
+
+def access_control(mission: str, n_observers: int,
+                   relays: dict[str, list[str]] | None = None,
+                   hub_certificate: str | None = None) -> dict[str, Any]:
     """The router's ``access_control`` block: default deny; every account may subscribe to the
     mission, query schemas and watch liveliness; each publisher may publish, declare its token
-    and serve its schemas in its own key space only; the recorder may declare its token."""
+    and serve its schemas in its own key space only; the recorder may declare its token.
+
+    Across hosts (docs/hosts.md): the hub's ``relays`` are the other hosts' routers' accounts,
+    each with the nodes of its host: a relay may publish what those nodes may, and is sent
+    everything in the mission.  A router that links to the hub trusts, in and out, the link
+    whose certificate is named ``hub_certificate`` (the hub enforced the rules already)."""
     mission_keys = [topics.mission_wildcard(mission)]
-    everyone = [*publishers(n_observers), RECORDER_ACCOUNT, TLM_ACCOUNT]
+    relays = relays or {}
+    everyone = [*publishers(n_observers), RECORDER_ACCOUNT, TLM_ACCOUNT, *relays]
     rules: list[dict[str, Any]] = [
         _rule("receive", ["put", "delete", "reply", "liveliness_token"], "egress", mission_keys),
         # a publisher must learn of subscribers, or it drops its data; a subscriber's key
@@ -99,11 +120,12 @@ def access_control(mission: str, n_observers: int) -> dict[str, Any]:
         _rule("subscribe", ["declare_subscriber", "declare_liveliness_subscriber", "query",
                             "liveliness_query"], "ingress", [f"{topics.ROOT}/**"]),
     ]
-    subjects = [{"id": f"user-{u}", "usernames": [u]} for u in everyone]
+    subjects: list[dict[str, Any]] = [{"id": f"user-{u}", "usernames": [u]} for u in everyone]
     policies = [{"rules": ["receive", "see-subscribers", "subscribe"],
                  "subjects": [f"user-{u}" for u in everyone]}]
-    own = {node: [f"{topics.node_prefix(mission, node)}/**"] for node in publishers(n_observers)}
-    own[RECORDER_ACCOUNT] = [topics.recorder_token(mission)]
+    own = {a: own_keys(mission, a) for a in [*publishers(n_observers), RECORDER_ACCOUNT]}
+    own.update({relay: [k for n in nodes for k in own_keys(mission, n)]
+                for relay, nodes in relays.items()})
     for user, keys in own.items():
         messages = (["liveliness_token"] if user == RECORDER_ACCOUNT else
                     ["put", "delete", "liveliness_token", "declare_queryable", "reply"])
@@ -111,6 +133,14 @@ def access_control(mission: str, n_observers: int) -> dict[str, Any]:
         rules.append(_rule(f"serve-{user}", ["query"], "egress", keys))
         policies.append({"rules": [f"publish-{user}", f"serve-{user}"],
                          "subjects": [f"user-{user}"]})
+    if relays:
+        rules.append(_rule("relay-out", EVERY_MESSAGE, "egress", mission_keys))
+        policies.append({"rules": ["relay-out"], "subjects": [f"user-{r}" for r in relays]})
+    if hub_certificate is not None:
+        rules += [_rule("hub-in", EVERY_MESSAGE, "ingress", [f"{topics.ROOT}/**"]),
+                  _rule("hub-out", EVERY_MESSAGE, "egress", [f"{topics.ROOT}/**"])]
+        subjects.append({"id": "hub", "cert_common_names": [hub_certificate]})
+        policies.append({"rules": ["hub-in", "hub-out"], "subjects": ["hub"]})
     return {"enabled": True, "default_permission": "deny", "rules": rules,
             "subjects": subjects, "policies": policies}
 
@@ -129,7 +159,7 @@ def router_config(endpoint: str, dictionary: Path, acl: dict[str, Any],
         transport["link"] = {"tls": {"listen_certificate": str(tls.certificate),
                                      "listen_private_key": str(tls.private_key)}}
     return {"mode": "router", "listen": {"endpoints": [endpoint]}, "connect": {"endpoints": []},
-            "scouting": _NO_SCOUTING, "transport": transport, "access_control": acl}
+            "scouting": NO_SCOUTING, "transport": transport, "access_control": acl}
 
 
 def client_config(endpoint: str, account: Account, authority: Path | None) -> dict[str, Any]:
@@ -140,11 +170,11 @@ def client_config(endpoint: str, account: Account, authority: Path | None) -> di
     if authority is not None:  # inline, so that the one file is all another host needs
         pem = base64.b64encode(authority.read_bytes()).decode()
         transport["link"] = {"tls": {"root_ca_certificate_base64": pem}}
-    return {"mode": "client", "connect": {"endpoints": [endpoint]}, "scouting": _NO_SCOUTING,
+    return {"mode": "client", "connect": {"endpoints": [endpoint]}, "scouting": NO_SCOUTING,
             "transport": transport}
 
 
-_NO_SCOUTING = {"multicast": {"enabled": False}, "gossip": {"enabled": False}}
+NO_SCOUTING = {"multicast": {"enabled": False}, "gossip": {"enabled": False}}
 
 
 def write_run_access(directory: Path, mission: str, n_observers: int, endpoint: str,
@@ -160,19 +190,19 @@ def write_run_access(directory: Path, mission: str, n_observers: int, endpoint: 
     users = [*publishers(n_observers), RECORDER_ACCOUNT, TLM_ACCOUNT]
     accounts = [Account(u, secrets.token_urlsafe(18)) for u in users]
     dictionary = directory / "users.txt"
-    _write_private(dictionary, "".join(f"{a.user}:{a.password}\n" for a in accounts))
+    write_private(dictionary, "".join(f"{a.user}:{a.password}\n" for a in accounts))
     authority = tls.authority if tls is not None else None
     for a in accounts:
-        _write_private(directory / f"{a.user}.json5",
+        write_private(directory / f"{a.user}.json5",
                        json.dumps(client_config(clients_connect or endpoint, a, authority),
                                   indent=2))
     router = directory / "router.json5"
-    _write_private(router, json.dumps(router_config(
+    write_private(router, json.dumps(router_config(
         endpoint, dictionary, access_control(mission, n_observers), tls), indent=2))
     return RunAccess(directory, router, endpoint)
 
 
-def _write_private(path: Path, text: str) -> None:
+def write_private(path: Path, text: str) -> None:
     """Write ``text`` to ``path``, readable and writable by the owner only."""
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
     with os.fdopen(fd, "w", encoding="utf-8") as f:
