@@ -12,6 +12,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
+from deploy.rehearsal.netns import enter as enter_netns
+
 _PR_SET_PDEATHSIG = 1
 
 
@@ -29,6 +31,8 @@ class Child:
     name: str
     argv: list[str]
     log_path: Path
+    netns: str | None = None
+    """the network namespace it runs in (a rehearsed host's: ``deploy/rehearsal``), or None"""
     proc: subprocess.Popen[bytes] | None = None
     _log: IO[bytes] | None = None
 
@@ -38,8 +42,14 @@ class Child:
         self.proc = subprocess.Popen(
             [sys.executable, *self.argv], cwd=cwd, stdout=self._log, stderr=subprocess.STDOUT,
             start_new_session=True,  # a Ctrl-C at the launcher does not hit children directly
-            preexec_fn=die_with_parent if sys.platform.startswith("linux") else None,
+            preexec_fn=self._prepare if sys.platform.startswith("linux") else None,
         )
+
+    def _prepare(self) -> None:
+        """In the child before exec: die with the launcher, and enter its host's network."""
+        die_with_parent()
+        if self.netns is not None:
+            enter_netns(self.netns)
 
     @property
     def returncode(self) -> int | None:
@@ -128,7 +138,7 @@ class Supervisor:
         """Start ``child``'s command again (its log continues in ``<name>.restart<N>.log``)."""
         child.close_log()
         again = Child(child.name, child.argv,
-                      child.log_path.with_name(f"{child.name}.restart{attempt}.log"))
+                      child.log_path.with_name(f"{child.name}.restart{attempt}.log"), child.netns)
         self.children[self.children.index(child)] = again
         again.start(self.cwd)
         return again

@@ -50,11 +50,17 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
-from deploy.access import TLM_ACCOUNT, RunAccess, write_run_access  # noqa: E402
+from deploy.access import RunAccess, write_run_access  # noqa: E402
+from deploy.host_access import write_host_access  # noqa: E402
+from deploy.host_map import HostMap, HostMapError, load_host_map, parse_link_event  # noqa: E402
 from deploy.interrupts import Interrupts  # noqa: E402
+from deploy.link_events import LinkEvents  # noqa: E402
 from deploy.out_folder import OutFolderError, written  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
+from deploy.placement import Placement, across_hosts, one_host  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor, host_cores  # noqa: E402
+from deploy.rehearsal.netns import RehearsalError, require_privilege  # noqa: E402
+from deploy.rehearsal.network import RehearsedNetwork  # noqa: E402
 from deploy.router import address_taken  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderProcess  # noqa: E402
@@ -74,7 +80,6 @@ from interfaces.contracts.topology import (  # noqa: E402
     ROUTER,
     SIM,
     Host,
-    hosting,
     topology,
 )
 from interfaces.runtime.arguments import add_log_level, endpoint, mission_name  # noqa: E402
@@ -131,6 +136,22 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--tls-host", action="append", default=[], metavar="NAME",
                    help="another name or address of this host in the TLS certificate (for "
                         "nodes on other hosts); repeatable")
+    p.add_argument("--hosts", type=Path, metavar="MAP",
+                   help="run across the hosts of a host map (deploy/hosts/<name>.toml, "
+                        "docs/hosts.md): a router per host, linked to the ground host's over "
+                        "TLS; without --rehearse, print each host's command and files")
+    p.add_argument("--rehearse", action="store_true",
+                   help="with --hosts: rehearse the map on this machine, a network namespace "
+                        "per host, their links delayed, lossy or cut as the map says (needs "
+                        "CAP_NET_ADMIN); everything made is removed at the end")
+    p.add_argument("--link-delay-ms", type=float, metavar="MS",
+                   help="with --hosts: every host's link delays what it sends by MS (one way)")
+    p.add_argument("--link-loss-pct", type=float, metavar="PCT",
+                   help="with --hosts: every host's link loses PCT percent of what it sends")
+    p.add_argument("--link-event", action="append", default=[], metavar="EVENT",
+                   help="with --rehearse: HOST:cut|delay=MS|loss=PCT:AT_S:DURATION_S, a host's "
+                        "link cut, or its delay or loss raised, from sim time AT_S for "
+                        "DURATION_S; repeatable (the map's [[events]] too)")
     p.add_argument("--restart-on-crash", action="store_true",
                    help="start a process again if it dies, the sim holding the clock: a flight "
                         "or ground process restores its critical-data store, the router comes "
@@ -175,6 +196,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: --realtime takes a positive speed (times real time), not {args.realtime}",
               file=sys.stderr)
         return 2
+    try:
+        host_map = _host_map(args, scenario)
+    except (HostMapError, RehearsalError, ValueError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     known = set(topology(scenario).participants)
     if set(args.external) - known or (args.external and args.transport == "inproc"):
         print(f"error: --external takes nodes of a Zenoh run ({', '.join(sorted(known))}), not "
@@ -198,8 +224,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.transport == "inproc":
             status, error, digest = _run_inproc(scenario, mission, out, scenario_text, args,
                                                 stop)
+        elif host_map is not None and not args.rehearse:
+            return _print_hosts(scenario, mission, out, args, host_map)
         else:
-            status, error = _run_zenoh(scenario, mission, out, args, stop)
+            status, error = _run_zenoh(scenario, mission, out, args, stop, host_map)
     wall_s = time.monotonic() - wall0
     digest = digest or _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
@@ -223,6 +251,39 @@ def main(argv: list[str] | None = None) -> int:
     if status == "interrupted":
         return caught.exit_status or 130
     return 0 if status == "completed" else 1
+
+
+def _host_map(args: argparse.Namespace, scenario: Scenario) -> HostMap | None:
+    """The run's host map (``--hosts``, with the link options applied), checked against the
+    run; with ``--rehearse``, the privilege checked at once.  None on one host."""
+    links = {"--rehearse": args.rehearse, "--link-delay-ms": args.link_delay_ms is not None,
+             "--link-loss-pct": args.link_loss_pct is not None,
+             "--link-event": bool(args.link_event)}
+    if args.hosts is None:
+        given = [name for name, on in links.items() if on]
+        if given:
+            raise ValueError(f"{', '.join(given)} apply only with --hosts")
+        return None
+    clash = [o for o, on in (("--transport inproc", args.transport == "inproc"),
+                             ("--external", args.external), ("--advertise", args.advertise),
+                             ("--tls-host", args.tls_host),
+                             ("--endpoint", args.endpoint != DEFAULT_ENDPOINT)) if on]
+    if clash:
+        raise ValueError(f"--hosts places every node and router itself; not with "
+                         f"{', '.join(clash)}")
+    if args.link_event and not args.rehearse:
+        raise ValueError("--link-event applies only to a rehearsal (--rehearse)")
+    events = [parse_link_event(e) for e in args.link_event]
+    host_map = load_host_map(args.hosts).with_links(args.link_delay_ms, args.link_loss_pct)
+    host_map = host_map.with_events(events)
+    host_map.check_run(topology(scenario).participants)
+    for e in host_map.events:
+        if e.cut and e.host == host_map.hub.name:
+            raise ValueError(f"host {e.host} is the hub: the launcher watches the run through "
+                             "its link, which a rehearsal does not cut")
+    if args.rehearse:
+        require_privilege()
+    return host_map
 
 
 def _zenoh_only(args: argparse.Namespace) -> list[str]:
@@ -315,24 +376,49 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
 
 
 def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
-               stop: threading.Event) -> tuple[str, str | None]:
+               stop: threading.Event, host_map: HostMap | None = None) -> tuple[str, str | None]:
+    """Over Zenoh: on this host (one router), or rehearsing ``host_map`` (a router per
+    host, each host in its network namespace, torn down at the end)."""
+    if host_map is None:
+        try:
+            access = _write_access(out, mission, scenario, args)
+        except ValueError as e:
+            return "failed", str(e)
+        return _run_placed(scenario, mission, out, args, stop, one_host(access))
+    access_h = write_host_access(out / "access", mission, scenario.observers.count, host_map)
     try:
-        access = _write_access(out, mission, scenario, args)
-    except ValueError as e:
+        with RehearsedNetwork(host_map, out / "logs", seed=scenario.seed) as net:
+            placement = across_hosts(access_h, host_map,
+                                     {h.name: net.netns(h.name) for h in host_map.hosts})
+            with LinkEvents(net, host_map) as events:
+                result = _run_placed(scenario, mission, out, args, stop, placement,
+                                     events.on_time)
+            (out / "logs" / "link-events.json").write_text(events.report(), encoding="utf-8")
+            return result
+    except RehearsalError as e:
         return "failed", str(e)
+
+
+def _run_placed(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
+                stop: threading.Event, placement: Placement,
+                on_time: Callable[[float], None] | None = None) -> tuple[str, str | None]:
+    """Start the routers, join the run (the launcher's own session) and supervise it;
+    ``on_time`` is told the sim time of each of the ground's heartbeats."""
     sup = Supervisor(REPO)
     audit = ["--audit", str(out / "logs" / "access.json")] if args.audit_access else []
-    router = sup.start(Child(ROUTER.name, [*ROUTER.command, "--config",
-                                           str(access.router_config), *audit],
-                             out / "logs" / "router.log"))
-    hub = _join(access, router, timeout_s=30.0)
+    routers = [sup.start(Child(r.name, [*ROUTER.command, "--config", str(r.config),
+                                        *(audit if i == 0 else [])],
+                               out / "logs" / f"{r.name}.log", r.netns))
+               for i, r in enumerate(placement.routers)]
+    hub = _join(placement.watch_config, routers, timeout_s=30.0)
     if hub is None:
         sup.stop_all()
-        clash = "; is another run using it?" if address_taken(router.log_tail()) else ""
-        return "failed", (f"the router did not start on {args.endpoint} "
-                          f"({router.describe_exit()}{clash}):\n"
-                          f"{router.log_tail()}")
-    progress = _Progress(scenario)
+        dead = next((r for r in routers if r.returncode is not None), routers[0])
+        place = next(p for p in placement.routers if p.name == dead.name)
+        clash = "; is another run using it?" if address_taken(dead.log_tail()) else ""
+        return "failed", (f"{dead.name} did not start on {place.endpoint} "
+                          f"({dead.describe_exit()}{clash}):\n{dead.log_tail()}")
+    progress = _Progress(scenario, on_time)
     live = None
     try:
         hub.session.declare_subscriber(cat.HEARTBEAT.key(mission, topics.GROUND),
@@ -341,12 +427,55 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         live = _live_view(args)
         if live is not None:
             hub.subscribe(topics.mission_wildcard(mission), live.forward)
-        return _supervise(scenario, mission, out, args, progress, hub, sup, access, stop)
+        return _supervise(scenario, mission, out, args, progress, hub, sup, placement, stop)
     finally:
         hub.close()
         if live is not None:
             live.close()
-        (sup.find(ROUTER.name) or router).stop()  # the one running: a restart replaced the first
+        for r in placement.routers:  # the ones running: a restart replaced the first
+            sup.named(r.name).stop()
+
+
+def _common_args(args: argparse.Namespace, mission: str, scenario: str) -> list[str]:
+    """The options every node process of the run takes (``scenario``: its file)."""
+    common = ["--scenario", scenario, "--mission", mission, "--log-level", args.log_level]
+    if args.seed is not None:
+        common += ["--seed", str(args.seed)]
+    if args.duration is not None:
+        common += ["--duration", str(args.duration)]
+    return common
+
+
+def _print_hosts(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
+                 host_map: HostMap) -> int:
+    """``--hosts`` on real machines: write every host's access files and print, host by
+    host, what to copy there and the commands to run (routers first, the ground host's
+    before the others')."""
+    access = write_host_access(out / "access", mission, scenario.observers.count, host_map)
+    placement = across_hosts(access, host_map)
+    common = _common_args(args, mission, args.scenario.name)
+    topo = topology(scenario)
+    processes = placement.processes(topo, args.hosting, 1)
+    lines = [f"{scenario.name} across {len(host_map.hosts)} hosts ({args.hosts}); on each "
+             f"host, from a checkout of this repository with {args.scenario.name} beside it:"]
+    for h in host_map.hosts:
+        folder = access.hosts[h.name].directory
+        lines += ["", f"host {h.name} ({h.address}): copy {folder}/ to access/ (owner only), "
+                      "then run, each in its own shell:",
+                  "  python -m deploy.router --config access/router.json5"]
+        mine = [p for p in processes if p.nodes[0].name in h.nodes]
+        lines += [f"  python {' '.join(p.command)} {' '.join(common)} --zenoh-config "
+                  + ("access/{node}.json5" if len(p.nodes) > 1 else f"access/{p.name}.json5")
+                  for p in mine]
+        for service, argv in ((SIM.name, SIM.command), (RECORDER.name, [
+                *RECORDER.command, "--out", "run.mcap", "--transport-name", "zenoh"])):
+            if service in h.nodes:
+                lines.append(f"  python {' '.join(argv)} {' '.join(common)} --zenoh-config "
+                             f"access/{service}.json5")
+    lines += ["", f"watch it from any host of the network: python -m ground.tools.tlm "
+                  f"--zenoh-config {access.tlm_config}"]
+    print("\n".join(lines))
+    return 0
 
 
 def _write_access(out: Path, mission: str, scenario: Scenario,
@@ -369,12 +498,12 @@ def _host_of(endpoint: str) -> str:
     return host.strip("[]")
 
 
-def _join(access: RunAccess, router: Child, timeout_s: float) -> ZenohTransport | None:
-    """The launcher's own session (read-only account), once the router accepts it; None if the
-    router died or never came up."""
+def _join(config: Path, routers: list[Child], timeout_s: float) -> ZenohTransport | None:
+    """The launcher's own session (read-only account, ``config``), once the hub's router
+    accepts it; None if a router died or none came up."""
     deadline = time.monotonic() + timeout_s
-    settings = ZenohSettings(config_file=str(access.client_config(TLM_ACCOUNT)))
-    while time.monotonic() < deadline and router.returncode is None:
+    settings = ZenohSettings(config_file=str(config))
+    while time.monotonic() < deadline and all(r.returncode is None for r in routers):
         try:
             return ZenohTransport(settings)
         except Exception:  # noqa: BLE001 - zenoh raises ZError while the router starts
@@ -395,23 +524,19 @@ def _access_audit(out: Path) -> AccessAudit | None:
 
 def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
                progress: _Progress, hub: ZenohTransport, sup: Supervisor,
-               access: RunAccess, stop: threading.Event) -> tuple[str, str | None]:
-    common = ["--scenario", str(args.scenario.resolve()), "--mission", mission,
-              "--log-level", args.log_level]
-    if args.seed is not None:
-        common += ["--seed", str(args.seed)]
-    if args.duration is not None:
-        common += ["--duration", str(args.duration)]
+               placement: Placement, stop: threading.Event) -> tuple[str, str | None]:
+    common = _common_args(args, mission, str(args.scenario.resolve()))
 
     def account(who: str | Host) -> list[str]:
         """The account options of a service, a node or a host (each of its nodes its own:
         ``{node}`` in the path)."""
         if isinstance(who, Host) and len(who.nodes) > 1:
             for n in who.nodes:
-                access.client_config(n.name)  # a clear error for a missing account
-            return [*common, "--zenoh-config", str(access.directory / "{node}.json5")]
+                placement.config(n.name)  # a clear error for a missing account
+            folder = placement.config(who.nodes[0].name).parent
+            return [*common, "--zenoh-config", str(folder / "{node}.json5")]
         name = who.name if isinstance(who, Host) else who
-        return [*common, "--zenoh-config", str(access.client_config(name))]
+        return [*common, "--zenoh-config", str(placement.config(name))]
 
     logs = out / "logs"
     remove_segments(run_archive(out))  # else the recorder continues an earlier run's archive
@@ -419,29 +544,30 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     recorder = sup.start(Child(RECORDER.name, [*RECORDER.command, *account(RECORDER.name),
                                                "--out", str(run_archive(out)),
                                                "--transport-name", "zenoh"],
-                               logs / "recorder.log"))
+                               logs / "recorder.log", placement.netns(RECORDER.name)))
     if not _wait_token(hub, topics.recorder_token(mission), recorder, timeout_s=RECORDER_READY_S):
-        sup.stop_all(exclude={ROUTER.name})
+        sup.stop_all(exclude={r.name for r in placement.routers})
         return "failed", (f"recorder did not start ({recorder.describe_exit()}):\n"
                           f"{recorder.log_tail()}")
     sim_argv = [*SIM.command, *account(SIM.name)] + (
         ["--realtime", str(args.realtime)] if args.realtime is not None else []) + (
         ["--hard-deadline"] if args.realtime is not None and args.hard_deadline else []) + (
         ["--hold-lost", str(RESTART_HOLD_S)] if args.restart_on_crash else [])
-    sup.start(Child(SIM.name, sim_argv, logs / "sim.log"))
+    sup.start(Child(SIM.name, sim_argv, logs / "sim.log", placement.netns(SIM.name)))
     topo = topology(scenario)
     cds = _store_args(out, args.restart_on_crash)
-    hosts = hosting(topo, args.hosting, args.processes or host_cores(), alone=args.external)
+    hosts = placement.processes(topo, args.hosting, args.processes or host_cores(),
+                                alone=args.external)
     for host in hosts:
         if host.name in args.external:
-            config = access.client_config(host.name)
+            config = placement.config(host.name)
             there = [config.name if a == str(config) else a
                      for a in [*host.command, *account(host.name), *cds]]
             log.info("%s runs elsewhere: on its host, with this run's scenario and %s there, "
                      "run: python %s", host.name, config, " ".join(there))
         else:
             sup.start(Child(host.name, [*host.command, *account(host), *cds],
-                            logs / f"{host.name}.log"))
+                            logs / f"{host.name}.log", placement.netns(host.nodes[0].name)))
     watch = _Watch(sup, progress, flight={h.name: [n.name for n in h.nodes] for h in hosts
                                           if h.name not in args.external},
                    restart=args.restart_on_crash, recorder_up=recorder_up.count,
@@ -452,7 +578,7 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     watch.read_restores(out / "cds")
     # Stop the flight side first, then the recorder, so the archive holds everything sent.
     sup.stop_all(order=[SIM.name, *(h.name for h in hosts)],
-                 exclude={RECORDER.name, ROUTER.name})
+                 exclude={RECORDER.name, *(r.name for r in placement.routers)})
     time.sleep(0.2)
     recorder = sup.named(RECORDER.name)
     if recorder.returncode is None:
@@ -587,11 +713,9 @@ class _Watch:
         """The services a run cannot go on without, each with the count of appearances that
         says it is back after a restart, and what follows its loss: the router (back when the
         sim's token reappears, seen through it) and the recorder (its own token)."""
-        out = [(self.sup.named(RECORDER.name), self.recorder_up, _NO_RECORD)]
-        router = self.sup.find(ROUTER.name)
-        if router is not None:
-            out.insert(0, (router, self.sim_up, _NO_BUS))
-        return out
+        routers = [c for c in self.sup.children if c.name.split("-")[0] == ROUTER.name]
+        return [*((r, self.sim_up, _NO_BUS) for r in routers),
+                (self.sup.named(RECORDER.name), self.recorder_up, _NO_RECORD)]
 
     def _stopped(self, child: Child, consequence: str) -> str:
         """The error naming ``child``, how it stopped, when, and what follows."""
@@ -618,7 +742,8 @@ class _Watch:
             return self._stopped(child, consequence + (f" (restarted {n} times)" if n else ""))
         incident = Incident(child.name, child.describe_exit(), self.progress.t_sim, True)
         self.incidents.append(incident)
-        log.error("%s; starting it again (%s)", incident, _AGAIN[child.name])
+        log.error("%s; starting it again (%s)", incident,
+                  _AGAIN[child.name.split("-")[0]])
         self._back[child.name] = (up(), time.monotonic() + SERVICE_READY_S)
         self._restart(child)
         return None
@@ -717,7 +842,10 @@ def _wait_token(hub: ZenohTransport, token: str, child: Child, timeout_s: float)
 class _Progress:
     """Progress of the run (one line every few seconds)."""
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario,
+                 on_time: Callable[[float], None] | None = None) -> None:
+        self.on_time = on_time
+        """told the sim time of each heartbeat (the link events' clock)"""
         self.n_ticks = scenario.n_ticks
         self.duration = scenario.duration_s
         self.t_sim = 0.0
@@ -734,6 +862,8 @@ class _Progress:
         except Exception:  # noqa: BLE001 - progress display only
             return
         self.k, self.t_sim = hb.k, hb.t_sim
+        if self.on_time is not None:
+            self.on_time(hb.t_sim)
 
     def on_status(self, sample: object) -> None:
         try:
