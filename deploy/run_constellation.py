@@ -40,6 +40,7 @@ import logging
 import sys
 import threading
 import time
+from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -405,11 +406,10 @@ def _run_placed(scenario: Scenario, mission: str, out: Path, args: argparse.Name
     """Start the routers, join the run (the launcher's own session) and supervise it;
     ``on_time`` is told the sim time of each of the ground's heartbeats."""
     sup = Supervisor(REPO)
-    audit = ["--audit", str(out / "logs" / "access.json")] if args.audit_access else []
     routers = [sup.start(Child(r.name, [*ROUTER.command, "--config", str(r.config),
-                                        *(audit if i == 0 else [])],
+                                        *_audit_args(args, out, r.name)],
                                out / "logs" / f"{r.name}.log", r.netns))
-               for i, r in enumerate(placement.routers)]
+               for r in placement.routers]
     hub = _join(placement.watch_config, routers, timeout_s=30.0)
     if hub is None:
         sup.stop_all()
@@ -511,15 +511,28 @@ def _join(config: Path, routers: list[Child], timeout_s: float) -> ZenohTranspor
     return None
 
 
+def _audit_args(args: argparse.Namespace, out: Path, router: str) -> list[str]:
+    """With --audit-access: the router's refusal counts go to ``logs/access.json`` (the run's
+    one router) or ``logs/access-<router>.json`` (a router per host)."""
+    if not args.audit_access:
+        return []
+    name = "access.json" if router == ROUTER.name else f"access-{router}.json"
+    return ["--audit", str(out / "logs" / name)]
+
+
 def _access_audit(out: Path) -> AccessAudit | None:
-    """The router's refusal counts, if the run was audited (and they can be read)."""
-    path = out / "logs" / "access.json"
-    if not path.is_file():
-        return None
+    """The routers' refusal counts, summed over the routers, if the run was audited (and they
+    can be read)."""
+    paths = sorted((out / "logs").glob("access*.json"))
+    refused: Counter[str] = Counter()
     try:
-        return AccessAudit.model_validate_json(path.read_bytes())
+        for path in paths:
+            refused.update(AccessAudit.model_validate_json(path.read_bytes()).refused)
     except (OSError, ValueError):
         return None
+    if not paths:
+        return None
+    return AccessAudit(refused=dict(refused), total=sum(refused.values()))
 
 
 def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,

@@ -84,7 +84,7 @@ def _attack(out: Path, endpoint: str) -> int:
     return 20 * len(_forgeries())
 
 
-def _open_when_up(config: Path, timeout_s: float = 30.0) -> zenoh.Session:
+def _open_when_up(config: Path | dict, timeout_s: float = 30.0) -> zenoh.Session:
     deadline = time.monotonic() + timeout_s
     while True:
         try:
