@@ -388,7 +388,8 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         return _run_placed(scenario, mission, out, args, stop, one_host(access))
     access_h = write_host_access(out / "access", mission, scenario.observers.count, host_map)
     try:
-        with RehearsedNetwork(host_map, out / "logs", seed=scenario.seed) as net:
+        with RehearsedNetwork(host_map.hosts, host_map.network, out / "logs",
+                              seed=scenario.seed) as net:
             placement = across_hosts(access_h, host_map,
                                      {h.name: net.netns(h.name) for h in host_map.hosts})
             with LinkEvents(net, host_map) as events:

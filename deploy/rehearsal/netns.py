@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import ipaddress
 import os
 import re
 import shutil
@@ -53,6 +54,18 @@ def require_privilege() -> None:
         raise RehearsalError("--rehearse needs CAP_NET_ADMIN (root, or a container that "
                              f"grants it) to make network namespaces: {e}") from None
     ip("netns", "delete", probe)
+
+
+def addresses_in(network: ipaddress.IPv4Network) -> list[str]:
+    """The interfaces of this namespace with an address in ``network`` (``name address``)."""
+    out = []
+    for line in ip("-o", "-4", "addr", "show").splitlines():
+        fields = line.split()
+        if "inet" in fields:
+            address = ipaddress.IPv4Interface(fields[fields.index("inet") + 1]).ip
+            if address in network:
+                out.append(f"{fields[1]} {address}")
+    return out
 
 
 def add(name: str) -> None:

@@ -17,10 +17,12 @@ import select
 import subprocess
 import sys
 import time
+from collections.abc import Sequence
+from ipaddress import IPv4Address, IPv4Network
 from pathlib import Path
-from typing import IO
+from typing import IO, Protocol
 
-from deploy.host_map import HostMap, LinkSpec
+from deploy.host_map import LinkSpec
 from deploy.processes import die_with_parent
 from deploy.rehearsal import netns
 from deploy.rehearsal.netns import RehearsalError
@@ -33,12 +35,24 @@ LAUNCHER_PORT = "launcher"
 log = logging.getLogger("insp.rehearsal")
 
 
-class RehearsedNetwork:
-    """The namespaces and wire of ``host_map`` for launcher ``pid`` (its logs in ``logs``);
-    the wire's random draws (losses, jitter) seeded by ``seed``."""
+class NetHost(Protocol):
+    """A host of a rehearsed network: a host map's (``HostSpec``), or a cluster's."""
 
-    def __init__(self, host_map: HostMap, logs: Path, seed: int, pid: int | None = None) -> None:
-        self.map, self.logs, self.seed = host_map, logs, seed
+    @property
+    def name(self) -> str: ...
+    @property
+    def address(self) -> IPv4Address: ...
+    @property
+    def link(self) -> LinkSpec: ...
+
+
+class RehearsedNetwork:
+    """The namespaces and wire of ``hosts`` on ``network`` for launcher ``pid`` (its logs in
+    ``logs``); the wire's random draws (losses, jitter) seeded by ``seed``."""
+
+    def __init__(self, hosts: Sequence[NetHost], network: IPv4Network, logs: Path, seed: int,
+                 pid: int | None = None) -> None:
+        self.hosts, self.network, self.logs, self.seed = list(hosts), network, logs, seed
         self.pid = os.getpid() if pid is None else pid
         self._wire: subprocess.Popen[bytes] | None = None
         self._wire_log: IO[bytes] | None = None
@@ -46,7 +60,7 @@ class RehearsedNetwork:
     @property
     def launcher_address(self) -> str:
         """This namespace's address on the hosts' network: the network's last host address."""
-        return str(self.map.network.broadcast_address - 1)
+        return str(self.network.broadcast_address - 1)
 
     def netns(self, host: str) -> str:
         """The namespace of ``host``."""
@@ -56,11 +70,16 @@ class RehearsedNetwork:
         netns.require_privilege()
         for gone in netns.sweep():
             log.warning("removed namespace %s, left by a launcher no longer running", gone)
-        if any(str(h.address) == self.launcher_address for h in self.map.hosts):
+        taken = netns.addresses_in(self.network)
+        if taken:
+            raise RehearsalError(f"network {self.network} is in use here ({', '.join(taken)}): "
+                                 "another rehearsal of it is running, or this machine's own; "
+                                 "give the map another network")
+        if any(str(h.address) == self.launcher_address for h in self.hosts):
             raise RehearsalError(f"{self.launcher_address} is the launcher's address in a "
                                  "rehearsal; give the host another")
         try:
-            for h in self.map.hosts:
+            for h in self.hosts:
                 netns.add(self.netns(h.name))
             self._start_wire()
         except BaseException:
@@ -86,14 +105,14 @@ class RehearsedNetwork:
         if answer != "ready":
             raise RehearsalError(f"the hosts' network could not be made: {answer}")
         log.info("hosts' network up: %s", ", ".join(
-            f"{h.name} {h.address} ({self.netns(h.name)})" for h in self.map.hosts))
+            f"{h.name} {h.address} ({self.netns(h.name)})" for h in self.hosts))
 
     def _plan(self) -> dict[str, object]:
-        prefix = self.map.network.prefixlen
+        prefix = self.network.prefixlen
         tag = f"i{self.pid % 100000}"
         ports = [{"name": h.name, "tap": f"{tag}.{h.name}", "netns": self.netns(h.name),
                   "address": f"{h.address}/{prefix}", "link": h.link.model_dump()}
-                 for h in self.map.hosts]
+                 for h in self.hosts]
         ports.append({"name": LAUNCHER_PORT, "tap": f"{tag}.{LAUNCHER_PORT}"[:15], "netns": None,
                       "address": f"{self.launcher_address}/{prefix}", "link": {}})
         return {"seed": self.seed, "mtu": MTU, "ports": ports}

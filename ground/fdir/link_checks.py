@@ -11,10 +11,12 @@ that does not reach the ground is a link fault, never zero information gain.
   10%: 6e-6 against 8e-5 for 30 s windows and 0.01 per hour).
 * **Silence**: an observer with its camera on that sends no image for ``fdir.silent_windows``
   windows in a row (once per episode, and not when its loss was declared already: one link
-  fault, declared once).  One silent window decides alone when a healthy link would lose all
-  of a window's images (one per ω_mid period) with a probability below the window's share,
-  as for loss (30 images at a nominal 15%: 2e-25; in bursts of 50 packets: 0.57, and the
-  silence waits for ``fdir.silent_windows``).
+  fault, declared once), or for as many ω_mid periods in a row straddling two windows, judged
+  when its images resume (a host's link cut for 30 s: docs/hosts.md).  One silent window
+  decides alone when a healthy link would lose all of a window's images (one per ω_mid
+  period) with a probability below the window's share, as for loss (30 images at a nominal
+  15%: 2e-25; in bursts of 50 packets: 0.57, and the silence waits for
+  ``fdir.silent_windows``).
 * **Lossy windows**: a window whose loss a healthy link would reach with a probability below
   ``LOSSY_TAIL``, or a silent one, marks its observer ``lossy`` (``ObserverState.lossy``):
   the data-integrity check judges no report while one is (its loss is not spread over the
@@ -108,6 +110,7 @@ class LinkChecks:
                 obs.received += len(images)
                 obs.last_seq = max(obs.last_seq, max(m.seq for m in images))
             obs.resync, obs.silent, obs.lossy = True, 0, True
+            obs.last_image_s = None
             self.loss.update(sc, False)
             return 0, []
         lost, reports = self._loss(sc, obs, images, b)
@@ -116,7 +119,10 @@ class LinkChecks:
         if expected and not images:
             reports += self._silence(sc, obs, b)
         elif expected:
+            reports += self._gap(sc, obs, images, b)
             obs.silent, obs.link_declared = 0, False
+        if not expected or images:
+            obs.last_image_s = max(m.image_t_s for m in images) if expected else None
         obs.overflow_declared = False
         return lost, reports
 
@@ -213,6 +219,24 @@ class LinkChecks:
                          "fault (store overflow)", sc, b)
         return [FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
                             window_end_s=b, cause="store_overflow")]
+
+    def _gap(self, sc: int, obs: ObserverState, images: list[PoiObservations],
+             b: float) -> list[FaultReport]:
+        """A silence straddling windows, ended by this window's first image: as many ω_mid
+        periods in a row without an image since the last one judged as a silent window holds,
+        decided as such a window would be (alone when decisive, else ``silent_windows`` of
+        them).  None when a silent window declared it already."""
+        if obs.last_image_s is None or obs.link_declared:
+            return []
+        first = min(m.image_t_s for m in images)
+        missing = round((first - obs.last_image_s) * self.images_per_window / self.period_s) - 1
+        n = self.images_per_window
+        if missing < (n if self.decisive(n, n) else n * self.cfg.silent_windows):
+            return []
+        self.log.warning("FDIR: sc%d sent no image for %.0f s (%.0f to %.0f s): link fault",
+                         sc, first - obs.last_image_s, obs.last_image_s, first)
+        return [FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
+                            metric=float(missing), threshold=float(n), window_end_s=b)]
 
     def _silence(self, sc: int, obs: ObserverState, b: float) -> list[FaultReport]:
         obs.silent += 1

@@ -122,6 +122,9 @@ class ObserverState:
     """when its onboard FDIR turned its camera off (s; None: on): no image is expected since"""
     silent: int = 0
     link_declared: bool = False
+    last_image_s: float | None = None
+    """time of its last image in a judged window while imaging and in reach (s; None: none
+    since it was last out of reach or off): a silence straddling windows is measured from it"""
     overflow: list[tuple[float, float]] = field(default_factory=list)
     """send times (first, last; s) of its FDIR reports its onboard store lost (ground passes)"""
     overflow_declared: bool = False

@@ -131,7 +131,7 @@ def test_a_launcher_killed_outright_leaves_namespaces_the_next_removes(tmp_path:
     for name in left:
         netns.add(name)
     try:
-        with RehearsedNetwork(trio, tmp_path / "logs", seed=1) as net:
+        with RehearsedNetwork(trio.hosts, trio.network, tmp_path / "logs", seed=1) as net:
             assert not any(n in os.listdir(netns.NETNS_DIR) for n in left)
             assert sorted(netns.ours(os.getpid())) == sorted(
                 net.netns(h.name) for h in trio.hosts)

@@ -80,6 +80,46 @@ def test_one_silent_window_decides_when_a_healthy_link_could_hardly_empty_it(los
     assert reports[0][0].fault_class == "link" and reports[0][0].window_end_s == 30.0
 
 
+def _windows(links: LinkChecks, obs: ObserverState, images: dict[float, list[float]],
+             reachable: bool = True) -> list[list[FaultReport]]:
+    """Judge one observer's windows, each ending at a key with images at the times listed (its
+    sequence numbers in order: nothing lost on the link)."""
+    seq = obs.last_seq
+    out = []
+    for b, times in images.items():
+        mine = [_obs(1, t, seq := seq + 1) for t in times]
+        out.append(links.judge(1, obs, mine, True, b, reachable)[1])
+    return out
+
+
+def test_a_silence_straddling_two_windows_is_a_link_fault_when_images_resume() -> None:
+    """A host's link cut for 30 s (docs/hosts.md): the observer's last image at 600 s, the next
+    at 636 s.  Neither window is silent; 35 ω_mid periods without an image, more than the 30 of
+    a window, are a link fault (as one silent window would be on this link), declared when the
+    images resume.  20 s without one are not; on a bursty link, 60 would be needed."""
+    links = LinkChecks(small_scenario(comms={"packet_loss": 0.1}), "ground", LOG)
+    cut = {600.0: [float(t) for t in range(570, 600)], 630.0: [600.0],
+           660.0: [float(t) for t in range(636, 660)]}
+    reports = _windows(links, ObserverState(), cut)
+    assert [len(r) for r in reports] == [0, 0, 1]
+    declared = reports[2][0]
+    assert (declared.fault_class, declared.window_end_s, declared.metric) == ("link", 660.0, 35)
+    short = {630.0: [float(t) for t in range(600, 616)], 660.0: [float(t) for t in range(636, 660)]}
+    assert _windows(links, ObserverState(), short) == [[], []]
+    bursty = LinkChecks(small_scenario(comms=BURSTY), "ground", LOG)
+    assert _windows(bursty, ObserverState(), cut) == [[], [], []]
+
+
+def test_a_silence_already_declared_or_out_of_reach_is_not_declared_again() -> None:
+    links = LinkChecks(small_scenario(comms={"packet_loss": 0.1}), "ground", LOG)
+    silent = {600.0: [590.0], 630.0: [], 660.0: [640.0]}  # the silent window declares it
+    assert [len(r) for r in _windows(links, ObserverState(), silent)] == [0, 1, 0]
+    obs = ObserverState()
+    _windows(links, obs, {600.0: [590.0]})
+    assert _windows(links, obs, {630.0: []}, reachable=False) == [[]]  # out of reach: no gap
+    assert _windows(links, obs, {660.0: [640.0]}) == [[]]
+
+
 def test_a_window_losing_more_than_its_link_explains_is_lossy() -> None:
     """At a nominal 5%: 1 of 10 lost is healthy (P = 0.40), 4 of 10 is not (P = 1e-3), and a
     silent window with its camera on is (with it off it says nothing)."""
