@@ -144,7 +144,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--rehearse", action="store_true",
                    help="with --hosts: rehearse the map on this machine, a network namespace "
                         "per host, their links delayed, lossy or cut as the map says (needs "
-                        "CAP_NET_ADMIN); everything made is removed at the end")
+                        "CAP_SYS_ADMIN and CAP_NET_ADMIN); everything made is removed at the "
+                        "end")
     p.add_argument("--link-delay-ms", type=float, metavar="MS",
                    help="with --hosts: every host's link delays what it sends by MS (one way)")
     p.add_argument("--link-loss-pct", type=float, metavar="PCT",

@@ -37,8 +37,8 @@ def ip(*args: str) -> str:
 
 def require_privilege() -> None:
     """Stop at once, naming what is missing, unless namespaces and TAP links can be made
-    here: Linux, iproute2's ``ip``, ``/dev/net/tun`` and CAP_NET_ADMIN (tried: a namespace
-    made and removed)."""
+    here: Linux, iproute2's ``ip``, ``/dev/net/tun``, CAP_SYS_ADMIN and CAP_NET_ADMIN (tried:
+    a namespace made and removed)."""
     if not os.uname().sysname == "Linux":
         raise RehearsalError("--rehearse needs Linux network namespaces; this is "
                              f"{os.uname().sysname}")
@@ -51,8 +51,9 @@ def require_privilege() -> None:
     try:
         ip("netns", "add", probe)
     except RehearsalError as e:
-        raise RehearsalError("--rehearse needs CAP_NET_ADMIN (root, or a container that "
-                             f"grants it) to make network namespaces: {e}") from None
+        raise RehearsalError("--rehearse needs CAP_SYS_ADMIN and CAP_NET_ADMIN (root, or a "
+                             "container that grants them) to make network namespaces: "
+                             f"{e}") from None
     ip("netns", "delete", probe)
 
 
@@ -66,6 +67,15 @@ def addresses_in(network: ipaddress.IPv4Network) -> list[str]:
             if address in network:
                 out.append(f"{fields[1]} {address}")
     return out
+
+
+def unavailable() -> str | None:
+    """Why a rehearsal cannot be made here (:func:`require_privilege`'s message), or None."""
+    try:
+        require_privilege()
+    except RehearsalError as e:
+        return str(e)
+    return None
 
 
 def add(name: str) -> None:

@@ -13,22 +13,14 @@ from pathlib import Path
 import pytest
 
 from deploy.rehearsal.cluster import NETWORK
-from deploy.rehearsal.netns import RehearsalError, addresses_in, require_privilege
+from deploy.rehearsal.netns import addresses_in, unavailable
 from deploy.run_campaign import main as run_campaign
 from tests.conftest import REPO
 from tests.deploy.test_campaign import _campaign
 from tests.missions.test_campaign_run import _results
 
 
-def _why_not() -> str | None:
-    try:
-        require_privilege()
-    except RehearsalError as e:
-        return str(e)
-    return None
-
-
-@pytest.mark.skipif(_why_not() is not None, reason=str(_why_not()))
+@pytest.mark.skipif(unavailable() is not None, reason=str(unavailable()))
 def test_a_campaign_across_namespaces_survives_a_lost_worker_host(tmp_path: Path) -> None:
     path = _campaign(tmp_path)
     assert run_campaign(["--campaign", str(path), "--out", str(tmp_path / "local"),

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -23,7 +24,7 @@ import zenoh
 
 from deploy.host_map import load_host_map
 from deploy.rehearsal import netns
-from deploy.rehearsal.netns import RehearsalError, require_privilege
+from deploy.rehearsal.netns import unavailable
 from deploy.rehearsal.network import RehearsedNetwork
 from interfaces.contracts import catalogue as cat
 from tests.conftest import REPO, settle, small_scenario, write_scenario
@@ -36,15 +37,7 @@ VARYING = {"wall_s", "real_time_factor", "messages", "exec", "access", "transpor
 """Summary fields that differ between two identical runs (wall clock), or count the attack."""
 
 
-def _why_not() -> str | None:
-    try:
-        require_privilege()
-    except RehearsalError as e:
-        return str(e)
-    return None
-
-
-pytestmark = pytest.mark.skipif(_why_not() is not None, reason=str(_why_not()))
+needs_namespaces = pytest.mark.skipif(unavailable() is not None, reason=str(unavailable()))
 
 
 def _open(config: dict[str, Any]) -> zenoh.Session:
@@ -90,6 +83,7 @@ def _stranger(out: Path) -> int:
     return 20 * len(_forgeries())
 
 
+@needs_namespaces
 def test_a_rehearsed_map_flies_as_in_one_process_and_leaves_nothing(tmp_path: Path) -> None:
     sc = small_scenario(M, duration_s=150.0, observers={"count": 2},
                         fdir={"floor": 0.05, "persistence": 2})
@@ -123,6 +117,7 @@ def test_a_rehearsed_map_flies_as_in_one_process_and_leaves_nothing(tmp_path: Pa
     assert f"i{rehearsal.pid % 100000}." not in links
 
 
+@needs_namespaces
 def test_a_launcher_killed_outright_leaves_namespaces_the_next_removes(tmp_path: Path) -> None:
     trio = load_host_map(TRIO)
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
@@ -139,3 +134,16 @@ def test_a_launcher_killed_outright_leaves_namespaces_the_next_removes(tmp_path:
     finally:
         for name in left:
             netns.remove(name)
+
+
+@pytest.mark.skipif(shutil.which("setpriv") is None, reason="needs util-linux's setpriv")
+def test_without_the_privilege_a_rehearsal_stops_at_once_naming_it(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    drop = ["setpriv", "--bounding-set", "-sys_admin,-net_admin", "--inh-caps",
+            "-sys_admin,-net_admin"]
+    done = subprocess.run([*drop, *LAUNCHER, "--hosts", str(REPO / "deploy" / "hosts" / "lab.toml"),
+                           "--rehearse", "--out",
+                           str(out)], cwd=REPO, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert "needs CAP_SYS_ADMIN and CAP_NET_ADMIN" in done.stderr, done.stderr
+    assert "Traceback" not in done.stderr and not out.exists()
