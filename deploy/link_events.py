@@ -2,9 +2,17 @@
 from a sim time for a sim duration, applied to the host's link in the rehearsed network (not
 in the Bus).
 
-The launcher's clock for them is the sim time of the ground's heartbeats (1 Hz of sim time),
-so an event starts at the first heartbeat at or after its time: up to a heartbeat period late,
-and by how much is recorded (``<out>/logs/link-events.json``).
+* **A cut** changes which spacecraft take part in the lockstep, so it must act at a tick, not
+  whenever the network notices: the sim is told the cut's times (``--await-link``,
+  :meth:`LinkEvents.awaits`), and after the tick at each it says in its status that it waits
+  (``sim.lockstep.LinkAwait``).  The launcher then cuts or restores the link
+  (:meth:`LinkEvents.on_waiting`) and the sim holds the clock until the host's spacecraft are
+  gone (Zenoh's lease, about 10 s of wall time) or back.  The cut spacecraft are lost from the
+  tick after ``at_s`` and rejoin at the tick after ``at_s + duration_s``, the same in every run.
+* **A delay or loss** changes no result (lockstep), so it is applied by the ground's heartbeats
+  (1 Hz of sim time, :meth:`LinkEvents.on_time`): up to a heartbeat period late.
+
+The sim times each event began and ended are in ``<out>/logs/link-events.json``.
 """
 
 from __future__ import annotations
@@ -16,6 +24,7 @@ from dataclasses import dataclass
 
 from deploy.host_map import HostMap, LinkEvent
 from deploy.rehearsal.network import RehearsedNetwork
+from interfaces.contracts import topics
 
 log = logging.getLogger("insp.links")
 
@@ -27,8 +36,32 @@ class _Applied:
     ended_t_s: float | None = None
 
 
+def cut_nodes(host_map: HostMap, host: str) -> tuple[str, ...]:
+    """The lockstep participants a cut of ``host`` takes away: its spacecraft."""
+    return tuple(n for n in host_map.hosts[_index(host_map, host)].nodes
+                 if topics.spacecraft_of(n) is not None)
+
+
+def _index(host_map: HostMap, host: str) -> int:
+    return next(i for i, h in enumerate(host_map.hosts) if h.name == host)
+
+
+def check_cuts(host_map: HostMap) -> None:
+    """Refuse cuts a rehearsal cannot make: of the hub (the launcher watches the run through
+    it), of the sim's host (the clock) or of a host without spacecraft (nothing to hold for)."""
+    for e in host_map.events:
+        if not e.cut:
+            continue
+        if e.host == host_map.hub.name:
+            raise ValueError(f"host {e.host} is the hub: the launcher watches the run through "
+                             "its link, which a rehearsal does not cut")
+        if e.host == host_map.host_of(topics.SIM).name or not cut_nodes(host_map, e.host):
+            raise ValueError(f"host {e.host}: a rehearsal cuts the link of a host of "
+                             "spacecraft (not the sim's)")
+
+
 class LinkEvents:
-    """The events of ``host_map`` on ``net``'s links; :meth:`on_time` moves them on."""
+    """The events of ``host_map`` on ``net``'s links (module docstring)."""
 
     def __init__(self, net: RehearsedNetwork, host_map: HostMap) -> None:
         self.net, self.map = net, host_map
@@ -43,31 +76,57 @@ class LinkEvents:
         with self._lock:
             for a in self._events:
                 if a.started_t_s is not None and a.ended_t_s is None:
-                    self._restore(a, self._t_sim)
+                    self._end(a, self._t_sim)
 
-    def on_time(self, t_sim: float) -> None:
-        """The sim time is ``t_sim`` (s): start and end the events due."""
+    def awaits(self) -> list[str]:
+        """The sim's ``--await-link`` values: each cut's start and end, in time order."""
+        out = []
+        for e in (a.event for a in self._events if a.event.cut):
+            nodes = ",".join(cut_nodes(self.map, e.host))
+            out += [(e.at_s, f"lost:{nodes}:{e.at_s:g}"),
+                    (e.at_s + e.duration_s, f"back:{nodes}:{e.at_s + e.duration_s:g}")]
+        return [text for _, text in sorted(out)]
+
+    def on_waiting(self, reason: str, t_sim: float) -> None:
+        """The sim waits at ``t_sim`` for a link change (its status' ``reason``, ``link <i>:
+        awaiting lost|back:NODES:T``): make it."""
+        what = reason.rpartition("awaiting ")[2]
         with self._lock:
-            self._t_sim = t_sim
+            self._t_sim = max(self._t_sim, t_sim)
             for a in self._events:
                 e = a.event
+                nodes = ",".join(cut_nodes(self.map, e.host)) if e.cut else ""
+                if a.started_t_s is None and what == f"lost:{nodes}:{e.at_s:g}":
+                    self._start(a, t_sim)
+                elif a.ended_t_s is None and what == (f"back:{nodes}:"
+                                                      f"{e.at_s + e.duration_s:g}"):
+                    self._end(a, t_sim)
+
+    def on_time(self, t_sim: float) -> None:
+        """The sim time is ``t_sim`` (s): start and end the delay and loss events due."""
+        with self._lock:
+            self._t_sim = max(self._t_sim, t_sim)
+            for a in self._events:
+                e = a.event
+                if e.cut:
+                    continue
                 if a.started_t_s is None and t_sim >= e.at_s:
-                    a.started_t_s = t_sim
-                    normal = self.map.hosts[self._index(e.host)].link
-                    self.net.set_link(e.host, e.during(normal), up=not e.cut)
-                    log.warning("link of %s %s at sim t=%.1f s (due %.1f s)", e.host,
-                                "cut" if e.cut else f"now {e.during(normal)}", t_sim, e.at_s)
+                    self._start(a, t_sim)
                 elif (a.started_t_s is not None and a.ended_t_s is None
                       and t_sim >= e.at_s + e.duration_s):
-                    self._restore(a, t_sim)
+                    self._end(a, t_sim)
 
-    def _restore(self, a: _Applied, t_sim: float) -> None:
+    def _start(self, a: _Applied, t_sim: float) -> None:
+        e, normal = a.event, self.map.hosts[_index(self.map, a.event.host)].link
+        a.started_t_s = t_sim
+        self.net.set_link(e.host, e.during(normal), up=not e.cut)
+        log.warning("link of %s %s at sim t=%.1f s (due %.1f s)", e.host,
+                    "cut" if e.cut else f"now {e.during(normal)}", t_sim, e.at_s)
+
+    def _end(self, a: _Applied, t_sim: float) -> None:
         a.ended_t_s = t_sim
-        self.net.set_link(a.event.host, self.map.hosts[self._index(a.event.host)].link)
+        self.net.set_link(a.event.host, self.map.hosts[_index(self.map, a.event.host)].link)
         log.warning("link of %s restored at sim t=%.1f s", a.event.host, t_sim)
-
-    def _index(self, host: str) -> int:
-        return next(i for i, h in enumerate(self.map.hosts) if h.name == host)
 
     def report(self) -> str:
         """The events as applied (JSON): each with the sim times it started and ended."""

@@ -55,7 +55,7 @@ from deploy.access import RunAccess, write_run_access  # noqa: E402
 from deploy.host_access import write_host_access  # noqa: E402
 from deploy.host_map import HostMap, HostMapError, load_host_map, parse_link_event  # noqa: E402
 from deploy.interrupts import Interrupts  # noqa: E402
-from deploy.link_events import LinkEvents  # noqa: E402
+from deploy.link_events import LinkEvents, check_cuts  # noqa: E402
 from deploy.out_folder import OutFolderError, written  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
 from deploy.placement import Placement, across_hosts, one_host  # noqa: E402
@@ -279,10 +279,7 @@ def _host_map(args: argparse.Namespace, scenario: Scenario) -> HostMap | None:
     host_map = load_host_map(args.hosts).with_links(args.link_delay_ms, args.link_loss_pct)
     host_map = host_map.with_events(events)
     host_map.check_run(topology(scenario).participants)
-    for e in host_map.events:
-        if e.cut and e.host == host_map.hub.name:
-            raise ValueError(f"host {e.host} is the hub: the launcher watches the run through "
-                             "its link, which a rehearsal does not cut")
+    check_cuts(host_map)
     if args.rehearse:
         require_privilege()
     return host_map
@@ -394,8 +391,7 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Names
             placement = across_hosts(access_h, host_map,
                                      {h.name: net.netns(h.name) for h in host_map.hosts})
             with LinkEvents(net, host_map) as events:
-                result = _run_placed(scenario, mission, out, args, stop, placement,
-                                     events.on_time)
+                result = _run_placed(scenario, mission, out, args, stop, placement, events)
             (out / "logs" / "link-events.json").write_text(events.report(), encoding="utf-8")
             return result
     except RehearsalError as e:
@@ -404,9 +400,9 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Names
 
 def _run_placed(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
                 stop: threading.Event, placement: Placement,
-                on_time: Callable[[float], None] | None = None) -> tuple[str, str | None]:
-    """Start the routers, join the run (the launcher's own session) and supervise it;
-    ``on_time`` is told the sim time of each of the ground's heartbeats."""
+                events: LinkEvents | None = None) -> tuple[str, str | None]:
+    """Start the routers, join the run (the launcher's own session) and supervise it, with a
+    rehearsal's link ``events``."""
     sup = Supervisor(REPO)
     routers = [sup.start(Child(r.name, [*ROUTER.command, "--config", str(r.config),
                                         *_audit_args(args, out, r.name)],
@@ -420,7 +416,7 @@ def _run_placed(scenario: Scenario, mission: str, out: Path, args: argparse.Name
         clash = "; is another run using it?" if address_taken(dead.log_tail()) else ""
         return "failed", (f"{dead.name} did not start on {place.endpoint} "
                           f"({dead.describe_exit()}{clash}):\n{dead.log_tail()}")
-    progress = _Progress(scenario, on_time)
+    progress = _Progress(scenario, events)
     live = None
     try:
         hub.session.declare_subscriber(cat.HEARTBEAT.key(mission, topics.GROUND),
@@ -429,7 +425,9 @@ def _run_placed(scenario: Scenario, mission: str, out: Path, args: argparse.Name
         live = _live_view(args)
         if live is not None:
             hub.subscribe(topics.mission_wildcard(mission), live.forward)
-        return _supervise(scenario, mission, out, args, progress, hub, sup, placement, stop)
+        awaits = [x for a in (events.awaits() if events else []) for x in ("--await-link", a)]
+        return _supervise(scenario, mission, out, args, progress, hub, sup, placement, stop,
+                          awaits)
     finally:
         hub.close()
         if live is not None:
@@ -539,7 +537,8 @@ def _access_audit(out: Path) -> AccessAudit | None:
 
 def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
                progress: _Progress, hub: ZenohTransport, sup: Supervisor,
-               placement: Placement, stop: threading.Event) -> tuple[str, str | None]:
+               placement: Placement, stop: threading.Event,
+               sim_extra: list[str] | None = None) -> tuple[str, str | None]:
     common = _common_args(args, mission, str(args.scenario.resolve()))
 
     def account(who: str | Host) -> list[str]:
@@ -567,7 +566,8 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     sim_argv = [*SIM.command, *account(SIM.name)] + (
         ["--realtime", str(args.realtime)] if args.realtime is not None else []) + (
         ["--hard-deadline"] if args.realtime is not None and args.hard_deadline else []) + (
-        ["--hold-lost", str(RESTART_HOLD_S)] if args.restart_on_crash else [])
+        ["--hold-lost", str(RESTART_HOLD_S)] if args.restart_on_crash else []) + (
+        sim_extra or [])
     sup.start(Child(SIM.name, sim_argv, logs / "sim.log", placement.netns(SIM.name)))
     topo = topology(scenario)
     cds = _store_args(out, args.restart_on_crash)
@@ -857,10 +857,9 @@ def _wait_token(hub: ZenohTransport, token: str, child: Child, timeout_s: float)
 class _Progress:
     """Progress of the run (one line every few seconds)."""
 
-    def __init__(self, scenario: Scenario,
-                 on_time: Callable[[float], None] | None = None) -> None:
-        self.on_time = on_time
-        """told the sim time of each heartbeat (the link events' clock)"""
+    def __init__(self, scenario: Scenario, events: LinkEvents | None = None) -> None:
+        self.events = events
+        """a rehearsal's link events: told the time of each heartbeat, and the sim's waits"""
         self.n_ticks = scenario.n_ticks
         self.duration = scenario.duration_s
         self.t_sim = 0.0
@@ -877,14 +876,17 @@ class _Progress:
         except Exception:  # noqa: BLE001 - progress display only
             return
         self.k, self.t_sim = hb.k, hb.t_sim
-        if self.on_time is not None:
-            self.on_time(hb.t_sim)
+        if self.events is not None:
+            self.events.on_time(hb.t_sim)
 
     def on_status(self, sample: object) -> None:
         try:
             status = SimStatus.model_validate_json(sample.payload.to_bytes())  # type: ignore[attr-defined]
         except Exception:  # noqa: BLE001
             return
+        if (status.state == "waiting" and status.reason.startswith("link ")
+                and self.events is not None):
+            self.events.on_waiting(status.reason, status.t_sim)
         if status.state in ("finished", "aborted"):
             self.final = status
             self.finished.set()

@@ -9,6 +9,7 @@ from interfaces.contracts.topology import topology
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import add_node_args, open_zenoh, start_node
 from interfaces.runtime.recent import depth_for
+from sim.lockstep import LinkAwait
 from sim.node import SimNode
 
 
@@ -26,6 +27,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--hold-lost", type=float, default=0.0, metavar="SECONDS",
                         help="wait up to SECONDS of wall time for a lost participant to come "
                              "back (its restart) before the next tick (default: fly on)")
+    parser.add_argument("--await-link", action="append", default=[], type=LinkAwait.parse,
+                        metavar="lost|back:NODES:T_S",
+                        help="a rehearsal's link cut or restored after the tick at T_S: held "
+                             "for until NODES are gone or back (docs/hosts.md); repeatable")
     args = parser.parse_args(argv)
     start = start_node(args, topics.SIM)
     log, scenario = start.log, start.scenario
@@ -35,7 +40,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime,
                       hard_deadline=args.hard_deadline, hold_lost_s=args.hold_lost, log=log,
-                      stop=start.stop)
+                      stop=start.stop,
+                      link_awaits=tuple(sorted(args.await_link, key=lambda a: a.t_s)))
         bus.watch_alive(sim.on_liveness)
         bus.serve_schemas()
         bus.serve_recent()

@@ -135,6 +135,23 @@ class Lockstep:
                 self._cond.wait(min(left, 0.5))
         return time.monotonic() - t0 if held else 0.0
 
+    def await_liveness(self, nodes: tuple[str, ...], alive: bool, timeout_s: float) -> float:
+        """Wait until every one of ``nodes`` is alive (``alive``) or gone, up to ``timeout_s``
+        (wall): a rehearsal's link cut or restored takes effect at this tick, whatever the
+        network's timing (:class:`LinkAwait`).  Returns the wall time held, s."""
+        t0 = time.monotonic()
+        with self._cond:
+            while not self.stop.is_set():
+                if all((n in self._alive) == alive for n in nodes):
+                    return time.monotonic() - t0
+                left = t0 + timeout_s - time.monotonic()
+                if left <= 0.0:
+                    self.log.error("%s not %s within %.0f s; flying on", ", ".join(nodes),
+                                   "back" if alive else "lost", timeout_s)
+                    break
+                self._cond.wait(min(left, 0.5))
+        return time.monotonic() - t0
+
     def wait_for_participants(self, timeout_s: float) -> None:
         """Block until every participant has announced itself (Zenoh liveliness)."""
         deadline = time.monotonic() + timeout_s
@@ -224,3 +241,28 @@ class Lockstep:
         """A copy of ``events``, taken under the lock."""
         with self._cond:
             return {n: list(e) for n, e in self.events.items()}
+
+
+@dataclass(frozen=True)
+class LinkAwait:
+    """A rehearsal's link cut (``alive`` False) or restored (True) at sim time ``t_s``
+    (``--await-link lost|back:NODES:T``, docs/hosts.md): after the tick at ``t_s`` the sim says
+    so in its status (``waiting``, reason ``link <index>: ...``), the launcher changes the link,
+    and the sim holds the clock until ``nodes`` are gone or back.  So the cut spacecraft are lost
+    from the tick after ``t_s`` and rejoin at the tick after the restore's, whatever the
+    network's timing."""
+
+    alive: bool
+    nodes: tuple[str, ...]
+    t_s: float
+
+    @classmethod
+    def parse(cls, text: str) -> LinkAwait:
+        """``lost:sc1,sc2:600`` or ``back:sc1,sc2:630``; ValueError saying the form."""
+        parts = text.split(":")
+        if len(parts) != 3 or parts[0] not in ("lost", "back") or not parts[1]:
+            raise ValueError(f"--await-link {text!r}: expected lost|back:NODE[,NODE...]:T_S")
+        return cls(parts[0] == "back", tuple(parts[1].split(",")), float(parts[2]))
+
+    def __str__(self) -> str:
+        return f"{'back' if self.alive else 'lost'}:{','.join(self.nodes)}:{self.t_s:g}"

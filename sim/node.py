@@ -35,7 +35,7 @@ from interfaces.runtime.bus import Bus
 from interfaces.runtime.recent import recover
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
 from sim.hardware import ObserverHardware
-from sim.lockstep import Lockstep
+from sim.lockstep import LinkAwait, Lockstep
 from sim.pacing import Pacer
 from sim.units import UNITS
 from sim.units.camera import Camera
@@ -94,6 +94,8 @@ class SimNode:
     """with ``realtime_speed``: answers waited for only until the next tick is due"""
     hold_lost_s: float = 0.0
     """how long a lost participant is waited for before the next tick (its restart), wall s"""
+    link_awaits: tuple[LinkAwait, ...] = ()
+    """a rehearsal's link cuts and restorations, in time order (``LinkAwait``)"""
     log: logging.Logger = field(default_factory=lambda: logging.getLogger("insp.sim"))
     stop: threading.Event = field(default_factory=threading.Event)
     completed: bool = field(default=False, init=False)
@@ -237,6 +239,7 @@ class SimNode:
                 accel = self.hw.accel_lvlh(t, self._q_now)
                 self.truth.step(dt, accel, substeps=sc.sim.substeps)
                 self.hw.step(t, dt)
+                self._await_links(k, t)
             if k % max(1, n_ticks // 10) == 0:
                 rate = (k + 1) / max(1e-9, time.monotonic() - wall0)
                 self.log.info("tick %d/%d  t=%.1f s  %.0f ticks/s", k, n_ticks, t, rate)
@@ -244,6 +247,17 @@ class SimNode:
         self.lockstep.await_departure(timeout_s=10.0)
         self.completed = True
         return True
+
+    def _await_links(self, k: int, t: float) -> None:
+        """After tick ``k`` (time ``t``): each link change due, said in the status and held for
+        until it took effect (``LinkAwait``)."""
+        for i, due in enumerate(self.link_awaits):
+            if abs(due.t_s - t) <= 0.5 * self._dt:
+                self._status("waiting", k, f"link {i}: awaiting {due}")
+                held = self.lockstep.await_liveness(due.nodes, due.alive,
+                                                    self.scenario.sim.lockstep_timeout_s)
+                if self.pacer is not None:
+                    self.pacer.slip(held)
 
     def _commands_in(self, expect: dict[str, int], deadline: float) -> None:
         """Wait until ``deadline`` (wall) for the commands the answers announce; those still

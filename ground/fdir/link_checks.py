@@ -11,8 +11,8 @@ that does not reach the ground is a link fault, never zero information gain.
   10%: 6e-6 against 8e-5 for 30 s windows and 0.01 per hour).
 * **Silence**: an observer with its camera on that sends no image for ``fdir.silent_windows``
   windows in a row (once per episode, and not when its loss was declared already: one link
-  fault, declared once), or for as many ω_mid periods in a row straddling two windows, judged
-  when its images resume (a host's link cut for 30 s: docs/hosts.md).  One silent window
+  fault, declared once), or for a window's time straddling two windows, judged when its
+  images resume (a host's link cut for 30 s: docs/hosts.md).  One silent window
   decides alone when a healthy link would lose all of a window's images (one per ω_mid
   period) with a probability below the window's share, as for loss (30 images at a nominal
   15%: 2e-25; in bursts of 50 packets: 0.57, and the silence waits for
@@ -122,7 +122,7 @@ class LinkChecks:
             reports += self._gap(sc, obs, images, b)
             obs.silent, obs.link_declared = 0, False
         if not expected or images:
-            obs.last_image_s = max(m.image_t_s for m in images) if expected else None
+            obs.last_image_s = max(m.t_sim for m in images) if expected else None
         obs.overflow_declared = False
         return lost, reports
 
@@ -222,21 +222,28 @@ class LinkChecks:
 
     def _gap(self, sc: int, obs: ObserverState, images: list[PoiObservations],
              b: float) -> list[FaultReport]:
-        """A silence straddling windows, ended by this window's first image: as many ω_mid
-        periods in a row without an image since the last one judged as a silent window holds,
-        decided as such a window would be (alone when decisive, else ``silent_windows`` of
-        them).  None when a silent window declared it already."""
-        if obs.last_image_s is None or obs.link_declared:
+        """A silence that no whole window holds, ended by this window's images: no image sent
+        (by the messages' own times: a rejoining node sends the images it recovers late) for
+        as long as a window, since the last one judged or between two of this window's;
+        decided as a silent window would be (alone when decisive, else ``silent_windows``
+        windows' time).  None when a silent window declared it already."""
+        if obs.link_declared:
             return []
-        first = min(m.image_t_s for m in images)
-        missing = round((first - obs.last_image_s) * self.images_per_window / self.period_s) - 1
+        sent = sorted([*([] if obs.last_image_s is None else [obs.last_image_s]),
+                       *(m.t_sim for m in images)])
+        gaps = np.diff(sent)
+        if not gaps.size:
+            return []
+        i = int(np.argmax(gaps))
+        silent_s = float(gaps[i])
         n = self.images_per_window
-        if missing < (n if self.decisive(n, n) else n * self.cfg.silent_windows):
+        need_s = self.period_s * (1 if self.decisive(n, n) else self.cfg.silent_windows)
+        if silent_s < need_s - TIME_TOL_S:
             return []
-        self.log.warning("FDIR: sc%d sent no image for %.0f s (%.0f to %.0f s): link fault",
-                         sc, first - obs.last_image_s, obs.last_image_s, first)
+        self.log.warning("FDIR: sc%d sent no image for %.1f s (%.1f to %.1f s): link fault",
+                         sc, silent_s, sent[i], sent[i + 1])
         return [FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
-                            metric=float(missing), threshold=float(n), window_end_s=b)]
+                            metric=silent_s, threshold=need_s, window_end_s=b)]
 
     def _silence(self, sc: int, obs: ObserverState, b: float) -> list[FaultReport]:
         obs.silent += 1

@@ -123,8 +123,9 @@ class ObserverState:
     silent: int = 0
     link_declared: bool = False
     last_image_s: float | None = None
-    """time of its last image in a judged window while imaging and in reach (s; None: none
-    since it was last out of reach or off): a silence straddling windows is measured from it"""
+    """when it sent its last image of a judged window while imaging and in reach (the
+    message's time, s; None: none since it was last out of reach or off): a silence
+    straddling windows is measured from it"""
     overflow: list[tuple[float, float]] = field(default_factory=list)
     """send times (first, last; s) of its FDIR reports its onboard store lost (ground passes)"""
     overflow_declared: bool = False

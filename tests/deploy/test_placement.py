@@ -6,10 +6,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from deploy.access import write_run_access
 from deploy.host_access import write_host_access
 from deploy.host_map import LinkSpec, load_host_map, parse_link_event
-from deploy.link_events import LinkEvents
+from deploy.link_events import LinkEvents, check_cuts
 from deploy.placement import across_hosts, one_host
 from interfaces.contracts.scenario import load_scenario
 from interfaces.contracts.topology import topology
@@ -56,18 +58,27 @@ class _Links:
         self.calls.append((host, link, up))
 
 
-def test_link_events_start_and_end_on_the_sim_clock() -> None:
+def test_a_cut_acts_when_the_sim_waits_for_it_and_delays_on_the_sim_clock() -> None:
+    """A cut is made when the sim says it waits for it (after the tick at its time), and so
+    is its end; a delay or loss is applied at the first heartbeat at or after its time."""
     lab = load_host_map(LAB).with_links(5.0, None).with_events([
-        parse_link_event("sca:cut:30:30"), parse_link_event("scb:loss=10:40:5")])
+        parse_link_event("scb:cut:30:30"), parse_link_event("sca:loss=10:40:5")])
     net = _Links()
     with LinkEvents(net, lab) as events:  # type: ignore[arg-type]
-        for t in (0.0, 29.0, 30.0, 31.0, 41.0, 46.0, 59.0, 60.0, 61.0):
+        assert events.awaits() == ["lost:sc3,sc4,sc5:30", "back:sc3,sc4,sc5:60"]
+        for t in (0.0, 29.0, 30.0, 31.0):
             events.on_time(t)
+        assert net.calls == []  # a cut waits for the sim
+        events.on_waiting("link 0: awaiting lost:sc3,sc4,sc5:30", 30.0)
+        for t in (41.0, 46.0, 59.0, 60.0):
+            events.on_time(t)
+        events.on_waiting("link 1: awaiting back:sc3,sc4,sc5:60", 60.0)
+        events.on_waiting("link 7: awaiting back:sc9:99", 99.0)  # not one of ours: nothing
         assert net.calls == [
-            ("sca", LinkSpec(delay_ms=5.0), False),
-            ("scb", LinkSpec(delay_ms=5.0, loss_pct=10.0), True),
-            ("scb", LinkSpec(delay_ms=5.0), True),
-            ("sca", LinkSpec(delay_ms=5.0), True)]
+            ("scb", LinkSpec(delay_ms=5.0), False),
+            ("sca", LinkSpec(delay_ms=5.0, loss_pct=10.0), True),
+            ("sca", LinkSpec(delay_ms=5.0), True),
+            ("scb", LinkSpec(delay_ms=5.0), True)]
         report = json.loads(events.report())
     assert [(r["started_t_s"], r["ended_t_s"]) for r in report] == [(30.0, 60.0), (41.0, 46.0)]
 
@@ -76,5 +87,13 @@ def test_an_event_still_on_at_the_end_is_undone() -> None:
     lab = load_host_map(LAB).with_events([parse_link_event("sca:cut:10:1000")])
     net = _Links()
     with LinkEvents(net, lab) as events:  # type: ignore[arg-type]
-        events.on_time(12.0)
+        events.on_waiting("link 0: awaiting lost:sc1,sc2:10", 10.0)
     assert net.calls == [("sca", LinkSpec(), False), ("sca", LinkSpec(), True)]
+
+
+@pytest.mark.parametrize("host, says", [("ground", "is the hub"), ("sim", "not the sim's")])
+def test_a_rehearsal_cuts_only_a_host_of_spacecraft(host: str, says: str) -> None:
+    lab = load_host_map(LAB).with_events([parse_link_event(f"{host}:cut:10:5")])
+    with pytest.raises(ValueError, match=says):
+        check_cuts(lab)
+    check_cuts(load_host_map(LAB).with_events([parse_link_event(f"{host}:delay=50:10:5")]))

@@ -11,7 +11,7 @@ import pytest
 
 from interfaces.contracts import topics
 from interfaces.contracts.messages import TickDone
-from sim.lockstep import Lockstep
+from sim.lockstep import LinkAwait, Lockstep
 
 M = "sl"
 
@@ -111,3 +111,34 @@ def test_the_clock_holds_while_the_recorder_restarts() -> None:
     ls.on_liveness(topics.RECORDER, False)
     threading.Timer(0.2, ls.on_liveness, (topics.RECORDER, True)).start()
     assert 0.15 <= ls.hold_for_services() < 4.0
+
+
+def test_a_link_change_holds_the_clock_until_the_nodes_are_gone_or_back() -> None:
+    """A rehearsal's cut (docs/hosts.md): the sim holds after the tick at the cut's time until
+    the cut host's spacecraft are lost, and after the restore's until they are back."""
+    now = [60.0]
+    ls = _lockstep(now)
+    for node in ("sc1", "sc2"):
+        ls.on_liveness(node, True)
+    ls.open_tick(1)
+    threading.Timer(0.2, ls.on_liveness, ("sc2", False)).start()
+    t0 = time.monotonic()
+    assert ls.await_liveness(("sc2",), False, timeout_s=10.0) >= 0.15
+    assert time.monotonic() - t0 < 5.0
+    assert ls.events_now() == {"sc2": [("lost", 60.0)]}
+    now[0] = 90.0
+    threading.Timer(0.2, ls.on_liveness, ("sc2", True)).start()
+    assert ls.await_liveness(("sc2",), True, timeout_s=10.0) >= 0.15
+    assert ls.open_tick(2) == ["sc2"]  # named in the next tick's rejoin
+    assert ls.events_now() == {"sc2": [("lost", 60.0), ("rejoined", 90.0)]}
+    held = ls.await_liveness(("sc1",), False, timeout_s=0.3)  # never lost: flies on
+    assert 0.3 <= held < 2.0
+
+
+def test_link_awaits_are_read_from_the_command_line() -> None:
+    cut = LinkAwait.parse("lost:sc1,sc2:600")
+    assert cut == LinkAwait(False, ("sc1", "sc2"), 600.0) and str(cut) == "lost:sc1,sc2:600"
+    assert LinkAwait.parse("back:sc3:630.5") == LinkAwait(True, ("sc3",), 630.5)
+    for bad in ("cut:sc1:600", "lost::600", "lost:sc1", "lost:sc1:x"):
+        with pytest.raises(ValueError):
+            LinkAwait.parse(bad)

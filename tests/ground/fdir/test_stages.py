@@ -81,33 +81,40 @@ def test_one_silent_window_decides_when_a_healthy_link_could_hardly_empty_it(los
 
 
 def _windows(links: LinkChecks, obs: ObserverState, images: dict[float, list[float]],
-             reachable: bool = True) -> list[list[FaultReport]]:
+             reachable: bool = True, sent: dict[float, float] | None = None
+             ) -> list[list[FaultReport]]:
     """Judge one observer's windows, each ending at a key with images at the times listed (its
-    sequence numbers in order: nothing lost on the link)."""
+    sequence numbers in order: nothing lost on the link), each sent at its time or later
+    (``sent``: image time -> the message's time)."""
     seq = obs.last_seq
     out = []
     for b, times in images.items():
-        mine = [_obs(1, t, seq := seq + 1) for t in times]
+        mine = [_obs(1, t, seq := seq + 1).model_copy(update={"t_sim": (sent or {}).get(t, t)})
+                for t in times]
         out.append(links.judge(1, obs, mine, True, b, reachable)[1])
     return out
 
 
 def test_a_silence_straddling_two_windows_is_a_link_fault_when_images_resume() -> None:
-    """A host's link cut for 30 s (docs/hosts.md): the observer's last image at 600 s, the next
-    at 636 s.  Neither window is silent; 35 ω_mid periods without an image, more than the 30 of
-    a window, are a link fault (as one silent window would be on this link), declared when the
-    images resume.  20 s without one are not; on a bursty link, 60 would be needed."""
+    """A host's link cut for 30 s (docs/hosts.md): the observer's last image sent at 600 s, the
+    next at 631 s (it rejoined at 630.1 s and sent the images of 628-630 s it recovered, late:
+    judged in the window ending at 630 s).  No window is silent; 31 s without an image sent, a
+    window's time, are a link fault (as one silent window would be on this link), declared with
+    the window the images resume in.  20 s are not; on a bursty link, 60 s would be needed."""
     links = LinkChecks(small_scenario(comms={"packet_loss": 0.1}), "ground", LOG)
-    cut = {600.0: [float(t) for t in range(570, 600)], 630.0: [600.0],
-           660.0: [float(t) for t in range(636, 660)]}
-    reports = _windows(links, ObserverState(), cut)
-    assert [len(r) for r in reports] == [0, 0, 1]
-    declared = reports[2][0]
-    assert (declared.fault_class, declared.window_end_s, declared.metric) == ("link", 660.0, 35)
+    cut = {600.0: [float(t) for t in range(570, 600)], 630.0: [600.0, 628.0, 629.0],
+           660.0: [float(t) for t in range(630, 660)]}
+    late = {628.0: 631.0, 629.0: 631.0, 630.0: 631.0}
+    reports = _windows(links, ObserverState(), cut, sent=late)
+    assert [len(r) for r in reports] == [0, 1, 0]
+    declared = reports[1][0]
+    assert (declared.fault_class, declared.window_end_s) == ("link", 630.0)
+    assert (declared.metric, declared.threshold) == (31.0, 30.0)
+    assert _windows(links, ObserverState(), cut) == [[], [], []]  # sent in time: 27 s
     short = {630.0: [float(t) for t in range(600, 616)], 660.0: [float(t) for t in range(636, 660)]}
     assert _windows(links, ObserverState(), short) == [[], []]
     bursty = LinkChecks(small_scenario(comms=BURSTY), "ground", LOG)
-    assert _windows(bursty, ObserverState(), cut) == [[], [], []]
+    assert _windows(bursty, ObserverState(), cut, sent=late) == [[], [], []]
 
 
 def test_a_silence_already_declared_or_out_of_reach_is_not_declared_again() -> None:
