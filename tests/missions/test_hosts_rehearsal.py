@@ -26,6 +26,7 @@ from deploy.host_map import load_host_map
 from deploy.rehearsal import netns
 from deploy.rehearsal.netns import unavailable
 from deploy.rehearsal.network import RehearsedNetwork
+from harness.archive.reader import load_run
 from interfaces.contracts import catalogue as cat
 from tests.conftest import REPO, settle, small_scenario, write_scenario
 from tests.missions.test_access_run import _forgeries, _open_when_up
@@ -115,6 +116,29 @@ def test_a_rehearsed_map_flies_as_in_one_process_and_leaves_nothing(tmp_path: Pa
     assert netns.ours(rehearsal.pid) == []
     links = subprocess.run(["ip", "-o", "link"], capture_output=True, text=True).stdout
     assert f"i{rehearsal.pid % 100000}." not in links
+
+
+@needs_namespaces
+def test_a_spacecraft_hosts_link_cut_for_30_s_is_a_link_fault_of_its_spacecraft_alone(
+        tmp_path: Path) -> None:
+    """sca's link cut at 40 s for 30 s: sc1 is lost from the tick after 40 s and rejoins at the
+    tick after 70 s (the sim holds the clock for the network at both), sc2 flies on, and the
+    ground names a link fault on sc1 and nothing else; nothing is lost from the archive."""
+    sc = small_scenario(M, duration_s=150.0, observers={"count": 2},
+                        fdir={"floor": 0.05, "persistence": 2})
+    path = write_scenario(tmp_path / "cut.toml", sc)
+    done = subprocess.run([*LAUNCHER, "--scenario", str(path), "--out", str(tmp_path / "cut"),
+                           "--hosts", str(TRIO), "--rehearse", "--link-event", "sca:cut:40:30"],
+                          cwd=REPO, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1, done.stderr  # degraded: sc1 was lost
+    summary = json.loads((tmp_path / "cut" / "summary.json").read_text())
+    assert summary["status"] == "degraded" and summary["t_sim_final_s"] == 150.0
+    assert summary["sim"]["participants"] == {"sc1": [{"what": "lost", "t_sim": 40.0},
+                                                      {"what": "rejoined", "t_sim": 70.0}]}
+    assert [(d["spacecraft"], d["class"]) for d in summary["detections"]] == [(1, "link")]
+    assert load_run(tmp_path / "cut" / "run.mcap").lost == {}
+    events = json.loads((tmp_path / "cut" / "logs" / "link-events.json").read_text())
+    assert [(e["started_t_s"], e["ended_t_s"]) for e in events] == [(40.0, 70.0)]
 
 
 @needs_namespaces
