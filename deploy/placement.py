@@ -15,7 +15,7 @@ from pathlib import Path
 from deploy.access import TLM_ACCOUNT, RunAccess
 from deploy.host_access import HostAccess
 from deploy.host_map import HostMap
-from interfaces.contracts.topology import ROUTER, Host, Hosting, Topology, hosting
+from interfaces.contracts.topology import ROUTER, Hosting, NodeProcess, Topology, hosting
 
 
 @dataclass(frozen=True)
@@ -54,21 +54,21 @@ class Placement:
         return self.namespaces.get(name)
 
     def processes(self, topo: Topology, mode: Hosting, processes: int,
-                  alone: Collection[str] = ()) -> tuple[Host, ...]:
+                  alone: Collection[str] = ()) -> tuple[NodeProcess, ...]:
         """The processes of the lockstep nodes: on one host, ``hosting`` over its cores;
         across hosts, each host's spacecraft in one process (``packed``) or each alone, the
         ground alone."""
         if self.host_map is None:
             return hosting(topo, mode, processes, alone)
-        out: list[Host] = []
+        out: list[NodeProcess] = []
         for h in self.host_map.hosts:
             nodes = [topo.node(n) for n in h.nodes if n in topo.participants]
             spacecraft = tuple(n for n in nodes if n.spacecraft is not None)
             if spacecraft and mode == "packed":
-                out.append(Host(spacecraft))
+                out.append(NodeProcess(spacecraft))
             else:
-                out += [Host((n,)) for n in spacecraft]
-            out += [Host((n,)) for n in nodes if n.spacecraft is None]
+                out += [NodeProcess((n,)) for n in spacecraft]
+            out += [NodeProcess((n,)) for n in nodes if n.spacecraft is None]
         return tuple(out)
 
 

@@ -80,7 +80,7 @@ from interfaces.contracts.topology import (  # noqa: E402
     RECORDER,
     ROUTER,
     SIM,
-    Host,
+    NodeProcess,
     topology,
 )
 from interfaces.runtime.arguments import add_log_level, endpoint, mission_name  # noqa: E402
@@ -541,15 +541,15 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
                sim_extra: list[str] | None = None) -> tuple[str, str | None]:
     common = _common_args(args, mission, str(args.scenario.resolve()))
 
-    def account(who: str | Host) -> list[str]:
+    def account(who: str | NodeProcess) -> list[str]:
         """The account options of a service, a node or a host (each of its nodes its own:
         ``{node}`` in the path)."""
-        if isinstance(who, Host) and len(who.nodes) > 1:
+        if isinstance(who, NodeProcess) and len(who.nodes) > 1:
             for n in who.nodes:
                 placement.config(n.name)  # a clear error for a missing account
             folder = placement.config(who.nodes[0].name).parent
             return [*common, "--zenoh-config", str(folder / "{node}.json5")]
-        name = who.name if isinstance(who, Host) else who
+        name = who.name if isinstance(who, NodeProcess) else who
         return [*common, "--zenoh-config", str(placement.config(name))]
 
     logs = out / "logs"
@@ -571,19 +571,20 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     sup.start(Child(SIM.name, sim_argv, logs / "sim.log", placement.netns(SIM.name)))
     topo = topology(scenario)
     cds = _store_args(out, args.restart_on_crash)
-    hosts = placement.processes(topo, args.hosting, args.processes or host_cores(),
-                                alone=args.external)
-    for host in hosts:
-        if host.name in args.external:
-            config = placement.config(host.name)
+    processes = placement.processes(topo, args.hosting, args.processes or host_cores(),
+                                    alone=args.external)
+    for process in processes:
+        if process.name in args.external:
+            config = placement.config(process.name)
             there = [config.name if a == str(config) else a
-                     for a in [*host.command, *account(host.name), *cds]]
+                     for a in [*process.command, *account(process.name), *cds]]
             log.info("%s runs elsewhere: on its host, with this run's scenario and %s there, "
-                     "run: python %s", host.name, config, " ".join(there))
+                     "run: python %s", process.name, config, " ".join(there))
         else:
-            sup.start(Child(host.name, [*host.command, *account(host), *cds],
-                            logs / f"{host.name}.log", placement.netns(host.nodes[0].name)))
-    watch = _Watch(sup, progress, flight={h.name: [n.name for n in h.nodes] for h in hosts
+            sup.start(Child(process.name, [*process.command, *account(process), *cds],
+                            logs / f"{process.name}.log",
+                            placement.netns(process.nodes[0].name)))
+    watch = _Watch(sup, progress, flight={h.name: [n.name for n in h.nodes] for h in processes
                                           if h.name not in args.external},
                    restart=args.restart_on_crash, recorder_up=recorder_up.count,
                    sim_up=_Appearances(hub, topics.alive_token(mission, SIM.name)).count,
@@ -592,7 +593,7 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     progress.report(final=True)
     watch.read_restores(out / "cds")
     # Stop the flight side first, then the recorder, so the archive holds everything sent.
-    sup.stop_all(order=[SIM.name, *(h.name for h in hosts)],
+    sup.stop_all(order=[SIM.name, *(h.name for h in processes)],
                  exclude={RECORDER.name, *(r.name for r in placement.routers)})
     time.sleep(0.2)
     recorder = sup.named(RECORDER.name)

@@ -131,7 +131,7 @@ separate computers.  The ground is always alone."""
 
 
 @dataclass(frozen=True)
-class Host:
+class NodeProcess:
     """One process of a multi-process run and the lockstep nodes it hosts (one account, bus
     and Zenoh session each): named for its node when alone, else for them all
     (``sc1+sc2+sc3``)."""
@@ -140,9 +140,9 @@ class Host:
 
     def __post_init__(self) -> None:
         if not self.nodes:
-            raise ValueError("a host needs at least one node")
+            raise ValueError("a process needs at least one node")
         if len({(n.module, n.args[:1]) for n in self.nodes}) != 1:
-            raise ValueError("the nodes of one host must start the same way, got "
+            raise ValueError("the nodes of one process must start the same way, got "
                              + ", ".join(" ".join(n.command) for n in self.nodes))
 
     @property
@@ -160,19 +160,19 @@ class Host:
 
 
 def hosting(topo: Topology, mode: Hosting, processes: int,
-            alone: Collection[str] = ()) -> tuple[Host, ...]:
+            alone: Collection[str] = ()) -> tuple[NodeProcess, ...]:
     """The processes of a multi-process run of ``topo`` (:data:`Hosting`): ``packed``, the
     spacecraft in ``processes`` processes of consecutive ids (sizes differing by one at most),
     the nodes named in ``alone`` (run elsewhere) and the ground each alone."""
     if processes < 1:
         raise ValueError(f"processes must be at least 1, got {processes}")
     packable = [n for n in topo.nodes if n.spacecraft is not None and n.name not in alone]
-    singles = [Host((n,)) for n in topo.nodes if n not in packable]
+    singles = [NodeProcess((n,)) for n in topo.nodes if n not in packable]
     if mode == "one-per-process" or not packable:
-        return tuple(Host((n,)) for n in topo.nodes)
+        return tuple(NodeProcess((n,)) for n in topo.nodes)
     count = min(processes, len(packable))
     ends = [round(len(packable) * (i + 1) / count) for i in range(count)]
-    blocks = [Host(tuple(packable[a:b])) for a, b in zip([0, *ends], ends, strict=False)]
+    blocks = [NodeProcess(tuple(packable[a:b])) for a, b in zip([0, *ends], ends, strict=False)]
     return tuple(blocks + singles)
 
 

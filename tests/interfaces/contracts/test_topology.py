@@ -14,8 +14,8 @@ from fsw.apps.infocost import InfoCostApp
 from interfaces.contracts import topics
 from interfaces.contracts.apps import GROUND_APPS, ONBOARD_FDIR_APPS, SPACECRAFT_APPS
 from interfaces.contracts.topology import (
-    Host,
     Node,
+    NodeProcess,
     describe,
     hosting,
     topology,
@@ -118,4 +118,4 @@ def test_a_packed_host_starts_its_spacecraft_together_and_one_alone_as_before() 
     with pytest.raises(ValueError, match="at least 1"):
         hosting(topo, "packed", 0)
     with pytest.raises(ValueError, match="start the same way"):
-        Host((topo.node("sc1"), topo.node(topics.GROUND)))
+        NodeProcess((topo.node("sc1"), topo.node(topics.GROUND)))
