@@ -897,7 +897,7 @@ class _Progress:
         if self.final is None:
             return []
         return [f"{node} " + ", ".join(f"{e.what} at t≈{e.t_sim:.1f} s" for e in events)
-                for node, events in self.final.participants.items()]
+                for node, events in sorted(self.final.participants.items())]
 
     def report(self, final: bool = False) -> None:
         now = time.monotonic()
