@@ -79,9 +79,11 @@ class HostAccess:
 
 
 def write_host_access(directory: Path, mission: str, n_observers: int,
-                      host_map: HostMap) -> HostAccess:
+                      host_map: HostMap, portable: bool = False) -> HostAccess:
     """Fresh accounts, certificates and router configurations for every host of ``host_map``
-    (see the module docstring); the map is assumed checked against the run."""
+    (see the module docstring); the map is assumed checked against the run.  ``portable``: the
+    routers name their files as ``access/<file>`` (the folder copied to its host as
+    ``access/``, the router started beside it), else by their paths here."""
     directory.mkdir(parents=True, exist_ok=True)
     directory.chmod(0o700)
     authority = write_authority(directory)
@@ -92,7 +94,7 @@ def write_host_access(directory: Path, mission: str, n_observers: int,
     accounts = {n: Account(n, secrets.token_urlsafe(18)) for n in names}
     relays = {relay_account(h): h.nodes for h in spokes}
     hosts = {h.name: _write_host(directory / h.name, mission, n_observers, host_map, h,
-                                 authority, accounts, relays if h is hub else {})
+                                 authority, accounts, relays if h is hub else {}, portable)
              for h in host_map.hosts}
     tlm = directory / f"{TLM_ACCOUNT}.json5"
     write_private(tlm, json.dumps(client_config(
@@ -102,12 +104,15 @@ def write_host_access(directory: Path, mission: str, n_observers: int,
 
 def _write_host(folder: Path, mission: str, n_observers: int, host_map: HostMap,
                 host: HostSpec, authority: Authority, accounts: dict[str, Account],
-                relays: dict[str, list[str]]) -> HostFiles:
+                relays: dict[str, list[str]], portable: bool) -> HostFiles:
     folder.mkdir(exist_ok=True)
     folder.chmod(0o700)
     (folder / "authority.pem").write_bytes(authority.pem.read_bytes())
-    tls = write_certificate(authority, folder, "router", relay_account(host),
-                            (str(host.address),))
+    written = write_certificate(authority, folder, "router", relay_account(host),
+                                (str(host.address),))
+    here = Path("access") if portable else folder
+    tls = TlsFiles(here / written.certificate.name, here / written.private_key.name,
+                   here / "authority.pem")
     local = [*host.nodes, TLM_ACCOUNT, *relays]
     dictionary = folder / "users.txt"
     write_private(dictionary, "".join(f"{a}:{accounts[a].password}\n" for a in local))
@@ -119,7 +124,7 @@ def _write_host(folder: Path, mission: str, n_observers: int, host_map: HostMap,
     uplink = None if host.name == hub.name else accounts[relay_account(host)]
     acl = access_control(mission, n_observers, relays=relays,
                          hub_certificate=None if uplink is None else relay_account(hub))
-    config = host_router_config(host_map, host, dictionary, tls, acl, uplink)
+    config = host_router_config(host_map, host, here / dictionary.name, tls, acl, uplink)
     router = folder / "router.json5"
     write_private(router, json.dumps(config, indent=2))
     return HostFiles(host, folder, router)

@@ -451,7 +451,8 @@ def _print_hosts(scenario: Scenario, mission: str, out: Path, args: argparse.Nam
     """``--hosts`` on real machines: write every host's access files and print, host by
     host, what to copy there and the commands to run (routers first, the ground host's
     before the others')."""
-    access = write_host_access(out / "access", mission, scenario.observers.count, host_map)
+    access = write_host_access(out / "access", mission, scenario.observers.count, host_map,
+                               portable=True)
     placement = across_hosts(access, host_map)
     common = _common_args(args, mission, args.scenario.name)
     topo = topology(scenario)

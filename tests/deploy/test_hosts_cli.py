@@ -60,3 +60,28 @@ def test_on_real_machines_each_hosts_files_and_commands_are_printed(
     assert f"--zenoh-config {out / 'access' / 'tlm.json5'}" in printed
     sim = json.loads((out / "access" / "sim" / "router.json5").read_text())
     assert sim["connect"]["endpoints"] == ["tls/10.77.0.1:7447"]
+    # the folder copied to its host as access/: the router finds its files there
+    assert sim["transport"]["auth"]["usrpwd"]["dictionary_file"] == "access/users.txt"
+    assert sim["transport"]["link"]["tls"] == {"listen_certificate": "access/router.pem",
+                                               "listen_private_key": "access/router.key",
+                                               "root_ca_certificate": "access/authority.pem"}
+
+
+def test_a_hosts_folder_copied_as_access_starts_its_router(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, free_port: int) -> None:
+    """The printed instructions work: the hub's folder, copied to another place as access/,
+    starts its router there (its files named relative to it); here on loopback ports, as the
+    map's addresses are not this machine's."""
+    import shutil
+
+    import zenoh
+
+    out = tmp_path / "lab"
+    assert main(["run", "--hosts", LAB, "--out", str(out)]) == 0
+    there = tmp_path / "groundhost"
+    shutil.copytree(out / "access" / "ground", there / "access")
+    monkeypatch.chdir(there)
+    config = json.loads((there / "access" / "router.json5").read_text())
+    config["listen"]["endpoints"] = [f"tls/127.0.0.1:{free_port}"]
+    router = zenoh.open(zenoh.Config.from_json5(json.dumps(config)))
+    router.close()
