@@ -226,8 +226,9 @@ class LinkChecks:
         (by the messages' own times: a rejoining node sends the images it recovers late) for
         as long as a window, since the last one judged or between two of this window's;
         decided as a silent window would be (alone when decisive, else ``silent_windows``
-        windows' time).  None when a silent window declared it already."""
-        if obs.link_declared:
+        windows' time).  None when the link fault was declared already (a silent window, a
+        loss, a dump's loss: one link fault, declared once)."""
+        if obs.link_declared or obs.dump_declared or self.loss.declared(sc):
             return []
         sent = sorted([*([] if obs.last_image_s is None else [obs.last_image_s]),
                        *(m.t_sim for m in images)])

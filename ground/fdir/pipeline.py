@@ -298,6 +298,7 @@ class FdirPipeline:
             lost_aboard = self._lost_aboard(sc, obs, a, b)
             if lost_aboard is not None:  # data lost or still aboard, of known cause
                 out += [*lost_aboard[1], window.model_copy(update={"unjudged": lost_aboard[0]})]
+                obs.last_image_s = None  # no silence is measured across a window not judged
                 continue
             imaging = not obs.camera_off_before(b)
             planned = obs.plan_at(a) is not None and imaging

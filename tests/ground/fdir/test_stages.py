@@ -485,3 +485,14 @@ def test_no_integrity_verdict_while_an_observer_is_not_heard_from() -> None:
     check.reported(report, 2)
     reports, unjudged = check.check(2, 20.0, settled, views, observers)
     assert unjudged == {} and [r.fault_class for r in reports] == ["data_integrity"]
+
+
+def test_no_silence_is_measured_on_a_link_whose_loss_was_declared() -> None:
+    """A link whose loss was declared a fault loses runs of images: no further link fault from
+    the gaps between those that come (one link fault, declared once)."""
+    links = LinkChecks(small_scenario(comms={"packet_loss": 0.1}), "ground", LOG)
+    obs = ObserverState()
+    first = links.judge(1, obs, [_obs(1, 570.0, 1), _obs(1, 599.0, 30)], True, 600.0)[1]
+    assert [r.fault_class for r in first] == ["link"] and links.loss.declared(1)
+    later = links.judge(1, obs, [_obs(1, 640.0, 71), _obs(1, 641.0, 72)], True, 660.0)[1]
+    assert later == []  # 41 s between 599 and 640 s: part of the declared loss
