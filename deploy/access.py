@@ -85,11 +85,16 @@ def publishers(n_observers: int) -> list[str]:
     return [topics.SIM, *(topics.sc_node(i) for i in range(1, n_observers + 1)), topics.GROUND]
 
 
-def own_keys(mission: str, account: str) -> list[str]:
-    """The key expressions ``account`` (a node, or the recorder) may publish on."""
+PUBLISH = ["put", "delete", "liveliness_token", "declare_queryable", "reply"]
+"""What a node may do in its own key space."""
+
+
+def grants(mission: str, account: str) -> list[tuple[list[str], list[str]]]:
+    """What ``account`` (a node, or the recorder) may publish, as (messages, key expressions):
+    a node everything in its key space, the recorder its liveliness token alone."""
     if account == RECORDER_ACCOUNT:
-        return [topics.recorder_token(mission)]
-    return [f"{topics.node_prefix(mission, account)}/**"]
+        return [(["liveliness_token"], [topics.recorder_token(mission)])]
+    return [(PUBLISH, [f"{topics.node_prefix(mission, account)}/**"])]
 
 
 EVERY_MESSAGE = ["put", "delete", "reply", "liveliness_token", "declare_subscriber",
@@ -100,7 +105,7 @@ EVERY_MESSAGE = ["put", "delete", "reply", "liveliness_token", "declare_subscrib
 
 def access_control(mission: str, n_observers: int,
                    relays: dict[str, list[str]] | None = None,
-                   hub_certificate: str | None = None) -> dict[str, Any]:
+                   hub_common_name: str | None = None) -> dict[str, Any]:
     """The router's ``access_control`` block: default deny; every account may subscribe to the
     mission, query schemas and watch liveliness; each publisher may publish, declare its token
     and serve its schemas in its own key space only; the recorder may declare its token.
@@ -108,7 +113,8 @@ def access_control(mission: str, n_observers: int,
     Across hosts (docs/hosts.md): the hub's ``relays`` are the other hosts' routers' accounts,
     each with the nodes of its host: a relay may publish what those nodes may, and is sent
     everything in the mission.  A router that links to the hub trusts, in and out, the link
-    whose certificate is named ``hub_certificate`` (the hub enforced the rules already)."""
+    whose certificate (verified against the run's authority) bears the common name
+    ``hub_common_name``: the hub enforced the rules already."""
     mission_keys = [topics.mission_wildcard(mission)]
     relays = relays or {}
     everyone = [*publishers(n_observers), RECORDER_ACCOUNT, TLM_ACCOUNT, *relays]
@@ -123,23 +129,23 @@ def access_control(mission: str, n_observers: int,
     subjects: list[dict[str, Any]] = [{"id": f"user-{u}", "usernames": [u]} for u in everyone]
     policies = [{"rules": ["receive", "see-subscribers", "subscribe"],
                  "subjects": [f"user-{u}" for u in everyone]}]
-    own = {a: own_keys(mission, a) for a in [*publishers(n_observers), RECORDER_ACCOUNT]}
-    own.update({relay: [k for n in nodes for k in own_keys(mission, n)]
+    own = {a: grants(mission, a) for a in [*publishers(n_observers), RECORDER_ACCOUNT]}
+    own.update({relay: [g for n in nodes for g in grants(mission, n)]
                 for relay, nodes in relays.items()})
-    for user, keys in own.items():
-        messages = (["liveliness_token"] if user == RECORDER_ACCOUNT else
-                    ["put", "delete", "liveliness_token", "declare_queryable", "reply"])
-        rules.append(_rule(f"publish-{user}", messages, "ingress", keys))
-        rules.append(_rule(f"serve-{user}", ["query"], "egress", keys))
-        policies.append({"rules": [f"publish-{user}", f"serve-{user}"],
-                         "subjects": [f"user-{user}"]})
+    for user, granted in own.items():
+        ids = []
+        for i, (messages, keys) in enumerate(granted):
+            rules += [_rule(f"publish-{user}-{i}", messages, "ingress", keys),
+                      _rule(f"serve-{user}-{i}", ["query"], "egress", keys)]
+            ids += [f"publish-{user}-{i}", f"serve-{user}-{i}"]
+        policies.append({"rules": ids, "subjects": [f"user-{user}"]})
     if relays:
         rules.append(_rule("relay-out", EVERY_MESSAGE, "egress", mission_keys))
         policies.append({"rules": ["relay-out"], "subjects": [f"user-{r}" for r in relays]})
-    if hub_certificate is not None:
+    if hub_common_name is not None:
         rules += [_rule("hub-in", EVERY_MESSAGE, "ingress", [f"{topics.ROOT}/**"]),
                   _rule("hub-out", EVERY_MESSAGE, "egress", [f"{topics.ROOT}/**"])]
-        subjects.append({"id": "hub", "cert_common_names": [hub_certificate]})
+        subjects.append({"id": "hub", "cert_common_names": [hub_common_name]})
         policies.append({"rules": ["hub-in", "hub-out"], "subjects": ["hub"]})
     return {"enabled": True, "default_permission": "deny", "rules": rules,
             "subjects": subjects, "policies": policies}

@@ -9,8 +9,8 @@ Written under ``<out>/access/<host>/`` (owner-only), one folder per host, all th
   over TLS with an account of its own (``router-<host>``) and verifies the hub's certificate;
 * ``router.pem`` / ``router.key``: its certificate, named ``router-<host>``, and key;
   ``authority.pem``: the run's authority;
-* ``users.txt``: the accounts that may log in to it: its own nodes', the read-only ``tlm``
-  and, on the hub, the other routers';
+* ``users.txt``: the accounts that may log in to it: its own nodes' and, on the hub, the
+  read-only ``tlm`` and the other routers';
 * ``<node>.json5``: each of its nodes' client configuration (its host's router, on loopback).
 
 The hub lets another host's router publish only what that host's nodes may
@@ -44,8 +44,9 @@ RECONNECT_MS = 500
 within about this)."""
 
 
-def relay_account(host: HostSpec) -> str:
-    """The account a host's router logs in to the hub with."""
+def router_name(host: HostSpec) -> str:
+    """A host's router's name: its certificate's common name and, but for the hub's, the
+    account it logs in to the hub with."""
     return f"router-{host.name}"
 
 
@@ -73,10 +74,6 @@ class HostAccess:
     hosts: dict[str, HostFiles]
     tlm_config: Path
 
-    def of(self, node: str, host_map: HostMap) -> HostFiles:
-        """The files of the host that runs ``node``."""
-        return self.hosts[host_map.host_of(node).name]
-
 
 def write_host_access(directory: Path, mission: str, n_observers: int,
                       host_map: HostMap, portable: bool = False) -> HostAccess:
@@ -90,11 +87,12 @@ def write_host_access(directory: Path, mission: str, n_observers: int,
     hub = host_map.hub
     spokes = [h for h in host_map.hosts if h.name != hub.name]
     names = [n for h in host_map.hosts for n in h.nodes] + [TLM_ACCOUNT]
-    names += [relay_account(h) for h in spokes]
+    names += [router_name(h) for h in spokes]
     accounts = {n: Account(n, secrets.token_urlsafe(18)) for n in names}
-    relays = {relay_account(h): h.nodes for h in spokes}
+    relays = {router_name(h): h.nodes for h in spokes}
     hosts = {h.name: _write_host(directory / h.name, mission, n_observers, host_map, h,
-                                 authority, accounts, relays if h is hub else {}, portable)
+                                 authority, accounts,
+                                 relays if h.name == hub.name else {}, portable)
              for h in host_map.hosts}
     tlm = directory / f"{TLM_ACCOUNT}.json5"
     write_private(tlm, json.dumps(client_config(
@@ -108,12 +106,13 @@ def _write_host(folder: Path, mission: str, n_observers: int, host_map: HostMap,
     folder.mkdir(exist_ok=True)
     folder.chmod(0o700)
     (folder / "authority.pem").write_bytes(authority.pem.read_bytes())
-    written = write_certificate(authority, folder, "router", relay_account(host),
+    written = write_certificate(authority, folder, "router", router_name(host),
                                 (str(host.address),))
     here = Path("access") if portable else folder
     tls = TlsFiles(here / written.certificate.name, here / written.private_key.name,
                    here / "authority.pem")
-    local = [*host.nodes, TLM_ACCOUNT, *relays]
+    # the read-only account on the hub alone: watchers connect there
+    local = [*host.nodes, *([TLM_ACCOUNT] if host.name == host_map.hub.name else []), *relays]
     dictionary = folder / "users.txt"
     write_private(dictionary, "".join(f"{a}:{accounts[a].password}\n" for a in local))
     endpoint = f"tcp/127.0.0.1:{host_map.port}"
@@ -121,9 +120,9 @@ def _write_host(folder: Path, mission: str, n_observers: int, host_map: HostMap,
         write_private(folder / f"{node}.json5",
                        json.dumps(client_config(endpoint, accounts[node], None), indent=2))
     hub = host_map.hub
-    uplink = None if host.name == hub.name else accounts[relay_account(host)]
+    uplink = None if host.name == hub.name else accounts[router_name(host)]
     acl = access_control(mission, n_observers, relays=relays,
-                         hub_certificate=None if uplink is None else relay_account(hub))
+                         hub_common_name=None if uplink is None else router_name(hub))
     config = host_router_config(host_map, host, here / dictionary.name, tls, acl, uplink)
     router = folder / "router.json5"
     write_private(router, json.dumps(config, indent=2))

@@ -9,9 +9,10 @@ interface would): a packet from host A to host B is delayed by A's ``delay_ms`` 
 ``delay_ms = 5``.  ``[[events]]`` change a host's link for a time, in sim seconds: cut it (both
 ways), or raise its delay or loss.
 
-Without ``--hosts`` a run is the map with one host (every node there) and no link: the
-default, on this machine.  A map is checked when loaded (:func:`load_host_map`): an unknown node,
-a node on two hosts, a host with no address, a negative delay... are refused naming the key;
+Without ``--hosts`` a run is on one host, every node on this machine with the run's one router
+(``deploy/access.py``), and no link: the default.  A map is checked when loaded
+(:func:`load_host_map`): an unknown node, a node on two hosts, a host with no address, a
+negative delay, overlapping events on one host... are refused naming the key;
 :func:`HostMap.check_run` then checks it against the run's nodes.
 """
 
@@ -126,11 +127,19 @@ class HostMap(Section):
         for i, e in enumerate(self.events):
             if e.host not in names:
                 raise ValueError(f"events.{i}.host: no host {e.host!r} in this map")
+            for j, o in enumerate(self.events[:i]):
+                if o.host == e.host and (e.at_s < o.at_s + o.duration_s
+                                         and o.at_s < e.at_s + e.duration_s):
+                    raise ValueError(f"events.{i}: overlaps events.{j} on host {e.host} (one "
+                                     "change of a link at a time)")
         return self
 
     def host_of(self, node: str) -> HostSpec:
-        """The host that runs ``node``."""
-        return next(h for h in self.hosts if node in h.nodes)
+        """The host that runs ``node``; ValueError when none does."""
+        for h in self.hosts:
+            if node in h.nodes:
+                return h
+        raise ValueError(f"host map {self.name}: no host runs {node}")
 
     @property
     def hub(self) -> HostSpec:

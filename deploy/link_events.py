@@ -22,9 +22,11 @@ import logging
 import threading
 from dataclasses import dataclass
 
-from deploy.host_map import HostMap, LinkEvent
+from deploy.host_map import HostMap, LinkEvent, LinkSpec
+from deploy.rehearsal.netns import RehearsalError
 from deploy.rehearsal.network import RehearsedNetwork
 from interfaces.contracts import topics
+from sim.lockstep import LinkAwait
 
 log = logging.getLogger("insp.links")
 
@@ -68,6 +70,8 @@ class LinkEvents:
         self._events = [_Applied(e) for e in host_map.events]
         self._lock = threading.Lock()
         self._t_sim = 0.0
+        self.failures: list[str] = []
+        """the link changes the network refused (the run is then not the one asked for)"""
 
     def __enter__(self) -> LinkEvents:
         return self
@@ -78,28 +82,29 @@ class LinkEvents:
                 if a.started_t_s is not None and a.ended_t_s is None:
                     self._end(a, self._t_sim)
 
+    def _awaits(self, a: _Applied) -> tuple[LinkAwait, LinkAwait]:
+        """What the sim waits for at a cut's start and end."""
+        e, nodes = a.event, cut_nodes(self.map, a.event.host)
+        return LinkAwait(False, nodes, e.at_s), LinkAwait(True, nodes, e.at_s + e.duration_s)
+
     def awaits(self) -> list[str]:
         """The sim's ``--await-link`` values: each cut's start and end, in time order."""
-        out = []
-        for e in (a.event for a in self._events if a.event.cut):
-            nodes = ",".join(cut_nodes(self.map, e.host))
-            out += [(e.at_s, f"lost:{nodes}:{e.at_s:g}"),
-                    (e.at_s + e.duration_s, f"back:{nodes}:{e.at_s + e.duration_s:g}")]
-        return [text for _, text in sorted(out)]
+        both = [w for a in self._events if a.event.cut for w in self._awaits(a)]
+        return [str(w) for w in sorted(both, key=lambda w: w.t_s)]
 
     def on_waiting(self, reason: str, t_sim: float) -> None:
         """The sim waits at ``t_sim`` for a link change (its status' ``reason``, ``link <i>:
-        awaiting lost|back:NODES:T``): make it."""
+        awaiting <LinkAwait>``): make it."""
         what = reason.rpartition("awaiting ")[2]
         with self._lock:
             self._t_sim = max(self._t_sim, t_sim)
             for a in self._events:
-                e = a.event
-                nodes = ",".join(cut_nodes(self.map, e.host)) if e.cut else ""
-                if a.started_t_s is None and what == f"lost:{nodes}:{e.at_s:g}":
+                if not a.event.cut:
+                    continue
+                start, end = (str(w) for w in self._awaits(a))
+                if a.started_t_s is None and what == start:
                     self._start(a, t_sim)
-                elif a.ended_t_s is None and what == (f"back:{nodes}:"
-                                                      f"{e.at_s + e.duration_s:g}"):
+                elif a.ended_t_s is None and what == end:
                     self._end(a, t_sim)
 
     def on_time(self, t_sim: float) -> None:
@@ -119,14 +124,26 @@ class LinkEvents:
     def _start(self, a: _Applied, t_sim: float) -> None:
         e, normal = a.event, self.map.hosts[_index(self.map, a.event.host)].link
         a.started_t_s = t_sim
-        self.net.set_link(e.host, e.during(normal), up=not e.cut)
-        log.warning("link of %s %s at sim t=%.1f s (due %.1f s)", e.host,
-                    "cut" if e.cut else f"now {e.during(normal)}", t_sim, e.at_s)
+        if self._set(e.host, e.during(normal), not e.cut, t_sim):
+            log.warning("link of %s %s at sim t=%.1f s (due %.1f s)", e.host,
+                        "cut" if e.cut else f"now {e.during(normal)}", t_sim, e.at_s)
 
     def _end(self, a: _Applied, t_sim: float) -> None:
         a.ended_t_s = t_sim
-        self.net.set_link(a.event.host, self.map.hosts[_index(self.map, a.event.host)].link)
-        log.warning("link of %s restored at sim t=%.1f s", a.event.host, t_sim)
+        host = a.event.host
+        if self._set(host, self.map.hosts[_index(self.map, host)].link, True, t_sim):
+            log.warning("link of %s restored at sim t=%.1f s", host, t_sim)
+
+    def _set(self, host: str, link: LinkSpec, up: bool, t_sim: float) -> bool:
+        """Change ``host``'s link; a refusal is logged and kept in ``failures`` (called on
+        the launcher's bus threads and at its exit: nothing is raised)."""
+        try:
+            self.net.set_link(host, link, up)
+        except RehearsalError as e:
+            self.failures.append(f"link of {host} not changed at sim t={t_sim:.1f} s: {e}")
+            log.error("%s", self.failures[-1])
+            return False
+        return True
 
     def report(self) -> str:
         """The events as applied (JSON): each with the sim times it started and ended."""

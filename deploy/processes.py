@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
 import os
 import signal
 import subprocess
@@ -12,16 +11,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
-from deploy.rehearsal.netns import enter as enter_netns
+from deploy.rehearsal.netns import Entry, libc
 
 _PR_SET_PDEATHSIG = 1
 
 
-def die_with_parent() -> None:
+def die_with_parent(library: ctypes.CDLL | None = None) -> None:
     """In the child before exec (Linux): get SIGTERM when the launcher dies, however it dies
-    (even SIGKILL), so no orphan keeps a port or a key space busy."""
-    libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-    libc.prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
+    (even SIGKILL), so no orphan keeps a port or a key space busy.  ``library``: the C library
+    loaded in the parent (else loaded here)."""
+    (library or libc()).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
 
 
 @dataclass
@@ -39,17 +38,25 @@ class Child:
     def start(self, cwd: Path) -> None:
         self.log_path.parent.mkdir(parents=True, exist_ok=True)
         self._log = self.log_path.open("wb")
-        self.proc = subprocess.Popen(
-            [sys.executable, *self.argv], cwd=cwd, stdout=self._log, stderr=subprocess.STDOUT,
-            start_new_session=True,  # a Ctrl-C at the launcher does not hit children directly
-            preexec_fn=self._prepare if sys.platform.startswith("linux") else None,
-        )
+        library = libc()
+        entry = Entry.open(self.netns, library) if self.netns is not None else None
 
-    def _prepare(self) -> None:
-        """In the child before exec: die with the launcher, and enter its host's network."""
-        die_with_parent()
-        if self.netns is not None:
-            enter_netns(self.netns)
+        def prepare() -> None:
+            """In the child before exec: die with the launcher, enter its host's network."""
+            die_with_parent(library)
+            if entry is not None:
+                entry.enter()
+
+        try:
+            self.proc = subprocess.Popen(
+                [sys.executable, *self.argv], cwd=cwd, stdout=self._log,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,  # a Ctrl-C at the launcher does not hit children
+                preexec_fn=prepare if sys.platform.startswith("linux") else None,
+            )
+        finally:
+            if entry is not None:
+                entry.close()
 
     @property
     def returncode(self) -> int | None:

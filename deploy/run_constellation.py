@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import subprocess
 import sys
 import threading
 import time
@@ -269,6 +270,8 @@ def _host_map(args: argparse.Namespace, scenario: Scenario) -> HostMap | None:
     clash = [o for o, on in (("--transport inproc", args.transport == "inproc"),
                              ("--external", args.external), ("--advertise", args.advertise),
                              ("--tls-host", args.tls_host),
+                             ("--restart-on-crash (not rehearsed across hosts)",
+                              args.restart_on_crash),
                              ("--endpoint", args.endpoint != DEFAULT_ENDPOINT)) if on]
     if clash:
         raise ValueError(f"--hosts places every node and router itself; not with "
@@ -391,11 +394,14 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Names
             placement = across_hosts(access_h, host_map,
                                      {h.name: net.netns(h.name) for h in host_map.hosts})
             with LinkEvents(net, host_map) as events:
-                result = _run_placed(scenario, mission, out, args, stop, placement, events)
+                status, error = _run_placed(scenario, mission, out, args, stop, placement,
+                                            events)
             (out / "logs" / "link-events.json").write_text(events.report(), encoding="utf-8")
-            return result
-    except RehearsalError as e:
-        return "failed", str(e)
+            if events.failures and status != "failed":  # not the run the map asked for
+                return "failed", "; ".join([*events.failures, *([error] if error else [])])
+            return status, error
+    except (RehearsalError, OSError, subprocess.SubprocessError) as e:
+        return "failed", f"the rehearsal failed: {type(e).__name__}: {e}"
 
 
 def _run_placed(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
@@ -404,10 +410,14 @@ def _run_placed(scenario: Scenario, mission: str, out: Path, args: argparse.Name
     """Start the routers, join the run (the launcher's own session) and supervise it, with a
     rehearsal's link ``events``."""
     sup = Supervisor(REPO)
-    routers = [sup.start(Child(r.name, [*ROUTER.command, "--config", str(r.config),
-                                        *_audit_args(args, out, r.name)],
-                               out / "logs" / f"{r.name}.log", r.netns))
-               for r in placement.routers]
+    try:
+        routers = [sup.start(Child(r.name, [*ROUTER.command, "--config", str(r.config),
+                                            *_audit_args(args, out, r.name)],
+                                   out / "logs" / f"{r.name}.log", r.netns))
+                   for r in placement.routers]
+    except BaseException:
+        sup.stop_all()  # the routers already started
+        raise
     hub = _join(placement.watch_config, routers, timeout_s=30.0)
     if hub is None:
         sup.stop_all()
@@ -459,7 +469,8 @@ def _print_hosts(scenario: Scenario, mission: str, out: Path, args: argparse.Nam
     processes = placement.processes(topo, args.hosting, 1)
     lines = [f"{scenario.name} across {len(host_map.hosts)} hosts ({args.hosts}); on each "
              f"host, from a checkout of this repository with {args.scenario.name} beside it:"]
-    for h in host_map.hosts:
+    hub = host_map.hub
+    for h in [hub, *(h for h in host_map.hosts if h.name != hub.name)]:
         folder = access.hosts[h.name].directory
         lines += ["", f"host {h.name} ({h.address}): copy {folder}/ to access/ (owner only), "
                       "then run, each in its own shell:",
@@ -589,7 +600,7 @@ def _supervise(scenario: Scenario, mission: str, out: Path, args: argparse.Names
                                           if h.name not in args.external},
                    restart=args.restart_on_crash, recorder_up=recorder_up.count,
                    sim_up=_Appearances(hub, topics.alive_token(mission, SIM.name)).count,
-                   stop=stop)
+                   stop=stop, routers=tuple(r.name for r in placement.routers))
     error = watch.run()
     progress.report(final=True)
     watch.read_restores(out / "cds")
@@ -663,12 +674,15 @@ class _Watch:
     def __init__(self, sup: Supervisor, progress: _Progress, flight: dict[str, list[str]],
                  restart: bool, recorder_up: Callable[[], int] = lambda: 0,
                  sim_up: Callable[[], int] = lambda: 0,
-                 stop: threading.Event | None = None) -> None:
+                 stop: threading.Event | None = None,
+                 routers: tuple[str, ...] = (ROUTER.name,)) -> None:
         self.sup, self.progress, self.flight, self.restart = sup, progress, flight, restart
         """``flight``: the flight and ground processes, each with the nodes it hosts"""
         self.recorder_up, self.sim_up = recorder_up, sim_up
         self.stop = stop or threading.Event()
         """set by SIGINT or SIGTERM: the watch ends at its next look"""
+        self.routers = routers
+        """the run's routers' processes (``router``, or ``router-<host>`` across hosts)"""
         self.incidents: list[Incident] = []
         self.restarts: dict[str, int] = {}
         """Restarts so far, per process."""
@@ -730,7 +744,7 @@ class _Watch:
         """The services a run cannot go on without, each with the count of appearances that
         says it is back after a restart, and what follows its loss: the router (back when the
         sim's token reappears, seen through it) and the recorder (its own token)."""
-        routers = [c for c in self.sup.children if c.name.split("-")[0] == ROUTER.name]
+        routers = [c for c in (self.sup.find(n) for n in self.routers) if c is not None]
         return [*((r, self.sim_up, _NO_BUS) for r in routers),
                 (self.sup.named(RECORDER.name), self.recorder_up, _NO_RECORD)]
 
@@ -760,7 +774,7 @@ class _Watch:
         incident = Incident(child.name, child.describe_exit(), self.progress.t_sim, True)
         self.incidents.append(incident)
         log.error("%s; starting it again (%s)", incident,
-                  _AGAIN[child.name.split("-")[0]])
+                  _AGAIN[ROUTER.name if child.name in self.routers else child.name])
         self._back[child.name] = (up(), time.monotonic() + SERVICE_READY_S)
         self._restart(child)
         return None

@@ -265,4 +265,6 @@ class LinkAwait:
         return cls(parts[0] == "back", tuple(parts[1].split(",")), float(parts[2]))
 
     def __str__(self) -> str:
-        return f"{'back' if self.alive else 'lost'}:{','.join(self.nodes)}:{self.t_s:g}"
+        """The form :meth:`parse` reads (the time as Python writes a float: read back the
+        same)."""
+        return f"{'back' if self.alive else 'lost'}:{','.join(self.nodes)}:{self.t_s!r}"

@@ -18,6 +18,7 @@ import argparse
 import ipaddress
 import logging
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -25,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from deploy.host_map import LinkSpec
-from deploy.processes import Child, Supervisor
+from deploy.processes import Child, Supervisor, die_with_parent
 from deploy.rehearsal import netns
 from deploy.rehearsal.netns import RehearsalError
 from deploy.rehearsal.network import RehearsedNetwork
@@ -128,6 +129,8 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(ours)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s cluster %(levelname)s %(message)s",
                         datefmt="%H:%M:%S")
+    # SIGTERM ends it as Ctrl-C does: the campaign stopped, everything made removed
+    signal.signal(signal.SIGTERM, signal.default_int_handler)
     out = _out_of(campaign_args)
     logs = out / "cluster-logs"
     hosts = cluster_hosts(args.workers, LinkSpec(delay_ms=args.link_delay_ms))
@@ -143,6 +146,9 @@ def main(argv: list[str] | None = None) -> int:
     except RehearsalError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("interrupted: the cluster's hosts removed", file=sys.stderr)
+        return 130
 
 
 def _fly(sup: Supervisor, net: RehearsedNetwork, hosts: list[ClusterHost],
@@ -150,7 +156,8 @@ def _fly(sup: Supervisor, net: RehearsedNetwork, hosts: list[ClusterHost],
     """Run the campaign on the cluster, tearing a worker's host down when due."""
     campaign = subprocess.Popen([sys.executable, str(REPO / "deploy" / "run_campaign.py"),
                                  *campaign_args, "--cluster", scheduler_address(hosts)],
-                                cwd=REPO, env={**os.environ, "PYTHONUNBUFFERED": "1"})
+                                cwd=REPO, env={**os.environ, "PYTHONUNBUFFERED": "1"},
+                                preexec_fn=die_with_parent)
     try:
         while campaign.poll() is None:
             if tear_down_after is not None and finished_runs(out) >= tear_down_after:

@@ -11,6 +11,7 @@ import os
 import re
 import shutil
 import subprocess
+from dataclasses import dataclass
 from pathlib import Path
 
 NETNS_DIR = Path("/run/netns")
@@ -121,13 +122,29 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def enter(name: str) -> None:
-    """Move the calling thread into namespace ``name`` (in a child before exec: the process
-    then runs on that host's network stack)."""
-    libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-    fd = os.open(NETNS_DIR / name, os.O_RDONLY)
-    try:
-        if libc.setns(fd, _CLONE_NEWNET) != 0:
-            raise OSError(ctypes.get_errno(), f"setns into {name}")
-    finally:
-        os.close(fd)
+def libc() -> ctypes.CDLL:
+    """The C library (to be loaded in a parent: a child forked from a process with threads
+    should only make system calls before exec)."""
+    return ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+
+
+@dataclass
+class Entry:
+    """Namespace ``name`` opened here, for a child to enter before exec (:meth:`enter`, one
+    system call) and for the parent to :meth:`close` once the child is started."""
+
+    name: str
+    library: ctypes.CDLL
+    fd: int
+
+    @classmethod
+    def open(cls, name: str, library: ctypes.CDLL) -> Entry:
+        return cls(name, library, os.open(NETNS_DIR / name, os.O_RDONLY | os.O_CLOEXEC))
+
+    def enter(self) -> None:
+        """Move the calling thread (the child) into the namespace."""
+        if self.library.setns(self.fd, _CLONE_NEWNET) != 0:
+            raise OSError(ctypes.get_errno(), f"setns into {self.name}")
+
+    def close(self) -> None:
+        os.close(self.fd)

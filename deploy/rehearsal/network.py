@@ -56,6 +56,7 @@ class RehearsedNetwork:
         self.pid = os.getpid() if pid is None else pid
         self._wire: subprocess.Popen[bytes] | None = None
         self._wire_log: IO[bytes] | None = None
+        self._mute = False
 
     @property
     def launcher_address(self) -> str:
@@ -122,18 +123,26 @@ class RehearsedNetwork:
         if self._wire is None or self._wire.stdin is None:
             raise RehearsalError("the hosts' network is not up")
         line = json.dumps({"port": host, **link.model_dump(), "up": up}) + "\n"
-        self._wire.stdin.write(line.encode())
-        self._wire.stdin.flush()
+        try:
+            self._wire.stdin.write(line.encode())
+            self._wire.stdin.flush()
+        except OSError as e:  # the wire is gone
+            raise RehearsalError(f"link of {host} not changed: the wire is gone ({e})") from None
         answer = self._read_answer(5.0)
         if answer != "ok":
             raise RehearsalError(f"link of {host} not changed: {answer}")
 
     def _read_answer(self, timeout_s: float) -> str:
+        """The wire's answer line; after none in time, every later change is refused (a late
+        answer would be taken for the next one's)."""
         assert self._wire is not None and self._wire.stdout is not None
+        if self._mute:
+            return "the wire stopped answering earlier"
         ready, _, _ = select.select([self._wire.stdout], [], [], timeout_s)
         line = self._wire.stdout.readline().decode().strip() if ready else ""
         if line:
             return line
+        self._mute = True
         return (f"no answer from the wire within {timeout_s:g} s "
                 f"({'running' if self._wire.poll() is None else 'exited'}; see "
                 f"{self.logs / 'wire.log'})")

@@ -184,19 +184,23 @@ def serve(switch: Switch, control: int, stop: list[bool]) -> None:
                 for line in lines:
                     _answer(_change(switch, line))
                 continue
-            _read_frames(switch, by_fd[key.fd], key.fd)
+            if not _read_frames(switch, by_fd[key.fd], key.fd):  # its host went away
+                sel.unregister(key.fd)
+                switch.ports[by_fd[key.fd]].link.up = False
         for name, frame in switch.deliver(time.monotonic()):
             _write_frame(switch.ports[name], frame)
 
 
-def _read_frames(switch: Switch, name: str, fd: int) -> None:
+def _read_frames(switch: Switch, name: str, fd: int) -> bool:
+    """Take every frame waiting on port ``name``; False when its TAP is gone (its namespace
+    removed: ``deploy/rehearsal/cluster.py`` tears a host down)."""
     while True:
         try:
             frame = os.read(fd, MAX_FRAME)
         except BlockingIOError:
-            return
-        except OSError:  # the interface went away
-            return
+            return True
+        except OSError:
+            return False
         switch.receive(name, frame, time.monotonic())
 
 

@@ -17,8 +17,10 @@ from cryptography import x509
 from cryptography.hazmat.primitives.asymmetric import ec
 from cryptography.x509.oid import NameOID
 
-from deploy.host_access import HostAccess, relay_account, write_host_access
+from deploy.access import access_control
+from deploy.host_access import HostAccess, router_name, write_host_access
 from deploy.host_map import HostMap, parse_host_map
+from interfaces.contracts import topics
 from tests.conftest import settle
 
 M = "hx"
@@ -66,7 +68,7 @@ def test_each_host_gets_its_own_folder_accounts_and_certificate(
     assert sorted(access.hosts) == ["ground", "sca", "scb"]
     sca = access.hosts["sca"]
     users = {line.split(":")[0] for line in (sca.directory / "users.txt").read_text().split()}
-    assert users == {"sc1", "sc2", "tlm"}  # no other host's account
+    assert users == {"sc1", "sc2"}  # no other host's account, nor the watchers'
     hub_users = (access.hosts["ground"].directory / "users.txt").read_text()
     assert {line.split(":")[0] for line in hub_users.split()} == {
         "ground", "recorder", "sim", "tlm", "router-sca", "router-scb"}
@@ -80,7 +82,7 @@ def test_each_host_gets_its_own_folder_accounts_and_certificate(
     assert isinstance(authority.public_key(), ec.EllipticCurvePublicKey)
     router = _read(sca.router_config)
     assert router["connect"]["endpoints"] == [f"tls/127.0.0.2:{host_map.port}"]
-    assert router["transport"]["auth"]["usrpwd"]["user"] == relay_account(host_map.hosts[1])
+    assert router["transport"]["auth"]["usrpwd"]["user"] == router_name(host_map.hosts[1])
     assert _read(sca.client_config("sc1"))["connect"]["endpoints"] == [
         f"tcp/127.0.0.1:{host_map.port}"]
     assert _read(access.hosts["ground"].router_config)["connect"]["endpoints"] == []
@@ -145,3 +147,17 @@ def test_no_credentials_no_session_on_any_router(hosts: tuple[HostMap, HostAcces
         config["transport"]["auth"] = {"usrpwd": {"user": "sc1", "password": "guess"}}
         with pytest.raises(zenoh.ZError):
             _open(config)
+
+
+def test_a_relay_may_do_no_more_than_its_hosts_nodes() -> None:
+    """The recorder on a spoke: the spoke's router may declare the recorder's token for it, and
+    no more on that key (it lies in the ground's key space)."""
+    acl = access_control(M, 2, relays={"router-x": ["sc1", "recorder"]})
+    mine = {r["id"]: r for r in acl["rules"] if r["id"].startswith(("publish-router-x",
+                                                                   "serve-router-x"))}
+    assert mine["publish-router-x-0"]["key_exprs"] == [f"insp/{M}/sc/1/**"]
+    assert "put" in mine["publish-router-x-0"]["messages"]
+    assert mine["publish-router-x-1"]["messages"] == ["liveliness_token"]
+    assert mine["publish-router-x-1"]["key_exprs"] == [topics.recorder_token(M)]
+    assert sorted(mine) == ["publish-router-x-0", "publish-router-x-1", "serve-router-x-0",
+                            "serve-router-x-1"]

@@ -83,6 +83,13 @@ def test_events_name_a_host_of_the_map_and_do_something() -> None:
         {"host": "sca", "at_s": 10, "duration_s": 30}]))
     assert "events.0.duration_s" in _refused(_map(events=[
         {"host": "sca", "at_s": 10, "duration_s": 0, "cut": True}]))
+    assert "events.1: overlaps events.0 on host sca" in _refused(_map(events=[
+        {"host": "sca", "at_s": 10, "duration_s": 30, "cut": True},
+        {"host": "sca", "at_s": 39, "duration_s": 5, "delay_ms": 50}]))
+    parse_host_map(_map(events=[{"host": "sca", "at_s": 10, "duration_s": 30, "cut": True},
+                                {"host": "sca", "at_s": 40, "duration_s": 5, "loss_pct": 5},
+                                {"host": "ground", "at_s": 20, "duration_s": 5,
+                                 "loss_pct": 5}]), "m.toml")
 
 
 def test_a_file_that_is_not_toml_or_not_there(tmp_path: Path) -> None:

@@ -27,6 +27,7 @@ def _refused(argv: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 @pytest.mark.parametrize("argv, says", [
     (["--hosts", LAB, "--transport", "inproc"], "not with --transport inproc"),
     (["--hosts", LAB, "--external", "sc3"], "not with --external"),
+    (["--hosts", LAB, "--restart-on-crash"], "--restart-on-crash (not rehearsed across hosts)"),
     (["--rehearse"], "--rehearse apply only with --hosts"),
     (["--link-delay-ms", "5", "--link-loss-pct", "1"],
      "--link-delay-ms, --link-loss-pct apply only with --hosts"),

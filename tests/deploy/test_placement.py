@@ -13,6 +13,7 @@ from deploy.host_access import write_host_access
 from deploy.host_map import LinkSpec, load_host_map, parse_link_event
 from deploy.link_events import LinkEvents, check_cuts
 from deploy.placement import across_hosts, one_host
+from deploy.rehearsal.netns import RehearsalError
 from interfaces.contracts.scenario import load_scenario
 from interfaces.contracts.topology import topology
 from tests.conftest import REPO
@@ -65,15 +66,15 @@ def test_a_cut_acts_when_the_sim_waits_for_it_and_delays_on_the_sim_clock() -> N
         parse_link_event("scb:cut:30:30"), parse_link_event("sca:loss=10:40:5")])
     net = _Links()
     with LinkEvents(net, lab) as events:  # type: ignore[arg-type]
-        assert events.awaits() == ["lost:sc3,sc4,sc5:30", "back:sc3,sc4,sc5:60"]
+        assert events.awaits() == ["lost:sc3,sc4,sc5:30.0", "back:sc3,sc4,sc5:60.0"]
         for t in (0.0, 29.0, 30.0, 31.0):
             events.on_time(t)
         assert net.calls == []  # a cut waits for the sim
-        events.on_waiting("link 0: awaiting lost:sc3,sc4,sc5:30", 30.0)
+        events.on_waiting("link 0: awaiting lost:sc3,sc4,sc5:30.0", 30.0)
         for t in (41.0, 46.0, 59.0, 60.0):
             events.on_time(t)
-        events.on_waiting("link 1: awaiting back:sc3,sc4,sc5:60", 60.0)
-        events.on_waiting("link 7: awaiting back:sc9:99", 99.0)  # not one of ours: nothing
+        events.on_waiting("link 1: awaiting back:sc3,sc4,sc5:60.0", 60.0)
+        events.on_waiting("link 7: awaiting back:sc9:99.0", 99.0)  # not one of ours: nothing
         assert net.calls == [
             ("scb", LinkSpec(delay_ms=5.0), False),
             ("sca", LinkSpec(delay_ms=5.0, loss_pct=10.0), True),
@@ -87,7 +88,7 @@ def test_an_event_still_on_at_the_end_is_undone() -> None:
     lab = load_host_map(LAB).with_events([parse_link_event("sca:cut:10:1000")])
     net = _Links()
     with LinkEvents(net, lab) as events:  # type: ignore[arg-type]
-        events.on_waiting("link 0: awaiting lost:sc1,sc2:10", 10.0)
+        events.on_waiting("link 0: awaiting lost:sc1,sc2:10.0", 10.0)
     assert net.calls == [("sca", LinkSpec(), False), ("sca", LinkSpec(), True)]
 
 
@@ -97,3 +98,18 @@ def test_a_rehearsal_cuts_only_a_host_of_spacecraft(host: str, says: str) -> Non
     with pytest.raises(ValueError, match=says):
         check_cuts(lab)
     check_cuts(load_host_map(LAB).with_events([parse_link_event(f"{host}:delay=50:10:5")]))
+
+
+class _Broken:
+    """A network that refuses every change (its switch gone)."""
+
+    def set_link(self, host: str, link: LinkSpec, up: bool = True) -> None:
+        raise RehearsalError("no answer from the wire")
+
+
+def test_a_link_change_the_network_refuses_is_kept_never_raised() -> None:
+    lab = load_host_map(LAB).with_events([parse_link_event("sca:cut:10:5")])
+    with LinkEvents(_Broken(), lab) as events:  # type: ignore[arg-type]
+        events.on_waiting("link 0: awaiting lost:sc1,sc2:10.0", 10.0)
+    assert len(events.failures) == 2 and "link of sca not changed at sim t=10.0 s" in (
+        events.failures[0])

@@ -137,7 +137,8 @@ def test_a_link_change_holds_the_clock_until_the_nodes_are_gone_or_back() -> Non
 
 def test_link_awaits_are_read_from_the_command_line() -> None:
     cut = LinkAwait.parse("lost:sc1,sc2:600")
-    assert cut == LinkAwait(False, ("sc1", "sc2"), 600.0) and str(cut) == "lost:sc1,sc2:600"
+    assert cut == LinkAwait(False, ("sc1", "sc2"), 600.0) and str(cut) == "lost:sc1,sc2:600.0"
+    assert LinkAwait.parse(str(LinkAwait(True, ("sc1",), 1234567.125))).t_s == 1234567.125
     assert LinkAwait.parse("back:sc3:630.5") == LinkAwait(True, ("sc3",), 630.5)
     for bad in ("cut:sc1:600", "lost::600", "lost:sc1", "lost:sc1:x"):
         with pytest.raises(ValueError):
