@@ -11,11 +11,14 @@ from __future__ import annotations
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from deploy.access import TLM_ACCOUNT, RunAccess
-from deploy.host_access import HostAccess
 from deploy.host_map import HostMap
 from interfaces.contracts.topology import ROUTER, Hosting, NodeProcess, Topology, hosting
+
+if TYPE_CHECKING:  # its certificates import cryptography: only across hosts
+    from deploy.host_access import HostAccess
 
 
 @dataclass(frozen=True)

@@ -53,7 +53,6 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.access import RunAccess, write_run_access  # noqa: E402
-from deploy.host_access import write_host_access  # noqa: E402
 from deploy.host_map import HostMap, HostMapError, load_host_map, parse_link_event  # noqa: E402
 from deploy.interrupts import Interrupts  # noqa: E402
 from deploy.link_events import LinkEvents, check_cuts  # noqa: E402
@@ -387,6 +386,8 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         except ValueError as e:
             return "failed", str(e)
         return _run_placed(scenario, mission, out, args, stop, one_host(access))
+    from deploy.host_access import write_host_access  # cryptography: only across hosts
+
     access_h = write_host_access(out / "access", mission, scenario.observers.count, host_map)
     try:
         with RehearsedNetwork(host_map.hosts, host_map.network, out / "logs",
@@ -461,6 +462,8 @@ def _print_hosts(scenario: Scenario, mission: str, out: Path, args: argparse.Nam
     """``--hosts`` on real machines: write every host's access files and print, host by
     host, what to copy there and the commands to run (routers first, the ground host's
     before the others')."""
+    from deploy.host_access import write_host_access  # cryptography: only across hosts
+
     access = write_host_access(out / "access", mission, scenario.observers.count, host_map,
                                portable=True)
     placement = across_hosts(access, host_map)
