@@ -74,10 +74,16 @@ class RunAccess:
 
     def client_config(self, account: str) -> Path:
         """The client configuration file of ``account`` (a node name, ``recorder`` or ``tlm``)."""
-        path = self.directory / f"{account}.json5"
-        if not path.is_file():
-            raise FileNotFoundError(f"no account {account!r} in {self.directory}")
-        return path
+        return account_file(self.directory, account)
+
+
+def account_file(directory: Path, account: str) -> Path:
+    """``account``'s client configuration in ``directory`` (a run's access folder, or a host's);
+    FileNotFoundError naming both when there is none."""
+    path = directory / f"{account}.json5"
+    if not path.is_file():
+        raise FileNotFoundError(f"no account {account!r} in {directory}")
+    return path
 
 
 def publishers(n_observers: int) -> list[str]:

@@ -33,6 +33,7 @@ from deploy.access import (
     Account,
     TlsFiles,
     access_control,
+    account_file,
     client_config,
     write_private,
 )
@@ -60,10 +61,7 @@ class HostFiles:
 
     def client_config(self, account: str) -> Path:
         """The client configuration of one of this host's nodes (or ``recorder``)."""
-        path = self.directory / f"{account}.json5"
-        if not path.is_file():
-            raise FileNotFoundError(f"no account {account!r} on host {self.host.name}")
-        return path
+        return account_file(self.directory, account)
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from deploy.cluster import ClusterError, dask_client
 from deploy.host_map import LinkSpec
 from deploy.processes import Child, Supervisor, die_with_parent
 from deploy.rehearsal import netns
@@ -79,18 +80,12 @@ def start_cluster(sup: Supervisor, net: RehearsedNetwork, hosts: list[ClusterHos
 
 
 def _wait_for_workers(address: str, n: int) -> None:
-    from distributed import Client
-
-    deadline = time.monotonic() + READY_S
-    while True:
-        try:
-            with Client(address, timeout="5s") as client:
-                client.wait_for_workers(n, timeout=max(1.0, deadline - time.monotonic()))
-                return
-        except (OSError, TimeoutError) as e:
-            if time.monotonic() > deadline:
-                raise RehearsalError(f"the rehearsed cluster did not come up: {e}") from None
-            time.sleep(0.5)
+    """Until the scheduler at ``address`` has ``n`` workers (``READY_S`` at most)."""
+    try:
+        with dask_client(address, READY_S) as client:
+            client.wait_for_workers(n, timeout=READY_S)
+    except (ClusterError, TimeoutError) as e:
+        raise RehearsalError(f"the rehearsed cluster did not come up: {e}") from None
 
 
 def tear_down_host(sup: Supervisor, net: RehearsedNetwork, host: str) -> None:

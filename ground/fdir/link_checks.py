@@ -47,6 +47,7 @@ that does not reach the ground is a link fault, never zero information gain.
 from __future__ import annotations
 
 import logging
+from itertools import pairwise
 
 import numpy as np
 
@@ -232,17 +233,15 @@ class LinkChecks:
             return []
         sent = sorted([*([] if obs.last_image_s is None else [obs.last_image_s]),
                        *(m.t_sim for m in images)])
-        gaps = np.diff(sent)
-        if not gaps.size:
+        if len(sent) < 2:
             return []
-        i = int(np.argmax(gaps))
-        silent_s = float(gaps[i])
+        silent_s, since = max((t1 - t0, t0) for t0, t1 in pairwise(sent))
         n = self.images_per_window
         need_s = self.period_s * (1 if self.decisive(n, n) else self.cfg.silent_windows)
         if silent_s < need_s - TIME_TOL_S:
             return []
         self.log.warning("FDIR: sc%d sent no image for %.1f s (%.1f to %.1f s): link fault",
-                         sc, silent_s, sent[i], sent[i + 1])
+                         sc, silent_s, since, since + silent_s)
         return [FaultReport(sender=self.node, t_sim=b, spacecraft=sc, fault_class="link",
                             metric=silent_s, threshold=need_s, window_end_s=b)]
 
