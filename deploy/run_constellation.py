@@ -388,8 +388,9 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         return _run_placed(scenario, mission, out, args, stop, one_host(access))
     from deploy.host_access import write_host_access  # cryptography: only across hosts
 
-    access_h = write_host_access(out / "access", mission, scenario.observers.count, host_map)
     try:
+        access_h = write_host_access(out / "access", mission, scenario.observers.count,
+                                     host_map)
         with RehearsedNetwork(host_map.hosts, host_map.network, out / "logs",
                               seed=scenario.seed) as net:
             placement = across_hosts(access_h, host_map,
