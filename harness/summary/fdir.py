@@ -13,6 +13,7 @@ from typing import Any, ClassVar, Literal, Self
 from pydantic import Field, SerializerFunctionWrapHandler, model_serializer
 
 from harness.archive.reader import RunArchive
+from harness.summary.declaring import TestName, declared_figures, report_test
 from harness.summary.delay_bound import NisSeries, nis_series, with_delay_bounds
 from harness.summary.records import SummaryRecord
 from harness.summary.scoring import (
@@ -60,8 +61,15 @@ class Detection(SummaryRecord):
                                            description="identified class (null: not yet)")
     direction: Literal["improved", "degraded"] | None = Field(
         description="the information gain's direction in the declaring window")
-    metric: float | None = Field(description="H_m,i of the declaring window (dimensionless)")
-    threshold: float | None = Field(description="τ_i it exceeded, same unit")
+    test: TestName | None = Field(
+        default=None, description="the test that declared it (harness/summary/declaring.py: "
+                                  "'information', 'nis_scan', 'global_check', ...; "
+                                  "'identification': a class named later in its episode); "
+                                  "absent: a summary before it was recorded")
+    metric: float | None = Field(description="the declaring test's statistic (the information "
+                                             "test: H_m,i of the declaring window)")
+    threshold: float | None = Field(description="the threshold it exceeded (the information "
+                                                "test: τ_i), same unit")
     evidence: dict[str, float] = Field(default_factory=dict,
                                        description="what the class rests on, by name")
     faithful: bool | None = Field(
@@ -257,13 +265,9 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
     judged = [Judged(w.spacecraft, w.t_start_s, w.t_end_s) for w in windows
               if w.exceeded is not None]
     scores = score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s)
+    by_window = {(w.spacecraft, w.t_end_s): w for w in windows}
     return FdirResults(
-        detections=[Detection(spacecraft=r.spacecraft, time_s=r.t_sim, fault_class=r.fault_class,
-                              direction=r.direction, metric=r.metric, threshold=r.threshold,
-                              evidence=dict(r.evidence), declared_s=r.declared_s,
-                              declared_by="ground",
-                              **({"cause": r.cause} if r.cause else {}),
-                              **({"detector": r.detector} if r.detector != "window" else {}))
+        detections=[detection(r, by_window.get((r.spacecraft, r.window_end_s)), scenario.fdir)
                     for r in reports],
         scores=(with_delay_bounds(scores, scenario.faults, windows, 1.0 / scenario.rates.mid_hz,
                                   nis)
@@ -273,6 +277,18 @@ def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
         fdir_thresholds=threshold_census(windows, scenario),
         fdir_settings=RunFdirSettings.model_validate(
             {"fdi_period_s": scenario.rates.fdi_period_s, **scenario.fdir.model_dump()}))
+
+
+def detection(r: FaultReport, window: FdirWindow | None, cfg: FdirSettings) -> Detection:
+    """The ground's report ``r`` as a detection, with the test that declared it (``window``:
+    the window it was declared on, if any) and that test's statistic and threshold."""
+    test = report_test(r, window)
+    metric, threshold = declared_figures(test, r, window, cfg)
+    return Detection(spacecraft=r.spacecraft, time_s=r.t_sim, fault_class=r.fault_class,
+                     direction=r.direction, test=test, metric=metric, threshold=threshold,
+                     evidence=dict(r.evidence), declared_s=r.declared_s, declared_by="ground",
+                     **({"cause": r.cause} if r.cause else {}),
+                     **({"detector": r.detector} if r.detector != "window" else {}))
 
 
 def _declaring_test(report: FaultReport) -> DeclaringTest:

@@ -111,13 +111,10 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
                if first is not None and first.detector is not None else {}),
         ))
 
-    def faulty(sc: int, t: float) -> bool:  # a common-mode fault (0) acts on every observer
-        return any(f.spacecraft in (0, sc) and _active(f, t, grace_s) for f in faults)
-
     def overlaps(j: Judged) -> bool:
         return overlaps_fault(faults, j.spacecraft, j.t_start_s, j.t_end_s)
 
-    false_alarms = [a for a in alarms if not faulty(a.spacecraft, a.at_s)]
+    false_alarms = false_alarms_of(faults, alarms, grace_s)
     nominal = [j for j in judged if not overlaps(j)]
     hours = sum(j.t_end_s - j.t_start_s for j in nominal) / 3600.0
     return Scores(
@@ -127,6 +124,15 @@ def score(faults: Sequence[Fault], alarms: Sequence[Alarm], judged: Sequence[Jud
         false_alarm_rate=len(false_alarms) / len(nominal) if nominal else None,
         false_alarms_per_hour=len(false_alarms) / hours if hours > 0 else None,
     )
+
+
+def false_alarms_of(faults: Sequence[Fault], alarms: Sequence[Alarm], grace_s: float
+                    ) -> list[Alarm]:
+    """The ``alarms`` on a spacecraft with no fault active at their time (a common-mode
+    fault, spacecraft 0, acts on every observer), in their order."""
+    return [a for a in alarms
+            if not any(f.spacecraft in (0, a.spacecraft) and _active(f, a.at_s, grace_s)
+                       for f in faults)]
 
 
 FaultClass = Literal["actuator", "camera", "state_sensor", "link", "data_integrity",
