@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -14,9 +15,19 @@ import numpy as np  # noqa: E402
 from ground.archive.segments import run_archive  # noqa: E402
 from harness.archive.reader import ArchiveError, RunArchive  # noqa: E402
 from harness.archive.span import seconds  # noqa: E402
+from harness.report_fdir_plot import plot_fdir  # noqa: E402
+from harness.report_head import head_lines  # noqa: E402
+from harness.report_scale import (  # noqa: E402
+    SHOWN_MOST,
+    capped_rows,
+    figure_height_in,
+    others_line,
+    shown_observers,
+)
 from harness.summary import RunSummary, Scores  # noqa: E402
 from harness.summary.control import GncSeries  # noqa: E402
 from harness.summary.coverage import Coverage  # noqa: E402
+from harness.summary.declaring import LABELS, detection_test  # noqa: E402
 from harness.summary.digest import RunDigest, digest_run  # noqa: E402
 from harness.summary.nav import NavErrors  # noqa: E402
 from harness.summary.truth_table import TruthTable  # noqa: E402
@@ -26,28 +37,22 @@ from interfaces.contracts.scenario import Scenario  # noqa: E402
 
 
 def write_report(out: Path, scenario: Scenario, mission: str | None = None,
-                 digest: RunDigest | None = None) -> Path:
+                 digest: RunDigest | None = None,
+                 settings: Mapping[str, str] | None = None) -> Path:
     """Write ``<out>/report.md`` (and its plots) from ``run.mcap`` (every segment of the
     archive) and ``summary.json``
-    (``digest``: the run's archive already read for the summary, ``harness.summary.digest``)."""
+    (``digest``: the run's archive already read for the summary, ``harness.summary.digest``;
+    ``settings``: what the run was launched with beyond the scenario, as given, printed with
+    its settings).  It opens on the verdict (``harness/report_head.py``)."""
     mission = mission or scenario.name
     summary = RunSummary.read(out / "summary.json")
-    lines = [f"# Run report: {scenario.name}", "",
-             f"Status **{summary.status}**, seed {scenario.seed}, transport "
-             f"{summary.transport}, {summary.t_sim_final_s or 0:.0f} s simulated in "
-             f"{summary.wall_s:.1f} s wall"
-             + (f" ({summary.real_time_factor:.0f}× real time)."
-                if summary.real_time_factor else "."),
-             ""]
-    if summary.error:
-        lines += ["```", summary.error, "```", ""]
-    lines += archive_end(summary)
     try:
         digest = digest or digest_run(run_archive(out), scenario, mission)
     except (ArchiveError, OSError) as e:
-        lines.append(f"The archive could not be read: {e}")
-        return _write(out, lines)
+        lines = head_lines(scenario, summary, {}, settings) + archive_end(summary)
+        return _write(out, [*lines, f"The archive could not be read: {e}"])
     archive = digest.archive
+    lines = head_lines(scenario, summary, archive.metadata, settings) + archive_end(summary)
     lines += _trajectory_section(out, digest.truth)
     lines += _nav_section(out, digest.nav_errors(mission), summary)
     lines += _gnc_section(out, digest.gnc_series(scenario, mission), summary)
@@ -81,7 +86,7 @@ def _trajectory_section(out: Path, truth: TruthTable) -> list[str]:
         ax.set_title(title)
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, alpha=0.3)
-    axes[0].legend(loc="best", fontsize=8)
+    _legend(axes[0], loc="best", fontsize=8)
     fig.suptitle("True relative trajectories (LVLH of the target)")
     fig.tight_layout()
     fig.savefig(out / "trajectories.png", dpi=110)
@@ -89,12 +94,24 @@ def _trajectory_section(out: Path, truth: TruthTable) -> list[str]:
     return ["## Relative trajectories", "", "![trajectories](trajectories.png)", ""]
 
 
+def _legend(ax: Any, **kw: Any) -> None:
+    """``ax``'s legend, of its first ``SHOWN_MOST`` + 1 entries (one per observer and the
+    target's, say) and a count of the others."""
+    handles, labels = ax.get_legend_handles_labels()
+    most = SHOWN_MOST + 1
+    if len(labels) > most:
+        handles, labels = handles[:most], [*labels[:most - 1], f"{labels[most - 1]} "
+                                           f"(and {len(labels) - most} more)"]
+    ax.legend(handles, labels, **kw)
+
+
 def _nav_section(out: Path, errs: dict[int, NavErrors], summary: RunSummary) -> list[str]:
     if not errs:
         return ["No navigation estimates recorded.", ""]
-    fig, axes = plt.subplots(len(errs), 1, figsize=(10, 2.2 * len(errs)), sharex=True,
-                             squeeze=False)
-    for ax, (sc, e) in zip(axes[:, 0], errs.items(), strict=True):
+    shown = shown_observers(errs, summary)
+    fig, axes = plt.subplots(len(shown), 1, figsize=(10, figure_height_in(len(shown), 2.2, 0.0)),
+                             sharex=True, squeeze=False)
+    for ax, (sc, e) in zip(axes[:, 0], ((sc, errs[sc]) for sc in shown), strict=True):
         pos = np.linalg.norm(e.error[:, :3], axis=1)
         bound = 3 * np.sqrt(np.sum(e.sigma[:, :3] ** 2, axis=1))
         ax.semilogy(e.t_s, pos, lw=0.8, label="|position error|")
@@ -111,12 +128,14 @@ def _nav_section(out: Path, errs: dict[int, NavErrors], summary: RunSummary) -> 
             "mean NEES (6 dof) | NEES in 95% | mean NIS |",
             "|---|---|---|---|---|---|---|"]
     for sc, st in (summary.nav or {}).items():
-        if st:
+        if st and int(sc) in shown:
             rows.append(f"| {sc} | {st.pos_rms_m:.3f} | {st.pos_max_m:.3f} | "
                         f"{st.vel_rms_mps:.4f} | {st.nees_mean:.2f} | "
                         f"{100 * st.nees_in_95_bounds:.0f}% | "
                         f"{st.nis_mean or float('nan'):.2f} |")
-    return ["## Navigation", "", "![nav error](nav_error.png)", "", *rows, ""]
+    rms = {int(sc): st.pos_rms_m for sc, st in (summary.nav or {}).items() if st}
+    return ["## Navigation", "", "![nav error](nav_error.png)", "", *rows, "",
+            *others_line("position error RMS", shown, rms, "m")]
 
 
 def _gnc_section(out: Path, series: dict[int, GncSeries], summary: RunSummary) -> list[str]:
@@ -134,7 +153,7 @@ def _gnc_section(out: Path, series: dict[int, GncSeries], summary: RunSummary) -
     axes[2].set_xlabel("sim time (s)")
     for ax in axes:
         ax.grid(True, alpha=0.3)
-    axes[0].legend(loc="upper left", fontsize=8, ncol=5)
+    _legend(axes[0], loc="upper left", fontsize=8, ncol=5)
     fig.suptitle("Guidance and attitude control against truth")
     fig.tight_layout()
     fig.savefig(out / "gnc.png", dpi=110)
@@ -146,14 +165,19 @@ def _gnc_section(out: Path, series: dict[int, GncSeries], summary: RunSummary) -
     rows = ["| sc | Δv delivered L1 (mm/s) | Δv planned L1 (mm/s) | transfers | min range (m) | "
             "hold error RMS / max (m) | pointing error mean / p95 (deg, tracking) | "
             "attitude knowledge RMS (arcsec) |", "|---|---|---|---|---|---|---|---|"]
+    shown = shown_observers((int(sc) for sc in summary.gnc or {}), summary)
     for sc, g in (summary.gnc or {}).items():
+        if int(sc) not in shown:
+            continue
         rows.append(
             f"| {sc} | {1e3 * g.dv_delivered_l1_mps:.1f} | {1e3 * g.dv_planned_l1_mps:.1f} | "
             f"{g.transfers} | {f(g.min_range_m, '.1f')} | "
             f"{f(g.hold_error_rms_m, '.3f')} / {f(g.hold_error_max_m, '.3f')} | "
             f"{f(g.pointing_error_mean_deg, '.3f')} / {f(g.pointing_error_p95_deg, '.3f')} | "
             f"{f(g.knowledge_error_rms_arcsec, '.1f')} |")
-    return ["## Guidance and attitude", "", "![gnc](gnc.png)", "", *rows, ""]
+    dv = {int(sc): 1e3 * g.dv_delivered_l1_mps for sc, g in (summary.gnc or {}).items()}
+    return ["## Guidance and attitude", "", "![gnc](gnc.png)", "", *rows, "",
+            *others_line("Δv delivered (L1)", shown, dv, "mm/s")]
 
 
 def _coverage_section(out: Path, c: Coverage, summary: RunSummary) -> list[str]:
@@ -165,7 +189,7 @@ def _coverage_section(out: Path, c: Coverage, summary: RunSummary) -> list[str]:
     for sc, (ts, hs) in sorted(c.h_i.items()):
         axes[1].plot(ts, hs, ".-", ms=3, lw=0.8, label=f"sc{sc}")
     axes[1].set_ylabel("H_i reported (Eq. 8)")
-    axes[1].legend(fontsize=8)
+    _legend(axes[1], fontsize=8)
     for ax in axes:
         ax.set_xlabel("sim time (s)")
         ax.grid(True, alpha=0.3)
@@ -202,33 +226,22 @@ def _decision_rows(c: Coverage) -> list[str]:
 
 def _fdir_section(out: Path, archive: RunArchive, mission: str, summary: RunSummary
                   ) -> list[str]:
-    """Per observer: log10 of the metric H_m,i against log10 of the threshold τ_i (as the
-    paper's Fig. 23-26, right), fault onsets (red) and declared faults (black)."""
+    """Per observer shown (``harness/report_scale.py``): each test's statistic over its
+    threshold, with each declaration named by the test that declared it
+    (``harness/report_fdir_plot.py``), fault onsets and the tables."""
     windows = archive.of(cat.FDIR_WINDOW, mission)
     judged = [w for w in windows if w.metric is not None and w.threshold is not None]
     if not judged:
         return ["No FDIR decision recorded.", ""]
-    ids = sorted({w.spacecraft for w in windows})
-    fig, axes = plt.subplots(len(ids), 1, figsize=(10, 1.8 * len(ids) + 1), sharex=True,
-                             squeeze=False)
-    floor = 1e-6  # log of a zero metric
-    for ax, sc in zip(axes[:, 0], ids, strict=True):
-        mine = [w for w in judged if w.spacecraft == sc]
-        t = [w.t_end_s for w in mine]
-        ax.plot(t, np.log10([max(w.metric, floor) for w in mine]), "o-", ms=3, lw=1.0,
-                label="log H_m")
-        ax.plot(t, np.log10([max(w.threshold, floor) for w in mine]), "--", lw=1.0,
-                label="log τ")
-        _mark_faults(ax, sc, summary)
-    axes[0, 0].legend(fontsize=8, loc="upper right")
-    axes[-1, 0].set_xlabel("sim time (s)  (red: fault onset, dotted: fault declared)")
-    fig.suptitle("FDIR: metric against adaptive threshold (Eq. 9, 12)")
-    fig.tight_layout()
-    fig.savefig(out / "fdir.png", dpi=110)
-    plt.close(fig)
+    ids = shown_observers({w.spacecraft for w in windows}, summary)
+    plot_fdir(out, windows, ids, summary)
     _gain_plot(out, judged, ids)
     scan = _scan_plot(out, windows, ids, summary)
-    rows = ["## FDIR", "", "![fdir](fdir.png)", "", "![fdir gain](fdir_gain.png)", "", *scan,
+    hidden = len({w.spacecraft for w in windows}) - len(ids)
+    note = [f"Plotted: {', '.join(f'sc{sc}' for sc in ids)}; the other {hidden} observers had "
+            "no fault and no declaration.", ""] if hidden else []
+    rows = ["## FDIR", "", "![fdir](fdir.png)", "", *note, "![fdir gain](fdir_gain.png)", "",
+            *scan,
             "| fault | spacecraft | onset (s) | detected | isolated | latency (s) | class |",
             "|---|---|---|---|---|---|---|"]
     scores = summary.scores
@@ -266,8 +279,8 @@ def _scan_plot(out: Path, windows: list[FdirWindow], ids: list[int], summary: Ru
     scanned = [w for w in windows if w.scan_z_max is not None and w.scan_threshold is not None]
     if not scanned:
         return []
-    fig, axes = plt.subplots(len(ids), 1, figsize=(10, 1.8 * len(ids) + 1), sharex=True,
-                             squeeze=False)
+    fig, axes = plt.subplots(len(ids), 1, figsize=(10, figure_height_in(len(ids))),
+                             sharex=True, squeeze=False)
     for ax, sc in zip(axes[:, 0], ids, strict=True):
         mine = [w for w in scanned if w.spacecraft == sc]
         t = [w.t_end_s for w in mine]
@@ -291,16 +304,20 @@ def _scan_plot(out: Path, windows: list[FdirWindow], ids: list[int], summary: Ru
 
 
 def _identification_rows(summary: RunSummary) -> list[str]:
-    """Each declared fault with the evidence its class rests on (ground/fdir/identify.py)."""
-    rows = ["| declared (s) | spacecraft | class | H_m | τ | evidence |",
-            "|---|---|---|---|---|---|"]
+    """Each declared fault with the test that declared it, that test's statistic and threshold
+    (named as the test names them) and the evidence its class rests on
+    (ground/fdir/identify.py)."""
+    rows = ["| declared (s) | spacecraft | class | declaring test | statistic | threshold | "
+            "evidence |", "|---|---|---|---|---|---|---|"]
     for d in summary.detections or []:
         ev = ", ".join(f"{k} {v:.3g}" for k, v in d.evidence.items()) or "-"
-        m = "-" if d.metric is None else f"{d.metric:.3g}"
-        tau = "-" if d.threshold is None else f"{d.threshold:.3g}"
+        label = LABELS[detection_test(d)]
+        m = "-" if d.metric is None else f"{label.statistic} {d.metric:.3g}"
+        tau = "-" if d.threshold is None else f"{label.threshold} {d.threshold:.3g}"
         who = (f"neighbours {', '.join(map(str, d.judges or []))}"
                if d.declared_by == "neighbours" else d.fault_class or "unidentified")
-        rows.append(f"| {d.time_s:.0f} | {d.spacecraft} | {who} | {m} | {tau} | {ev} |")
+        rows.append(f"| {d.time_s:.0f} | {d.spacecraft} | {who} | {label.name} | {m} | {tau} | "
+                    f"{ev} |")
     return rows + [""] if len(rows) > 2 else []
 
 
@@ -437,10 +454,11 @@ def _links_section(summary: RunSummary) -> list[str]:
     rows = ["## Links", "",
             "| link | sent | delivered | dropped (range) | dropped (loss) | dropped (cut) |",
             "|---|---|---|---|---|---|"]
-    for c in summary.links or []:
-        rows.append(f"| {c.src} → {c.dst} | {c.sent} | {c.delivered} | "
-                    f"{c.dropped_range} | {c.dropped_loss} | {c.dropped_cut} |")
-    return rows + [""]
+    links = summary.links or []
+    body = [f"| {c.src} → {c.dst} | {c.sent} | {c.delivered} | {c.dropped_range} | "
+            f"{c.dropped_loss} | {c.dropped_cut} |" for c in links]
+    dropped = [c.dropped_range + c.dropped_loss + c.dropped_cut for c in links]
+    return rows + capped_rows(body, lambda i: dropped[i], "links") + [""]
 
 
 def _incidents_section(summary: RunSummary) -> list[str]:
@@ -526,9 +544,12 @@ def _exec_section(summary: RunSummary) -> list[str]:
             "| node | cycle slips (high/mid/low) | max exec ms (high/mid/low) | app errors "
             "| invalid msgs | refused msgs | barrier timeouts |",
             "|---|---|---|---|---|---|---|"]
+    body, trouble = [], []
     for node, e in (summary.exec or {}).items():
         slips = "/".join(str(e.cycle_slips.get(g, 0)) for g in ("high", "mid", "low"))
         ms = "/".join(f"{e.max_exec_ms.get(g, 0):.2f}" for g in ("high", "mid", "low"))
-        rows.append(f"| {node} | {slips} | {ms} | {e.app_errors} | {e.invalid_dropped} | "
+        body.append(f"| {node} | {slips} | {ms} | {e.app_errors} | {e.invalid_dropped} | "
                     f"{e.refused} | {e.barrier_timeouts} |")
-    return rows + [""]
+        trouble.append(sum(e.cycle_slips.values()) + e.app_errors + e.invalid_dropped
+                       + e.refused + e.barrier_timeouts + (0 if node.startswith("sc") else 1))
+    return rows + capped_rows(body, lambda i: trouble[i], "nodes") + [""]

@@ -70,8 +70,9 @@ class BaselinesApp(App):
     def _verdict(self, detector: Detector, w: FdirWindow, statistic: float | None,
                  threshold: float | None, exceeded: bool | None, alarm: bool) -> None:
         if alarm:
-            self.log.warning("baseline %s: fault declared on sc%d at %.0f s", detector,
-                             w.spacecraft, w.t_end_s)
+            self.log.info("baseline %s would declare sc%d at %.0f s (a baseline, scored "
+                          "beside the FDIR: nothing declared)", detector, w.spacecraft,
+                          w.t_end_s)
         self.publish("verdict", BaselineVerdict(
             sender=self.ctx.node, t_sim=w.t_end_s, detector=detector,
             spacecraft=w.spacecraft, t_start_s=w.t_start_s, t_end_s=w.t_end_s,

@@ -53,7 +53,13 @@ from harness.campaign.rescore import (  # noqa: E402
     spread,
     window_margins,
 )
-from harness.campaign.targets import rate, share, target_figures, target_lines  # noqa: E402
+from harness.campaign.targets import (  # noqa: E402
+    noted_rate,
+    rate,
+    share,
+    target_figures,
+    target_lines,
+)
 from harness.summary.scoring import EXPECTED_CLASS  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", "common_mode", None)
@@ -129,7 +135,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
         w.writerows(rows)
     detectors = ["main"] + sorted({r["detector"] for r in rows} - {"main"})
     hours = {d: nominal_hours(runs, d) for d in detectors}
-    lines = _head_lines(name, loaded, len(ids), hours["main"])
+    lines = _head_lines(name, loaded, len(ids), hours["main"]) + settings_lines(out)
     lines += target_lines(target_figures(rows, runs))
     lines += _side_by_side_lines(rows, detectors, hours)
     groups = list(dict.fromkeys(r.group for r in runs))
@@ -163,6 +169,22 @@ def _head_lines(name: str, loaded: list[CampaignRun], requested: int,
                else "") + "; failed runs are left out of every figure below); "
             f"{main_hours:.1f} nominal spacecraft-hours judged by the main detector.", "",
             _versions(loaded), "", _wall_time(loaded), ""]
+
+
+def settings_lines(out: Path) -> list[str]:
+    """The settings the campaign's runs were made with, from ``<out>/campaign.json``: those
+    given with ``--set`` over the campaign file's (or a replay's), and the campaign replayed;
+    nothing without the file."""
+    index = out / "campaign.json"
+    if not index.exists():
+        return []
+    meta = json.loads(index.read_text())
+    given = meta.get("settings") or {}
+    text = ", ".join(f"{k} = {v}" for k, v in given.items())
+    source = f"replay of {meta['replay_of']}: " if meta.get("replay_of") else ""
+    return [f"Settings: {source}"
+            + (f"{text} (--set, over each run's own)." if text else
+               "each run's own, nothing set over them (no --set)."), ""]
 
 
 def _side_by_side_lines(rows: list[dict[str, Any]], detectors: list[str],
@@ -226,8 +248,8 @@ def _bin_row(b: BinFigures) -> str:
     return (f"| {label} | {b.runs} | {b.failed} | {b.faults} | {b.unjudged} | "
             f"{share(b.isolated, b.judgeable)} | {share(b.identified, b.judgeable)} | "
             f"{_fmt(b.latency_median_s)} / {_fmt(b.latency_p90_s)} | "
-            f"{_fmt(b.onset_latency_median_s)} | {rate(b.false_alarms, b.windows)} | "
-            f"{rate(b.neighbour_false_alarms, b.neighbour_windows)} |")
+            f"{_fmt(b.onset_latency_median_s)} | {noted_rate(b.false_alarms, b.windows)} | "
+            f"{noted_rate(b.neighbour_false_alarms, b.neighbour_windows)} |")
 
 
 def _magnitude_lines(rows: list[dict[str, Any]], detectors: list[str],
