@@ -4,7 +4,8 @@
 Joins the run's Zenoh network as a client with the run's read-only telemetry account
 (``<out>/access/tlm.json5``, written by deploy/run_constellation.py: endpoint, user, password
 and, over TLS, the certificate authority) and shows the latest message of every key matching the
-filter as a table refreshed once per second, or, with ``--stream``, one line per message.
+filter as a table refreshed once per second (one row per observer where the observers share a
+key, as the ground's FDIR windows do), or, with ``--stream``, one line per message.
 Without ``--zenoh-config`` it connects to ``--connect`` with no credentials (a network without
 access control).  Ctrl-C quits.
 """
@@ -53,6 +54,20 @@ def summarize(payload: bytes, width: int = 90) -> tuple[int, float, str]:
             text if len(text) <= width else text[: width - 1] + "…")
 
 
+def row_key(key: str, payload: bytes) -> str:
+    """The table row of a message on ``key``: the key, and where its observers share it (the
+    ground's FDIR windows, fault reports...), the observer the message is about, so each
+    observer keeps its own row ("``key`` [sc2]")."""
+    try:
+        d = json.loads(payload)
+    except ValueError:
+        return key
+    sc = d.get("spacecraft") if isinstance(d, dict) else None
+    if not isinstance(sc, int) or isinstance(sc, bool) or f"/sc/{sc}/" in f"{key}/":
+        return key
+    return f"{key} [sc{sc}]"
+
+
 def _short(v: object) -> str:
     if isinstance(v, float):
         return f"{v:.4g}"
@@ -98,9 +113,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.stream:
             print(f"{t:10.1f}  {key}  {type_name}#{seq}  {text}", flush=True)
             return
+        row = row_key(key, payload)
         with lock:
-            prev = rows.get(key)
-            rows[key] = _Row(type_name, seq, t, (prev.count if prev else 0) + 1, text)
+            prev = rows.get(row)
+            rows[row] = _Row(type_name, seq, t, (prev.count if prev else 0) + 1, text)
 
     try:
         transport = ZenohTransport(ZenohSettings(connect=(args.connect,), mode="client",

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from ground.tools.tlm import _Row, summarize, table
+from ground.tools.tlm import _Row, row_key, summarize, table
 from interfaces.contracts.messages import FaultReport, StateEstimate
 
 
@@ -47,3 +47,24 @@ def test_the_table_is_the_latest_row_per_key_sorted_and_aligned() -> None:
     assert [ln.split()[0] for ln in lines[2:]] == sorted(rows)
     assert lines[2].split()[1:] == ["FaultReport", "1", "40.0", "1", "spacecraft=2"]
     assert lines[2].index("FaultReport") == lines[3].index("StateEstimate")
+
+
+def test_each_observer_keeps_its_row_on_a_key_the_observers_share() -> None:
+    """The ground's FDIR windows of every observer share one key: each observer keeps its own
+    row; a key of one observer (its ``/sc/<n>/``) and a message about none keep the key."""
+    from interfaces.contracts.messages import FdirWindow
+
+    key = "insp/m/ground/fdir/window"
+    rows = {}
+    for sc in (1, 2, 3, 2):
+        w = FdirWindow(sender="ground", t_sim=30.0, spacecraft=sc, t_start_s=0.0,
+                       t_end_s=30.0, images=10)
+        row = row_key(key, w.model_dump_json().encode())
+        rows[row] = _Row("FdirWindow", 0, 30.0, rows[row].count + 1 if row in rows else 1, "")
+    assert sorted(rows) == [f"{key} [sc1]", f"{key} [sc2]", f"{key} [sc3]"]
+    assert rows[f"{key} [sc2]"].count == 2
+    assert [ln.split()[1] for ln in table(rows).splitlines()[2:]] == ["[sc1]", "[sc2]", "[sc3]"]
+    own = "insp/m/sc/2/nav/estimate"
+    assert row_key(own, b'{"spacecraft": 2}') == own
+    assert row_key("insp/m/sim/tick", b'{"t_sim": 1.0}') == "insp/m/sim/tick"
+    assert row_key(key, b"not json") == key
