@@ -120,8 +120,10 @@ def test_the_report_has_a_table_per_dimension(campaign: Path) -> None:
     assert "## By drawn dimension" in report
     for name in ("mission", "observers.count", "fault.phase"):
         assert f"\n### {name}\n" in report
+    # 0 in 20 windows cannot show 1e-3; 1 in 100 is over it
     assert ("| nominal | 2 | 0 | 2 | 0 | 100% (2/2) | 50% (1/2) | 30 / 38 | 30 | 0.0000 (0/20; "
-            "95% ≤ 0.14) | 0.0100 (1/100; 95% ≤ 0.047) |") in report
+            "95% ≤ 0.14); too few windows to show the target: needs ≥ 2,995 windows (has 20) | "
+            "0.0100 (1/100; 95% ≤ 0.047) |") in report
     assert ("| **default** (worst) | 2 | 1 | 1 | 0 | 0% (0/1) | 0% (0/1) | - / - | - | 0.0600 "
             "(3/50;") in report
     assert "| 6–7 | 0 | 0 | 0 | 0 | - | - | - / - | - | - | - |" in report
