@@ -6,6 +6,8 @@ synchronously inside the sim's publish, so no threads are involved, and the spac
 together as one fleet (``interfaces/runtime/fleet.py``).  The lean runtime: routes
 resolved once per key, messages made in this process not re-admitted, one truth feed for every
 node's channel stage, no barrier wait (every announced message was delivered before the tick).
+The compiled kernels are loaded before the clock starts (``interfaces/runtime/kernels.py``), so
+no rate group pays for their first call.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from interfaces.runtime.blas_threads import one_blas_thread
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.fleet import fleets_of
+from interfaces.runtime.kernels import compile_kernels
 from interfaces.runtime.transport import InprocNetwork, RawHandler, SampleHandler
 from links.channel import ChannelModel
 from links.truth import history_for
@@ -42,8 +45,10 @@ def run_inproc(
     ``stop``, set, stops the run at the next tick boundary (``SimNode.completed`` stays
     False).  ``fleet``: the spacecraft step together (False: each alone, as it would in a
     process of its own).  Returns the sim and the executives by node.  This process's BLAS
-    runs on one thread from then on (``interfaces.runtime.blas_threads``)."""
+    runs on one thread from then on (``interfaces.runtime.blas_threads``), and it holds the
+    compiled kernels, loaded before the clock starts (``interfaces.runtime.kernels``)."""
     one_blas_thread()
+    compile_kernels()
     mission = mission or scenario.name
     net = InprocNetwork()
     if tap is not None:

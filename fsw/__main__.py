@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import argparse
+import sys
+from functools import partial
 
 from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario
@@ -12,6 +14,7 @@ from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import add_node_args, run_participants
 from interfaces.runtime.executive import Executive
+from interfaces.runtime.kernels import compile_kernels
 from links.channel import ChannelModel
 
 
@@ -35,6 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     if len(args.spacecraft) > 1 and args.zenoh_config and "{node}" not in args.zenoh_config:
         parser.error("several spacecraft need an account each: put '{node}' in --zenoh-config")
     nodes = [topics.sc_node(i) for i in args.spacecraft]
+    compile_kernels(partial(print, file=sys.stderr))  # loaded before the first tick
     return run_participants(args, nodes, _build, ChannelModel.of)
 
 

@@ -32,6 +32,7 @@ from interfaces.contracts.catalogue import Topic
 from interfaces.contracts.messages import FaultEvent, SimStatus, Tick, TickDone, TruthState
 from interfaces.contracts.scenario import Scenario
 from interfaces.runtime.bus import Bus
+from interfaces.runtime.kernels import compile_kernels
 from interfaces.runtime.recent import recover
 from sim.dynamics import RelativeTruth, circular_chief_eci, lvlh_basis
 from sim.hardware import ObserverHardware
@@ -102,6 +103,7 @@ class SimNode:
     """whether every tick ran (False: stopped by ``stop`` before the end)"""
 
     def __post_init__(self) -> None:
+        compile_kernels()  # loaded before the first tick (compiled if the cache lacks them)
         sc = self.scenario
         self.constants = MissionConstants.of(sc)
         chief = circular_chief_eci(

@@ -17,12 +17,18 @@ from interfaces.contracts.messages import (
 
 
 class ExecRecord(SummaryRecord):
-    """One node's executive counters, cumulative over the run (``ExecStats``)."""
+    """One node's executive counters, cumulative over the run (``ExecStats``).  A rate
+    group's first run in a process is its start-up, counted in neither ``cycle_slips`` nor
+    ``max_exec_ms`` (``interfaces.runtime.executive.judge_run``)."""
 
-    FILLABLE: ClassVar[tuple[str, ...]] = ("refused",)
+    FILLABLE: ClassVar[tuple[str, ...]] = ("refused", "budget_ms")
 
-    cycle_slips: dict[str, int] = Field(description="runs over budget, by rate group")
-    max_exec_ms: dict[str, float] = Field(description="longest run, ms (wall), by rate group")
+    cycle_slips: dict[str, int] = Field(
+        description="runs that took more CPU time than their budget, by rate group")
+    max_exec_ms: dict[str, float] = Field(
+        description="longest run, ms of CPU time, by rate group")
+    budget_ms: dict[str, float] = Field(
+        default_factory=dict, description="a run's budget, ms of CPU time, by rate group")
     app_errors: int = Field(ge=0)
     invalid_dropped: int = Field(ge=0, description="invalid messages dropped")
     refused: int = Field(default=0, ge=0, description="messages refused at admission")
@@ -55,6 +61,7 @@ class SimRecord(SummaryRecord):
 def exec_record(m: ExecStats) -> ExecRecord:
     return ExecRecord(cycle_slips={g: s.cycle_slips for g, s in m.groups.items()},
                       max_exec_ms={g: round(s.max_exec_ms, 3) for g, s in m.groups.items()},
+                      budget_ms={g: round(s.budget_ms, 3) for g, s in m.groups.items()},
                       app_errors=m.app_errors, invalid_dropped=m.invalid_dropped,
                       refused=m.refused, barrier_timeouts=m.barrier_timeouts)
 
@@ -70,3 +77,28 @@ def sim_record(statuses: list[SimStatus]) -> SimRecord:
         record.pace = PaceRecord(ceiling=last.pace_ceiling, hard_deadline=last.hard_deadline,
                                  late_ticks=dict(last.late_ticks))
     return record
+
+
+SLIP_MEANING = ("A cycle slip is a run of a rate group that took more CPU time than its budget "
+                "(its period × `sim.cycle_budget_scale`); a group's first run in a process, its "
+                "start-up (code loaded on first use), is not counted, and the max exec ms are "
+                "the longest runs counted, in ms of CPU time.")
+
+
+def cycle_slip_notes(execs: dict[str, ExecRecord] | None) -> list[str]:
+    """The report's lines under the executives' table: what a cycle slip is, then each
+    node's slips by rate group, against the group's budget (none: said so)."""
+    slipped = [(node, g, n, e) for node, e in (execs or {}).items()
+               for g, n in e.cycle_slips.items() if n]
+    if not slipped:
+        return [SLIP_MEANING + " No cycle slips.", ""]
+    return [SLIP_MEANING + " Each slip is logged by its node with its time, its duration and "
+            "the app that took longest (over Zenoh in `logs/`, in one process on the "
+            "console):", "", *(_slip_line(node, g, n, e) for node, g, n, e in slipped), ""]
+
+
+def _slip_line(node: str, group: str, slips: int, e: ExecRecord) -> str:
+    budget = e.budget_ms.get(group)
+    over = f" over its {budget:.0f} ms budget" if budget else ""
+    return (f"- {node}, {group} group: {slips} cycle slip{'s' if slips > 1 else ''}, the "
+            f"longest {e.max_exec_ms.get(group, 0.0):.1f} ms of CPU{over}.")

@@ -2,10 +2,14 @@
 
 Per tick k (t = k·dt): wait until the messages announced in the Tick have arrived (barrier), then
 for each due rate group (high every tick, mid every ω_high/ω_mid ticks, low every ω_high/ω_low),
-deliver the due messages and run the group's apps in declaration order; a group whose wall time
-exceeds its period × ``sim.cycle_budget_scale`` counts a cycle slip (an overrun is reported, never
-absorbed).  At ω_mid the node publishes its heartbeat, executive stats and link stats.  Finally it
-answers the sim with TickDone(k), announcing what it published.
+deliver the due messages and run the group's apps in declaration order; a group whose run takes
+more CPU time than its period × ``sim.cycle_budget_scale`` counts a cycle slip (an overrun is
+reported, never absorbed), logged with the app that took longest, the time and the duration.
+The budget is judged on the thread's CPU time, the flight software's own work: the wall time of
+a run on a shared host also holds the time other processes had the core.  A group's first run
+in a process is its start-up (code loaded on first use): logged when over budget, not counted
+(:func:`judge_run`).  At ω_mid the node publishes its heartbeat, executive stats and link
+stats.  Finally it answers the sim with TickDone(k), announcing what it published.
 
 The same executive runs onboard (one per spacecraft) and on the ground.
 """
@@ -18,7 +22,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import ClassVar
+from typing import ClassVar, Literal
 
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
@@ -42,7 +46,8 @@ from interfaces.runtime.recent import recover
 
 @dataclass
 class GroupCount:
-    """A rate group's running statistics (published as :class:`GroupStats` at ω_mid)."""
+    """A rate group's running statistics (published as :class:`GroupStats` at ω_mid):
+    ``max_exec_ms`` is the longest run counted, in ms of CPU time."""
 
     budget_ms: float
     runs: int = 0
@@ -52,6 +57,26 @@ class GroupCount:
     def message(self) -> GroupStats:
         return GroupStats(runs=self.runs, cycle_slips=self.cycle_slips,
                           max_exec_ms=self.max_exec_ms, budget_ms=self.budget_ms)
+
+
+RunVerdict = Literal["within", "start-up", "slip"]
+"""A group run judged: within its budget, a start-up overrun (not counted), a cycle slip."""
+
+
+def judge_run(count: GroupCount, cpu_ms: float, first: bool) -> RunVerdict:
+    """Count a run of the group ``count`` that took ``cpu_ms`` (ms of CPU time); ``first``:
+    the group's first run in this process.  A first run loads the code its apps reach (the
+    modules they import on first use, the compiled kernels not loaded before the clock
+    started): it is the process's start-up, not a cycle of the flight software, so neither
+    its time nor an overrun is counted.  Any later run over ``budget_ms`` is a cycle slip."""
+    if first:
+        return "start-up" if cpu_ms > count.budget_ms else "within"
+    count.runs += 1
+    count.max_exec_ms = max(count.max_exec_ms, cpu_ms)
+    if cpu_ms <= count.budget_ms:
+        return "within"
+    count.cycle_slips += 1
+    return "slip"
 
 
 @dataclass(eq=False)
@@ -90,6 +115,11 @@ class Executive:
         self.app_errors = 0
         self.barrier_timeouts = 0
         self.ticks = 0
+        self._started: set[RateGroupName] = set()
+        """The groups that ran in this process (a restarted process starts again)."""
+        self._run: list[tuple[str, float]] = []
+        """(app, ms of CPU time) of the group run under way."""
+        self._run_t = 0.0
         m, n = self.bus.mission, self.bus.node
         self._keys = {
             "done": cat.TICK_DONE.key(m, n), "heartbeat": cat.HEARTBEAT.key(m, n),
@@ -132,7 +162,9 @@ class Executive:
         return [g for g in RATE_GROUPS if k % self.period[g] == 0]
 
     def run_app(self, app: App, t: float) -> None:
-        """One app's step at ``t`` (s); a failure is counted and logged, never raised."""
+        """One app's step at ``t`` (s), its CPU time kept for the group's run
+        (:meth:`count_group`); a failure is counted and logged, never raised."""
+        started = time.thread_time()
         try:
             app.step(t)
         except Exception:  # noqa: BLE001 - one app's failure must not stop the node
@@ -140,14 +172,33 @@ class Executive:
             if self.app_errors <= 5 or self.app_errors % 100 == 0:
                 self.log.exception("%s: app %s failed at t=%.3f s (error #%d)",
                                    self.bus.node, app.NAME, t, self.app_errors)
+        self._run.append((app.NAME, 1e3 * (time.thread_time() - started)))
+        self._run_t = t
 
-    def count_group(self, g: RateGroupName, ms: float) -> None:
-        """Group ``g`` ran for ``ms`` (wall): counted, and a cycle slip beyond its budget."""
-        s = self.stats[g]
-        s.runs += 1
-        s.max_exec_ms = max(s.max_exec_ms, ms)
-        if ms > s.budget_ms:
-            s.cycle_slips += 1
+    def count_group(self, g: RateGroupName, wall_ms: float) -> None:
+        """Group ``g`` ran its apps (:meth:`run_app`; ``wall_ms``: the run's wall time, ms):
+        the run is judged on its CPU time (:func:`judge_run`), and an overrun logged."""
+        run, self._run = self._run, []
+        cpu_ms = sum(ms for _, ms in run)
+        first = g not in self._started
+        self._started.add(g)
+        verdict = judge_run(self.stats[g], cpu_ms, first)
+        if verdict != "within":
+            self._log_overrun(g, verdict, cpu_ms, wall_ms, run)
+
+    def _log_overrun(self, g: RateGroupName, verdict: RunVerdict, cpu_ms: float,
+                     wall_ms: float, run: list[tuple[str, float]]) -> None:
+        """Log a group run over budget: which group, when, how long, which app took longest
+        (every start-up; the first 5 slips, then every 100th)."""
+        slips = self.stats[g].cycle_slips
+        if verdict == "slip" and not (slips <= 5 or slips % 100 == 0):
+            return
+        app, app_ms = max(run, key=lambda r: r[1], default=("none", 0.0))
+        what = ("start-up, its first run: not counted" if verdict == "start-up"
+                else f"cycle slip #{slips}")
+        self.log.warning("%s: %s group took %.1f ms of CPU (%.1f ms wall) at t=%.3f s, over its "
+                         "%.0f ms budget; %s took %.1f ms (%s)", self.bus.node, g, cpu_ms,
+                         wall_ms, self._run_t, self.stats[g].budget_ms, app, app_ms, what)
 
     def end_tick(self, tick: Tick) -> None:
         """The end of ``tick``: housekeeping at ω_mid, the answer (TickDone), the
