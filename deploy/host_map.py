@@ -12,8 +12,9 @@ ways), or raise its delay or loss.
 Without ``--hosts`` a run is on one host, every node on this machine with the run's one router
 (``deploy/access.py``), and no link: the default.  A map is checked when loaded
 (:func:`load_host_map`): an unknown node, a node on two hosts, a host with no address, a
-negative delay, overlapping events on one host... are refused naming the key;
-:func:`HostMap.check_run` then checks it against the run's nodes.
+negative delay, overlapping events on one host... are refused naming the key, one line each,
+hosts by their name and events counted from 1 (``events[#1]``); :func:`HostMap.check_run` then
+checks it against the run: its spacecraft, and no event at or after the run's end.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from typing import Annotated
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from interfaces.contracts import topics
+from interfaces.contracts.errors import describe, did_you_mean
 from interfaces.contracts.scenario.base import Section
 
 RECORDER_NODE = "recorder"
@@ -65,8 +67,8 @@ class HostSpec(Section):
     def _known_nodes(cls, nodes: list[str]) -> list[str]:
         for node in nodes:
             if node not in SERVICES and not _SPACECRAFT.match(node):
-                raise ValueError(f"unknown node {node!r} (a host runs {', '.join(SERVICES)} "
-                                 f"or spacecraft sc<N>)")
+                raise ValueError(f"unknown node {node!r}{did_you_mean(node, SERVICES)} (a "
+                                 f"host runs {', '.join(SERVICES)} or spacecraft sc<N>)")
         if len(set(nodes)) != len(nodes):
             raise ValueError(f"a node listed twice: {nodes}")
         return nodes
@@ -110,28 +112,29 @@ class HostMap(Section):
         _unique("hosts: names", [h.name for h in self.hosts])
         _unique("hosts: addresses", [str(h.address) for h in self.hosts])
         where: dict[str, str] = {}
-        for i, h in enumerate(self.hosts):
+        for h in self.hosts:
             if h.address not in self.network or h.address in (self.network.network_address,
                                                               self.network.broadcast_address):
-                raise ValueError(f"hosts.{i}.address: {h.address} is not a host address of "
-                                 f"network {self.network}")
+                raise ValueError(f"hosts[{h.name}].address: {h.address} is not a host address "
+                                 f"of network {self.network}")
             for node in h.nodes:
                 if node in where:
-                    raise ValueError(f"hosts.{i}.nodes: {node} is on two hosts, {where[node]} "
-                                     f"and {h.name}")
+                    raise ValueError(f"hosts[{h.name}].nodes: {node} is on two hosts, "
+                                     f"{where[node]} and {h.name}")
                 where[node] = h.name
         missing = [s for s in SERVICES if s not in where]
         if missing:
             raise ValueError(f"hosts: no host runs {', '.join(missing)}")
-        names = {h.name for h in self.hosts}
+        names = [h.name for h in self.hosts]
         for i, e in enumerate(self.events):
             if e.host not in names:
-                raise ValueError(f"events.{i}.host: no host {e.host!r} in this map")
+                raise ValueError(f"events[#{i + 1}].host: no host {e.host!r} in this map"
+                                 f"{did_you_mean(e.host, names)} (hosts: {', '.join(names)})")
             for j, o in enumerate(self.events[:i]):
                 if o.host == e.host and (e.at_s < o.at_s + o.duration_s
                                          and o.at_s < e.at_s + e.duration_s):
-                    raise ValueError(f"events.{i}: overlaps events.{j} on host {e.host} (one "
-                                     "change of a link at a time)")
+                    raise ValueError(f"events[#{i + 1}]: overlaps events[#{j + 1}] on host "
+                                     f"{e.host} (one change of a link at a time)")
         return self
 
     def host_of(self, node: str) -> HostSpec:
@@ -146,9 +149,15 @@ class HostMap(Section):
         """The ground host, whose router the others link to."""
         return self.host_of(topics.GROUND)
 
-    def check_run(self, participants: list[str]) -> None:
+    def check_run(self, participants: list[str], duration_s: float | None = None) -> None:
         """Refuse a map whose spacecraft are not exactly the run's (``participants``: the
-        lockstep nodes, ``sc1``... and ``ground``)."""
+        lockstep nodes, ``sc1``... and ``ground``), or, given the run's ``duration_s`` (s), an
+        event starting at or after its end (it would never happen)."""
+        for i, e in enumerate(self.events):
+            if duration_s is not None and e.at_s >= duration_s:
+                raise HostMapError(f"host map {self.name}: events[#{i + 1}] (host {e.host}) "
+                                   f"at_s = {e.at_s:g}: not before the end of the run "
+                                   f"(duration_s = {duration_s:g})")
         placed = {n for h in self.hosts for n in h.nodes if _SPACECRAFT.match(n)}
         run = {p for p in participants if _SPACECRAFT.match(p)}
         if placed - run:
@@ -162,14 +171,19 @@ class HostMap(Section):
         """This map with every host's link delay and/or loss set (None: as declared)."""
         update = {k: v for k, v in (("delay_ms", delay_ms), ("loss_pct", loss_pct))
                   if v is not None}
-        hosts = [h.model_copy(update={"link": LinkSpec.model_validate(
-            {**h.link.model_dump(), **update})}) for h in self.hosts]
+        try:
+            hosts = [h.model_copy(update={"link": LinkSpec.model_validate(
+                {**h.link.model_dump(), **update})}) for h in self.hosts]
+        except ValidationError as e:
+            raise HostMapError(describe(e, "--link-delay-ms/--link-loss-pct", LinkSpec)) from None
         return self.model_copy(update={"hosts": hosts})
 
     def with_events(self, events: list[LinkEvent]) -> HostMap:
-        """This map with ``events`` added (checked as the map's own)."""
-        return HostMap.model_validate({**self.model_dump(), "events": [
-            *(e.model_dump() for e in self.events), *(e.model_dump() for e in events)]})
+        """This map with ``events`` added (checked as the map's own; HostMapError naming the
+        first that is not, as ``--link-event``)."""
+        return parse_host_map({**self.model_dump(), "events": [
+            *(e.model_dump() for e in self.events), *(e.model_dump() for e in events)]},
+            f"--link-event (host map {self.name})")
 
 
 def _unique(what: str, values: list[str]) -> None:
@@ -190,16 +204,12 @@ def load_host_map(path: Path) -> HostMap:
 
 
 def parse_host_map(data: dict[str, object], source: str) -> HostMap:
-    """``data`` (a parsed TOML table) as a HostMap; :class:`HostMapError` naming each bad key."""
+    """``data`` (a parsed TOML table) as a HostMap; :class:`HostMapError` naming each bad key,
+    one line each (hosts by their name)."""
     try:
         return HostMap.model_validate(data)
     except ValidationError as e:
-        lines = [f"{source}: invalid host map:"]
-        for err in e.errors():
-            where = "".join(f"{x}: " if i == len(err["loc"]) - 1 else f"{x}."
-                            for i, x in enumerate(err["loc"]))
-            lines.append(f"  {where}{err['msg'].removeprefix('Value error, ')}")
-        raise HostMapError("\n".join(lines)) from None
+        raise HostMapError(describe(e, source, HostMap, data)) from None
 
 
 def parse_link_event(text: str) -> LinkEvent:
@@ -221,6 +231,4 @@ def parse_link_event(text: str) -> LinkEvent:
     try:
         return LinkEvent.model_validate(fields)
     except ValidationError as e:
-        raise ValueError(f"--link-event {text!r}: " + "; ".join(
-            f"{'.'.join(map(str, err['loc'])) or 'event'}: {err['msg']}"
-            for err in e.errors())) from None
+        raise ValueError(describe(e, f"--link-event {text!r}", LinkEvent)) from None

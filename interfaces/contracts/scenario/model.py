@@ -2,18 +2,23 @@
 
 Every section has defaults, so a scenario states only what differs.  Unknown keys are errors
 (a typo must not silently fall back to a default); values are checked for range and
-consistency, and errors name the file and the offending field.
+consistency, and errors name the file and the offending field and value, one line each
+(``interfaces/contracts/errors.py``).  The command line's seed and duration are applied before
+the scenario is checked (:func:`load_scenario`), so it is checked once, as the run will fly.
 """
 
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 from pathlib import Path
+from typing import Any
 
 from pydantic import Field, ValidationError, model_validator
 
+from interfaces.contracts.errors import describe
 from interfaces.contracts.scenario.base import Section
 from interfaces.contracts.scenario.comms import Comms
 from interfaces.contracts.scenario.faults import Fault
@@ -92,21 +97,21 @@ class Scenario(Section):
     def with_overrides(self, seed: int | None = None, duration_s: float | None = None) -> Scenario:
         """A copy with the command-line overrides applied, validated as a file is (a
         ScenarioError naming the key, e.g. ``duration_s``)."""
-        data = self.model_dump()
-        if seed is not None:
-            data["seed"] = seed
-        if duration_s is not None:
-            data["duration_s"] = duration_s
-        return validated(data, "the command line")
+        data = overridden(self.model_dump(), seed, duration_s)
+        return validated(data, "the command line" + _overrides_text(seed, duration_s))
 
 
 class ScenarioError(ValueError):
-    """A scenario file that cannot be read or does not validate; the message names the field."""
+    """A scenario file that cannot be read or does not validate; the message names the field,
+    one line per error."""
 
 
-def load_scenario(path: str | Path) -> Scenario:
+def load_scenario(path: str | Path, seed: int | None = None,
+                  duration_s: float | None = None) -> Scenario:
     """Read and validate a scenario TOML file (or, with a ``.json`` suffix, a resolved scenario
-    as written by campaigns); raise ScenarioError with a readable message."""
+    as written by campaigns), with the command line's ``seed`` and ``duration_s`` (s) in place
+    of the file's where given: checked once, as the run will fly (a fault is checked against
+    the run's duration, not the file's); raise ScenarioError with a readable message."""
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
@@ -117,28 +122,45 @@ def load_scenario(path: str | Path) -> Scenario:
                             "a TOML file") from None
     if p.suffix == ".json":
         try:
-            return Scenario.model_validate_json(text)
-        except ValidationError as e:
-            raise ScenarioError(f"{p}: invalid scenario: {e}") from None
-    return parse_scenario(text, source=str(p))
+            data = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise ScenarioError(f"{p}: not valid JSON: {e}") from None
+    else:
+        data = _toml(text, str(p))
+    return validated(overridden(data, seed, duration_s),
+                     str(p) + _overrides_text(seed, duration_s))
+
+
+def overridden(data: dict[str, Any], seed: int | None, duration_s: float | None
+               ) -> dict[str, Any]:
+    """A scenario table with the command line's ``seed`` and ``duration_s`` (s) where given."""
+    given = {k: v for k, v in (("seed", seed), ("duration_s", duration_s)) if v is not None}
+    return {**data, **given} if isinstance(data, dict) else data
+
+
+def _overrides_text(seed: int | None, duration_s: float | None) -> str:
+    """`` with seed = 3, duration_s = 1400`` for the overrides given (nothing for none)."""
+    given = [f"{k} = {v:g}" for k, v in (("seed", seed), ("duration_s", duration_s))
+             if v is not None]
+    return f" with {', '.join(given)}" if given else ""
 
 
 def parse_scenario(text: str, source: str = "<string>") -> Scenario:
     """Validate scenario TOML text (see load_scenario)."""
+    return validated(_toml(text, source), source)
+
+
+def _toml(text: str, source: str) -> dict[str, Any]:
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise ScenarioError(f"{source}: not valid TOML: {e}") from e
-    return validated(data, source)
 
 
-def validated(data: dict[str, object], source: str) -> Scenario:
-    """``data`` as a Scenario; ScenarioError naming each invalid key, from ``source``."""
+def validated(data: dict[str, Any], source: str) -> Scenario:
+    """``data`` as a Scenario; ScenarioError naming each invalid key and its value, one line
+    each, from ``source`` (``interfaces.contracts.errors``)."""
     try:
         return Scenario.model_validate(data)
     except ValidationError as e:
-        lines = [f"{source}: invalid scenario:"]
-        for err in e.errors():
-            where = ".".join(str(x) for x in err["loc"]) or "(top level)"
-            lines.append(f"  {where}: {err['msg']}")
-        raise ScenarioError("\n".join(lines)) from None
+        raise ScenarioError(describe(e, source, Scenario, data)) from None

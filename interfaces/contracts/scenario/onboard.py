@@ -21,6 +21,7 @@ from typing import Literal
 
 from pydantic import Field, ValidationError, model_validator
 
+from interfaces.contracts.errors import lines
 from interfaces.contracts.scenario.base import Section
 
 SequenceName = Literal["safe_hold", "camera_off", "nav_reset", "request_plan", "none"]
@@ -78,8 +79,7 @@ class OnboardFdir(Section):
             try:
                 Watchpoint.model_validate({**DEFAULT_WATCHPOINTS[name].model_dump(), **values})
             except ValidationError as e:
-                why = "; ".join(f"{'.'.join(map(str, err['loc']))}: {err['msg']}"
-                                for err in e.errors())
+                why = "; ".join(lines(e, model=Watchpoint))
                 raise ValueError(f"onboard_fdir.watchpoints.{name}: {why}") from None
         return self
 

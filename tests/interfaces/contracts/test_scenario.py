@@ -44,9 +44,9 @@ def test_defaults_and_pro_phasing() -> None:
     ('name = "x"\nduration_s = 10\n[ground]\ncontact = "passes"\n', "[[ground.stations]]"),
     ('name = "x"\nduration_s = 10\n[ground]\nepoch = 2026-03-20T12:00:00\n', "time zone"),
     ('name = "x"\nduration_s = 10\n[[ground.stations]]\nname = "gs"\nlatitude_deg = 40\n'
-     'longitude_deg = 0\nelevation_mask_deg = -2\n', "ground.stations.0.elevation_mask_deg"),
+     'longitude_deg = 0\nelevation_mask_deg = -2\n', "ground.stations[gs].elevation_mask_deg = -2"),
     ('name = "x"\nduration_s = 10\n[[ground.stations]]\nname = "gs"\nlatitude_deg = 95\n'
-     'longitude_deg = 0\n', "ground.stations.0.latitude_deg"),
+     'longitude_deg = 0\n', "ground.stations[gs].latitude_deg = 95"),
     ('name = "x"\nduration_s = 10\n[neighbours]\nagree = 0\n', "neighbours.agree"),
     ('name = "x"\nduration_s = 10\n[neighbours]\naction = "panic"\n', "neighbours.action"),
     ('name = "x"\nduration_s = 10\n[neighbours]\nenable = true\n', "neighbours.enable"),
