@@ -29,6 +29,7 @@ from harness.summary.control import GncSeries  # noqa: E402
 from harness.summary.coverage import Coverage  # noqa: E402
 from harness.summary.declaring import LABELS, detection_test  # noqa: E402
 from harness.summary.digest import RunDigest, digest_run  # noqa: E402
+from harness.summary.execution import cycle_slip_notes  # noqa: E402
 from harness.summary.nav import NavErrors  # noqa: E402
 from harness.summary.truth_table import TruthTable  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
@@ -552,4 +553,5 @@ def _exec_section(summary: RunSummary) -> list[str]:
                     f"{e.refused} | {e.barrier_timeouts} |")
         trouble.append(sum(e.cycle_slips.values()) + e.app_errors + e.invalid_dropped
                        + e.refused + e.barrier_timeouts + (0 if node.startswith("sc") else 1))
-    return rows + capped_rows(body, lambda i: trouble[i], "nodes") + [""]
+    return (rows + capped_rows(body, lambda i: trouble[i], "nodes") + [""]
+            + cycle_slip_notes(summary.exec))
