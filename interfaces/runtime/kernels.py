@@ -113,8 +113,8 @@ def compile_kernels(progress: Callable[[str], None] | None = None,
     started = time.perf_counter()
     todo = [k for k in kernels if k.missing()]
     tell = progress if todo and progress is not None else _silent
-    tell(f"compiling {len(todo)} numba kernels into the cache (first run only, about "
-         f"{COMPILE_S_EACH * len(todo):.0f} s on two cores)...")
+    tell(f"compiling {len(todo)} of the {len(kernels)} numba kernels into the cache (first "
+         f"run only, about {COMPILE_S_EACH * len(todo):.0f} s on two cores)...")
     last = started
     for i, kernel in enumerate(kernels, 1):
         kernel.compile()
@@ -124,6 +124,22 @@ def compile_kernels(progress: Callable[[str], None] | None = None,
     spent = time.perf_counter() - started
     tell(f"kernels compiled in {spent:.1f} s")
     return spent
+
+
+def unlisted_signatures(kernels: tuple[Kernel, ...] = KERNELS) -> dict[str, list[str]]:
+    """The argument types this process compiled a kernel of ``kernels``'s modules for that
+    :data:`KERNELS` does not list, by kernel (a caller that changed the types it passes: the
+    run would compile them inside a tick).  Kernels only other kernels call are not listed:
+    they are compiled into their callers."""
+    listed = {k.label: set(k.signatures) for k in kernels}
+    out: dict[str, list[str]] = {}
+    for module in dict.fromkeys(k.module for k in kernels):
+        for name, found in vars(importlib.import_module(module)).items():
+            if isinstance(found, Dispatcher):
+                extra = set(found.signatures) - listed.get(f"{module}.{name}", set())
+                if extra:
+                    out[f"{module}.{name}"] = sorted(str(sig) for sig in extra)
+    return out
 
 
 COMPILE_S_EACH = 4.0
