@@ -16,18 +16,20 @@ from __future__ import annotations
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from deploy.draws import Record
+from deploy.draws import Record, Uniform
 from deploy.onsets import OnsetPhase, draw_onset
-from interfaces.contracts.scenario import COMMON_MODE_KINDS, FaultKind, Scenario
+from interfaces.contracts.errors import reason
+from interfaces.contracts.scenario import COMMON_MODE_KINDS, Fault, FaultKind, Scenario
 from interfaces.contracts.scenario.faults import NO_MAGNITUDE
 
 
 class Strict(BaseModel):
-    """A table of the campaign file: unknown keys are errors, values are frozen."""
+    """A table of the campaign file: unknown keys and non-finite numbers are errors, values
+    are frozen."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
 
 
 class Range(Strict):
@@ -87,6 +89,48 @@ class FaultSpec(Strict):
                 raise ValueError(f"magnitude.per_kind has no entry for kind {', '.join(missing)}")
         return self
 
+    @model_validator(mode="after")
+    def _limits(self) -> FaultSpec:
+        """Every value the fault may take -- a range's both bounds, as written, a grid's every
+        value -- within the limits of each kind it may be (``Fault``'s own checks)."""
+        kinds = self.kinds()
+        for kind in kinds:
+            for name in ("magnitude", "velocity_mps", "start_s", "end_s"):
+                for label, written, value in bounds(self._of(name, kind)):
+                    why = _refusal(self._trial(kind), name, written, value)
+                    if why is not None:
+                        of_kind = f" (kind {kind})" if len(kinds) > 1 else ""
+                        raise ValueError(f"{name}{label} = {written:g}{of_kind}: {why}")
+        return self
+
+    def _of(self, name: str, kind: str) -> Any:
+        """Field ``name`` as written, for ``kind`` (a per-kind magnitude: its entry)."""
+        value = getattr(self, name)
+        return value.per_kind.get(kind) if isinstance(value, PerKind) else value
+
+    def _trial(self, kind: str) -> dict[str, Any]:
+        """A fault of ``kind`` with each field at the value nearest its largest written one
+        (no end), against which one field's values are tried."""
+        trial: dict[str, Any] = {"spacecraft": 0 if kind in COMMON_MODE_KINDS else 1,
+                                 "kind": kind, "start_s": 0.0}
+        for name in ("magnitude", "velocity_mps", "start_s"):
+            values = [v for _, _, v in bounds(self._of(name, kind))]
+            if values:
+                trial[name] = max(values)
+        disturbance = self.disturbance
+        if disturbance is not None:
+            trial["disturbance"] = disturbance[0] if isinstance(disturbance, list) \
+                else disturbance
+        return trial
+
+    def check_within(self, duration_s: float) -> None:
+        """Refuse a start the fault may take (a range's max, as written) at or after the end
+        of a run of ``duration_s`` (s); ValueError naming it."""
+        for label, written, value in bounds(self.start_s):
+            if value >= duration_s:
+                raise ValueError(f"start_s{label} = {written:g}: not before the end of the run "
+                                 f"(duration_s = {duration_s:g})")
+
     def kinds(self) -> list[str]:
         """Every kind the fault may take."""
         k = self.kind
@@ -104,6 +148,32 @@ class FaultSpec(Strict):
         if sc == "any":
             return []
         return list(sc) if isinstance(sc, list) else [sc]
+
+
+def bounds(value: Any) -> list[tuple[str, float, float]]:
+    """The values a fault's field may take, as (label, as written, value to check): a range's
+    extremes (its max as the largest draw below it, ``deploy.draws.Uniform.extremes``), a
+    grid's values, a fixed value; none for a field drawn otherwise or not given."""
+    if isinstance(value, Range):
+        return [(f" range {name}", written, v)
+                for name, written, v in Uniform(value.min, value.max, False).extremes()]
+    if isinstance(value, list):
+        return [(f"[#{i}]", v, v) for i, v in enumerate(value, 1)]
+    return [] if value is None or isinstance(value, During) else [("", value, value)]
+
+
+def _refusal(trial: dict[str, Any], name: str, written: float, value: float) -> str | None:
+    """Why a fault ``trial`` with ``name`` at ``value`` is not one (None: it is), said of the
+    value as ``written``."""
+    try:
+        Fault.model_validate({**trial, name: value})
+    except ValidationError as e:
+        try:
+            Fault.model_validate({**trial, name: written})
+        except ValidationError as said:
+            return reason(said)
+        return reason(e)
+    return None
 
 
 class Seeds(Strict):

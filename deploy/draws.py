@@ -4,9 +4,11 @@
 In an ``overrides`` table, at any depth, a value may be
 
 * a range ``{ min = a, max = b }``: drawn uniformly in [a, b] per run, an integer when both
-  bounds are integers;
+  bounds are integers; both bounds are checked at load against the setting's own limits (a
+  float's draws lie below ``b``, so ``b`` may be a limit the setting excludes: 360° for an
+  angle in [0°, 360°));
 * a choice ``{ choose = [v1, v2, ...] }``: one value drawn uniformly per run (any TOML values,
-  taken as they are);
+  taken as they are; each checked at load as a value of the setting);
 * a subset ``{ choose = [...], count = n }`` (``count`` an integer or a range of integers):
   that many distinct values drawn, in list order (for a list setting, such as
   ``[[ground.stations]]``).
@@ -28,15 +30,18 @@ from __future__ import annotations
 import hashlib
 import inspect
 import json
+import math
 import types
 import typing
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
-from pydantic import BaseModel
+from pydantic import BaseModel, ConfigDict, TypeAdapter, ValidationError
+from pydantic.fields import FieldInfo
 
+from interfaces.contracts.errors import did_you_mean, reason
 from interfaces.contracts.scenario import Scenario
 
 
@@ -78,6 +83,14 @@ class Uniform:
     def domain(self) -> dict[str, Any]:
         return {"min": self.low, "max": self.high, "integer": self.integer}
 
+    def extremes(self) -> tuple[tuple[str, float, float], ...]:
+        """(bound, as written, the draw nearest it): ``min`` itself; ``max`` itself for an
+        integer range, else the largest float below it (numpy's uniform draws in [low,
+        high)), so that a range up to an excluded limit (an angle below 360°) is one."""
+        top = self.high if self.integer or self.high == self.low else \
+            math.nextafter(self.high, self.low)
+        return ("min", self.low, self.low), ("max", self.high, top)
+
 
 @dataclass(frozen=True)
 class Choice:
@@ -113,7 +126,7 @@ def is_draw(value: Any) -> bool:
 
 
 def _number(v: Any) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool)
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
 
 
 def parse_range(spec: Mapping[str, Any], where: str) -> Uniform:
@@ -122,7 +135,7 @@ def parse_range(spec: Mapping[str, Any], where: str) -> Uniform:
         raise DrawError(f"{where}: a range is {{ min = a, max = b }}, got keys {sorted(spec)}")
     lo, hi = spec["min"], spec["max"]
     if not (_number(lo) and _number(hi)):
-        raise DrawError(f"{where}: range bounds must be numbers, got {lo!r} and {hi!r}")
+        raise DrawError(f"{where}: range bounds must be finite numbers, got {lo!r} and {hi!r}")
     if lo > hi:
         raise DrawError(f"{where}: range min {lo} exceeds max {hi}")
     return Uniform(lo, hi, isinstance(lo, int) and isinstance(hi, int))
@@ -207,26 +220,33 @@ def draw_tree(tree: Any, stream: Callable[[str], np.random.Generator], record: R
 
 def check_settings(tree: Mapping[str, Any], where: str) -> None:
     """Every key of an overrides ``tree`` (drawn or not, down to the values of a choice) is a
-    setting of the scenario; DrawError names the first that is not (``where`` and its path)."""
+    setting of the scenario, and every value of a setting of its own (a number, a name; not a
+    table) within the setting's limits -- a range's both bounds, as written, so that no draw
+    can fall outside them; DrawError names the first that is not (``where`` and its path)."""
     _check(Scenario, dict(tree), where)
 
 
-def _check(annotation: Any, value: Any, where: str) -> None:
+def _check(annotation: Any, value: Any, where: str, setting: FieldInfo | None = None) -> None:
     if isinstance(value, Uniform):
+        _within(setting, value.extremes(), where, "range ")
         return
     if isinstance(value, Choice):
-        _check_choice(annotation, value, where)
+        _check_choice(annotation, value, where, setting)
         return
     model = _model_of(annotation)
     if model is not None and isinstance(value, dict):
         for key, v in value.items():
             if key not in model.model_fields:
-                raise DrawError(f"{where}.{key}: the scenario has no such setting ("
+                raise DrawError(f"{where}.{key}: the scenario has no such setting"
+                                f"{did_you_mean(key, model.model_fields)} ("
                                 f"{', '.join(model.model_fields)})")
-            _check(model.model_fields[key].annotation, v, f"{where}.{key}")
+            _check(model.model_fields[key].annotation, v, f"{where}.{key}",
+                   model.model_fields[key])
         return
+    if not isinstance(value, list | dict):
+        _within(setting, (("", value, value),), where, "")
     if isinstance(value, list):
-        _check_items(_inner(annotation, list), enumerate(value), where, "[{}]")
+        _check_items(_inner(annotation, list), enumerate(value, 1), where, "[#{}]")
     elif isinstance(value, dict):
         _check_items(_inner(annotation, dict), value.items(), where, ".{}")
 
@@ -238,15 +258,34 @@ def _check_items(inner: Any, items: Iterable[tuple[Any, Any]], where: str, key: 
             _check(inner, v, where + key.format(k))
 
 
-def _check_choice(annotation: Any, choice: Choice, where: str) -> None:
+def _within(setting: FieldInfo | None, values: tuple[tuple[str, Any, Any], ...], where: str,
+            what: str) -> None:
+    """Each of ``values`` ((name, as written, value checked): a range's extremes, or a value)
+    a value of ``setting`` (its type and limits; a setting holding tables is left to the
+    scenario's own check); DrawError naming the first that is not, as written."""
+    if setting is None or _model_of(setting.annotation) is not None or \
+            _inner(setting.annotation, list) is not None:
+        return
+    check = TypeAdapter(Annotated[setting.annotation, setting],
+                        config=ConfigDict(allow_inf_nan=False))
+    for name, written, v in values:
+        try:
+            check.validate_python(v)
+        except ValidationError as e:
+            raise DrawError(f"{where}: {what}{name}{' ' if name else ''}= {written!r}: "
+                            f"{reason(e)}") from None
+
+
+def _check_choice(annotation: Any, choice: Choice, where: str,
+                  setting: FieldInfo | None) -> None:
     """A choice's values are each a value of the setting; a subset's, each an element of it."""
     element = annotation
     if choice.count is not None:
-        element = _inner(annotation, list)
+        element, setting = _inner(annotation, list), None
         if element is None:
             raise DrawError(f"{where}: a subset (count) of a setting that is not a list")
-    for k, v in enumerate(choice.values):
-        _check(element, v, f"{where}.choose[{k}]")
+    for k, v in enumerate(choice.values, 1):
+        _check(element, v, f"{where}.choose[#{k}]", setting)
 
 
 def _members(annotation: Any) -> tuple[Any, ...]:

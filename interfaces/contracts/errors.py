@@ -126,22 +126,33 @@ def _path(loc: Iterable[Any]) -> tuple[Any, ...]:
 
 def _line(err: ErrorDetails, model: type[BaseModel] | None, data: Any) -> str:
     """One error: where, the value given, what is wrong."""
-    path = _path(err["loc"])
-    where = _where(path, data)
+    where = _where(_path(err["loc"]), data)
+    why = _reason(err, model)
+    if err["type"] == "value_error":  # a validator's message, which may name its own key
+        return f"{where}: {why}" if where and not why.startswith(where) else why
+    value = err.get("input")
+    given = f" = {value!r}" if _scalar(value) and err["type"] not in _SHAPE else ""
+    return f"{where}{given}: {why}"
+
+
+def reason(error: ValidationError) -> str:
+    """What is wrong, for the first error that matters, without where or the value (for a
+    caller that says those itself)."""
+    return _reason(_unfold(list(error.errors(include_url=False)))[0], None)
+
+
+def _reason(err: ErrorDetails, model: type[BaseModel] | None) -> str:
     kind, value = err["type"], err.get("input")
     if kind == "extra_forbidden":
-        return f"{where}: unknown key{_suggest(str(path[-1]), _keys(model, err['loc']))}"
+        return "unknown key" + _suggest(str(_path(err["loc"])[-1]), _keys(model, err["loc"]))
     if kind == "missing":
-        return f"{where}: missing (required)"
-    msg = str(err["msg"]).removeprefix("Value error, ").removeprefix("Assertion failed, ")
-    if kind == "value_error":  # a validator's message, which may name its own key already
-        return f"{where}: {msg}" if where and not msg.startswith(where) else msg
-    given = f" = {value!r}" if _scalar(value) else ""
+        return "missing (required)"
     if kind in ("literal_error", "enum"):
         choices = re.findall(r"'([^']*)'", str(err.get("ctx", {}).get("expected", "")))
         hint = did_you_mean(str(value), choices)
-        return f"{where}{given}: " + (f"unknown{hint}" if hint else f"one of {', '.join(choices)}")
-    return f"{where}{given}: {msg.replace('Input should', 'should')}"
+        return f"unknown{hint}" if hint else f"one of {', '.join(choices)}"
+    msg = str(err["msg"]).removeprefix("Value error, ").removeprefix("Assertion failed, ")
+    return _clean(msg.replace("Input should", "should"))
 
 
 def _scalar(value: Any) -> bool:

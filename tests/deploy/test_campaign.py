@@ -72,7 +72,8 @@ def test_expansion_is_deterministic_and_complete(tmp_path: Path) -> None:
     (lambda t: t.replace('name = "tc"', 'name = "tc"\ncolour = 1'), "colour"),
     (lambda t: t.replace("max = 10.0", "max = -1.0"), "below min"),
     (lambda t: t.replace('kind = "camera_degradation"', 'kind = "gremlins"'), "kind"),
-    (lambda t: t.replace("magnitude = 0.5", "magnitude = 1.5"), "cam-0000"),
+    (lambda t: t.replace("magnitude = 0.5", "magnitude = 1.5"),
+     r"magnitude = 1.5: camera_degradation magnitude must be in \(0, 1\)"),
     (lambda t: t.replace('base = "base.toml"', 'base = "missing.toml"'), "cannot read"),
     (lambda t: t + "[[groups]]\nname = \"nom\"\nnominal = true\n", "unique"),
 ])

@@ -176,7 +176,8 @@ def test_the_existing_campaigns_expand_as_before(name: str) -> None:
                          '{ min = 0.0, max = 360.0 } } }\n'),
      r"group f: groups\[0\].overrides.orbit.raan_degs: the scenario has no such setting"),
     (lambda t: t.replace('{ name = "Perth"', '{ nam = "Perth"'),
-     r"overrides.ground.stations.choose\[3\].nam: the scenario has no such setting"),
+     r"overrides.ground.stations.choose\[#4\].nam: the scenario has no such setting; did "
+     r"you mean 'name'\?"),
     (lambda t: t.replace("camera_degradation = 0.5\n", ""),
      r"magnitude.per_kind has no entry for kind camera_degradation"),
     (lambda t: t.replace('during = ["inspection"]', 'during = ["deployment", "transfer"]'),
@@ -203,11 +204,15 @@ def test_a_spacecraft_above_a_drawn_count_is_refused(tmp_path: Path) -> None:
 
 
 def test_a_run_that_does_not_validate_says_what_it_drew(tmp_path: Path) -> None:
-    text = DRAWN.format(spacecraft='"any"').replace("min = 10.0, max = 25.0",
-                                                    "min = 80.0, max = 95.0")
-    with pytest.raises(CampaignError, match=r"run f-\d{4}: invalid scenario: "
-                                            r"camera.half_angle_deg: .* less than 90 \(drawn: "
-                                            r"observers.count = \d, camera.half_angle_deg = 9"):
+    """Settings each within its own limits, which only some runs' draws make inconsistent: a
+    camera's field of view against its pointing margin... here the star tracker's rate, drawn,
+    that must divide the high rate."""
+    text = DRAWN.format(spacecraft='"any"').replace(
+        "[overrides.ground]", "sensors = { star_tracker_hz = { choose = [1.0, 3.0] } }\n"
+        "[overrides.ground]")
+    with pytest.raises(CampaignError, match=r"run f-\d{4}: invalid scenario: .*"
+                                            r"star_tracker_hz = 3.0 must divide .* \(drawn: "
+                                            r"observers.count = \d, camera.half_angle_deg = "):
         load_campaign(_write(tmp_path, text))
 
 
