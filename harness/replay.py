@@ -1,11 +1,20 @@
 """Replay: the live ground re-run on the telemetry in a run's archive, under the run's own or
 other detector settings.
 
-    python -m harness.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR]
+    python -m harness.replay RUN [RUN ...] [--set fdir.KEY=VALUE ...] [--out DIR] [--overwrite]
 
 RUN is a run directory (holding ``run.mcap``) or an archive (its first segment: the segments
 after it, a restarted recorder's, are read with it as one run); any other path is refused, one
 line each, exit status 2, before anything is replayed (``harness/archive/locate.py``).
+
+Each replay is written beside its archive as ``replay.json`` (the run's own settings) or
+``replay-<settings>.json`` (``--set`` given: e.g. ``replay-fdir.persistence=3.json``, the
+settings sorted by name, joined by ``+``), or into ``--out DIR`` as ``<run>.replay.json`` /
+``<run>.replay-<settings>.json``: replays under other settings never replace each other.
+Before anything is replayed, every run's settings are checked against its scenario, and every
+destination must be writable (a read-only folder is refused, naming it and ``--out``) and must
+not hold a replay with the same settings already (refused unless ``--overwrite``): one line,
+exit status 2.  A replay that fails midway is said in one line; the exit status is then 1.
 
 The ground node itself, built from the declared topology as a run builds it
 (``interfaces.contracts.topology``: planner, telemetry monitor, FDIR, baselines -- the code the
@@ -41,8 +50,10 @@ at and the sim time its data ends at).
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import logging
+import re
 import sys
 import time
 from collections.abc import Iterable
@@ -50,15 +61,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from harness.archive.locate import ArchivePathError, archive_file
+from pydantic import ValidationError
+
+from harness.archive.locate import archive_file
 from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
-from harness.archive.run_scenario import scenario_from_metadata
+from harness.archive.run_scenario import archived_scenario, scenario_from_metadata
 from harness.archive.span import ArchiveSpan
+from harness.destination import DestinationError, check_file
 from harness.summary import ReplayResults
 from harness.summary.delay_bound import NisSeries
 from harness.summary.fdir import archived_nis, fdir_results
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
+from interfaces.contracts.errors import describe, did_you_mean
 from interfaces.contracts.messages import (
     BaselineVerdict,
     ConstellationWindow,
@@ -208,6 +223,10 @@ def with_settings(scenario: Scenario, settings: dict[str, str]) -> Scenario:
     """``scenario`` with ``section.key = value`` settings (values parsed as JSON where they
     are, else kept as text); only detector settings (``SETTABLE``).  Raises ScenarioError."""
     for name in settings:
+        section = name.partition(".")[0]
+        if section not in Scenario.model_fields:
+            raise ScenarioError(f"--set {name}: the scenario has no [{section}]"
+                                f"{did_you_mean(section, Scenario.model_fields)}")
         if not name.startswith(SETTABLE[0]) and name not in SETTABLE[1:]:
             raise ScenarioError(f"--set {name}: a replay re-runs the ground's detector only "
                                 f"(fdir.*, rates.fdi_period_s); {name} changes what was flown, "
@@ -222,15 +241,22 @@ def scenario_with(scenario: Scenario, settings: dict[str, str]) -> Scenario:
     for name, text in settings.items():
         section, _, key = name.partition(".")
         if not isinstance(data.get(section), dict) or key not in data[section]:
-            raise ScenarioError(f"--set {name}: no such setting in [{section}]")
-        try:
-            data[section][key] = json.loads(text)
-        except json.JSONDecodeError:
-            data[section][key] = text
+            known = data[section] if isinstance(data.get(section), dict) else data
+            raise ScenarioError(f"--set {name}: no such setting in [{section}]"
+                                f"{did_you_mean(key if section in data else section, known)}")
+        data[section][key] = _value(text)
     try:
         return Scenario.model_validate(data)
-    except ValueError as e:
-        raise ScenarioError(f"--set: {e}") from e
+    except ValidationError as e:
+        raise ScenarioError(describe(e, "--set", Scenario, data)) from None
+
+
+def _value(text: str) -> Any:
+    """A ``--set`` value: JSON where it is (a number, true, a list...), else the text."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError:
+        return text
 
 
 # --- the replay ---------------------------------------------------------------------------------
@@ -318,37 +344,74 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--set", dest="settings", action="append", default=[],
                    metavar="fdir.KEY=VALUE", help="a detector setting (repeatable)")
     p.add_argument("--out", type=Path, default=None,
-                   help="directory for <run>.replay.json (default: beside each archive)")
+                   help="directory for <run>.replay[-SETTINGS].json (default: beside each "
+                        "archive, replay[-SETTINGS].json)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace a replay already written with the same settings")
     args = p.parse_args(argv)
     logging.basicConfig(level=logging.ERROR)
     try:
         settings = parse_settings(args.settings)
-    except ScenarioError as e:
-        p.error(str(e))
-    try:
         files = [archive_file(run) for run in args.runs]
-    except ArchivePathError as e:
+        dests = [_checked(run, file, args.out, settings, args.overwrite)
+                 for run, file in zip(args.runs, files, strict=True)]
+    except (ArchiveError, ScenarioError, DestinationError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     failed = 0
-    for run, file in zip(args.runs, files, strict=True):
+    for run, file, dest in zip(args.runs, files, dests, strict=True):
         try:
             replay = replay_run(file, settings)
+            _write(replay, run, dest)
         except (ArchiveError, ScenarioError, OSError) as e:
             print(f"{run}: {e}", file=sys.stderr)
             failed += 1
-            continue
-        _write(replay, run, file, args.out)
     return 1 if failed else 0
 
 
-def _write(replay: Replay, run: Path, file: Path, out: Path | None) -> None:
-    """Write the replay's results beside ``file`` (the archive of ``run``, as given) or into
-    ``out``, and say what it found in one line."""
+def output_name(values: dict[str, Any]) -> str:
+    """The replay's file name for settings set to ``values`` (as the scenario holds them, so
+    that ``3``, ``3.0`` and ``3.00`` name one file): ``replay`` with none (the run's own), else
+    ``replay-`` and the settings, sorted, as ``KEY=VALUE`` (the value as JSON writes it)
+    joined by ``+``, each character a file name should not hold as ``_``; a name over 120
+    characters cut, with a digest of the whole."""
+    if not values:
+        return "replay"
+    text = "+".join(f"{k}={json.dumps(v)}".replace('"', "") for k, v in sorted(values.items()))
+    safe = re.sub(r"[^A-Za-z0-9._=+,-]", "_", text)
+    if len(safe) > 120:
+        safe = f"{safe[:100]}-{hashlib.sha256(text.encode()).hexdigest()[:12]}"
+    return f"replay-{safe}"
+
+
+def output_path(run: Path, file: Path, out: Path | None, values: dict[str, Any]) -> Path:
+    """Where the replay of ``run`` (its archive ``file``) with settings at ``values`` is
+    written: ``<name>.json`` beside the archive, or ``<run>.<name>.json`` in ``out``."""
+    name = output_name(values)
+    if out is None:
+        return file.parent / f"{name}.json"
+    return out / f"{(run if run.is_dir() else run.parent).name or 'run'}.{name}.json"
+
+
+def _checked(run: Path, file: Path, out: Path | None, settings: dict[str, str],
+             overwrite: bool) -> Path:
+    """Before any replay: the run's scenario takes ``settings``, and its replay's file can be
+    written and replaces none unless ``overwrite``; where it goes.  ScenarioError,
+    ArchiveError, DestinationError."""
+    try:
+        scenario = with_settings(archived_scenario(file), settings)
+    except ScenarioError as e:
+        raise ScenarioError(f"{run}: {e}") from None
+    values = {name: getattr(getattr(scenario, name.partition(".")[0]), name.partition(".")[2])
+              for name in settings}
+    dest = output_path(run, file, out, values)
+    check_file(dest, overwrite, "--out DIR" if out is None else "another --out")
+    return dest
+
+
+def _write(replay: Replay, run: Path, dest: Path) -> None:
+    """Write the replay's results to ``dest`` and say what it found in one line."""
     res = replay.results()
-    name = (run if run.is_dir() else run.parent).name or "run"
-    dest = (out / f"{name}.replay.json") if out else file.parent / "replay.json"
-    dest.parent.mkdir(parents=True, exist_ok=True)
     dest.write_text(res.to_json(indent=1))
     dets = ", ".join(f"sc{d.spacecraft} {d.fault_class or 'unidentified'} at {d.time_s:.0f} s"
                      + ("" if d.faithful else " (after divergence)")

@@ -2,7 +2,7 @@
 
     python -m harness.archive list RUN [RUN2 ...]
     python -m harness.archive summary RUN
-    python -m harness.archive export RUN --topic KEY_EXPR [--out FILE.csv|FILE.parquet]
+    python -m harness.archive export RUN --topic KEY_EXPR [--out FILE.csv|.parquet] [--overwrite]
 
 RUN is a run folder (holding ``run.mcap``) or an archive file; anything else (a missing path, a
 folder without ``run.mcap``, a file that is not MCAP) is refused with one line saying so, exit
@@ -15,7 +15,10 @@ a key expression (``*`` one chunk, ``**`` any number) as CSV, one row per messag
 fields flattened (``r_m.0``, ``P.2.3``), to ``--out`` or stdout; an ``--out`` ending in
 ``.parquet`` (or ``.pq``) gets instead the topic's DataFrame (harness/archive/frame.py: indexed
 by sim time ``t_sim_s``, lists of varying length kept whole) as Parquet, which
-``pandas.read_parquet`` reads back as it was.  A damaged archive is read up to its last
+``pandas.read_parquet`` reads back as it was.  Refused before any work, one line and exit
+status 2: an ``--out`` of another suffix (the suffix chooses the format), an ``--out`` that
+exists (unless ``--overwrite``) or cannot be written; and, either format, a key expression
+that matches nothing (nothing is written).  A damaged archive is read up to its last
 complete chunk (harness/archive/reader.py) and said so: where the file was cut and the sim time
 its data ends at.  ``RUN.mcap`` is a run's first segment:
 the segments after it (``run-1.mcap``, ...: a restarted recorder's) are read with it as one
@@ -37,10 +40,13 @@ from harness.archive.locate import ArchivePathError, archive_file
 from harness.archive.reader import ArchiveError, RunArchive, load_run
 from harness.archive.sequences import by_topic
 from harness.archive.span import cut_of, seconds
+from harness.destination import DestinationError, check_file
 from interfaces.runtime.arguments import prog_name
 
 PARQUET_SUFFIXES = (".parquet", ".pq")
 """``export --out`` file suffixes that choose Parquet over CSV."""
+EXPORT_SUFFIXES = (".csv", *PARQUET_SUFFIXES)
+"""Every ``export --out`` file suffix (any case)."""
 
 
 def flatten(value: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
@@ -126,12 +132,28 @@ def export_csv(archive: RunArchive, key_expr: str, out: TextIO) -> int:
     return len(rows)
 
 
+def check_export_out(out: Path | None, overwrite: bool) -> None:
+    """Refuse an ``export --out`` with an unknown suffix, that exists (unless ``overwrite``)
+    or cannot be written: DestinationError, one line."""
+    if out is None:
+        return
+    if out.suffix.lower() not in EXPORT_SUFFIXES:
+        raise DestinationError(f"--out {out}: the suffix chooses the format: one of "
+                               f"{', '.join(EXPORT_SUFFIXES)}")
+    check_file(out, overwrite, "another --out")
+
+
 def export(run: Path, key_expr: str, out: Path | None) -> tuple[int, str | None]:
     """Export the messages of ``key_expr``: Parquet if ``out`` has a Parquet suffix, else CSV
-    to ``out`` or stdout; returns the number of rows (a Parquet export of nothing raises) and,
-    for an archive cut short, where it was cut (``span.cut_of``: the export ends there)."""
+    to ``out`` or stdout; returns the number of rows and, for an archive cut short, where it
+    was cut (``span.cut_of``: the export ends there).  ArchiveError, writing nothing, when no
+    key matches."""
     archive = load_run(run)
     cut = cut_of(archive)
+    if not archive.records(key_expr):
+        raise ArchiveError(f"{archive.path}: no key matches {key_expr!r} ("
+                           f"{len(archive.topics())} keys; `python -m harness.archive list "
+                           f"{archive.path}` shows them)")
     if out is not None and out.suffix.lower() in PARQUET_SUFFIXES:
         frame = topic_frame(archive, key_expr)
         frame.to_parquet(out)
@@ -155,11 +177,14 @@ def main(argv: list[str] | None = None) -> int:
     e.add_argument("run", type=Path, help=run_help)
     e.add_argument("--topic", required=True, help="key expression, e.g. 'insp/*/sc/1/nav/**'")
     e.add_argument("--out", type=Path,
-                   help="CSV file (default: stdout), or Parquet if it ends in .parquet or .pq")
+                   help="a .csv file (default: CSV to stdout), or Parquet for .parquet or .pq")
+    e.add_argument("--overwrite", action="store_true", help="replace an --out that exists")
     args = p.parse_args(argv)
     try:
         runs = [archive_file(r) for r in (args.runs if args.command == "list" else [args.run])]
-    except ArchivePathError as err:
+        if args.command == "export":
+            check_export_out(args.out, args.overwrite)
+    except (ArchivePathError, DestinationError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
     try:
@@ -174,9 +199,6 @@ def main(argv: list[str] | None = None) -> int:
             if cut is not None:
                 print(f"warning: the archive is truncated ({cut}): the export ends where it "
                       "does", file=sys.stderr)
-            if n == 0:
-                print(f"warning: no message matches {args.topic!r}; `list` shows the keys",
-                      file=sys.stderr)
     except BrokenPipeError:  # e.g. piped into `head`
         return 0
     except (ArchiveError, OSError, ValueError) as err:

@@ -131,8 +131,8 @@ def test_command_line_writes_the_replay_and_refuses_an_archive_without_scenario(
     bare = tmp_path / "bare.mcap"
     with McapRecorder(bare, {}):
         pass
-    assert main([str(bare)]) == 1
-    assert "no scenario" in capsys.readouterr().err
+    assert main([str(bare)]) == 2  # refused before any replay, in one line
+    assert capsys.readouterr().err == f"error: {bare}: no scenario in the archive's metadata\n"
     with pytest.raises(ArchiveError, match="no scenario"):
         replay_run(bare)
     with pytest.raises(ArchiveError, match="no scenario"):

@@ -40,5 +40,5 @@ def test_an_export_of_a_cut_archive_warns_where_it_ends(
     rows = list(csv.DictReader(open(out)))
     assert 0 < len(rows) < 200 and f"{len(rows)} messages exported" in err
     assert "warning: the archive is truncated (cut.mcap read up to byte" in err
-    assert main(["export", str(path), "--topic", key, "--out", str(out)]) == 0
+    assert main(["export", str(path), "--topic", key, "--out", str(out), "--overwrite"]) == 0
     assert "truncated" not in capsys.readouterr().err
