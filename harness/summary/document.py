@@ -28,6 +28,7 @@ from harness.summary.records import SummaryRecord, filled_fields
 from harness.summary.recovery import RecoveryComparison
 from harness.summary.scoring import Scores
 from harness.summary.series import FdirSeries
+from interfaces.contracts.errors import describe
 from interfaces.contracts.messages import LinkCounter, TelemetryStatus
 from interfaces.contracts.scenario import Fault
 
@@ -116,4 +117,4 @@ class RunSummary(SummaryRecord):
         try:
             return cls.model_validate_json(path.read_bytes())
         except ValidationError as e:
-            raise SummaryError(f"{path}: not a valid summary.json: {e}") from e
+            raise SummaryError(describe(e, f"{path}: not a valid summary.json", cls)) from None

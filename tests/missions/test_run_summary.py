@@ -142,7 +142,8 @@ def test_reading_a_malformed_file_names_the_file(run: tuple[Path, RunSummary],
     path, _ = run
     bad = tmp_path / "summary.json"
     bad.write_text(path.read_text().replace('"seed": 3', '"seed": "three"'))
-    with pytest.raises(SummaryError, match=rf"{bad}: not a valid summary\.json: .*\nseed\n"):
+    with pytest.raises(SummaryError, match=rf"^{bad}: not a valid summary\.json: seed = 'three': "
+                                           r"should be a valid integer"):
         RunSummary.read(bad)
 
 
