@@ -48,7 +48,7 @@ def run_inproc(
     runs on one thread from then on (``interfaces.runtime.blas_threads``), and it holds the
     compiled kernels, loaded before the clock starts (``interfaces.runtime.kernels``)."""
     one_blas_thread()
-    compile_kernels()
+    compile_kernels(logging.getLogger("insp.kernels").info)
     mission = mission or scenario.name
     net = InprocNetwork()
     if tap is not None:

@@ -63,6 +63,11 @@ class Kernel:
             raise TypeError(f"{self.label} is not a compiled kernel")
         return found
 
+    def loaded(self) -> bool:
+        """Whether this process holds the machine code of every signature."""
+        disp = self.dispatcher()
+        return all(tuple(sig) in disp.overloads for sig in self.signatures)
+
     def missing(self) -> list[Signature]:
         """The signatures the on-disk cache holds no current machine code for."""
         disp = self.dispatcher()
@@ -111,7 +116,7 @@ def compile_kernels(progress: Callable[[str], None] | None = None,
     returns the time it took (s, wall).  ``progress``, when given and something is to be
     compiled, is told so first, then every ``every_s`` (s) how far it is, then the time."""
     started = time.perf_counter()
-    todo = [k for k in kernels if k.missing()]
+    todo = [k for k in kernels if not k.loaded() and k.missing()]
     tell = progress if todo and progress is not None else _silent
     tell(f"compiling {len(todo)} of the {len(kernels)} numba kernels into the cache (first "
          f"run only, about {COMPILE_S_EACH * len(todo):.0f} s on two cores)...")
