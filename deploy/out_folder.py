@@ -4,11 +4,13 @@ A folder that holds anything is refused unless the user says ``--overwrite``, wh
 wholly first, so two runs never mix in one folder; and ``--overwrite`` removes only a run's
 folder (one holding a run's files), never another folder given by mistake.  The default name,
 ``runs/<scenario>-<time>``, is made unique with a counter.  Errors name the folder and what is
-in it (``OutFolderError``), for the command to print with exit 2.
+in it (``OutFolderError``), for the command to print with exit 2; so does a folder that cannot
+be written (a read-only disk), before any work.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
@@ -53,7 +55,22 @@ def prepare(out: Path | None, default: Path, overwrite: bool,
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise OutFolderError(f"--out {out}: cannot make the folder: {e.strerror or e}") from None
+    writable(out)
     return out
+
+
+def writable(folder: Path, option: str = "--out") -> Path:
+    """``folder`` if a file can be written in it (a probe written and removed), else
+    OutFolderError naming ``option``: checked before any work, so a read-only destination
+    never costs a run or a replay its results."""
+    probe = folder / f".write-probe-{os.getpid()}"
+    try:
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as e:
+        raise OutFolderError(f"{option} {folder}: cannot write there ({e.strerror or e})"
+                             ) from None
+    return folder
 
 
 def written(out: Path, layout: Path, report: bool) -> list[Path]:

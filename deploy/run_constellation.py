@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import subprocess
 import sys
 import threading
@@ -44,7 +45,7 @@ import time
 from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 import zenoh
 
@@ -53,6 +54,7 @@ if str(REPO) not in sys.path:  # run as a script from a checkout
     sys.path.insert(0, str(REPO))
 
 from deploy.access import RunAccess, write_run_access  # noqa: E402
+from deploy.disk_space import DiskSpaceError, Reserve, check_space, disk_full_logged  # noqa: E402
 from deploy.host_map import HostMap, HostMapError, load_host_map, parse_link_event  # noqa: E402
 from deploy.interrupts import Interrupts  # noqa: E402
 from deploy.link_events import LinkEvents, check_cuts  # noqa: E402
@@ -64,7 +66,7 @@ from deploy.rehearsal.netns import RehearsalError, require_privilege  # noqa: E4
 from deploy.rehearsal.network import RehearsedNetwork  # noqa: E402
 from deploy.router import address_taken  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
-from ground.archive.recorder_process import RecorderProcess  # noqa: E402
+from ground.archive.recorder_process import RecorderDied, RecorderProcess  # noqa: E402
 from ground.archive.segments import remove_segments, run_archive  # noqa: E402
 from harness.archive.reader import ArchiveError  # noqa: E402
 from harness.foxglove_layout import write_layout  # noqa: E402
@@ -96,6 +98,7 @@ DEFAULT_SCENARIO = REPO / "deploy" / "scenarios" / "default.toml"
 INTERRUPTED = "interrupted by the user (SIGINT or SIGTERM)"
 """The error of a run stopped by a signal before its sim finished (status ``interrupted``)."""
 log = logging.getLogger("insp.launcher")
+T = TypeVar("T")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
@@ -164,6 +167,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     p.add_argument("--mission", type=mission_name,
                    help="key-space name: letters, digits, '_' or '-' (default: scenario name)")
     p.add_argument("--no-report", action="store_true", help="skip report.md and plots")
+    p.add_argument("--skip-disk-check", action="store_true",
+                   help="start even when --out's disk looks too small for the run's estimated "
+                        "archive (the run then ends 'failed: disk full' where the disk fills)")
     p.add_argument("--live", type=int, metavar="PORT", default=0,
                    help="stream the run to Foxglove on ws://127.0.0.1:PORT (off by default)")
     p.add_argument("--compare-recovery", action="store_true",
@@ -215,6 +221,21 @@ def main(argv: list[str] | None = None) -> int:
     except OutFolderError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    if host_map is not None and not args.rehearse:
+        return _print_hosts(scenario, args.mission or scenario.name, out, args, host_map)
+    try:
+        if not args.skip_disk_check:
+            check_space(out, scenario)
+    except DiskSpaceError as e:
+        print(f"error: {e.strerror}", file=sys.stderr)
+        return 2
+    with Reserve(out) as reserve:
+        return _fly(scenario, out, args, host_map, reserve)
+
+
+def _fly(scenario: Scenario, out: Path, args: argparse.Namespace, host_map: HostMap | None,
+         reserve: Reserve) -> int:
+    """Fly the run into ``out`` and write it (``reserve`` released first): its exit status."""
     mission = args.mission or scenario.name
     scenario_text = args.scenario.read_text(encoding="utf-8")
     wall0 = time.monotonic()
@@ -226,33 +247,67 @@ def main(argv: list[str] | None = None) -> int:
         if args.transport == "inproc":
             status, error, digest = _run_inproc(scenario, mission, out, scenario_text, args,
                                                 stop)
-        elif host_map is not None and not args.rehearse:
-            return _print_hosts(scenario, mission, out, args, host_map)
         else:
             status, error = _run_zenoh(scenario, mission, out, args, stop, host_map)
-    wall_s = time.monotonic() - wall0
+        if status == "interrupted" and caught.signum is not None:
+            error = f"interrupted by {signal.Signals(caught.signum).name}"
+        reserve.release()
+        summary, layout = _write_run(scenario, mission, out, args, time.monotonic() - wall0,
+                                     (status, error), digest)
+    print(_closing_line(summary, scenario, args)
+          + "".join(f"\n  {p}" for p in written(out, layout, not args.no_report)))
+    if error:
+        print(f"error: {_first_line(error)}" + (" (the whole error: summary.json)"
+                                                   if "\n" in error.strip() else ""),
+              file=sys.stderr)
+    if summary.status == "interrupted":
+        return caught.exit_status or 130
+    return 0 if summary.status == "completed" else 1
+
+
+def _write_run(scenario: Scenario, mission: str, out: Path, args: argparse.Namespace,
+               wall_s: float, outcome: tuple[str, str | None], digest: RunDigest | None
+               ) -> tuple[RunSummary, Path | None]:
+    """The run's summary, layout, counterfactual and report, each written whatever the others
+    do: a file that cannot be written is named in the log, in one line, and the run goes on
+    to the next.  The summary and the layout's path (None: not written)."""
+    status, error = outcome
     digest = digest or _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
                             status=status, error=error, mission=mission, digest=digest,
                             access=_access_audit(out))
-    layout = write_layout(out, scenario, mission)
+    layout = _attempt("the Foxglove layout", lambda: write_layout(out, scenario, mission))
     if args.compare_recovery and status == "completed":
-        summary = _compare_recovery(scenario, mission, out, scenario_text, args, summary)
+        summary = _compare_recovery(scenario, mission, out, args.scenario.read_text(
+            encoding="utf-8"), args, summary)
     if not args.no_report:
-        write_report(out, scenario, mission, digest=digest)
+        _attempt("report.md", lambda: write_report(out, scenario, mission, digest=digest))
+    return summary, layout
+
+
+def _attempt(what: str, write: Callable[[], T]) -> T | None:
+    """``write()``, or None with one line in the log when the disk refuses it."""
+    try:
+        return write()
+    except OSError as e:
+        log.error("%s not written: %s", what, e.strerror or e)
+        return None
+
+
+def _first_line(text: str) -> str:
+    """The first line of an error (the rest, log tails, stays in summary.json)."""
+    return text.strip().splitlines()[0] if text.strip() else text
+
+
+def _closing_line(summary: RunSummary, scenario: Scenario, args: argparse.Namespace) -> str:
+    """The console's line on how the run went: status, how far, how fast."""
     rtf = summary.real_time_factor
-    reached = "" if status == "completed" else f"{summary.t_sim_final_s or 0.0:.0f} of "
-    print(f"{status}: {scenario.name} seed {scenario.seed}, "
-          f"{reached}{scenario.duration_s:.0f} s simulated in "
-          f"{wall_s:.1f} s wall" + (f" ({rtf:.0f}x real time" if rtf else "")
-          + (f", at most {args.realtime:g}x" if rtf and args.realtime else "")
-          + (")" if rtf else "")
-          + "".join(f"\n  {p}" for p in written(out, layout, not args.no_report)))
-    if error:
-        print(f"error: {error}", file=sys.stderr)
-    if status == "interrupted":
-        return caught.exit_status or 130
-    return 0 if status == "completed" else 1
+    reached = ("" if summary.status == "completed"
+               else f"{summary.t_sim_final_s or 0.0:.0f} of ")
+    speed = ((f" ({rtf:.0f}x real time" + (f", at most {args.realtime:g}x" if args.realtime
+                                            else "") + ")") if rtf else "")
+    return (f"{summary.status}: {scenario.name} seed {scenario.seed}, {reached}"
+            f"{scenario.duration_s:.0f} s simulated in {summary.wall_s or 0.0:.1f} s wall{speed}")
 
 
 def _host_map(args: argparse.Namespace, scenario: Scenario) -> HostMap | None:
@@ -315,10 +370,11 @@ def _read_archive(out: Path, scenario: Scenario, mission: str) -> RunDigest | No
 
 def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
                 args: argparse.Namespace, stop: threading.Event
-                ) -> tuple[str, str | None, RunDigest]:
+                ) -> tuple[str, str | None, RunDigest | None]:
     """Run in this process, recording into ``<out>/run.mcap`` (the recorder in a child
     process) and digesting the run for its summary as it goes; ``stop`` set stops it at the
-    next tick boundary (``interrupted``)."""
+    next tick boundary (``interrupted``).  A recorder that dies (a full disk: "disk full at
+    t = ... s") fails the run, whose summary is then read from the archive (no digest)."""
     from deploy.inproc import run_inproc
 
     if args.realtime:
@@ -327,19 +383,33 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
     metadata = run_metadata(scenario, "inproc", scenario_text)
     remove_segments(run_archive(out))  # an earlier run's in this directory: not this run's
     digest = LiveDigest(scenario, mission, out / "run.mcap", metadata)
-    with RecorderProcess(out / "run.mcap", metadata) as rec:
-        record = digest.tap(rec)
+    died: list[RecorderDied] = []
+    try:
+        with RecorderProcess(out / "run.mcap", metadata) as rec:
+            record = digest.tap(rec)
 
-        def tap(sample: Sample) -> None:
-            record(sample)
-            if live is not None:
-                live.forward(sample.key, sample.type_name, sample.payload)
+            def tap(sample: Sample) -> None:
+                if died:
+                    return
+                try:
+                    record(sample)
+                except RecorderDied as e:  # never into the publishing app: the run stops
+                    died.append(e)
+                    stop.set()
+                    return
+                if live is not None:
+                    live.forward(sample.key, sample.type_name, sample.payload)
 
-        try:
-            sim, _ = run_inproc(scenario, mission, sample_tap=tap, stop=stop)
-        finally:
-            if live is not None:
-                live.close()
+            try:
+                sim, _ = run_inproc(scenario, mission, sample_tap=tap, stop=stop)
+            finally:
+                if live is not None:
+                    live.close()
+    except RecorderDied as e:
+        died.append(e)
+    if died:  # the summary is read from what the archive holds
+        log.error("%s", died[0])
+        return "failed", str(died[0]), None
     if not sim.completed:
         return "interrupted", INTERRUPTED, digest.finish()
     return "completed", None, digest.finish()
@@ -366,7 +436,8 @@ def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text
     note = f"\n# counterfactual run: [fdir] recovery = {str(flipped.fdir.recovery).lower()}\n"
     digest: RunDigest | None = None
     try:
-        status, error, digest = _run_inproc(flipped, mission, other, scenario_text + note, args)
+        status, error, digest = _run_inproc(flipped, mission, other, scenario_text + note, args,
+                                            threading.Event())
     except Exception as e:  # noqa: BLE001 - the primary run's results must still be written
         log.exception("counterfactual run failed")
         status, error = "failed", f"{type(e).__name__}: {e}"
@@ -753,10 +824,14 @@ class _Watch:
                 (self.sup.named(RECORDER.name), self.recorder_up, _NO_RECORD)]
 
     def _stopped(self, child: Child, consequence: str) -> str:
-        """The error naming ``child``, how it stopped, when, and what follows."""
-        return (f"{child.name} (pid {child.proc.pid if child.proc else '?'}) "
+        """The error naming ``child``, how it stopped, when, and what follows; first, when its
+        log says so, that the disk is full."""
+        tail = child.log_tail()
+        full = (f"disk full at t ≈ {self.progress.t_sim:.1f} s: " if disk_full_logged(tail)
+                else "")
+        return (f"{full}{child.name} (pid {child.proc.pid if child.proc else '?'}) "
                 f"{child.describe_exit()} at sim t≈{self.progress.t_sim:.1f} s: "
-                f"{consequence}.\n--- last lines of {child.log_path}:\n{child.log_tail()}")
+                f"{consequence}.\n--- last lines of {child.log_path}:\n{tail}")
 
     def _services_stopped(self, sim_done: bool) -> str | None:
         """With ``restart``: start a dead router or recorder again, or the error if it cannot
@@ -773,7 +848,7 @@ class _Watch:
     def _service_restart(self, child: Child, up: Callable[[], int], consequence: str,
                          sim_done: bool) -> str | None:
         n = self.restarts.get(child.name, 0)
-        if sim_done or self._looping(child.name):
+        if sim_done or self._looping(child.name) or disk_full_logged(child.log_tail()):
             return self._stopped(child, consequence + (f" (restarted {n} times)" if n else ""))
         incident = Incident(child.name, child.describe_exit(), self.progress.t_sim, True)
         self.incidents.append(incident)

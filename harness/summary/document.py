@@ -107,8 +107,14 @@ class RunSummary(SummaryRecord):
         self.fdir_settings = fdir.fdir_settings
 
     def write(self, path: Path) -> None:
-        """Write the summary to ``path`` (indent 2, a final newline)."""
-        path.write_text(self.to_json() + "\n")
+        """Write the summary to ``path`` (indent 2, a final newline), whole or not at all: it
+        is written beside and renamed, so a full disk leaves no empty or cut summary."""
+        partial = path.with_name(f".{path.name}.partial")
+        try:
+            partial.write_text(self.to_json() + "\n")
+            partial.replace(path)
+        finally:
+            partial.unlink(missing_ok=True)
 
     @classmethod
     def read(cls, path: Path) -> RunSummary:

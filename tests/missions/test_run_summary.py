@@ -156,3 +156,16 @@ def test_threshold_censuses_add_up_field_by_field(run: tuple[Path, RunSummary]) 
     assert total.nominal_windows == 3 * c.nominal_windows
     assert total.threshold_by.model == 3 * c.threshold_by.model
     assert total.model_z.windows == 3 * c.model_z.windows
+
+
+def test_the_disk_estimate_bounds_the_archive_a_run_writes(run: tuple[Path, RunSummary]
+                                                           ) -> None:
+    """The launcher's disk check (deploy/disk_space.py) is an upper estimate of the archive,
+    and not a loose one: a run writes between half of it and all of it."""
+    from deploy.disk_space import estimate_archive_bytes
+
+    path, _ = run
+    sc = small_scenario("rs", duration_s=200.0, target={"pois": 500},
+                        rates={"fdi_period_s": 20.0})
+    written = (path.parent / "run.mcap").stat().st_size
+    assert 0.5 < written / estimate_archive_bytes(sc) <= 1.0
