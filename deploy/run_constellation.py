@@ -74,6 +74,7 @@ from harness.report import write_report  # noqa: E402
 from harness.summary import AccessAudit, RunSummary  # noqa: E402
 from harness.summary.build import add_recovery_comparison, write_summary  # noqa: E402
 from harness.summary.digest import LiveDigest, RunDigest, digest_run  # noqa: E402
+from harness.summary.verdict import verdict  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402
 from interfaces.contracts import topics  # noqa: E402
 from interfaces.contracts.messages import Heartbeat, SimStatus  # noqa: E402
@@ -255,7 +256,8 @@ def _fly(scenario: Scenario, out: Path, args: argparse.Namespace, host_map: Host
         summary, layout = _write_run(scenario, mission, out, args, time.monotonic() - wall0,
                                      (status, error), digest)
     print(_closing_line(summary, scenario, args)
-          + "".join(f"\n  {p}" for p in written(out, layout, not args.no_report)))
+          + "".join(f"\n  {p}" for p in written(out, layout, not args.no_report))
+          + f"\n{verdict(summary).line()}")
     if error:
         print(f"error: {_first_line(error)}" + (" (the whole error: summary.json)"
                                                    if "\n" in error.strip() else ""),
@@ -281,8 +283,19 @@ def _write_run(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         summary = _compare_recovery(scenario, mission, out, args.scenario.read_text(
             encoding="utf-8"), args, summary)
     if not args.no_report:
-        _attempt("report.md", lambda: write_report(out, scenario, mission, digest=digest))
+        _attempt("report.md", lambda: write_report(out, scenario, mission, digest=digest,
+                                                   settings=_launch_settings(args)))
     return summary, layout
+
+
+def _launch_settings(args: argparse.Namespace) -> dict[str, str]:
+    """What the run was launched with beyond the scenario, for the report."""
+    given = {"scenario file": str(args.scenario),
+             "--seed": args.seed, "--duration": args.duration, "--realtime": args.realtime,
+             "--hosts": args.hosts, "--hosting": None if args.transport == "inproc"
+             else args.hosting}
+    return {k: f"{v:g}" if isinstance(v, float) else str(v) for k, v in given.items()
+            if v is not None}
 
 
 def _attempt(what: str, write: Callable[[], T]) -> T | None:
