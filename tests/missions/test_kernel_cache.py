@@ -19,7 +19,7 @@ from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.scenario.model import parse_scenario
 from interfaces.runtime.kernels import unlisted_signatures
 
-REPO = Path(__file__).resolve().parents[3]
+REPO = Path(__file__).resolve().parents[2]
 
 _COLD = """
 import json
@@ -66,7 +66,6 @@ def test_kernels_compile_into_an_empty_cache_and_a_fresh_process_finds_them(
     assert _python(_WARM, tmp_path) == "True 0"
 
 
-@pytest.mark.mission
 def test_a_run_calls_the_kernels_with_the_listed_types_only(
         monkeypatch: pytest.MonkeyPatch) -> None:
     """The default scenario's first 200 s with two observers, in one process: truth, sensors,
