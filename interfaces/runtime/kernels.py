@@ -12,8 +12,9 @@ is called with.  :func:`kernels_cached` says whether the cache holds all of them
 their source; :func:`compile_kernels` compiles those missing into the cache and loads every
 one into the calling process.  The launcher calls it, with a message, before a run whose
 kernels are not cached; every process of a run calls it as it starts (then it only loads:
-well under a second), so no first call falls inside a tick.  ``tests/interfaces/runtime/
-test_kernels.py`` checks that a run calls the kernels with no other argument types.
+well under a second), so no first call falls inside a tick.
+``tests/missions/test_kernel_cache.py`` checks that a run calls the kernels with no other
+argument types.
 """
 
 from __future__ import annotations
