@@ -22,7 +22,7 @@ from deploy.draws import Record, Uniform
 from deploy.onsets import OnsetPhase, draw_onset
 from interfaces.contracts.errors import reason
 from interfaces.contracts.scenario import COMMON_MODE_KINDS, Fault, FaultKind, Scenario
-from interfaces.contracts.scenario.faults import NO_MAGNITUDE
+from interfaces.contracts.scenario.faults import MAGNITUDES, NO_MAGNITUDE
 
 
 class Strict(BaseModel):
@@ -96,8 +96,9 @@ class FaultSpec(Strict):
         kinds = self.kinds()
         for kind in kinds:
             for name in ("magnitude", "velocity_mps", "start_s", "end_s"):
+                trial = self._trial(kind) | ({"start_s": 0.0} if name == "start_s" else {})
                 for label, written, value in bounds(self._of(name, kind)):
-                    why = _refusal(self._trial(kind), name, written, value)
+                    why = _refusal(trial, name, written, value)
                     if why is not None:
                         of_kind = f" (kind {kind})" if len(kinds) > 1 else ""
                         raise ValueError(f"{name}{label} = {written:g}{of_kind}: {why}")
@@ -109,14 +110,19 @@ class FaultSpec(Strict):
         return value.per_kind.get(kind) if isinstance(value, PerKind) else value
 
     def _trial(self, kind: str) -> dict[str, Any]:
-        """A fault of ``kind`` with each field at the value nearest its largest written one
-        (no end), against which one field's values are tried."""
+        """A valid fault of ``kind``, against which one field's values are tried: every field
+        at a value of its own limits (the middle of the kind's magnitudes; a disturbance of
+        1 m and 0.01 m/s), but ``start_s`` at the latest written (an end is tried after it)."""
         trial: dict[str, Any] = {"spacecraft": 0 if kind in COMMON_MODE_KINDS else 1,
                                  "kind": kind, "start_s": 0.0}
-        for name in ("magnitude", "velocity_mps", "start_s"):
-            values = [v for _, _, v in bounds(self._of(name, kind))]
-            if values:
-                trial[name] = max(values)
+        limits = MAGNITUDES[kind]
+        if kind == "state_disturbance":
+            trial |= {"magnitude": 1.0, "velocity_mps": 0.01}
+        elif limits is not None:
+            trial["magnitude"] = (limits.low + limits.high) / 2.0
+        starts = [v for _, _, v in bounds(self.start_s)]
+        if starts:
+            trial["start_s"] = max(starts)
         disturbance = self.disturbance
         if disturbance is not None:
             trial["disturbance"] = disturbance[0] if isinstance(disturbance, list) \
