@@ -13,6 +13,11 @@ after each), is among it.  It declares its liveliness token (``topics.recorder_t
 subscribed, ready to record (the sim holds the clock until then).  When the network goes down
 (the sim's token gone: the router died) it takes the token back, and once the sim is seen again
 records what the nodes still keep of their last ticks before it declares it again.
+
+After each chunk it closes it tells every node the sim time of the last tick the archive now
+holds for good (``interfaces.runtime.recent.archived_key``): the nodes keep what they sent
+until then, so that a recorder killed at any moment, however late the sim holds the clock,
+finds in their replies everything it had not closed in a chunk.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
 from interfaces.contracts.topology import topology
 from interfaces.runtime.cli import add_node_args, open_zenoh, start_node
-from interfaces.runtime.recent import fetch
+from interfaces.runtime.recent import archived_key, fetch
 from interfaces.runtime.zenoh_transport import ZenohTransport
 
 
@@ -56,20 +61,21 @@ def main(argv: list[str] | None = None) -> int:
             gate.hold()
         transport.subscribe(topics.mission_wildcard(mission), gate.record)
         if segment:
-            gate.release(_recent(transport, mission, nodes, log))
+            gate.release(_recent(transport, mission, nodes, log, start.stop))
         presence = _Presence(transport, topics.recorder_token(mission), gate)
         transport.watch_alive(topics.alive_token(mission, topics.SIM), presence.on_sim)
         log.info("recording %s to %s", topics.mission_wildcard(mission), path)
-        flushed = time.monotonic()
+        flushed, told = time.monotonic(), -1
         while not start.stop.wait(0.1):
             if presence.sim_back.is_set():  # the network is back (the router restarted)
                 presence.sim_back.clear()
                 holds = gate.holds
-                gate.release(_recent(transport, mission, nodes, log), ending=holds)
+                gate.release(_recent(transport, mission, nodes, log, start.stop), ending=holds)
                 presence.announce()
             if time.monotonic() - flushed > 2.0:
-                rec.flush()  # and at least every 2 s of wall time
+                gate.flush()  # and at least every 2 s of wall time
                 flushed = time.monotonic()
+            told = _tell_archived(transport, mission, nodes, gate.archived_ns, told)
     finally:
         transport.close()  # no callback can write after this
         gate.release([])
@@ -96,6 +102,9 @@ class _Gate:
         """Per key, the (sim time ns, number) of the last sample written."""
         self._ticks = 0
         self._holds = 0
+        self.archived_ns = -1
+        """The sim time of the last tick written before the last chunk closed, ns (-1: none):
+        the archive holds for good every message received before it."""
 
     def record(self, key: str, type_name: str, payload: bytes) -> None:
         """Transport callback: one live sample."""
@@ -133,13 +142,22 @@ class _Gate:
                     written += 1
             return written
 
+    def flush(self) -> None:
+        """Close the chunk in progress (``archived_ns`` follows)."""
+        with self._lock:
+            self._flush()
+
+    def _flush(self) -> None:
+        self._rec.flush()
+        self.archived_ns = self._last.get(self._tick_key, (-1, -1))[0]
+
     def _write(self, pending: Pending) -> None:
         self._rec.take(pending)
         self._last[_key(pending)] = _place(pending)
         if _key(pending) == self._tick_key:
             self._ticks += 1
             if self._ticks % self._every == 0:
-                self._rec.flush()
+                self._flush()
 
 
 def _key(pending: Pending) -> str:
@@ -190,15 +208,48 @@ class _Presence:
                 self.sim_back.set()
 
 
-def _recent(transport: ZenohTransport, mission: str, nodes: list[str],
-            log: logging.Logger) -> list[Pending]:
-    """What ``nodes`` sent in their last ticks, ready to write (their own keys only)."""
+def _tell_archived(transport: ZenohTransport, mission: str, nodes: list[str], archived_ns: int,
+                   told_ns: int) -> int:
+    """Tell every one of ``nodes`` that the archive holds every tick up to ``archived_ns`` (sim
+    time, ns), if that is news (``told_ns`` was said last); returns what is said now."""
+    if archived_ns > told_ns:
+        for node in nodes:
+            transport.notify(archived_key(mission, node, archived_ns))
+    return max(archived_ns, told_ns)
+
+
+FETCH_TIMEOUT_S = 10.0
+"""How long a node's reply to what it kept is waited for (s, wall; the sim holds the clock
+meanwhile): a node of a loaded host may be slow to answer."""
+ASK_AGAIN_FOR_S = 30.0
+"""How long a node that does not answer (not back on the network yet: the router restarted,
+or the node itself) is asked again, every half second (s, wall; the sim holds the clock for
+the recorder, and for every participant lost)."""
+
+
+def _recent(transport: ZenohTransport, mission: str, nodes: list[str], log: logging.Logger,
+            stop: threading.Event) -> list[Pending]:
+    """What ``nodes`` sent in their last ticks, and what they kept since the last tick archived,
+    ready to write (their own keys only); each node is asked until it answers, up to
+    ``ASK_AGAIN_FOR_S`` (or ``stop``)."""
     out: list[Pending] = []
-    for node in nodes:
-        samples, malformed = fetch(transport, mission, node)
-        for why in malformed:
-            log.warning("%s answered what it sent lately with a malformed reply: %s", node, why)
-        out += [prepare_raw(s.key, s.type_name, s.payload) for s in samples]
+    waiting = list(nodes)
+    deadline = time.monotonic() + ASK_AGAIN_FOR_S
+    while True:
+        for node in list(waiting):
+            got = fetch(transport, mission, node, FETCH_TIMEOUT_S)
+            for why in got.malformed:
+                log.warning("%s answered what it sent lately with a malformed reply: %s", node,
+                            why)
+            if got.answered:
+                waiting.remove(node)
+                out += [prepare_raw(s.key, s.type_name, s.payload) for s in got.samples]
+        if not waiting or time.monotonic() > deadline or stop.wait(0.5):
+            break
+    if waiting:
+        log.error("%s never answered what they kept within %.0f s: what they sent while the "
+                  "recorder could not hear them is counted lost", ", ".join(waiting),
+                  ASK_AGAIN_FOR_S)
     log.warning("took %d messages the nodes kept of their last ticks", len(out))
     return out
 

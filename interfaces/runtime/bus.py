@@ -27,6 +27,8 @@ What the Bus guarantees, identically on every transport:
 * **Barrier.** ``wait_for(expect)`` blocks until the messages announced in a Tick have arrived.
 * **Recovery.** Each node keeps what it sent in its last ticks and sends it again to a node that
   asks (``interfaces.runtime.recent``): ``recover`` fetches what a tick announced and never came.
+  With a recorder, it keeps too what the recorder has not yet archived for good, so that a
+  recorder restarted takes back what it lost (bounded; what is forgotten is counted lost).
 
 The Bus's parts of their own: the subscription table (``interfaces.runtime.subscriptions``), the
 inbox of deferred messages with the delivery order and the barrier (``interfaces.runtime.inbox``),
@@ -50,7 +52,7 @@ from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
 from interfaces.runtime.inbox import Envelope, Inbox
 from interfaces.runtime.link_stage import LinkStage
-from interfaces.runtime.recent import RECENT_TICKS, RecentSent
+from interfaces.runtime.recent import RECENT_TICKS, RecentSent, archived_queryable
 from interfaces.runtime.schemas import serve_schemas
 from interfaces.runtime.subscriptions import Route, Sub, SubscriptionTable
 from interfaces.runtime.transport import LivenessHandler, RawHandler, Sample, Transport
@@ -141,7 +143,12 @@ class Bus:
     def published_since_last(self) -> dict[str, int]:
         """Keys published since the previous call, with their last sequence number."""
         out, self._published_since = self._published_since, {}
+        forgotten = self.recent.forgotten
         self.recent.next_tick()
+        if self.recent.forgotten != forgotten:
+            self.log.warning("%s forgot %d message(s) the recorder has not archived (%d so "
+                             "far): they will be counted lost", self.node,
+                             self.recent.forgotten - forgotten, self.recent.forgotten)
         return out
 
     # --- subscribing -----------------------------------------------------------------------
@@ -403,8 +410,12 @@ class Bus:
         self.transport.send(Sample(key, type(msg).__name__, message=msg))
 
     def serve_recent(self) -> None:
-        """Answer ``<prefix>/bus/recent`` with what this node sent in its last ticks."""
+        """Answer ``<prefix>/bus/recent`` with what this node sent in its last ticks, and keep
+        from now on also what the run's recorder has not archived, until it says it has
+        (``<prefix>/bus/archived/<t_ns>``: ``interfaces.runtime.recent``)."""
+        self.recent.keep_until_archived()
         self.transport.serve(topics.recent_queryable(self.mission, self.node), self.recent.reply)
+        self.transport.serve(archived_queryable(self.mission, self.node), self.recent.archived)
 
     def serve_schemas(self) -> None:
         """Answer ``<prefix>/schema/<Type>`` queries with the message type's JSON schema

@@ -92,6 +92,9 @@ class Transport(Protocol):
 
     def query(self, selector: str, timeout_s: float = 2.0) -> list[tuple[str, bytes]]: ...
 
+    def notify(self, selector: str) -> None:
+        """A query whose replies nobody waits for: a notice to the queryables it reaches."""
+
     def declare_alive(self, node: str, token_key: str) -> None: ...
 
     def watch_alive(self, key_expr: str, handler: LivenessHandler) -> None: ...
@@ -193,6 +196,9 @@ class InprocTransport:
 
     def query(self, selector: str, timeout_s: float = 2.0) -> list[tuple[str, bytes]]:
         return self.network._query(selector)
+
+    def notify(self, selector: str) -> None:
+        self.network._query(selector)
 
     def declare_alive(self, node: str, token_key: str) -> None:
         self.alive.append(node)

@@ -155,6 +155,11 @@ class ZenohTransport:
                 out.append((str(reply.ok.key_expr), reply.ok.payload.to_bytes()))
         return out
 
+    def notify(self, selector: str) -> None:
+        """Send a query whose replies nobody waits for (a notice to the queryables it
+        reaches); returns at once."""
+        self._session.get(selector, _ignore_reply)
+
     def declare_alive(self, node: str, token_key: str) -> None:
         self._entities.append(self._session.liveliness().declare_token(token_key))
 
@@ -226,6 +231,10 @@ class SharedReceiver:
                 except Exception:  # noqa: BLE001 - one node's failure is not the others'
                     logging.getLogger(f"insp.bus.{node}").exception(
                         "%s: taking in a sample on %s failed", node, key)
+
+
+def _ignore_reply(_reply: zenoh.Reply) -> None:
+    """The handler of a notice's replies (``ZenohTransport.notify``): none is needed."""
 
 
 def _node_from_token(token_key: str) -> str | None:

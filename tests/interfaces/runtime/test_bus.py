@@ -11,7 +11,7 @@ import pytest
 from interfaces.contracts import topics
 from interfaces.contracts.messages import Heartbeat, StateEstimate, json_schema
 from interfaces.runtime.bus import Bus
-from interfaces.runtime.recent import fetch_recent, recover
+from interfaces.runtime.recent import archived_key, fetch_recent, recover
 from interfaces.runtime.transport import InprocNetwork
 from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
 from tests.conftest import settle
@@ -151,11 +151,15 @@ def test_a_message_seen_before_is_a_duplicate_and_a_fresh_start_counts_from_one(
 def test_what_a_node_missed_is_sent_again_on_request(pair) -> None:  # noqa: ANN001
     """A node that subscribed late (as one restarted while the others ran on) asks the
     publisher for what it sent in its last ticks and takes it in; what it holds already is a
-    duplicate; older ticks than the publisher keeps are gone."""
+    duplicate; older ticks than the publisher keeps are gone, once the run's recorder said
+    it archived them (until then they are kept for it: test_recent.py)."""
     bus_a, bus_b, raw = pair
     key = topics.key(M, "sc1", "exec", "heartbeat")
     bus_a.recent.keep(2)
     bus_a.serve_recent()
+    time.sleep(0.3)  # its queryables known on the network
+    raw.notify(archived_key(M, "sc1", 10_000_000_000))  # the recorder archived up to 10 s
+    time.sleep(0.3)
     for t in (1.0, 2.0, 3.0):  # three ticks; sc1 keeps the last two
         bus_a.publish(key, _hb(t))
         bus_a.published_since_last()
