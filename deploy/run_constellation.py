@@ -62,6 +62,7 @@ from deploy.out_folder import OutFolderError, written  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
 from deploy.placement import Placement, across_hosts, one_host  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor, host_cores  # noqa: E402
+from deploy.recorder_guard import RecorderGuard  # noqa: E402
 from deploy.rehearsal.netns import RehearsalError, require_privilege  # noqa: E402
 from deploy.rehearsal.network import RehearsedNetwork  # noqa: E402
 from deploy.router import address_taken  # noqa: E402
@@ -396,20 +397,12 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
     metadata = run_metadata(scenario, "inproc", scenario_text)
     remove_segments(run_archive(out))  # an earlier run's in this directory: not this run's
     digest = LiveDigest(scenario, mission, out / "run.mcap", metadata)
-    died: list[RecorderDied] = []
     try:
         with RecorderProcess(out / "run.mcap", metadata) as rec:
-            record = digest.tap(rec)
+            guard = RecorderGuard(digest.tap(rec), stop)
 
             def tap(sample: Sample) -> None:
-                if died:
-                    return
-                try:
-                    record(sample)
-                except RecorderDied as e:  # never into the publishing app: the run stops
-                    died.append(e)
-                    stop.set()
-                    return
+                guard(sample)
                 if live is not None:
                     live.forward(sample.key, sample.type_name, sample.payload)
 
@@ -418,11 +411,11 @@ def _run_inproc(scenario: Scenario, mission: str, out: Path, scenario_text: str,
             finally:
                 if live is not None:
                     live.close()
-    except RecorderDied as e:
-        died.append(e)
-    if died:  # the summary is read from what the archive holds
-        log.error("%s", died[0])
-        return "failed", str(died[0]), None
+    except RecorderDied as e:  # at the close: the archive's end was not written
+        guard.error = guard.error or e
+    if guard.cause is not None:  # the summary is read from what the archive holds
+        log.error("%s", guard.cause)
+        return "failed", guard.cause, None
     if not sim.completed:
         return "interrupted", INTERRUPTED, digest.finish()
     return "completed", None, digest.finish()
