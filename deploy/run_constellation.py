@@ -62,6 +62,7 @@ from deploy.out_folder import OutFolderError, written  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
 from deploy.placement import Placement, across_hosts, one_host  # noqa: E402
 from deploy.processes import Child, Incident, Supervisor, host_cores  # noqa: E402
+from deploy.progress_line import progress_line  # noqa: E402
 from deploy.recorder_guard import RecorderGuard  # noqa: E402
 from deploy.rehearsal.netns import RehearsalError, require_privilege  # noqa: E402
 from deploy.rehearsal.network import RehearsedNetwork  # noqa: E402
@@ -89,6 +90,7 @@ from interfaces.contracts.topology import (  # noqa: E402
 )
 from interfaces.runtime.arguments import add_log_level, endpoint, mission_name  # noqa: E402
 from interfaces.runtime.cds import read_starts, write_run_key  # noqa: E402
+from interfaces.runtime.kernels import compile_kernels, kernels_cached  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport  # noqa: E402
 from links.data_budget import budget  # noqa: E402
@@ -240,6 +242,8 @@ def _fly(scenario: Scenario, out: Path, args: argparse.Namespace, host_map: Host
     """Fly the run into ``out`` and write it (``reserve`` released first): its exit status."""
     mission = args.mission or scenario.name
     scenario_text = args.scenario.read_text(encoding="utf-8")
+    if not kernels_cached():  # the first run after an install or an edit of a kernel
+        compile_kernels(log.info)
     wall0 = time.monotonic()
     digest: RunDigest | None = None
     stop = threading.Event()
@@ -1004,11 +1008,7 @@ class _Progress:
         if not final and now - self._last < 5.0:
             return
         self._last = now
-        wall = now - self._wall0
-        frac = self.t_sim / self.duration if self.duration else 0.0
-        eta = wall * (1 - frac) / frac if frac > 0 else float("nan")
-        log.info("t_sim %7.1f / %.0f s (%3.0f%%)  %6.0fx real time  ETA %5.0f s", self.t_sim,
-                 self.duration, 100 * frac, self.t_sim / max(wall, 1e-9), eta)
+        log.info("%s", progress_line(self.t_sim, self.duration, now - self._wall0))
 
 
 if __name__ == "__main__":

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import sys
+from functools import partial
 
 from interfaces.contracts import topics
 from interfaces.contracts.scenario import Scenario
@@ -11,6 +13,7 @@ from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.cli import add_node_args, run_participant
 from interfaces.runtime.executive import Executive
+from interfaces.runtime.kernels import compile_kernels
 from links.channel import ChannelModel
 
 
@@ -21,7 +24,9 @@ def _build(bus: Bus, scenario: Scenario) -> Executive:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m ground", description=__doc__)
     add_node_args(parser)
-    return run_participant(parser.parse_args(argv), topics.GROUND, _build, ChannelModel.of)
+    args = parser.parse_args(argv)
+    compile_kernels(partial(print, file=sys.stderr))  # loaded before the first tick
+    return run_participant(args, topics.GROUND, _build, ChannelModel.of)
 
 
 if __name__ == "__main__":
