@@ -93,12 +93,13 @@ import shutil
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from pydantic import ValidationError
 
 from deploy.campaign_file import Campaign, Group, ScenarioChoice, draw_fault, grid_axes, seeds
+from deploy.disk_space import is_disk_full
 from deploy.draws import (
     Choice,
     DrawError,
@@ -110,8 +111,12 @@ from deploy.draws import (
     rng_for,
 )
 from deploy.onsets import OnsetError, heard_by_s
+from deploy.recorder_guard import DISK_FULL, disk_full_cause
 from harness.summary import RunSummary
 from interfaces.contracts.scenario import Scenario
+
+if TYPE_CHECKING:
+    from harness.summary.digest import RunDigest
 
 
 class CampaignError(ValueError):
@@ -341,21 +346,53 @@ def execute_run(spec: RunSpec, out_root: str, transport: str = "inproc") -> dict
     """Run one campaign run into ``<out_root>/runs/<id>/`` (run.mcap, summary.json, a log) and
     return {id, status, error, wall_s}.  The run is written under ``<id>.partial-<random>`` and
     renamed when complete, so a run directory exists only for a finished run; a crash is caught
-    and recorded as a failed run with its error.  ``transport``: ``inproc`` (this process) or
-    ``zenoh`` (deploy/run_constellation.py as a child, one process per node, on a free
-    loopback port and its own mission key space, so runs on one machine never cross).  A
-    module-level function, so a Dask worker can import it."""
+    and recorded as a failed run with its error.  A run stopped by its host rather than by
+    itself (a full disk, a signal) is not finished: its attempt is removed and the result's
+    status is ``retry``, for a resumed campaign to fly it again.  ``transport``: ``inproc``
+    (this process) or ``zenoh`` (deploy/run_constellation.py as a child, one process per node,
+    on a free loopback port and its own mission key space, so runs on one machine never
+    cross).  A module-level function, so a Dask worker can import it."""
     runs = Path(out_root) / "runs"
     final, partial = runs / spec.id, _attempt_dir(runs, spec.id, "partial")
-    if transport == "zenoh":
-        summary = _zenoh_run(spec, partial)
-    elif transport == "inproc":
-        summary = _inproc_run(spec, partial)
-    else:
-        raise ValueError(f"unknown transport {transport!r}")
-    _finish(spec, partial, final, transport)
+    try:
+        if transport == "zenoh":
+            summary = _zenoh_run(spec, partial)
+        elif transport == "inproc":
+            summary = _inproc_run(spec, partial)
+        else:
+            raise ValueError(f"unknown transport {transport!r}")
+        cause = host_fault(summary)
+        if cause is None:
+            _finish(spec, partial, final, transport)
+    except OSError as e:
+        if not is_disk_full(e):
+            raise
+        summary, cause = None, f"{DISK_FULL} while writing the run: {e.strerror or e}"
+    if cause is not None:
+        return record_retry(spec, out_root, cause)
     return {"id": spec.id, "status": summary.status, "error": summary.error,
             "wall_s": summary.wall_s}
+
+
+def host_fault(summary: RunSummary) -> str | None:
+    """Why a run ended by a fault of its host, not of the run (None: it ended by itself): a
+    full disk, or a signal that interrupted it."""
+    if disk_full_cause(summary.error):
+        return summary.error
+    if summary.status == "interrupted":
+        return summary.error or "interrupted"
+    return None
+
+
+def record_retry(spec: RunSpec, out_root: str, cause: str) -> dict[str, Any]:
+    """A run stopped by its host (a full disk, a dead worker, a signal): what its attempts
+    left is removed, so that the run is not finished and a resumed campaign flies it again;
+    returns its result, status ``retry`` with the cause."""
+    runs = Path(out_root) / "runs"
+    for pattern in (f"{spec.id}.partial*", f"{spec.id}.failed*"):
+        for stale in runs.glob(pattern):
+            shutil.rmtree(stale, ignore_errors=True)
+    return {"id": spec.id, "status": "retry", "error": cause, "wall_s": None}
 
 
 def _attempt_dir(runs: Path, run_id: str, kind: str) -> Path:
@@ -431,12 +468,8 @@ def _inproc_run(spec: RunSpec, out: Path) -> RunSummary:
     import time
     import traceback
 
-    from deploy.inproc import run_inproc
-    from ground.archive.metadata import run_metadata
-    from ground.archive.recorder import McapRecorder
     from harness.foxglove_layout import write_layout
     from harness.summary.build import write_summary
-    from harness.summary.digest import LiveDigest, RunDigest
 
     handler = logging.FileHandler(out / "run.log")
     handler.setFormatter(logging.Formatter("%(asctime)s %(name)s %(levelname)s %(message)s"))
@@ -445,15 +478,9 @@ def _inproc_run(spec: RunSpec, out: Path) -> RunSummary:
     root.addHandler(handler)
     root.setLevel(logging.INFO)  # the run's log keeps its INFO lines (slews, assignments...)
     t0 = time.monotonic()
-    status, error = "completed", None
     digest: RunDigest | None = None  # a failed run's summary reads what its archive holds
     try:
-        note = f"# campaign run {spec.id} (group {spec.group}, seed {spec.seed}): resolved_json\n"
-        metadata = run_metadata(spec.scenario, "inproc", note)
-        live = LiveDigest(spec.scenario, spec.scenario.name, out / "run.mcap", metadata)
-        with McapRecorder(out / "run.mcap", metadata) as rec:
-            run_inproc(spec.scenario, sample_tap=live.tap(rec))
-        digest = live.finish()
+        status, error, digest = _fly_inproc(spec, out)
     except Exception as e:  # noqa: BLE001 - a crashed run is a result, not the campaign's end
         status, error = "failed", f"{type(e).__name__}: {e}\n{traceback.format_exc()}"
         logging.getLogger("insp.campaign").error("run %s failed: %s", spec.id, error)
@@ -465,6 +492,35 @@ def _inproc_run(spec: RunSpec, out: Path) -> RunSummary:
                             digest=digest)
     write_layout(out, spec.scenario)
     return summary
+
+
+def _fly_inproc(spec: RunSpec, out: Path) -> tuple[str, str | None, RunDigest | None]:
+    """Fly ``spec`` in this process, recording into ``out/run.mcap``: its status, error and
+    digest (None when the recorder failed: the summary then reads what the archive holds)."""
+    import threading
+
+    from deploy.inproc import run_inproc
+    from deploy.recorder_guard import RecorderGuard
+    from ground.archive.metadata import run_metadata
+    from ground.archive.recorder import McapRecorder
+    from harness.summary.digest import LiveDigest
+
+    note = f"# campaign run {spec.id} (group {spec.group}, seed {spec.seed}): resolved_json\n"
+    metadata = run_metadata(spec.scenario, "inproc", note)
+    live = LiveDigest(spec.scenario, spec.scenario.name, out / "run.mcap", metadata)
+    stop = threading.Event()
+    guard = RecorderGuard(lambda _: None, stop)
+    try:
+        with McapRecorder(out / "run.mcap", metadata) as rec:
+            guard = RecorderGuard(live.tap(rec), stop)
+            run_inproc(spec.scenario, sample_tap=guard, stop=stop)
+    except OSError as e:  # the archive's end not written: a full disk, most likely
+        if guard.error is None and not is_disk_full(e):
+            raise
+        guard.error = guard.error or e
+    if guard.cause is not None:
+        return "failed", guard.cause, None
+    return "completed", None, live.finish()
 
 
 def _zenoh_run(spec: RunSpec, out: Path) -> RunSummary:
@@ -488,7 +544,8 @@ def _zenoh_run(spec: RunSpec, out: Path) -> RunSummary:
             port = s.getsockname()[1]
         cmd = [sys.executable, str(Path(__file__).resolve().parent / "run_constellation.py"),
                "--scenario", str(scenario), "--out", str(out), "--no-report",
-               "--endpoint", f"tcp/127.0.0.1:{port}", "--mission", f"{spec.scenario.name}-{port}"]
+               "--endpoint", f"tcp/127.0.0.1:{port}", "--mission", f"{spec.scenario.name}-{port}",
+               "--skip-disk-check"]  # the campaign checks its disk, and stops when it fills
         with open(launch / "launcher.log", "w") as log_file:
             try:
                 subprocess.run(cmd, stdout=log_file, stderr=subprocess.STDOUT, check=False,

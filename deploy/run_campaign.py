@@ -43,7 +43,7 @@ import signal
 import sys
 import time
 from collections.abc import Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import FIRST_COMPLETED, CancelledError, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import replace
 from multiprocessing import get_context
@@ -61,9 +61,22 @@ from deploy.campaign import (  # noqa: E402
     finished,
     load_campaign,
     record_failure,
+    record_retry,
 )
+from deploy.campaign_file import Campaign  # noqa: E402
 from deploy.campaign_replay import print_progress, rejudge, sweep  # noqa: E402
 from deploy.cluster import CONNECT_TIMEOUT_S, ClusterError, dask_client  # noqa: E402
+from deploy.disk_space import (  # noqa: E402
+    RESERVE_BYTES,
+    DiskSpaceError,
+    Reserve,
+    check_space,
+    estimate_archive_bytes,
+    free_bytes,
+    megabytes,
+)
+from deploy.out_folder import OutFolderError, writable  # noqa: E402
+from deploy.recorder_guard import disk_full_cause  # noqa: E402
 from harness.campaign.formation_study import write_formation_study  # noqa: E402
 from harness.campaign.neighbours_study import write_neighbours_study  # noqa: E402
 from harness.campaign.report import write_campaign_report  # noqa: E402
@@ -71,6 +84,7 @@ from harness.replay import parse_settings, scenario_with  # noqa: E402
 from harness.summary import RunSummary  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
 from interfaces.runtime.arguments import positive_int  # noqa: E402
+from interfaces.runtime.kernels import compile_kernels, kernels_cached  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
 
@@ -80,7 +94,14 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--campaign", type=Path,
                    help="campaign TOML (not needed with --report-only on an existing --out)")
-    p.add_argument("--out", type=Path, required=True, help="campaign directory")
+    p.add_argument("--out", type=Path,
+                   help="campaign directory (default when flying: runs/<campaign>-<time>; "
+                        "required with --report-only without --campaign, --replay, --sweep)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="fly into an --out whose finished runs were flown with other settings "
+                        "or another campaign file, replacing them")
+    p.add_argument("--skip-disk-check", action="store_true",
+                   help="start even when --out's disk looks too small for one run")
     p.add_argument("--workers", type=positive_int, default=os.cpu_count() or 1,
                    help="local worker processes, at least 1 (default: one per core)")
     p.add_argument("--limit", type=positive_int, help="run only the first N runs of the list")
@@ -111,11 +132,16 @@ class Progress:
     def __init__(self, total: int, skipped: int) -> None:
         self.total, self.skipped = total, skipped
         self.done = self.failed = 0
+        self.retry: dict[str, str] = {}
+        """The runs stopped by their host this time, each with its cause: flown on resume."""
         self.t0 = time.monotonic()
 
     def update(self, result: dict[str, Any]) -> None:
         self.done += 1
-        self.failed += result["status"] != "completed"
+        if result["status"] == "retry":
+            self.retry[result["id"]] = result["error"]
+        else:
+            self.failed += result["status"] != "completed"
         left = self.total - self.skipped - self.done
         rate = self.done / max(time.monotonic() - self.t0, 1e-9)
         eta = left / rate if rate > 0 else math.inf
@@ -123,13 +149,20 @@ class Progress:
         tty = sys.stderr.isatty()
         start = "\r" if tty else ""
         print(f"{start}[{bar:<30}] {self.skipped + self.done}/{self.total} runs "
-              f"({self.failed} failed) ETA {eta / 60:5.1f} min  last {result['id']} "
+              f"({self.failed} failed, {len(self.retry)} to retry) ETA {eta / 60:5.1f} min  "
+              f"last {result['id']} "
               f"{result['status']}", end="\n" if left == 0 or not tty else "", file=sys.stderr,
               flush=True)
 
 
 def _interrupt(signum: int, _frame: object) -> None:
-    raise KeyboardInterrupt(f"signal {signum}")
+    raise KeyboardInterrupt(signum)
+
+
+def _interrupted_status(e: KeyboardInterrupt) -> int:
+    """128 + the signal's number: 143 for SIGTERM (raised by :func:`_interrupt`), 130 for
+    Ctrl-C."""
+    return 128 + (e.args[0] if e.args and isinstance(e.args[0], int) else signal.SIGINT)
 
 
 def _local(todo: list[RunSpec], out: Path, workers: int, transport: str
@@ -157,7 +190,7 @@ def _local(todo: list[RunSpec], out: Path, workers: int, transport: str
                         yield f.result()
                     except BrokenProcessPool as e:
                         if spec.id in broke:
-                            yield record_failure(spec, str(out), f"worker died: {e}")
+                            yield record_retry(spec, str(out), f"worker died: {e}")
                         else:
                             broke.add(spec.id)
                             queue.append(spec)
@@ -196,50 +229,110 @@ def _dask(todo: list[RunSpec], out: Path, address: str, transport: str
             for f in as_completed(list(futures)):
                 try:
                     yield f.result()
-                except Exception as e:  # noqa: BLE001 - a lost worker: recorded as failed
-                    yield record_failure(futures[f], str(out), f"{type(e).__name__}: {e}")
+                except Exception as e:  # noqa: BLE001 - a lost worker: flown again on resume
+                    record = record_retry if _host_lost(e) else record_failure
+                    yield record(futures[f], str(out), f"{type(e).__name__}: {e}")
         finally:
             client.cancel([f for f in futures if not f.done()])
+
+
+def _host_lost(e: BaseException) -> bool:
+    """Whether a Dask task failed because its worker or the network was lost (a fault of the
+    host), not in the run (``execute_run`` records the run's own crashes itself)."""
+    return (isinstance(e, (OSError, TimeoutError, CancelledError))
+            or type(e).__module__.startswith("distributed") or type(e).__name__ == "KilledWorker")
 
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s campaign %(levelname)s %(message)s",
                         datefmt="%H:%M:%S")
-    index = args.out / "campaign.json"
-    if args.replay or args.sweep:
-        return _replay(args)
-    if args.campaign is None:
-        if not (args.report_only and index.exists()):
-            print("error: --campaign is required (except --report-only on a campaign "
-                  "directory)", file=sys.stderr)
-            return 2
-        saved = json.loads(index.read_text())
-        _reports(args.out, saved["name"], saved["runs"], saved.get("study"))
-        return 0
     try:
-        campaign, runs = load_campaign(args.campaign)
-        settings = parse_settings(args.settings)
-        _refuse_drawn(settings, runs)
-        runs = [replace(r, scenario=scenario_with(r.scenario, settings)) for r in runs]
-    except (CampaignError, ScenarioError) as e:
+        if args.replay or args.sweep or args.campaign is None:
+            return _replay(args) if args.replay or args.sweep else _report_again(args)
+        campaign, runs, settings = _load(args)
+        args.out = _campaign_folder(args, campaign.name, runs, settings)
+    except (CampaignError, ScenarioError, OutFolderError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    if args.limit is not None:
-        runs = runs[:args.limit]
-    args.out.mkdir(parents=True, exist_ok=True)
     if args.campaign.resolve() != (args.out / "campaign.toml").resolve():
         shutil.copyfile(args.campaign, args.out / "campaign.toml")
-    index.write_text(json.dumps({"name": campaign.name, "runs": [r.id for r in runs],
-                                 "study": campaign.study, "settings": settings},
-                                indent=1) + "\n")
+    (args.out / "campaign.json").write_text(json.dumps(
+        {"name": campaign.name, "runs": [r.id for r in runs], "study": campaign.study,
+         "settings": settings}, indent=1) + "\n")
     status = 0
     if not args.report_only:
         status = _run(runs, args)
-    _reports(args.out, campaign.name, [r.id for r in runs], campaign.study)
+        if status == 2:  # refused before any run: nothing to report
+            return status
+    if not _reports(args.out, campaign.name, [r.id for r in runs], campaign.study):
+        return status or 1
     if status == 0 and any(_failed(args.out, r.id) for r in runs):
         return 1
     return status
+
+
+def _load(args: argparse.Namespace) -> tuple[Campaign, list[RunSpec], dict[str, str]]:
+    """The campaign's runs as they will fly (``--set`` applied, ``--limit`` taken) and the
+    settings given; CampaignError or ScenarioError names what is wrong."""
+    campaign, runs = load_campaign(args.campaign)
+    settings = parse_settings(args.settings)
+    _refuse_drawn(settings, runs)
+    runs = [replace(r, scenario=scenario_with(r.scenario, settings)) for r in runs]
+    return campaign, runs[:args.limit] if args.limit is not None else runs, settings
+
+
+def _campaign_folder(args: argparse.Namespace, name: str, runs: list[RunSpec],
+                     settings: dict[str, str]) -> Path:
+    """The campaign's folder (``--out``, or ``runs/<name>-<time>``), made and writable; a
+    folder whose finished runs this command would replace is refused unless ``--overwrite``
+    (OutFolderError naming the difference)."""
+    out = args.out or REPO / "runs" / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    if args.out is None:
+        log.info("campaign folder: %s", out)
+    _destination(out, "--out")
+    if not args.overwrite:
+        _refuse_reuse(out, name, runs, settings)
+    return out
+
+
+def _refuse_reuse(out: Path, name: str, runs: list[RunSpec], settings: dict[str, str]) -> None:
+    """OutFolderError when ``out``'s finished runs differ from those this command flies: other
+    ``--set`` settings, another campaign, or another version of its file."""
+    try:
+        saved = json.loads((out / "campaign.json").read_text())
+    except (OSError, ValueError):
+        return
+    replaced = [r.id for r in runs
+                if (out / "runs" / r.id).is_dir() and not finished(r, out)]
+    if saved.get("name") != name:
+        why = f"holds campaign {saved.get('name')!r}, not {name!r}"
+    elif (saved.get("settings") or {}) != settings:
+        why = (f"was flown with {_settings_text(saved.get('settings') or {})}; this command "
+               f"sets {_settings_text(settings)}")
+    elif replaced:
+        why = (f"holds {len(replaced)} finished runs flown from another version of the "
+               f"campaign file (first: {replaced[0]})")
+    else:
+        return
+    raise OutFolderError(f"--out {out} {why}: give another --out, or --overwrite to replace "
+                         "its runs")
+
+
+def _settings_text(settings: dict[str, str]) -> str:
+    """``--set a=1 --set b=2``, or ``no --set``."""
+    return " ".join(f"--set {k}={v}" for k, v in settings.items()) or "no --set"
+
+
+def _report_again(args: argparse.Namespace) -> int:
+    """--report-only on a campaign folder, from the run list saved there."""
+    if args.out is None or not args.report_only or not (args.out / "campaign.json").exists():
+        print("error: --campaign is required (except --report-only --out on a campaign "
+              "folder)", file=sys.stderr)
+        return 2
+    writable(args.out)
+    saved = json.loads((args.out / "campaign.json").read_text())
+    return 0 if _reports(args.out, saved["name"], saved["runs"], saved.get("study")) else 1
 
 
 def _refuse_drawn(settings: dict[str, str], runs: list[RunSpec]) -> None:
@@ -251,20 +344,28 @@ def _refuse_drawn(settings: dict[str, str], runs: list[RunSpec]) -> None:
         raise CampaignError(f"--set {clash[0]}: the campaign draws this setting per run")
 
 
-def _reports(out: Path, name: str, ids: list[str], study: str | None) -> None:
-    """The campaign's report, and its study's (``study = "formations"``) when it names one."""
-    write_campaign_report(out, name, ids)
-    print(f"report: {out / 'report.md'}", file=sys.stderr)
-    if study == "formations":
-        print(f"study: {write_formation_study(out, ids)}", file=sys.stderr)
-    elif study == "neighbours":
-        print(f"study: {write_neighbours_study(out, ids)}", file=sys.stderr)
+def _reports(out: Path, name: str, ids: list[str], study: str | None) -> bool:
+    """The campaign's report, and its study's (``study = "formations"``) when it names one;
+    False, with one line, when the disk refuses them."""
+    try:
+        write_campaign_report(out, name, ids)
+        print(f"report: {out / 'report.md'}", file=sys.stderr)
+        if study == "formations":
+            print(f"study: {write_formation_study(out, ids)}", file=sys.stderr)
+        elif study == "neighbours":
+            print(f"study: {write_neighbours_study(out, ids)}", file=sys.stderr)
+    except OSError as e:
+        print(f"error: the report could not be written in {out}: {e.strerror or e}",
+              file=sys.stderr)
+        return False
+    return True
 
 
 def _replay(args: argparse.Namespace) -> int:
     """--replay / --sweep: re-judge a finished campaign (deploy/campaign_replay.py)."""
-    if not (args.out / "campaign.json").exists():
-        print(f"error: {args.out} holds no campaign to replay (no campaign.json)", file=sys.stderr)
+    if args.out is None or not (args.out / "campaign.json").exists():
+        print(f"error: --out {args.out or '(not given)'} holds no campaign to replay (no "
+              "campaign.json)", file=sys.stderr)
         return 2
     try:
         settings = parse_settings(args.settings)
@@ -272,6 +373,7 @@ def _replay(args: argparse.Namespace) -> int:
         slug = "_".join(f"{k}={v}" for k, v in settings.items())
         dest = args.out_report or args.out / (f"sweep-{name}" if args.sweep else
                                               f"replay-{slug or 'own-settings'}")
+        _destination(dest, "--out-report" if args.out_report else "--out")
         kw = {"workers": args.workers, "cluster": args.cluster, "progress": print_progress}
         path = (sweep(args.out, name, values, dest, settings, **kw) if args.sweep
                 else rejudge(args.out, settings, dest, **kw))
@@ -280,6 +382,17 @@ def _replay(args: argparse.Namespace) -> int:
         return 2
     print(f"report: {path}", file=sys.stderr)
     return 0
+
+
+def _destination(dest: Path, option: str) -> Path:
+    """A replay's folder, made and writable before any run is judged (OutFolderError naming
+    ``option``)."""
+    try:
+        dest.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise OutFolderError(f"{option} {dest}: cannot make the folder: {e.strerror or e}"
+                             ) from None
+    return writable(dest, option)
 
 
 def _sweep_values(text: str) -> tuple[str, list[str]]:
@@ -305,36 +418,85 @@ def _run(runs: list[RunSpec], args: argparse.Namespace) -> int:
         print(f"error: another campaign is running in {args.out}", file=sys.stderr)
         return 2
     try:
-        return _run_locked(runs, args, runs_dir)
+        for partial in [*runs_dir.glob("*.partial*"), *runs_dir.glob("*.failed-*")]:
+            shutil.rmtree(partial, ignore_errors=True)  # half-written by an interrupted campaign
+        todo = [r for r in runs if not finished(r, args.out)]
+        if todo and not args.skip_disk_check:
+            _check_disk(args.out, todo)
+        with Reserve(args.out):  # released before the report is written
+            return _run_locked(runs, todo, args)
+    except DiskSpaceError as e:
+        print(f"error: {e.strerror}", file=sys.stderr)
+        return 2
     finally:
         lock.close()
 
 
-def _run_locked(runs: list[RunSpec], args: argparse.Namespace, runs_dir: Path) -> int:
-    for partial in [*runs_dir.glob("*.partial*"), *runs_dir.glob("*.failed-*")]:
-        shutil.rmtree(partial, ignore_errors=True)  # half-written by an interrupted campaign
-    todo = [r for r in runs if not finished(r, args.out)]
+def _check_disk(out: Path, todo: list[RunSpec]) -> None:
+    """DiskSpaceError when ``out`` cannot hold the largest run left; a warning when it cannot
+    hold them all (the campaign then stops cleanly where the disk fills)."""
+    largest = max(todo, key=lambda r: estimate_archive_bytes(r.scenario))
+    check_space(out, largest.scenario)
+    need = sum(estimate_archive_bytes(r.scenario) for r in todo) + RESERVE_BYTES
+    free = free_bytes(out)
+    if free < need:
+        log.warning("%s has %s free; the %d runs left need about %s: the campaign stops "
+                    "cleanly when the disk fills, and the same command then flies the rest",
+                    out, megabytes(free), len(todo), megabytes(need))
+
+
+def _run_locked(runs: list[RunSpec], todo: list[RunSpec], args: argparse.Namespace) -> int:
     log.info("%d runs, %d already finished, %d to run on %s", len(runs), len(runs) - len(todo),
              len(todo), args.cluster or f"{args.workers} local workers")
+    if todo and not kernels_cached():  # once here, not in every worker
+        compile_kernels(log.info)
     progress = Progress(len(runs), len(runs) - len(todo))
     main_thread = signal.getsignal(signal.SIGTERM)
     signal.signal(signal.SIGTERM, _interrupt)
     try:
         results = _dask(todo, args.out, args.cluster, args.transport) if args.cluster else \
             _local(todo, args.out, args.workers, args.transport)
-        for result in results:
-            progress.update(result)
+        status = _follow(results, progress)
     except ClusterError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as e:
         print("", file=sys.stderr)
         log.warning("interrupted: %d runs finished this time; start again with the same --out "
-                    "to go on", progress.done)
-        return 130
+                    "to go on", progress.done - len(progress.retry))
+        status = _interrupted_status(e)
     finally:
         signal.signal(signal.SIGTERM, main_thread)
+    _write_retries(args.out, progress.retry)
+    return status
+
+
+def _follow(results: Iterator[dict[str, Any]], progress: Progress) -> int:
+    """Follow the runs as they finish; stop at the first full disk (0, or 1 with one line when
+    the disk filled)."""
+    for result in results:
+        progress.update(result)
+        if result["status"] == "retry" and disk_full_cause(result["error"]):
+            print(f"error: {result['error']} (run {result['id']}): the campaign stopped; "
+                  "free some space and run the same command again to fly the runs left",
+                  file=sys.stderr)
+            return 1
     return 0
+
+
+def _write_retries(out: Path, retry: dict[str, str]) -> None:
+    """``<out>/retry.json``: the runs stopped by their host this time, each with its cause
+    (flown again by the next run of the same command); removed when there are none."""
+    path = out / "retry.json"
+    try:
+        if retry:
+            path.write_text(json.dumps(retry, indent=1) + "\n")
+            log.warning("%d runs to fly again (stopped by their host, not by themselves): %s",
+                        len(retry), path)
+        else:
+            path.unlink(missing_ok=True)
+    except OSError as e:
+        log.error("retry.json not written: %s", e.strerror or e)
 
 
 if __name__ == "__main__":

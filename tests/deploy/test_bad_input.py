@@ -172,6 +172,7 @@ def test_an_unreachable_cluster_is_named_within_the_stated_time(
     err = capsys.readouterr().err
     assert code == 2 and "no Dask scheduler answered within 1 s" in err, err
     assert "Traceback" not in err
+    assert not (tmp_path / "c" / "report.md").exists()  # nothing flown, nothing reported
 
 
 def test_a_router_that_did_not_start_is_named_for_what_its_log_says(tmp_path: Path) -> None:

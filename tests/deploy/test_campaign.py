@@ -204,3 +204,48 @@ def test_variants_fly_every_group_with_the_same_faults(tmp_path: Path) -> None:
         assert not any(s.neighbours.enabled for s in off) and all(s.neighbours.enabled for s in on)
     starts = [f.start_s for r in runs for f in r.scenario.faults]
     assert starts and all(500.0 <= t <= 560.0 for t in starts)  # just after the pass (498 s)
+
+
+def test_a_folder_flown_otherwise_is_refused_naming_the_difference(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Other --set settings, or finished runs of another version of the campaign file, are not
+    replaced without --overwrite; the refusal names the difference, in one line, exit 2."""
+    from deploy.campaign import record_failure
+
+    path, out = _campaign(tmp_path), tmp_path / "out"
+    args = ["--campaign", str(path), "--out", str(out), "--report-only"]
+    assert run_campaign([*args, "--set", "fdir.floor=0.04"]) == 0
+    capsys.readouterr()
+    assert run_campaign(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"error: --out {out} was flown with --set fdir.floor=0.04; this command sets "
+                   "no --set: give another --out, or --overwrite to replace its runs"]
+    assert json.loads((out / "campaign.json").read_text())["settings"] == \
+        {"fdir.floor": "0.04"}  # untouched
+    assert run_campaign([*args, "--overwrite"]) == 0
+    _, runs = load_campaign(path)
+    record_failure(runs[0], str(out), "a run finished before the file was edited")
+    path.write_text(CAMPAIGN.format(seeds=1).replace("magnitude = 0.5", "magnitude = 0.6"))
+    capsys.readouterr()
+    assert run_campaign(args) == 2
+    assert (f"holds 1 finished runs flown from another version of the campaign file (first: "
+            f"{runs[0].id})") in capsys.readouterr().err
+
+
+def test_a_read_only_campaign_folder_is_refused_before_any_work(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from tests.mounts import read_only
+
+    path, out = _campaign(tmp_path), tmp_path / "ro" / "out"
+    assert run_campaign(["--campaign", str(path), "--out", str(out), "--report-only"]) == 0
+    report = (out / "report.md").read_bytes()
+    capsys.readouterr()
+    with read_only(tmp_path / "ro"):
+        for extra in (["--report-only"], ["--replay"], ["--replay", "--set", "fdir.floor=0.05"]):
+            assert run_campaign(["--out", str(out), *extra]) == 2, extra
+            err = capsys.readouterr().err.strip().splitlines()
+            assert len(err) == 1 and "Read-only file system" in err[0], err
+            assert "--out" in err[0]
+        assert run_campaign(["--campaign", str(path), "--out", str(out)]) == 2
+        assert "cannot write there (Read-only file system)" in capsys.readouterr().err
+    assert (out / "report.md").read_bytes() == report
