@@ -272,8 +272,8 @@ def _within(setting: FieldInfo | None, values: tuple[tuple[str, Any, Any], ...],
         try:
             check.validate_python(v)
         except ValidationError as e:
-            raise DrawError(f"{where}: {what}{name}{' ' if name else ''}= {written!r}: "
-                            f"{reason(e)}") from None
+            said = f"{where}: {what}{name} = " if name else f"{where} = "
+            raise DrawError(f"{said}{written!r}: {reason(e)}") from None
 
 
 def _check_choice(annotation: Any, choice: Choice, where: str,

@@ -131,8 +131,8 @@ def _line(err: ErrorDetails, model: type[BaseModel] | None, data: Any) -> str:
     if err["type"] == "value_error":  # a validator's message, which may name its own key
         return f"{where}: {why}" if where and not why.startswith(where) else why
     value = err.get("input")
-    given = f" = {value!r}" if _scalar(value) and err["type"] not in _SHAPE else ""
-    return f"{where}{given}: {why}"
+    given = f" = {value!r}" if where and _scalar(value) and err["type"] not in _SHAPE else ""
+    return f"{where}{given}: {why}" if where else why
 
 
 def reason(error: ValidationError) -> str:

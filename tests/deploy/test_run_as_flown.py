@@ -65,8 +65,8 @@ def test_the_command_line_is_applied_before_the_scenario_is_checked(
     ({"duration_s": {"min": -10.0, "max": 100.0}},
      "overrides.duration_s: range min = -10.0: should be greater than 0"),
     ({"fdir": {"detector": {"choose": ["window", "windw"]}}},
-     "overrides.fdir.detector.choose[#2]: = 'windw': unknown; did you mean 'window'?"),
-    ({"fdir": {"floor": -1.0}}, "overrides.fdir.floor: = -1.0: should be greater than or "
+     "overrides.fdir.detector.choose[#2] = 'windw': unknown; did you mean 'window'?"),
+    ({"fdir": {"floor": -1.0}}, "overrides.fdir.floor = -1.0: should be greater than or "
                                 "equal to 0"),
     ({"fdir": {"floor": {"min": float("nan"), "max": 1.0}}},
      "overrides.fdir.floor: range bounds must be finite numbers, got nan and 1.0"),
