@@ -554,7 +554,8 @@ def _zenoh_run(spec: RunSpec, out: Path) -> RunSummary:
                                else None)  # a killed worker takes its run down with it
             except subprocess.TimeoutExpired:
                 pass  # recorded below from what the launcher left
-        if "cannot listen on" not in (launch / "launcher.log").read_text(errors="replace"):
+        said = (launch / "launcher.log").read_text(errors="replace")
+        if not any(t in said for t in ("the address is in use", "another run using it")):
             break
     for name in ("scenario.json", "launcher.log"):  # into the run's folder, as before
         (launch / name).replace(out / name)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ctypes
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -14,6 +15,8 @@ from typing import IO
 from deploy.rehearsal.netns import Entry, libc
 
 _PR_SET_PDEATHSIG = 1
+ANSI_ESCAPE = re.compile(r"\x1b\[[0-9;?]*[ -/]*[@-~]")
+"""A terminal control sequence (colours, styles)."""
 
 
 def die_with_parent(library: ctypes.CDLL | None = None) -> None:
@@ -104,11 +107,13 @@ class Child:
         return f"exited with code {code}"
 
     def log_tail(self, lines: int = 15) -> str:
+        """The last ``lines`` of its log, without terminal colour codes (Zenoh's logger
+        colours its lines), for errors, summaries and reports."""
         try:
             text = self.log_path.read_text(errors="replace").splitlines()
         except OSError:
             return ""
-        return "\n".join(text[-lines:])
+        return ANSI_ESCAPE.sub("", "\n".join(text[-lines:]))
 
 
 @dataclass

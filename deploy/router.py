@@ -18,11 +18,13 @@ a few log lines per message routed, so it is off by default.
 from __future__ import annotations
 
 import argparse
+import errno
 import json
 import logging
 import os
 import re
 import signal
+import socket
 import sys
 import threading
 from collections import Counter
@@ -52,6 +54,29 @@ def address_taken(log_text: str) -> bool:
     """Whether the router's log (``log_text``) says its endpoint's address is taken (another
     run on it, say), rather than another failure (a malformed endpoint, a bad configuration)."""
     return any(t in log_text.lower() for t in ADDRESS_TAKEN)
+
+
+def endpoint_taken(endpoint: str) -> str | None:
+    """Before a router is started on a tcp or tls ``endpoint`` of this host: the error naming
+    it, and a free port to give instead, if another process listens there (None: free, or not
+    a tcp/tls endpoint, or not an address of this host: the router itself then says)."""
+    proto, _, rest = endpoint.partition("/")
+    host, _, port = rest.split("?", 1)[0].rpartition(":")
+    if proto not in ("tcp", "tls") or not port.isdigit():
+        return None
+    family = socket.AF_INET6 if ":" in host.strip("[]") else socket.AF_INET
+    with socket.socket(family, socket.SOCK_STREAM) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as the router binds
+        try:
+            probe.bind((host.strip("[]"), int(port)))
+        except OSError as e:
+            if e.errno != errno.EADDRINUSE:
+                return None
+            probe.bind((host.strip("[]"), 0))
+            free = probe.getsockname()[1]
+            return (f"--endpoint {endpoint}: the address is in use (another run?): give "
+                    f"another, e.g. --endpoint {proto}/{host}:{free}")
+    return None
 
 
 class Audit:

@@ -66,7 +66,7 @@ from deploy.progress_line import progress_line  # noqa: E402
 from deploy.recorder_guard import RecorderGuard  # noqa: E402
 from deploy.rehearsal.netns import RehearsalError, require_privilege  # noqa: E402
 from deploy.rehearsal.network import RehearsedNetwork  # noqa: E402
-from deploy.router import address_taken  # noqa: E402
+from deploy.router import address_taken, endpoint_taken  # noqa: E402
 from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderDied, RecorderProcess  # noqa: E402
 from ground.archive.segments import remove_segments, run_archive  # noqa: E402
@@ -213,6 +213,11 @@ def main(argv: list[str] | None = None) -> int:
     except (HostMapError, RehearsalError, ValueError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
+    taken = endpoint_taken(args.endpoint) if args.transport == "zenoh" and host_map is None \
+        else None
+    if taken:
+        print(f"error: {taken}", file=sys.stderr)
+        return 2
     known = set(topology(scenario).participants)
     if set(args.external) - known or (args.external and args.transport == "inproc"):
         print(f"error: --external takes nodes of a Zenoh run ({', '.join(sorted(known))}), not "
@@ -262,7 +267,7 @@ def _fly(scenario: Scenario, out: Path, args: argparse.Namespace, host_map: Host
                                      (status, error), digest)
     print(_closing_line(summary, scenario, args)
           + "".join(f"\n  {p}" for p in written(out, layout, not args.no_report))
-          + f"\n{verdict(summary).line()}")
+          + (f"\n{verdict(summary).line()}" if summary.t_sim_final_s else ""))
     if error:
         print(f"error: {_first_line(error)}" + (" (the whole error: summary.json)"
                                                    if "\n" in error.strip() else ""),

@@ -185,3 +185,21 @@ def test_a_router_that_did_not_start_is_named_for_what_its_log_says(tmp_path: Pa
     layout = tmp_path / "run.foxglove.json"
     layout.write_text("{}")
     assert written(tmp_path, layout, report=True) == [layout, tmp_path / "summary.json"]
+
+
+def test_a_busy_endpoint_is_refused_before_any_work_with_a_free_one_to_give(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import socket
+
+    from deploy.run_constellation import main as run
+
+    with socket.socket() as held:
+        held.bind(("127.0.0.1", 0))
+        held.listen()
+        port = held.getsockname()[1]
+        assert run(["--out", str(tmp_path / "run"), "--endpoint", f"tcp/127.0.0.1:{port}"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(
+        f"error: --endpoint tcp/127.0.0.1:{port}: the address is in use (another run?): give "
+        "another, e.g. --endpoint tcp/127.0.0.1:"), err
+    assert not (tmp_path / "run").exists()
