@@ -113,6 +113,7 @@ from deploy.draws import (
 from deploy.onsets import OnsetError, heard_by_s
 from deploy.recorder_guard import DISK_FULL, disk_full_cause
 from harness.summary import RunSummary
+from interfaces.contracts.errors import lines
 from interfaces.contracts.scenario import Scenario
 
 if TYPE_CHECKING:
@@ -269,6 +270,8 @@ def _expand_group(campaign: Campaign, group: Group, vi: int | None,
             data["seed"] = seed
             if campaign.duration_s is not None:
                 data["duration_s"] = campaign.duration_s
+            _check_within(group, float(data.get("duration_s",
+                                                Scenario.model_fields["duration_s"].default)))
             data["name"] = f"{campaign.name}-{run_id}"
             if group.nominal:
                 data["faults"] = []
@@ -279,6 +282,15 @@ def _expand_group(campaign: Campaign, group: Group, vi: int | None,
             runs.append(RunSpec(run_id, label, _validated(run_id, data, record),
                                 record.values, record.domains))
     return runs
+
+
+def _check_within(group: Group, duration_s: float) -> None:
+    """Every fault of ``group`` starts, as written (any draw), before the run ends."""
+    for j, f in enumerate(group.faults, 1):
+        try:
+            f.check_within(duration_s)
+        except ValueError as e:
+            raise CampaignError(f"groups[{group.name}].faults[#{j}]: {e}") from None
 
 
 def _faults(campaign: Campaign, group: Group, index: int, chosen: dict[int, dict[str, Any]],
@@ -324,8 +336,7 @@ def _validated(run_id: str, data: dict[str, Any], record: Record | None = None) 
         return Scenario.model_validate(data)
     except ValidationError as e:
         raise CampaignError(f"run {run_id}: invalid scenario: "
-                            + "; ".join(f"{'.'.join(map(str, err['loc']))}: {err['msg']}"
-                                        for err in e.errors()) + drawn) from None
+                            + "; ".join(lines(e, "", Scenario, data)) + drawn) from None
 
 
 def load_campaign(path: str | Path) -> tuple[Campaign, list[RunSpec]]:
@@ -335,10 +346,7 @@ def load_campaign(path: str | Path) -> tuple[Campaign, list[RunSpec]]:
     try:
         campaign = Campaign.model_validate(data)
     except ValidationError as e:
-        lines = [f"{p}: invalid campaign:"]
-        for err in e.errors():
-            lines.append(f"  {'.'.join(map(str, err['loc'])) or '(top level)'}: {err['msg']}")
-        raise CampaignError("\n".join(lines)) from None
+        raise CampaignError(lines(e, str(p), Campaign, data)[0]) from None
     return campaign, expand(campaign, p.parent)
 
 

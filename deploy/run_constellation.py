@@ -188,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=getattr(logging, args.log_level),
                         format="%(asctime)s launcher %(levelname)s %(message)s", datefmt="%H:%M:%S")
     try:
-        scenario = load_scenario(args.scenario).with_overrides(args.seed, args.duration)
+        scenario = load_scenario(args.scenario, seed=args.seed, duration_s=args.duration)
     except ScenarioError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
@@ -358,7 +358,7 @@ def _host_map(args: argparse.Namespace, scenario: Scenario) -> HostMap | None:
     events = [parse_link_event(e) for e in args.link_event]
     host_map = load_host_map(args.hosts).with_links(args.link_delay_ms, args.link_loss_pct)
     host_map = host_map.with_events(events)
-    host_map.check_run(topology(scenario).participants)
+    host_map.check_run(topology(scenario).participants, scenario.duration_s)
     check_cuts(host_map)
     if args.rehearse:
         require_privilege()

@@ -68,6 +68,7 @@ from pydantic import ValidationError
 from ground.archive.segments import SEGMENT_RECORD, segment_paths
 from harness.archive.sequences import SequenceLedger
 from interfaces.contracts.catalogue import TICK, Topic, topic_of
+from interfaces.contracts.errors import reason
 from interfaces.contracts.messages import Message, registry
 from interfaces.contracts.topics import matches
 
@@ -142,7 +143,7 @@ def _decode(record: Record, model: type[M]) -> M:
     except ValidationError as exc:
         raise ArchiveError(
             f"{record.key} at {record.log_time_ns} ns: payload is not a valid "
-            f"{model.__name__}: {exc.error_count()} error(s)"
+            f"{model.__name__}: {reason(exc)}"
         ) from exc
 
 

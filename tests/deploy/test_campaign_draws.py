@@ -184,7 +184,7 @@ def test_the_existing_campaigns_expand_as_before(name: str) -> None:
      r"run f-0000: no onset phase in this set-up: deployment: the observers start on their "
      r"PROs .*transfer: the scenario has no \[\[phases\]\]"),
     (lambda t: t.replace('base = "base.toml"', 'base = { choose = [] }'),
-     r"base.ScenarioChoice.choose"),
+     r"base.choose: List should have at least 1 item"),
 ])
 def test_bad_draws_are_refused_at_load_naming_them(tmp_path: Path, edit: Any,
                                                    message: str) -> None:
