@@ -83,14 +83,15 @@ from harness.campaign.report import write_campaign_report  # noqa: E402
 from harness.replay import parse_settings, scenario_with  # noqa: E402
 from harness.summary import RunSummary  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
-from interfaces.runtime.arguments import positive_int  # noqa: E402
+from interfaces.runtime.arguments import command_help, positive_int  # noqa: E402
 from interfaces.runtime.kernels import compile_kernels, kernels_cached  # noqa: E402
 
 log = logging.getLogger("insp.campaign")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(description=__doc__,
+    p = argparse.ArgumentParser(description=command_help(__doc__,
+                                                         "docs/campaigns-and-replay.md"),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--campaign", type=Path,
                    help="campaign TOML (not needed with --report-only on an existing --out)")

@@ -88,7 +88,12 @@ from interfaces.contracts.topology import (  # noqa: E402
     NodeProcess,
     topology,
 )
-from interfaces.runtime.arguments import add_log_level, endpoint, mission_name  # noqa: E402
+from interfaces.runtime.arguments import (  # noqa: E402
+    add_log_level,
+    command_help,
+    endpoint,
+    mission_name,
+)
 from interfaces.runtime.cds import read_starts, write_run_key  # noqa: E402
 from interfaces.runtime.kernels import compile_kernels, kernels_cached  # noqa: E402
 from interfaces.runtime.transport import Sample  # noqa: E402
@@ -106,7 +111,8 @@ T = TypeVar("T")
 
 
 def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(description=__doc__,
+    p = argparse.ArgumentParser(description=command_help(__doc__, "docs/contracts.md, "
+                                                         "docs/bus-and-security.md", 2),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO,
                    help="scenario TOML (default %(default)s)")

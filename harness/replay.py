@@ -83,7 +83,7 @@ from interfaces.contracts.messages import (
 )
 from interfaces.contracts.scenario import Scenario, ScenarioError
 from interfaces.contracts.topology import topology
-from interfaces.runtime.arguments import prog_name
+from interfaces.runtime.arguments import command_help, prog_name
 from interfaces.runtime.assembly import executive_of
 from interfaces.runtime.blas_threads import one_blas_thread
 from interfaces.runtime.bus import Bus
@@ -338,7 +338,9 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog=prog_name("python -m harness.replay"), description=__doc__,
+    p = argparse.ArgumentParser(prog=prog_name("python -m harness.replay"),
+                                description=command_help(__doc__,
+                                                         "docs/campaigns-and-replay.md", 2),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("runs", nargs="+", type=Path, help="run directories or run.mcap files")
     p.add_argument("--set", dest="settings", action="append", default=[],

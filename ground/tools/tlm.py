@@ -19,7 +19,7 @@ import threading
 import time
 from dataclasses import dataclass
 
-from interfaces.runtime.arguments import endpoint, prog_name
+from interfaces.runtime.arguments import command_help, endpoint, prog_name
 from interfaces.runtime.zenoh_transport import DEFAULT_ENDPOINT, ZenohSettings, ZenohTransport
 
 SKIP_FIELDS = {"sender", "seq", "t_sim", "t_wall"}
@@ -95,7 +95,9 @@ def table(rows: dict[str, _Row]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog=prog_name("python -m ground.tools.tlm"), description=__doc__,
+    p = argparse.ArgumentParser(prog=prog_name("python -m ground.tools.tlm"),
+                                description=command_help(__doc__, "docs/bus-and-security.md",
+                                                         2),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--filter", default="insp/**", help="Zenoh key expression (default insp/**)")
     p.add_argument("--connect", default=DEFAULT_ENDPOINT, type=endpoint,

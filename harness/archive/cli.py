@@ -41,7 +41,7 @@ from harness.archive.reader import ArchiveError, RunArchive, load_run
 from harness.archive.sequences import by_topic
 from harness.archive.span import cut_of, seconds
 from harness.destination import DestinationError, check_file
-from interfaces.runtime.arguments import prog_name
+from interfaces.runtime.arguments import command_help, prog_name
 
 PARQUET_SUFFIXES = (".parquet", ".pq")
 """``export --out`` file suffixes that choose Parquet over CSV."""
@@ -165,7 +165,9 @@ def export(run: Path, key_expr: str, out: Path | None) -> tuple[int, str | None]
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog=prog_name("python -m harness.archive"), description=__doc__,
+    p = argparse.ArgumentParser(prog=prog_name("python -m harness.archive"),
+                                description=command_help(__doc__,
+                                                         "docs/campaigns-and-replay.md", 3),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     run_help = "a run folder (holding run.mcap) or an archive file"

@@ -6,7 +6,9 @@ a traceback."""
 from __future__ import annotations
 
 import argparse
+import re
 import sys
+import textwrap
 
 from interfaces.contracts.topics import is_segment
 
@@ -72,3 +74,22 @@ def add_log_level(parser: argparse.ArgumentParser) -> None:
     """``--log-level LEVEL``, default INFO."""
     parser.add_argument("--log-level", type=log_level, default="INFO", metavar="LEVEL",
                         help=f"console log level: {', '.join(LOG_LEVELS)} (default %(default)s)")
+
+
+ROLES = re.compile(r":[a-z]+:`~?([^`]+)`|``([^`]+)``|`([^`]+)`")
+"""reST markup in a docstring: a role (``:class:`x```), a literal (````x````), a reference."""
+
+
+HELP_WIDTH = 79
+"""Columns of a command's description (``argparse.RawDescriptionHelpFormatter`` keeps its
+paragraphs)."""
+
+
+def command_help(doc: str | None, details: str, paragraphs: int = 1) -> str:
+    """A command's ``--help`` text from its module docstring: the first ``paragraphs``
+    (indented usage blocks left out: argparse prints its own), without reST markup, then
+    where the details are (``details``: a document of docs/)."""
+    blocks = [b for b in (doc or "").strip().split("\n\n") if not b.startswith("    ")]
+    plain = [ROLES.sub(lambda m: next(g for g in m.groups() if g is not None), " ".join(
+        b.split())) for b in blocks[:paragraphs]]
+    return "\n\n".join(textwrap.fill(b, HELP_WIDTH) for b in [*plain, f"Details: {details}"])

@@ -6,7 +6,10 @@ from __future__ import annotations
 
 import importlib
 import inspect
+import re
 import tomllib
+
+import pytest
 
 from deploy import cli
 from tests.conftest import REPO
@@ -31,3 +34,17 @@ def test_every_subcommand_is_a_main_taking_argv() -> None:
         assert callable(main)
         params = inspect.signature(main).parameters
         assert "argv" in params and params["argv"].default is None, name
+
+
+def test_every_commands_help_is_plain_and_short(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--help`` of every tool: no reST markup (backquotes, roles), a description of a few
+    paragraphs that names where the details are."""
+    for name in cli.COMMANDS:
+        with pytest.raises(SystemExit) as stop:
+            cli.main([name, "--help"])
+        assert stop.value.code == 0
+        text = capsys.readouterr().out
+        description = re.split(r"\n(?:positional arguments|options):",
+                               text.split("\n\n", 1)[1])[0]
+        assert "`" not in text and ":class:" not in text, name
+        assert "Details: docs/" in description and len(description.splitlines()) <= 20, name
