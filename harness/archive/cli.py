@@ -167,7 +167,7 @@ def export(run: Path, key_expr: str, out: Path | None) -> tuple[int, str | None]
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog=prog_name("python -m harness.archive"),
                                 description=command_help(__doc__,
-                                                         "docs/campaigns-and-replay.md", 3),
+                                                         "docs/campaigns-and-replay.md", 2),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
     run_help = "a run folder (holding run.mcap) or an archive file"
