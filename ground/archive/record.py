@@ -7,17 +7,17 @@ When ``--out`` exists already (the recorder was restarted, by the launcher's
 ``--restart-on-crash``, with the same command), it continues the run's archive in the next
 free segment, ``run-1.mcap``, ``run-2.mcap``, ... (``ground/archive/segments.py``): never over
 what exists, with the same run metadata and a ``segment`` record.  Restarted, it first records
-what every node still keeps of its last ticks (``interfaces.runtime.recent``): the chunk in
-progress when it was killed, at most one ω_mid period's worth of ticks (a chunk is closed
-after each), is among it.  It declares its liveliness token (``topics.recorder_token``) once
-subscribed, ready to record (the sim holds the clock until then).  When the network goes down
-(the sim's token gone: the router died) it takes the token back, and once the sim is seen again
-records what the nodes still keep of their last ticks before it declares it again.
-
-After each chunk it closes it tells every node the sim time of the last tick the archive now
-holds for good (``interfaces.runtime.recent.archived_key``): the nodes keep what they sent
-until then, so that a recorder killed at any moment, however late the sim holds the clock,
-finds in their replies everything it had not closed in a chunk.
+what every node keeps (``interfaces.runtime.recent``): its last ticks, and all it sent since the
+last tick the recorder told it was archived.  After each chunk it closes (one every ω_mid
+period's worth of ticks, and every 2 s of wall time) the recorder tells every node the sim
+time of the last tick written (``interfaces.runtime.recent.archived_key``), so that the chunk
+in progress when it was killed, what was in flight to it and what was sent before the sim
+held the clock are all among what the nodes keep, however late the sim held it.  It declares
+its liveliness token (``topics.recorder_token``) once subscribed and caught up, ready to
+record (the sim holds the clock until then).  When the network goes down (the sim's token
+gone: the router died) it takes the token back, and once the sim is seen again records what
+the nodes keep before it declares it again, asking each node until it answers (the nodes
+reconnect one by one).
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     nodes = [topics.SIM, *topology(start.scenario).participants]
     gate = _Gate(rec, cat.TICK.key(mission), start.scenario.rates.ticks_per("mid"))
     try:
-        if segment:  # restarted: what the nodes still keep of their last ticks, in order
+        if segment:  # restarted: what the nodes keep, in order
             gate.hold()
         transport.subscribe(topics.mission_wildcard(mission), gate.record)
         if segment:
@@ -86,9 +86,9 @@ def main(argv: list[str] | None = None) -> int:
 
 class _Gate:
     """What the recorder writes, in order.  Live samples go to the file as they come, and a
-    chunk is closed at every ``every``-th tick (each ω_mid period of sim time: a killed
-    recorder loses at most the period it was writing, which the nodes still keep of their last
-    ticks, ``interfaces.runtime.recent``).  While the network is down, or while a restarted
+    chunk is closed at every ``every``-th tick (each ω_mid period of sim time: what a killed
+    recorder loses the nodes keep until told it is archived, ``archived_ns``,
+    ``interfaces.runtime.recent``).  While the network is down, or while a restarted
     recorder takes what the nodes kept, live samples wait (``hold``); ``release`` then writes
     those kept that were not written yet and the waiting ones, sorted by sim time, so that
     every key's messages stay in order in the archive."""

@@ -2,7 +2,10 @@
 process, the ground, the router and the recorder killed in turn mid-run, each restarted (the
 nodes restored from their critical-data stores, the router on its endpoint, the recorder in a
 next segment) while the sim holds the clock: every message of the clean run of the same
-scenario and seed is in the killed run's archive, with the same content, and none is lost."""
+scenario and seed is in the killed run's archive, with the same content, and none is lost
+(the nodes keep what the recorder has not archived yet, whatever the sim flew before it held
+the clock, and the recorder asks every node again once the router is back:
+``interfaces.runtime.recent``)."""
 
 from __future__ import annotations
 
