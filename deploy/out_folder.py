@@ -10,9 +10,10 @@ be written (a read-only disk), before any work.
 
 from __future__ import annotations
 
-import os
 import shutil
 from pathlib import Path
+
+from harness.destination import DestinationError, check_folder
 
 RUN_FILES = ("run.mcap", "summary.json", "run.log", "report.md", "run.foxglove.json")
 """Files only a run writes: a folder holding one of them is a run's."""
@@ -55,22 +56,11 @@ def prepare(out: Path | None, default: Path, overwrite: bool,
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise OutFolderError(f"--out {out}: cannot make the folder: {e.strerror or e}") from None
-    writable(out)
-    return out
-
-
-def writable(folder: Path, option: str = "--out") -> Path:
-    """``folder`` if a file can be written in it (a probe written and removed), else
-    OutFolderError naming ``option``: checked before any work, so a read-only destination
-    never costs a run or a replay its results."""
-    probe = folder / f".write-probe-{os.getpid()}"
     try:
-        probe.write_bytes(b"")
-        probe.unlink()
-    except OSError as e:
-        raise OutFolderError(f"{option} {folder}: cannot write there ({e.strerror or e})"
-                             ) from None
-    return folder
+        check_folder(out, "another --out")
+    except DestinationError as e:
+        raise OutFolderError(str(e)) from None
+    return out
 
 
 def written(out: Path, layout: Path, report: bool) -> list[Path]:

@@ -75,11 +75,12 @@ from deploy.disk_space import (  # noqa: E402
     free_bytes,
     megabytes,
 )
-from deploy.out_folder import OutFolderError, writable  # noqa: E402
+from deploy.out_folder import OutFolderError  # noqa: E402
 from deploy.recorder_guard import disk_full_cause  # noqa: E402
 from harness.campaign.formation_study import write_formation_study  # noqa: E402
 from harness.campaign.neighbours_study import write_neighbours_study  # noqa: E402
 from harness.campaign.report import write_campaign_report  # noqa: E402
+from harness.destination import DestinationError, check_folder  # noqa: E402
 from harness.replay import parse_settings, scenario_with  # noqa: E402
 from harness.summary import RunSummary  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
@@ -253,7 +254,7 @@ def main(argv: list[str] | None = None) -> int:
             return _replay(args) if args.replay or args.sweep else _report_again(args)
         campaign, runs, settings = _load(args)
         args.out = _campaign_folder(args, campaign.name, runs, settings)
-    except (CampaignError, ScenarioError, OutFolderError) as e:
+    except (CampaignError, ScenarioError, OutFolderError, DestinationError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     if args.campaign.resolve() != (args.out / "campaign.toml").resolve():
@@ -291,7 +292,7 @@ def _campaign_folder(args: argparse.Namespace, name: str, runs: list[RunSpec],
     out = args.out or REPO / "runs" / f"{name}-{time.strftime('%Y%m%d-%H%M%S')}"
     if args.out is None:
         log.info("campaign folder: %s", out)
-    _destination(out, "--out")
+    check_folder(out, "--out")
     if not args.overwrite:
         _refuse_reuse(out, name, runs, settings)
     return out
@@ -331,7 +332,7 @@ def _report_again(args: argparse.Namespace) -> int:
         print("error: --campaign is required (except --report-only --out on a campaign "
               "folder)", file=sys.stderr)
         return 2
-    writable(args.out)
+    check_folder(args.out, "--out")
     saved = json.loads((args.out / "campaign.json").read_text())
     return 0 if _reports(args.out, saved["name"], saved["runs"], saved.get("study")) else 1
 
@@ -374,7 +375,7 @@ def _replay(args: argparse.Namespace) -> int:
         slug = "_".join(f"{k}={v}" for k, v in settings.items())
         dest = args.out_report or args.out / (f"sweep-{name}" if args.sweep else
                                               f"replay-{slug or 'own-settings'}")
-        _destination(dest, "--out-report" if args.out_report else "--out")
+        check_folder(dest, "--out-report" if args.out_report else "--out")
         kw = {"workers": args.workers, "cluster": args.cluster, "progress": print_progress}
         path = (sweep(args.out, name, values, dest, settings, **kw) if args.sweep
                 else rejudge(args.out, settings, dest, **kw))
@@ -383,17 +384,6 @@ def _replay(args: argparse.Namespace) -> int:
         return 2
     print(f"report: {path}", file=sys.stderr)
     return 0
-
-
-def _destination(dest: Path, option: str) -> Path:
-    """A replay's folder, made and writable before any run is judged (OutFolderError naming
-    ``option``)."""
-    try:
-        dest.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise OutFolderError(f"{option} {dest}: cannot make the folder: {e.strerror or e}"
-                             ) from None
-    return writable(dest, option)
 
 
 def _sweep_values(text: str) -> tuple[str, list[str]]:

@@ -27,9 +27,10 @@ from harness.report_scale import (  # noqa: E402
 from harness.summary import RunSummary, Scores  # noqa: E402
 from harness.summary.control import GncSeries  # noqa: E402
 from harness.summary.coverage import Coverage  # noqa: E402
-from harness.summary.declaring import LABELS, detection_test  # noqa: E402
+from harness.summary.declaring import LABELS  # noqa: E402
 from harness.summary.digest import RunDigest, digest_run  # noqa: E402
 from harness.summary.execution import cycle_slip_notes  # noqa: E402
+from harness.summary.fdir import detection_test  # noqa: E402
 from harness.summary.nav import NavErrors  # noqa: E402
 from harness.summary.truth_table import TruthTable  # noqa: E402
 from interfaces.contracts import catalogue as cat  # noqa: E402

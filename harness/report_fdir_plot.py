@@ -23,7 +23,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from harness.report_scale import figure_height_in  # noqa: E402
 from harness.summary import Detection, RunSummary  # noqa: E402
-from harness.summary.declaring import LABELS, detection_test  # noqa: E402
+from harness.summary.declaring import LABELS  # noqa: E402
+from harness.summary.fdir import detection_test  # noqa: E402
 from interfaces.contracts.messages import FdirWindow  # noqa: E402
 
 SERIES: tuple[tuple[str, str, str], ...] = (

@@ -27,13 +27,10 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Literal
+from typing import Literal
 
 from interfaces.contracts.messages import FaultReport, FdirWindow
 from interfaces.contracts.scenario import FdirSettings
-
-if TYPE_CHECKING:
-    from harness.summary.fdir import Detection
 
 TestName = Literal["information", "nis", "plan", "pointing", "dv_rate", "image_scan",
                    "nis_scan", "pointing_scan", "global_check", "common_scans",
@@ -115,17 +112,3 @@ def declared_figures(test: TestName, report: FaultReport, window: FdirWindow | N
         value, tol = POSE_TESTS[test]
         return report.evidence.get(value), float(getattr(cfg, tol))
     return report.metric, report.threshold
-
-
-def detection_test(d: Detection) -> TestName:
-    """The test that declared ``d``: as recorded, or, for a summary written before the test
-    was recorded, from the detection's own fields (a window's declaration is then taken for
-    the information test's)."""
-    if d.test is not None:
-        return d.test
-    if d.declared_by == "neighbours":
-        return "neighbours"
-    report = FaultReport(sender="summary", t_sim=d.time_s, spacecraft=d.spacecraft,
-                         fault_class=d.fault_class, window_end_s=d.time_s,
-                         evidence=d.evidence, cause=d.cause, detector=d.detector)
-    return report_test(report, None)

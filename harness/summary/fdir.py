@@ -356,3 +356,17 @@ def baseline_scores(verdicts: list[BaselineVerdict], scenario: Scenario) -> dict
                   if v.exceeded is not None]
         out[name] = score(scenario.faults, alarms, judged, grace_s=scenario.rates.fdi_period_s)
     return out
+
+
+def detection_test(d: Detection) -> TestName:
+    """The test that declared ``d``: as recorded, or, for a summary written before the test
+    was recorded, from the detection's own fields (a window's declaration is then taken for
+    the information test's)."""
+    if d.test is not None:
+        return d.test
+    if d.declared_by == "neighbours":
+        return "neighbours"
+    report = FaultReport(sender="summary", t_sim=d.time_s, spacecraft=d.spacecraft,
+                         fault_class=d.fault_class, window_end_s=d.time_s,
+                         evidence=d.evidence, cause=d.cause, detector=d.detector)
+    return report_test(report, None)

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from harness.summary.declaring import LABELS, detection_test
+from harness.summary.declaring import LABELS
 from harness.summary.document import RunSummary
-from harness.summary.fdir import Detection
+from harness.summary.fdir import Detection, detection_test
 from harness.summary.scoring import Alarm, FaultScore, false_alarms_of
 
 NAMED_MOST = 4

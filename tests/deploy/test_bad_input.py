@@ -191,13 +191,12 @@ def test_a_busy_endpoint_is_refused_before_any_work_with_a_free_one_to_give(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     import socket
 
-    from deploy.run_constellation import main as run
-
     with socket.socket() as held:
         held.bind(("127.0.0.1", 0))
         held.listen()
         port = held.getsockname()[1]
-        assert run(["--out", str(tmp_path / "run"), "--endpoint", f"tcp/127.0.0.1:{port}"]) == 2
+        assert main(["run", "--out", str(tmp_path / "run"), "--endpoint",
+                     f"tcp/127.0.0.1:{port}"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(
         f"error: --endpoint tcp/127.0.0.1:{port}: the address is in use (another run?): give "

@@ -7,7 +7,6 @@ ticks alone (a replay of a flown run: tests/missions/test_replay.py)."""
 from __future__ import annotations
 
 import shutil
-import subprocess
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -20,6 +19,7 @@ from harness.replay import main, output_name
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.messages import Tick
 from tests.conftest import small_scenario
+from tests.mounts import read_only as mounted_read_only
 
 
 @pytest.fixture
@@ -97,22 +97,11 @@ def test_a_bad_setting_is_refused_before_any_replay(
 
 @pytest.fixture
 def read_only(tmp_path: Path) -> Iterator[Path]:
-    """A folder on a read-only mount (a tmpfs remounted read-only: permissions do not stop
-    root), holding a copy of nothing yet; skipped where a mount cannot be made."""
+    """A folder to be made read-only by :func:`tests.mounts.read_only` (a bind mount remounted
+    read-only: permissions do not stop root); skipped where a mount cannot be made."""
     folder = tmp_path / "ro"
     folder.mkdir()
-    made = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", str(folder)],
-                          capture_output=True, text=True)
-    if made.returncode != 0:
-        pytest.skip(f"cannot mount a tmpfs here: {made.stderr.strip() or made.returncode}")
-    try:
-        yield folder
-    finally:
-        subprocess.run(["umount", str(folder)], check=False)
-
-
-def _remount_read_only(folder: Path) -> None:
-    subprocess.run(["mount", "-o", "remount,ro", str(folder)], check=True)
+    yield folder
 
 
 @pytest.mark.parametrize("where", ["beside the archive", "--out"])
@@ -122,14 +111,13 @@ def test_a_read_only_destination_is_refused_before_any_replay(
     replayed: list[Path] = []
     monkeypatch.setattr(harness.replay, "replay_run", lambda *a, **k: replayed.append(a[0]))
     if where == "--out":
-        _remount_read_only(read_only)
         argv, folder, option = [str(run), "--out", str(read_only / "x")], read_only / "x", \
             "another --out"
     else:
         shutil.copytree(run, read_only / "run")
-        _remount_read_only(read_only)
         argv, folder, option = [str(read_only / "run")], read_only / "run", "--out DIR"
-    assert main(argv) == 2
+    with mounted_read_only(read_only):
+        assert main(argv) == 2
     assert capsys.readouterr().err == (f"error: cannot write into {folder}: Read-only file "
                                        f"system (give {option})\n")
     assert replayed == []

@@ -40,7 +40,7 @@ INDIRECT: dict[str, str] = {
     "interfaces.contracts.messages.lockstep": _MESSAGES,
     "interfaces.contracts.messages.sim": _MESSAGES,
     **{f"interfaces.contracts.scenario.{m}": _SCENARIO
-       for m in ("base", "comms", "faults", "fdir", "flight", "ground", "mission", "model",
+       for m in ("base", "comms", "faults", "fdir", "flight", "ground", "mission",
                  "neighbours", "observers", "onboard", "planning", "rates", "sim")},
     "interfaces.contracts.timing": (
         "one constant, TIME_TOL_S: a fault switching on the tick at its time whatever the "
@@ -62,7 +62,7 @@ INDIRECT: dict[str, str] = {
     "harness.summary.control": _EVALUATION.format("tests/missions/test_gnc_run.py"),
     "harness.summary.onboard": _EVALUATION.format("tests/missions/test_onboard_fdir_run.py"),
     **{f"harness.summary.{m}": _SUMMARY
-       for m in ("access", "document", "execution", "fault_events", "recovery", "records",
+       for m in ("access", "document", "fault_events", "recovery", "records",
                  "series")},
     "harness.archive.__main__": (
         "``python -m harness.archive``, two lines handing over to harness/archive/cli.py's main "
@@ -74,9 +74,14 @@ INDIRECT: dict[str, str] = {
         "the FDIR's stages in their order, driven by the FDIR app: "
         "tests/ground/apps/test_fdir.py feeds it message by message, "
         "tests/ground/fdir/test_stages.py tests each stage"),
-    "deploy.processes": (
-        "the launcher's supervision of OS processes: tests/missions/test_constellation.py "
-        "(dead, stalled and restarted processes, a terminated launcher)"),
+    "harness.report_head": (
+        "the opening of report.md (verdict, settings, status), written by "
+        "harness/report.py's write_report: tests/harness/test_report.py reads it in a real "
+        "report"),
+    "harness.summary.declaring": (
+        "which test declared each report, filled into summary.json's detections by "
+        "harness/summary/fdir.py: tests/harness/summary/test_verdict.py and "
+        "tests/harness/test_report.py read it from summaries"),
 }
 """Module -> why no test imports it directly (and which test exercises it)."""
 

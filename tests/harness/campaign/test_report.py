@@ -370,6 +370,6 @@ def test_a_malformed_summary_is_refused_naming_its_file_and_field(tmp_path: Path
     bad.mkdir()
     text = (tmp_path / "runs" / "ok" / "summary.json").read_text()
     (bad / "summary.json").write_text(text.replace('"nominal_cycles": 1', '"nominal_cycles": -1'))
-    with pytest.raises(SummaryError, match=r"runs/bad/summary\.json: .*\nscores\.nominal_cycles\n"
-                                           r".*greater than or equal to 0"):
+    with pytest.raises(SummaryError, match=r"runs/bad/summary\.json: .*scores\.nominal_cycles "
+                                           r"= -1: should be greater than or equal to 0"):
         write_campaign_report(tmp_path, "x", ["ok", "bad"])
