@@ -42,6 +42,10 @@ MARGIN = 1.25
 runs about 25 % above what a run writes."""
 
 
+_CHUNK = 1 << 20
+"""What a reserve takes at a time when the disk has less than it asks (bytes)."""
+
+
 class DiskSpaceError(OSError):
     """The run's folder has too little free space; the message gives the figures."""
 
@@ -111,10 +115,14 @@ class Reserve:
     def __post_init__(self) -> None:
         self.path = self.folder / RESERVE_NAME
         try:
-            with open(self.path, "wb") as f:
-                os.posix_fallocate(f.fileno(), 0, self.nbytes)
+            with open(self.path, "wb", buffering=0) as f:
+                try:
+                    os.posix_fallocate(f.fileno(), 0, self.nbytes)
+                except OSError:  # all or nothing: take what the disk has, a chunk at a time
+                    for _ in range(0, self.nbytes, _CHUNK):
+                        f.write(bytes(_CHUNK))
         except OSError:
-            pass  # as much as the disk had: what is there is released all the same
+            pass  # the disk is full: what is held is released all the same
 
     def release(self) -> None:
         """Give the space back (idempotent)."""

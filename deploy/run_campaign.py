@@ -80,7 +80,7 @@ from deploy.recorder_guard import disk_full_cause  # noqa: E402
 from harness.campaign.formation_study import write_formation_study  # noqa: E402
 from harness.campaign.neighbours_study import write_neighbours_study  # noqa: E402
 from harness.campaign.report import write_campaign_report  # noqa: E402
-from harness.destination import DestinationError, check_folder  # noqa: E402
+from harness.destination import DestinationError, check_folder, write_whole  # noqa: E402
 from harness.replay import parse_settings, scenario_with  # noqa: E402
 from harness.summary import RunSummary  # noqa: E402
 from interfaces.contracts.scenario import ScenarioError  # noqa: E402
@@ -259,7 +259,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     if args.campaign.resolve() != (args.out / "campaign.toml").resolve():
         shutil.copyfile(args.campaign, args.out / "campaign.toml")
-    (args.out / "campaign.json").write_text(json.dumps(
+    write_whole(args.out / "campaign.json", json.dumps(
         {"name": campaign.name, "runs": [r.id for r in runs], "study": campaign.study,
          "settings": settings}, indent=1) + "\n")
     status = 0
@@ -481,7 +481,7 @@ def _write_retries(out: Path, retry: dict[str, str]) -> None:
     path = out / "retry.json"
     try:
         if retry:
-            path.write_text(json.dumps(retry, indent=1) + "\n")
+            write_whole(path, json.dumps(retry, indent=1) + "\n")
             log.warning("%d runs to fly again (stopped by their host, not by themselves): %s",
                         len(retry), path)
         else:

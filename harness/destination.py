@@ -38,3 +38,14 @@ def check_file(file: Path, overwrite: bool, option: str) -> None:
     if file.exists() and not overwrite:
         raise DestinationError(f"{file} exists: give --overwrite to replace it, or {option}")
     check_folder(file.parent, option)
+
+
+def write_whole(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` whole or not at all: written beside, then renamed over it,
+    so a full disk or a kill leaves the old file or none, never an empty or cut one."""
+    partial = path.with_name(f".{path.name}.partial")
+    try:
+        partial.write_text(text, encoding="utf-8")
+        partial.replace(path)
+    finally:
+        partial.unlink(missing_ok=True)

@@ -7,6 +7,7 @@ from typing import Literal
 
 from pydantic import Field, ValidationError
 
+from harness.destination import write_whole
 from harness.summary.access import AccessAudit
 from harness.summary.archive_info import ArchiveInfo, MessageCounts
 from harness.summary.control import GncStats
@@ -109,12 +110,7 @@ class RunSummary(SummaryRecord):
     def write(self, path: Path) -> None:
         """Write the summary to ``path`` (indent 2, a final newline), whole or not at all: it
         is written beside and renamed, so a full disk leaves no empty or cut summary."""
-        partial = path.with_name(f".{path.name}.partial")
-        try:
-            partial.write_text(self.to_json() + "\n")
-            partial.replace(path)
-        finally:
-            partial.unlink(missing_ok=True)
+        write_whole(path, self.to_json() + "\n")
 
     @classmethod
     def read(cls, path: Path) -> RunSummary:

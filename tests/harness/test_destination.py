@@ -33,3 +33,24 @@ def test_a_file_is_not_replaced_unless_asked(tmp_path: Path, make: object, overw
     if target.is_file():
         assert target.read_text() == "kept"
         check_file(target, True, "--out")  # --overwrite: accepted
+
+
+def test_a_file_is_written_whole_or_not_at_all(tmp_path: Path) -> None:
+    """A disk that fills while a file is rewritten leaves the old file, whole, and no part
+    of the new one."""
+    import errno
+
+    from harness.destination import write_whole
+    from tests.mounts import tmpfs
+
+    with tmpfs(tmp_path / "disk", 1.0) as disk:
+        target = disk / "summary.json"
+        write_whole(target, "old\n")
+        with open(disk / "filler", "wb", buffering=0) as f, pytest.raises(OSError):
+            while True:  # as much as there is
+                f.write(bytes(65536))
+        with pytest.raises(OSError) as full:
+            write_whole(target, "x" * 100_000)
+        assert full.value.errno == errno.ENOSPC
+        assert target.read_text() == "old\n"
+        assert sorted(p.name for p in disk.iterdir()) == ["filler", "summary.json"]
