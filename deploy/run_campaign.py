@@ -101,7 +101,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                         "required with --report-only without --campaign, --replay, --sweep)")
     p.add_argument("--overwrite", action="store_true",
                    help="fly into an --out whose finished runs were flown with other settings "
-                        "or another campaign file, replacing them")
+                        "or another campaign file, replacing them; with --replay/--sweep, "
+                        "replace a replay already in its folder")
     p.add_argument("--skip-disk-check", action="store_true",
                    help="start even when --out's disk looks too small for one run")
     p.add_argument("--workers", type=positive_int, default=os.cpu_count() or 1,
@@ -375,7 +376,11 @@ def _replay(args: argparse.Namespace) -> int:
         slug = "_".join(f"{k}={v}" for k, v in settings.items())
         dest = args.out_report or args.out / (f"sweep-{name}" if args.sweep else
                                               f"replay-{slug or 'own-settings'}")
-        check_folder(dest, "--out-report" if args.out_report else "--out")
+        option = "--out-report" if args.out_report else "another --out-report"
+        if (dest / "report.md").exists() and not args.overwrite:
+            raise DestinationError(f"{dest} holds a replay already: give --overwrite to replace "
+                                   f"it, or {option}")
+        check_folder(dest, option)
         kw = {"workers": args.workers, "cluster": args.cluster, "progress": print_progress}
         path = (sweep(args.out, name, values, dest, settings, **kw) if args.sweep
                 else rejudge(args.out, settings, dest, **kw))

@@ -249,3 +249,18 @@ def test_a_read_only_campaign_folder_is_refused_before_any_work(
         assert run_campaign(["--campaign", str(path), "--out", str(out)]) == 2
         assert "Read-only file system" in capsys.readouterr().err
     assert (out / "report.md").read_bytes() == report
+
+
+def test_a_campaign_replay_is_not_replaced_without_overwrite(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path, out = _campaign(tmp_path), tmp_path / "out"
+    assert run_campaign(["--campaign", str(path), "--out", str(out), "--report-only"]) == 0
+    earlier = out / "replay-fdir.floor=0.05"
+    earlier.mkdir()
+    (earlier / "report.md").write_text("an earlier replay")
+    capsys.readouterr()
+    assert run_campaign(["--out", str(out), "--replay", "--set", "fdir.floor=0.05"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"error: {earlier} holds a replay already: give --overwrite to replace it, "
+                   "or another --out-report"]
+    assert (earlier / "report.md").read_text() == "an earlier replay"
