@@ -464,6 +464,11 @@ def _run_locked(runs: list[RunSpec], todo: list[RunSpec], args: argparse.Namespa
     finally:
         signal.signal(signal.SIGTERM, main_thread)
     _write_retries(args.out, progress.retry)
+    if status == 0 and progress.retry:
+        print(f"error: {len(progress.retry)} runs were stopped by their host, not by "
+              f"themselves ({args.out / 'retry.json'}): run the same command again to fly them",
+              file=sys.stderr)
+        return 1
     return status
 
 

@@ -264,3 +264,23 @@ def test_a_campaign_replay_is_not_replaced_without_overwrite(
     assert err == [f"error: {earlier} holds a replay already: give --overwrite to replace it, "
                    "or another --out-report"]
     assert (earlier / "report.md").read_text() == "an earlier replay"
+
+
+def test_a_run_stopped_by_its_host_is_flown_again_not_failed(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A full disk is the host's fault, not the run's: the attempt is removed and the result
+    is ``retry`` with the cause, so the run is not finished and a resume flies it."""
+    import errno
+
+    import deploy.inproc
+    from deploy.campaign import execute_run, finished
+
+    def disk_full(*_a: object, **_k: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(deploy.inproc, "run_inproc", disk_full)
+    _, runs = load_campaign(_campaign(tmp_path))
+    result = execute_run(runs[0], str(tmp_path / "out"))
+    assert result["status"] == "retry" and result["error"].startswith("disk full")
+    assert list((tmp_path / "out" / "runs").iterdir()) == []
+    assert not finished(runs[0], tmp_path / "out")
