@@ -37,6 +37,7 @@ from typing import Any, Final, Literal
 
 from gnc.passes import scenario_pass_table
 from harness import foxglove_scene as scene
+from harness.destination import write_whole
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts.scenario import Fault, Scenario
 from interfaces.contracts.topics import GROUND, sc_node
@@ -82,7 +83,7 @@ def write_layout(out: Path, scenario: Scenario, mission: str | None = None) -> P
     default); returns its path."""
     path = out / LAYOUT_FILE
     doc = layout(scenario, mission or scenario.name)
-    path.write_text(json.dumps(doc, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
+    write_whole(path, json.dumps(doc, indent=1, ensure_ascii=False) + "\n")
     return path
 
 

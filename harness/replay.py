@@ -67,7 +67,7 @@ from harness.archive.locate import archive_file
 from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
 from harness.archive.run_scenario import archived_scenario, scenario_from_metadata
 from harness.archive.span import ArchiveSpan
-from harness.destination import DestinationError, check_file
+from harness.destination import DestinationError, check_file, write_whole
 from harness.summary import ReplayResults
 from harness.summary.delay_bound import NisSeries
 from harness.summary.fdir import archived_nis, fdir_results
@@ -414,7 +414,7 @@ def _checked(run: Path, file: Path, out: Path | None, settings: dict[str, str],
 def _write(replay: Replay, run: Path, dest: Path) -> None:
     """Write the replay's results to ``dest`` and say what it found in one line."""
     res = replay.results()
-    dest.write_text(res.to_json(indent=1))
+    write_whole(dest, res.to_json(indent=1))
     dets = ", ".join(f"sc{d.spacecraft} {d.fault_class or 'unidentified'} at {d.time_s:.0f} s"
                      + ("" if d.faithful else " (after divergence)")
                      for d in res.detections) or "no detection"

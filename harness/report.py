@@ -15,6 +15,7 @@ import numpy as np  # noqa: E402
 from ground.archive.segments import run_archive  # noqa: E402
 from harness.archive.reader import ArchiveError, RunArchive  # noqa: E402
 from harness.archive.span import seconds  # noqa: E402
+from harness.destination import write_whole  # noqa: E402
 from harness.report_fdir_plot import plot_fdir  # noqa: E402
 from harness.report_head import head_lines  # noqa: E402
 from harness.report_scale import (  # noqa: E402
@@ -68,7 +69,7 @@ def write_report(out: Path, scenario: Scenario, mission: str | None = None,
 
 def _write(out: Path, lines: list[str]) -> Path:
     path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n")
+    write_whole(path, "\n".join(lines) + "\n")
     return path
 
 

@@ -60,6 +60,7 @@ from harness.campaign.targets import (  # noqa: E402
     target_figures,
     target_lines,
 )
+from harness.destination import write_whole  # noqa: E402
 from harness.summary.scoring import EXPECTED_CLASS  # noqa: E402
 
 CLASSES = ("actuator", "camera", "state_sensor", "link", "data_integrity", "common_mode", None)
@@ -155,7 +156,7 @@ def write_campaign_report(out: Path, name: str, ids: Sequence[str]) -> Path:
     _roc_plot(out, runs, detectors)
     _margin_plot(out, margins)
     path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n")
+    write_whole(path, "\n".join(lines) + "\n")
     return path
 
 
