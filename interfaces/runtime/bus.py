@@ -405,8 +405,17 @@ class Bus:
         self._seq = {}
 
     def send_again(self, key: str, msg: Message) -> None:
-        """Send a message this node published already, as it was (same number): a receiver
-        that had it drops it as a duplicate, one that missed it takes it."""
+        """Send again the answer to the last tick this node ran, ``msg``, as it was (same
+        number), and before it what else the node sent in that tick (``RecentSent.last_tick``;
+        not the answer to the tick before, sent in it too):
+        the sim not having the answer, the tick's messages may be lost too, with the network
+        or with the process, killed before its transport sent them (restored from its store of
+        that tick, it does not run the tick again).  A receiver that had them drops them as
+        duplicates, one that missed them takes them; the recorder writes them, and the archive
+        keeps each once."""
+        for sample in self.recent.last_tick():
+            if sample.key != key:
+                self.transport.send(sample)
         self.transport.send(Sample(key, type(msg).__name__, message=msg))
 
     def serve_recent(self) -> None:

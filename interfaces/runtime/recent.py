@@ -126,6 +126,10 @@ class RecentSent:
         self._ticks.append(_Tick())
         self._trim()
 
+    def last_tick(self) -> list[Sample]:
+        """The samples of the last tick that has ended (none before the first)."""
+        return list(self._ticks[-2].samples) if len(self._ticks) > 1 else []
+
     def archived(self, key: str) -> None:
         """Query responder of ``archived_key``: the recorder archived every tick up to the
         sim time its last segment names (ns).  Nothing is replied."""

@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import json
+import pickle
 import time
 from collections.abc import Iterator
 
 import pytest
 
+from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
-from interfaces.contracts.messages import Heartbeat, StateEstimate, json_schema
+from interfaces.contracts.messages import Heartbeat, StateEstimate, TickDone, json_schema
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.recent import archived_key, fetch_recent, recover
 from interfaces.runtime.transport import InprocNetwork
@@ -174,3 +176,26 @@ def test_what_a_node_missed_is_sent_again_on_request(pair) -> None:  # noqa: ANN
     raw.serve(topics.recent_queryable(M, "sc3"), lambda _k: b'[["x"]]')  # a broken answer
     time.sleep(0.3)
     assert fetch_recent(bus_b, "sc3") == [] and bus_b.stats.invalid_dropped == 1
+
+
+@pytest.mark.parametrize("restored", [False, True])
+def test_an_answer_sent_again_brings_its_ticks_messages_again(restored: bool) -> None:
+    """The sim did not get a node's answer to a tick (lost with the network, or with the
+    process killed before its transport sent it, ``restored`` from its store of that tick):
+    the node sends the tick's messages again, as they were, then the answer; not the answer
+    to the tick before."""
+    net = InprocNetwork()
+    bus, raw = Bus("sc1", M, net.endpoint()), net.endpoint()
+    seen: list[tuple[str, int]] = []
+    raw.subscribe(f"insp/{M}/sc/1/**", lambda k, _t, p: seen.append(
+        (k.rsplit("/", 1)[-1], json.loads(p)["seq"])))
+    done_key, beat = cat.TICK_DONE.key(M, "sc1"), topics.key(M, "sc1", "exec", "heartbeat")
+    for k in (1, 2):
+        bus.publish(beat, _hb(float(k)))
+        done = TickDone(sender="sc1", t_sim=float(k), k=k, published=bus.published_since_last())
+        bus.publish(done_key, done, announce=False)
+    if restored:
+        bus.recent.restore(pickle.loads(pickle.dumps(bus.recent.checkpoint())))
+    seen.clear()
+    bus.send_again(done_key, done)
+    assert seen == [("heartbeat", 2), ("tick_done", 2)]
