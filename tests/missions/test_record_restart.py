@@ -28,8 +28,6 @@ from interfaces.runtime.recent import parse_reply
 from interfaces.runtime.zenoh_transport import ZenohSettings, ZenohTransport
 from tests.conftest import small_scenario, write_scenario
 
-pytestmark = pytest.mark.mission  # starts recorder processes
-
 M = "recrestart"
 REPO = Path(__file__).resolve().parents[3]
 DT_S = 0.5
