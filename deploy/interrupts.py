@@ -30,10 +30,15 @@ class Interrupts:
     _previous: dict[int, Any] = field(default_factory=dict)
 
     def _handle(self, signum: int, _frame: FrameType | None) -> None:
+        """Note the signal and react on a thread of its own: a handler runs in the main thread
+        between two of its bytecodes, maybe while it holds a lock the reaction needs (the
+        stop event's, which the launcher's watch waits on; the logging module's), and a
+        reaction taking that lock there would wait for ever."""
         first = self.signum is None
         self.signum = self.signum or signum
         if first:
-            self.react(signum)
+            threading.Thread(target=self.react, args=(signum,), name="interrupt",
+                             daemon=True).start()
 
     def __enter__(self) -> Interrupts:
         if threading.current_thread() is threading.main_thread():

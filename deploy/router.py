@@ -30,6 +30,8 @@ import threading
 from collections import Counter
 from pathlib import Path
 
+from interfaces.runtime.signals import signal_setter
+
 AUDIT_TARGETS = ("warn,zenoh::net::routing::interceptor::access_control=trace,"
                  "zenoh_transport::unicast::establishment::accept=debug")
 """Zenoh log directives of an audited router: access-control decisions, authentication."""
@@ -190,7 +192,7 @@ def main(argv: list[str] | None = None) -> int:
     zenoh.init_log_from_env_or("warn")
     stop = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
+        signal.signal(sig, signal_setter(stop))
     try:
         session = zenoh.open(zenoh.Config.from_file(str(args.config)))
     except Exception as e:  # noqa: BLE001 - zenoh raises ZError

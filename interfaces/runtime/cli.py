@@ -24,6 +24,7 @@ from interfaces.runtime.fleet import fleets_of
 from interfaces.runtime.link_stage import LinkStageFactory
 from interfaces.runtime.recent import depth_for
 from interfaces.runtime.restart import resume_together
+from interfaces.runtime.signals import signal_setter
 from interfaces.runtime.zenoh_transport import (
     DEFAULT_ENDPOINT,
     SharedReceiver,
@@ -106,12 +107,8 @@ def start_node(args: argparse.Namespace, name: str) -> NodeStart:
 def stop_on_signals() -> threading.Event:
     """An event set by SIGINT/SIGTERM, so a node finishes its loop and closes cleanly."""
     stop = threading.Event()
-
-    def handler(signum: int, _frame: object) -> None:
-        stop.set()
-
-    signal.signal(signal.SIGINT, handler)
-    signal.signal(signal.SIGTERM, handler)
+    signal.signal(signal.SIGINT, signal_setter(stop))
+    signal.signal(signal.SIGTERM, signal_setter(stop))
     return stop
 
 
