@@ -135,7 +135,8 @@ class RecorderProcess:
         self._batch: list[Pending] = []
         self._closed = False
         self.t_last_s: float | None = None
-        """Sim time (s) of the last sample handed over with a sim time (None: none yet)."""
+        """Sim time (s) of the last sample sent to the child with a sim time (None: none
+        yet): where a child that died stopped, within a batch."""
 
     def record_sample(self, sample: Sample) -> None:
         """Queue one bus sample for the archive."""
@@ -144,12 +145,12 @@ class RecorderProcess:
     def take(self, pending: Pending) -> None:
         """Queue one sample already prepared (:func:`prepare_sample`)."""
         self._batch.append(pending)
-        if pending[5] is not None:
-            self.t_last_s = pending[5] * 1e-9
         if len(self._batch) >= BATCH:
             self._send()
 
     def _send(self) -> None:
+        self.t_last_s = next((p[5] * 1e-9 for p in reversed(self._batch) if p[5] is not None),
+                             self.t_last_s)  # once a batch, not once a sample
         data, self._batch = pickle.dumps(self._batch, protocol=pickle.HIGHEST_PROTOCOL), []
         try:
             self._conn.send_bytes(data)

@@ -65,10 +65,11 @@ class _Tick:
         self.t_ns = -1
         self.size = 0
 
-    def close(self, count_bytes: bool) -> None:
-        """The tick has ended: its latest sim time and, with ``count_bytes``, its size."""
-        self.t_ns = max((_t_ns(s) for s in self.samples), default=-1)
-        if count_bytes:
+    def close(self, until_archived: bool) -> None:
+        """The tick has ended: with ``until_archived`` (the only use of both), its latest sim
+        time and its size; nothing otherwise (a tick of every node in every run: no work)."""
+        if until_archived:
+            self.t_ns = max((_t_ns(s) for s in self.samples), default=-1)
             self.size = sum(len(s.payload) for s in self.samples)
 
 
