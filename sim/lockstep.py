@@ -6,7 +6,9 @@ sim's waits on them.
   any more, and the sim flies on with its last commands held; unless restarts are supervised
   (``hold_s``): then the open tick waits for it up to ``hold_s``, and is sent again when it is
   back (restored from its critical-data store, it runs the tick as if nothing happened).
-* One seen again is named in the ticks' ``rejoin`` until it answers a tick.
+* One seen again is named in the ticks' ``rejoin`` until it answers a tick.  One that answers
+  the open tick is back even before its token is seen (a restored node runs that tick as it
+  catches up, before it announces itself).
 * Both are recorded with their sim time (``events``) for the final status.
 * An answer counts only for the current tick, and announces only keys of its sender's own space.
 
@@ -76,6 +78,8 @@ class Lockstep:
                 self.answers[msg.sender] = {k: s for k, s in msg.published.items()
                                             if k.startswith(own)}
                 self.rejoining.discard(msg.sender)
+                if msg.sender in self._dead:  # back before its token: a restarted node
+                    self._rejoined(msg.sender)  # answers the open tick as it catches up
                 self._cond.notify_all()
 
     def on_liveness(self, node: str, alive: bool) -> None:
@@ -96,12 +100,9 @@ class Lockstep:
             elif alive:
                 self._alive.add(node)
                 if node in self._dead:
-                    self._dead.discard(node)
-                    self._lost_at.pop(node, None)
                     self.rejoining.add(node)
                     self._back.add(node)
-                    self.events.setdefault(node, []).append(("rejoined", t))
-                    self.log.warning("participant %s rejoined at t=%.1f s", node, t)
+                    self._rejoined(node)
             elif node in self.participants and node in self._alive:
                 self._alive.discard(node)
                 if self._answer_k < self.last_tick:
@@ -113,6 +114,15 @@ class Lockstep:
                                    f"holding the clock up to {self.hold_s:.0f} s for its restart"
                                    if self.hold_s > 0.0 else "flying on with its last commands")
             self._cond.notify_all()
+
+    def _rejoined(self, node: str) -> None:
+        """Under the lock: lost ``node`` is back in the lockstep, now (its liveliness token
+        seen again, or its answer to the open tick, whichever comes first)."""
+        t = self.now()
+        self._dead.discard(node)
+        self._lost_at.pop(node, None)
+        self.events.setdefault(node, []).append(("rejoined", t))
+        self.log.warning("participant %s rejoined at t=%.1f s", node, t)
 
     def hold_for_services(self) -> float:
         """Before the next tick, with restarts supervised (``hold_s``): wait while the recorder,

@@ -102,6 +102,29 @@ def test_a_lost_participant_holds_the_tick_until_it_is_back_and_is_sent_it_again
     assert time.monotonic() - t0 < 0.2 and ls.held_s == 0.0
 
 
+def test_an_answer_to_the_open_tick_is_the_rejoin_even_before_the_token() -> None:
+    """A restored node runs the open tick as it catches up, before it announces itself: its
+    answer ends the hold, and the rejoin is dated at that tick, not at the token's later one."""
+    now = [4.0]
+    ls = _lockstep(now)
+    ls.hold_s = 60.0
+    for node in ("sc1", "sc2"):
+        ls.on_liveness(node, True)
+    ls.open_tick(8)
+    ls.on_done(_done("sc1", 8, {}))
+    ls.on_liveness("sc2", False)
+    threading.Timer(0.1, ls.on_done, (_done("sc2", 8, {}),)).start()
+    t0 = time.monotonic()
+    ls.collect_answers(8, deadline=time.monotonic())
+    assert time.monotonic() - t0 < 30.0 and set(ls.answers) == {"sc1", "sc2"}
+    now[0] = 4.5
+    assert ls.open_tick(9) == []  # answered: not named rejoining
+    ls.on_liveness("sc2", True)  # its token, a tick later: no second event
+    assert ls.events_now() == {"sc2": [("lost", 4.0), ("rejoined", 4.0)]}
+    ls.on_done(_done("sc1", 9, {}))
+    ls.on_done(_done("sc2", 9, {}))
+    assert ls.collect_answers(9, deadline=time.monotonic()) == {} and ls.missed_answers == 0
+
 def test_the_clock_holds_while_the_recorder_restarts() -> None:
     ls = _lockstep([3.0])
     assert ls.hold_for_services() == 0.0  # no restarts supervised
