@@ -71,8 +71,6 @@ from ground.archive.metadata import run_metadata  # noqa: E402
 from ground.archive.recorder_process import RecorderDied, RecorderProcess  # noqa: E402
 from ground.archive.segments import remove_segments, run_archive  # noqa: E402
 from harness.archive.reader import ArchiveError  # noqa: E402
-from harness.foxglove_layout import write_layout  # noqa: E402
-from harness.report import write_report  # noqa: E402
 from harness.summary import AccessAudit, RunSummary  # noqa: E402
 from harness.summary.build import add_recovery_comparison, write_summary  # noqa: E402
 from harness.summary.digest import LiveDigest, RunDigest, digest_run  # noqa: E402
@@ -289,6 +287,8 @@ def _write_run(scenario: Scenario, mission: str, out: Path, args: argparse.Names
     """The run's summary, layout, counterfactual and report, each written whatever the others
     do: a file that cannot be written is named in the log, in one line, and the run goes on
     to the next.  The summary and the layout's path (None: not written)."""
+    from harness.foxglove_layout import write_layout  # the wrap-up's: not at start-up
+
     status, error = outcome
     digest = digest or _read_archive(out, scenario, mission)
     summary = write_summary(out, scenario, transport=args.transport, wall_s=wall_s,
@@ -299,6 +299,8 @@ def _write_run(scenario: Scenario, mission: str, out: Path, args: argparse.Names
         summary = _compare_recovery(scenario, mission, out, args.scenario.read_text(
             encoding="utf-8"), args, summary)
     if not args.no_report:
+        from harness.report import write_report  # matplotlib: only when a report is written
+
         _attempt("report.md", lambda: write_report(out, scenario, mission, digest=digest,
                                                    settings=_launch_settings(args)))
     return summary, layout
@@ -448,6 +450,8 @@ def _live_view(args: argparse.Namespace) -> LiveView | None:
 def _compare_recovery(scenario: Scenario, mission: str, out: Path, scenario_text: str,
                       args: argparse.Namespace, summary: RunSummary) -> RunSummary:
     """Run the counterfactual (recovery flipped) in-process and add the comparison."""
+    from harness.foxglove_layout import write_layout
+
     flipped = scenario.model_copy(update={"fdir": scenario.fdir.model_copy(
         update={"recovery": not scenario.fdir.recovery})})
     other = out / "counterfactual"

@@ -21,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from scipy.stats import chi2
+from gnc.chi2 import chi2_quantile
 
 NIS_DOF = 6
 """Measurement dimension of the relative-navigation update (position and velocity)."""
@@ -33,7 +33,7 @@ def nis_window_test(nis: Sequence[float], alpha: float,
     without any update."""
     if not nis:
         return None
-    return float(sum(nis)), float(chi2.ppf(1.0 - alpha, dof * len(nis)))
+    return float(sum(nis)), float(chi2_quantile(1.0 - alpha, dof * len(nis)))
 
 
 @dataclass

@@ -26,8 +26,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2
 
+from gnc.chi2 import chi2_quantile
 from gnc.hardware_threshold import RatioModel
 
 MIN_OBSERVERS = 3
@@ -107,4 +107,4 @@ def common_factor_fits(gains: Sequence[ObserverGain], q: float) -> bool:
     if not c > 0.0:
         return False
     stat = float(np.sum(((x - c * mu) / (c * sd)) ** 2))
-    return stat <= float(chi2.ppf(1.0 - q, len(gains) - 1))
+    return stat <= float(chi2_quantile(1.0 - q, len(gains) - 1))

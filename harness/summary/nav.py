@@ -13,8 +13,8 @@ from pydantic import (
     SerializerFunctionWrapHandler,
     WrapSerializer,
 )
-from scipy.stats import chi2
 
+from gnc.chi2 import chi2_quantile
 from gnc.kalman import nees
 from harness.archive.reader import RunArchive
 from harness.summary.records import Figure, SummaryRecord
@@ -69,7 +69,7 @@ class NavErrors:
             return {}
         e, q = self.error[m], self.nees[m]
         pos, vel = np.linalg.norm(e[:, :3], axis=1), np.linalg.norm(e[:, 3:], axis=1)
-        lo, hi = chi2.ppf([0.025, 0.975], 6)
+        lo, hi = chi2_quantile([0.025, 0.975], 6)
         nis = self.nis[m][np.isfinite(self.nis[m])]
         return {
             "samples": int(m.sum()),
