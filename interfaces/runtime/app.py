@@ -10,9 +10,10 @@ an app's step stays short.
 from __future__ import annotations
 
 import logging
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from operator import attrgetter
-from typing import ClassVar
+from typing import ClassVar, Self
 
 import numpy as np
 
@@ -117,6 +118,17 @@ class App:
     def step(self, t: float) -> None:
         """Run one cycle at simulation time ``t`` (s)."""
         raise NotImplementedError
+
+    @classmethod
+    def step_all(cls, apps: Sequence[Self], t: float) -> Sequence[Self]:
+        """Run one cycle at ``t`` (s) of ``apps``, this class's apps on the spacecraft of one
+        fleet (the nodes one process hosts: ``interfaces.runtime.fleet``), together, and
+        return those left to their own :meth:`step`.  A class that batches over spacecraft
+        (over arrays) overrides it; each member must receive, hold and publish exactly what
+        its own ``step`` would (bits equal), and a member whose row fails is that
+        spacecraft's failure alone: left to its own ``step``, or its error raised there.
+        The default batches nothing."""
+        return apps
 
     def checkpoint(self) -> dict[str, object]:
         """The CRITICAL attributes and the app's random stream's state (to be pickled at once:

@@ -135,12 +135,7 @@ class Executive:
         published)."""
         if not self.begin_tick(tick, barrier):
             return
-        for g in self.due_groups(tick.k):
-            self.bus.dispatch(tick.t_sim)
-            start = time.perf_counter()
-            for app in self.groups[g]:
-                self.run_app(app, tick.t_sim)
-            self.count_group(g, 1e3 * (time.perf_counter() - start))
+        step_together([self], tick)  # an executive alone is a fleet of one
         self.end_tick(tick)
 
     def begin_tick(self, tick: Tick, barrier: bool) -> bool:
@@ -168,12 +163,23 @@ class Executive:
         try:
             app.step(t)
         except Exception:  # noqa: BLE001 - one app's failure must not stop the node
-            self.app_errors += 1
-            if self.app_errors <= 5 or self.app_errors % 100 == 0:
-                self.log.exception("%s: app %s failed at t=%.3f s (error #%d)",
-                                   self.bus.node, app.NAME, t, self.app_errors)
-        self._run.append((app.NAME, 1e3 * (time.thread_time() - started)))
+            self.app_failed(app, t)
+        self.note_app(app, 1e3 * (time.thread_time() - started), t)
+
+    def note_app(self, app: App, cpu_ms: float, t: float) -> None:
+        """``app`` ran at ``t`` (s) in a step shared with other members of its fleet
+        (``App.step_all``), its share of the CPU time ``cpu_ms`` (ms), for the group's run."""
+        self._run.append((app.NAME, cpu_ms))
         self._run_t = t
+
+    def app_failed(self, app: App, t: float, batched: bool = False) -> None:
+        """Count and log (rate-limited) a failure of ``app`` at ``t`` (s), raised in its own
+        step or, ``batched``, in a step it shared with its fleet (every member counts it)."""
+        self.app_errors += 1
+        if self.app_errors <= 5 or self.app_errors % 100 == 0:
+            self.log.exception("%s: app %s failed at t=%.3f s%s (error #%d)", self.bus.node,
+                               app.NAME, t, " in its fleet's shared step" if batched else "",
+                               self.app_errors)
 
     def count_group(self, g: RateGroupName, wall_ms: float) -> None:
         """Group ``g`` ran its apps (:meth:`run_app`; ``wall_ms``: the run's wall time, ms):
@@ -258,6 +264,53 @@ class Executive:
         if self.bus.channel is not None:
             self.bus.publish(self._keys["links"], LinkStats(
                 sender=node, t_sim=t, node=node, links=self.bus.channel.counters()))
+
+
+def step_together(members: Sequence[Executive], tick: Tick) -> None:
+    """The rate-group loop, for an executive alone (a fleet of one) and for the executives of
+    the spacecraft one process hosts (``interfaces.runtime.fleet``).  For each group due at
+    ``tick``: every member's bus delivers its due messages; then each app slot (the same app
+    class in the same place on every member) runs for all members together, its class's
+    :meth:`App.step_all` first and every member it leaves by its own ``step``; each member's
+    group run is judged on its CPU time (``Executive.count_group``).  A message a member
+    publishes is delivered at a later tick (``Inbox``), so the order changes nothing any
+    member receives."""
+    t = tick.t_sim
+    for g in members[0].due_groups(tick.k):
+        for m in members:
+            m.bus.dispatch(t)
+        spent = [0.0] * len(members)
+        for slot in zip(*(m.groups[g] for m in members), strict=True):
+            _step_slot(members, list(slot), t, spent)
+        for m, s in zip(members, spent, strict=True):
+            m.count_group(g, 1e3 * s)
+
+
+def _step_slot(members: Sequence[Executive], apps: list[App], t: float,
+               spent: list[float]) -> None:
+    """One app slot of ``members`` at ``t`` (s): stepped together where the class batches
+    (its CPU time shared evenly among the members it stepped; a failure of the shared step is
+    every member's), the rest each alone.  ``spent``: each member's wall time so far (s)."""
+    left = apps
+    if type(apps[0]).step_all is not App.step_all:
+        wall, cpu = time.perf_counter(), time.thread_time()
+        try:
+            left = list(type(apps[0]).step_all(apps, t))
+        except Exception:  # noqa: BLE001 - the fleet's failure must not stop the process
+            left = []
+            for m, app in zip(members, apps, strict=True):
+                m.app_failed(app, t, batched=True)
+        done = [i for i, app in enumerate(apps) if all(app is not x for x in left)]
+        cpu_ms = 1e3 * (time.thread_time() - cpu) / max(1, len(done))
+        wall_s = (time.perf_counter() - wall) / max(1, len(done))
+        for i in done:
+            members[i].note_app(apps[i], cpu_ms, t)
+            spent[i] += wall_s
+    for i, app in enumerate(apps):
+        if any(app is x for x in left):
+            start = time.perf_counter()
+            members[i].run_app(app, t)
+            spent[i] += time.perf_counter() - start
 
 
 def serve_together(clients: Sequence[TickClient], stop: threading.Event | None = None) -> None:

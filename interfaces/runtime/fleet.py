@@ -4,9 +4,10 @@ step"): the executives of the spacecraft one process hosts run each tick as one.
 Each spacecraft keeps its own executive: its bus, messages, state, rate groups, counters and
 answer (TickDone).  The fleet only orders their work.  For each rate group due at the tick,
 every member's bus first delivers its due messages; then each app slot (the same app class in
-the same place on every member) runs for all members, one after the other: the place where an
-app whose work batches over spacecraft takes them in one call over arrays.  Finally every
-member publishes its housekeeping and answers.
+the same place on every member) runs for all members: in one call where the app's class
+batches over spacecraft (``App.step_all``, over arrays), else one after the other.  Finally
+every member publishes its housekeeping and answers.  The rate-group loop is the executive's
+own (``interfaces.runtime.executive.step_together``): an executive alone is a fleet of one.
 
 What an app sees and publishes does not depend on who shares its process: a message another
 node published during a tick is delivered at a later tick (``Inbox``: sent strictly before
@@ -17,12 +18,11 @@ answering a tick again); the fleet runs a tick once every member has taken it.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 
 from interfaces.contracts.messages import Tick
 from interfaces.contracts.topology import Node
-from interfaces.runtime.executive import Executive
+from interfaces.runtime.executive import Executive, step_together
 
 
 @dataclass(eq=False)
@@ -62,18 +62,7 @@ class Fleet:
         started = [m for m in members if m.begin_tick(tick, barrier)]
         if not started:
             return
-        t = tick.t_sim
-        for g in started[0].due_groups(tick.k):
-            for m in started:
-                m.bus.dispatch(t)
-            spent = [0.0] * len(started)
-            for slot in zip(*(m.groups[g] for m in started), strict=True):
-                for i, (m, app) in enumerate(zip(started, slot, strict=True)):
-                    start = time.perf_counter()
-                    m.run_app(app, t)
-                    spent[i] += time.perf_counter() - start
-            for m, s in zip(started, spent, strict=True):
-                m.count_group(g, 1e3 * s)
+        step_together(started, tick)
         for m in started:
             m.end_tick(tick)
 

@@ -5,8 +5,9 @@ fleet changes no message is flown in tests/missions/test_fleet_run.py."""
 from __future__ import annotations
 
 import queue
+from collections.abc import Sequence
 from dataclasses import replace
-from typing import Any
+from typing import Any, ClassVar
 
 import pytest
 
@@ -36,9 +37,34 @@ class _Count(App):
         self.steps.append(t)
 
 
-def _executive(net: InprocNetwork, node: str, scenario: Scenario) -> Executive:
-    """An executive of node ``node`` running one ``_Count`` app."""
-    return build_executive(Node(node, (f"{__name__}:_Count",), "", ("t", 0), "", spacecraft=1),
+class _Batched(_Count):
+    """Steps its members together (``App.step_all``), leaving those whose ``alone`` is set to
+    their own step; raises for every member when ``fail`` is set."""
+
+    NAME = "batched"
+    calls: ClassVar[list[tuple[float, list[str]]]] = []
+    fail: ClassVar[bool] = False
+
+    def __init__(self, ctx: Any) -> None:
+        super().__init__(ctx)
+        self.alone = False
+        self.batched: list[float] = []
+
+    @classmethod
+    def step_all(cls, apps: Sequence[_Batched], t: float) -> Sequence[_Batched]:
+        cls.calls.append((t, [a.ctx.node for a in apps]))
+        if cls.fail:
+            raise RuntimeError("the batched kernel failed")
+        for a in apps:
+            if not a.alone:
+                a.batched.append(t)
+        return [a for a in apps if a.alone]
+
+
+def _executive(net: InprocNetwork, node: str, scenario: Scenario,
+               app: str = "_Count") -> Executive:
+    """An executive of node ``node`` running one ``app`` (a class of this module)."""
+    return build_executive(Node(node, (f"{__name__}:{app}",), "", ("t", 0), "", spacecraft=1),
                            Bus(node, "m", net.endpoint()), scenario)
 
 
@@ -103,3 +129,40 @@ def test_nodes_of_one_process_served_together_step_as_a_fleet() -> None:
     assert answers == [("sc1", 0), ("sc2", 0), ("sc1", 1), ("sc2", 1), ("sc1", 2), ("sc2", 2)]
     with pytest.raises(ValueError, match="share one tick queue"):
         serve_together([clients[0], TickClient(_executive(net, "sc3", scenario))])
+
+
+def test_an_app_class_that_batches_steps_its_members_together() -> None:
+    """``App.step_all`` runs once per slot for every member; a member it leaves steps alone;
+    each member's group run is counted; an executive alone is a fleet of one."""
+    scenario = small_scenario("f")
+    net = InprocNetwork()
+    _Batched.calls, _Batched.fail = [], False
+    a, b, c = (_executive(net, n, scenario, "_Batched") for n in ("sc1", "sc2", "sc3"))
+    fleet = Fleet([a, b])
+    b.apps[0].alone = True
+    for k in range(2):
+        for m in (a, b):
+            fleet.take(m, _tick(k, scenario), barrier=False)
+    assert _Batched.calls == [(0.0, ["sc1", "sc2"]), (0.5, ["sc1", "sc2"])]
+    assert a.apps[0].batched == [0.0, 0.5] and a.apps[0].steps == []
+    assert b.apps[0].batched == [] and b.apps[0].steps == [0.0, 0.5]  # left to its own step
+    assert a.stats["high"].runs == b.stats["high"].runs == 1  # the first run is start-up
+    assert a.last_done is not None and a.last_done.k == 1
+    c.run_tick(_tick(0, scenario), barrier=False)
+    assert _Batched.calls[-1] == (0.0, ["sc3"]) and c.apps[0].batched == [0.0]
+
+
+def test_a_failing_shared_step_is_every_members_failure_and_the_fleet_flies_on() -> None:
+    scenario = small_scenario("f")
+    net = InprocNetwork()
+    _Batched.calls, _Batched.fail = [], True
+    a, b = (_executive(net, n, scenario, "_Batched") for n in ("sc1", "sc2"))
+    fleet = Fleet([a, b])
+    try:
+        for m in (a, b):
+            fleet.take(m, _tick(0, scenario), barrier=False)
+    finally:
+        _Batched.fail = False
+    assert a.app_errors == b.app_errors == 1
+    assert a.apps[0].steps == b.apps[0].steps == []  # not stepped twice
+    assert a.last_done is not None and b.last_done is not None  # both answered
