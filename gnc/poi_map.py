@@ -11,6 +11,7 @@ import numpy.typing as npt
 
 from gnc import infocost
 from gnc.checks import finite_array
+from gnc.fusion_kernels import ADDED, add_checked
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -47,7 +48,21 @@ class PoiMap:
 
     def add(self, agent: int, poi: npt.ArrayLike, precision: npt.ArrayLike) -> None:
         """Fuse the observations of observer ``agent`` (1-based): precision σ⁻¹ ≥ 0 on POIs
-        ``poi`` (indices; repeated indices add up)."""
+        ``poi`` (indices; repeated indices add up).  An image's arrays (int64 and float64
+        vectors) are checked and added in one compiled pass (``gnc.fusion_kernels``, the same
+        sums); anything else, or anything it refuses, goes the numpy way (:meth:`add_numpy`,
+        which raises the error)."""
+        if (type(poi) is np.ndarray and type(precision) is np.ndarray
+                and poi.dtype == np.int64 and precision.dtype == np.float64
+                and poi.ndim == 1 and poi.shape == precision.shape
+                and poi.flags.c_contiguous and precision.flags.c_contiguous
+                and 1 <= agent <= self.n_agents
+                and add_checked(self.F[agent - 1], poi, precision) == ADDED):
+            return
+        self.add_numpy(agent, poi, precision)
+
+    def add_numpy(self, agent: int, poi: npt.ArrayLike, precision: npt.ArrayLike) -> None:
+        """:meth:`add` in numpy: the tested reference."""
         idx = np.asarray(poi, dtype=np.int64)
         prec = finite_array("precision", precision, (len(idx),))
         if not 1 <= agent <= self.n_agents:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gnc.fusion_kernels import add_to_rows
 from gnc.poi_map import PoiMap
 from ground.fdir.observer import MAX_JUDGED_LOSS, ObserverState
 from interfaces.contracts.messages import PoiObservations
@@ -54,7 +55,9 @@ class FusedViews:
         reach[own, k] = True
         for m, rows in zip(images, reach.T, strict=True):
             idx, prec = m.arrays()
-            self.by_source[np.flatnonzero(rows)[:, None], m.spacecraft - 1, idx[None, :]] += prec
+            receivers = np.flatnonzero(rows)
+            if not add_to_rows(self.by_source, receivers, m.spacecraft - 1, idx, prec):
+                self.by_source[receivers[:, None], m.spacecraft - 1, idx[None, :]] += prec
             self.images[rows, m.spacecraft - 1] += 1
 
     def contributions(self, settled: PoiMap, lost: np.ndarray,

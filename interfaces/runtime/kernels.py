@@ -42,6 +42,10 @@ T3 = types.Array(F8, 3, "C")
 """a contiguous float64 array of 3 dimensions (a stack of matrices)"""
 IV = types.Array(I8, 1, "C")
 """a contiguous int64 vector"""
+V_READ = types.Array(F8, 1, "C", readonly=True)
+"""a contiguous read-only float64 vector (a message's unpacked array)"""
+IV_READ = types.Array(I8, 1, "C", readonly=True)
+"""a contiguous read-only int64 vector (a message's unpacked array)"""
 
 
 @dataclass(frozen=True)
@@ -102,6 +106,9 @@ KERNELS: tuple[Kernel, ...] = (
     Kernel("gnc.infocost_kernels", "_fill",
            tuple((p, M, V, V, V, V, V, V, V, V, BOOL, F8, F8, F8, M) for p in (M, M_ANY))),
     Kernel("ground.fdir.trilateration", "normal_equations_each", ((M_READ, IV, V, IV),)),
+    Kernel("gnc.fusion_kernels", "add_checked", ((V, IV_READ, V_READ), (V, IV, V))),
+    Kernel("gnc.fusion_kernels", "add_to_rows",
+           ((T3, IV, I8, IV_READ, V_READ), (T3, IV, I8, IV, V))),
 )
 
 
