@@ -59,8 +59,8 @@ def run_inproc(
     executives: dict[str, Executive] = {}
     truth = history_for(scenario)  # one truth feed for every node's channel
     for node in topo.nodes:
-        bus = Bus(node.name, mission, net.endpoint(),
-                  channel=ChannelModel.of(node.name, scenario, truth))
+        bus = Bus(node.name, mission, net.endpoint(),  # no resend ring: nothing asks
+                  channel=ChannelModel.of(node.name, scenario, truth), recent_ticks=0)
         executives[node.name] = executive_of(node, bus, scenario)
     fleets = fleets_of([n for n in topo.nodes if fleet and n.spacecraft is not None],
                        executives)
@@ -68,7 +68,8 @@ def run_inproc(
         fleet = fleets.get(node.name)
         TickClient(executives[node.name], synchronous=True,
                    fleet=fleet.take if fleet is not None else None)
-    sim = SimNode(Bus(topics.SIM, mission, net.endpoint()), scenario, topo.participants,
-                  log=logging.getLogger("insp.sim"), stop=stop or threading.Event())
+    sim = SimNode(Bus(topics.SIM, mission, net.endpoint(), recent_ticks=0), scenario,
+                  topo.participants, log=logging.getLogger("insp.sim"),
+                  stop=stop or threading.Event())
     sim.run()
     return sim, executives

@@ -116,11 +116,15 @@ class RecentSent:
         self._until_archived = True
 
     def add(self, sample: Sample) -> None:
-        """A sample sent in the current tick."""
-        self._ticks[-1].samples.append(sample)
+        """A sample sent in the current tick (none kept at depth 0: in one process nothing
+        can ask for a resend)."""
+        if self._depth or self._until_archived:
+            self._ticks[-1].samples.append(sample)
 
     def next_tick(self) -> None:
         """The current tick has ended: what is no longer needed is forgotten."""
+        if not (self._depth or self._until_archived):
+            return  # depth 0: nothing was kept
         ended = self._ticks[-1]
         ended.close(self._until_archived)
         self._size += ended.size

@@ -124,3 +124,17 @@ def test_kept_until_archived_across_a_restore() -> None:
     _told(again, 6.0)
     _tick(again, 7.0)
     assert _kept_times(again) == [4.0, 5.0, 6.0, 7.0]
+
+
+def test_at_depth_zero_nothing_is_kept_unless_for_a_recorder() -> None:
+    """One process (``deploy.inproc``): nothing can ask for a resend, so nothing is kept; a
+    recorder that has not archived still is (``keep_until_archived``)."""
+    recent = RecentSent(depth=0)
+    for k in range(3):
+        recent.add(Sample(f"k/{k}", "T", payload=b'{"t_sim": 1.0}'))
+        recent.next_tick()
+    assert recent.last_tick() == [] and json.loads(recent.reply()) == []
+    recent.keep_until_archived()
+    recent.add(Sample("k/9", "T", payload=b'{"t_sim": 1.0}'))
+    recent.next_tick()
+    assert [s.key for s in recent.last_tick()] == ["k/9"]
