@@ -157,8 +157,9 @@ class ZenohTransport:
 
     def notify(self, selector: str) -> None:
         """Send a query whose replies nobody waits for (a notice to the queryables it
-        reaches); returns at once."""
-        self._session.get(selector, _ignore_reply)
+        reaches); returns at once.  The replies go to a channel of one that nobody reads: a
+        Python callback would start a thread of its own for every notice."""
+        self._session.get(selector, zenoh.handlers.RingChannel(1))
 
     def declare_alive(self, node: str, token_key: str) -> None:
         self._entities.append(self._session.liveliness().declare_token(token_key))
@@ -231,10 +232,6 @@ class SharedReceiver:
                 except Exception:  # noqa: BLE001 - one node's failure is not the others'
                     logging.getLogger(f"insp.bus.{node}").exception(
                         "%s: taking in a sample on %s failed", node, key)
-
-
-def _ignore_reply(_reply: zenoh.Reply) -> None:
-    """The handler of a notice's replies (``ZenohTransport.notify``): none is needed."""
 
 
 def _node_from_token(token_key: str) -> str | None:

@@ -4,6 +4,7 @@ message is validated once for all of them (``interfaces.runtime.zenoh_transport`
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -129,3 +130,24 @@ def test_a_node_whose_intake_fails_does_not_deprive_the_others(process: Process)
     process.sc3.publish(key, _hb("sc3"))
     settle(lambda: got == [key])
     assert got == [key]
+
+
+def test_a_notice_reaches_the_queryables_and_starts_no_thread(free_port: int) -> None:
+    """``notify`` (the recorder's archived notices, one per node and chunk): every queryable
+    it reaches hears it, and no thread is started for its replies."""
+    ep = f"tcp/127.0.0.1:{free_port}"
+    hub, other = ZenohTransport(ZenohSettings.hub(ep)), ZenohTransport(
+        ZenohSettings(connect=(ep,)))
+    try:
+        heard: list[str] = []
+        other.serve(f"{M}/sc1/bus/archived/*", lambda k: heard.append(k) or b"{}")
+        time.sleep(0.5)
+        threads = threading.active_count()
+        for t_ns in range(20):
+            hub.notify(f"{M}/sc1/bus/archived/{t_ns}")
+        assert threading.active_count() == threads
+        settle(lambda: len(heard) == 20, 5.0)
+        assert sorted(heard) == sorted(f"{M}/sc1/bus/archived/{t}" for t in range(20))
+    finally:
+        for t in (other, hub):
+            t.close()
