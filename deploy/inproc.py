@@ -23,6 +23,7 @@ from interfaces.runtime.blas_threads import one_blas_thread
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.executive import Executive, TickClient
 from interfaces.runtime.fleet import fleets_of
+from interfaces.runtime.heap import frozen_heap
 from interfaces.runtime.kernels import compile_kernels
 from interfaces.runtime.transport import InprocNetwork, RawHandler, SampleHandler
 from links.channel import ChannelModel
@@ -71,5 +72,6 @@ def run_inproc(
     sim = SimNode(Bus(topics.SIM, mission, net.endpoint(), recent_ticks=0), scenario,
                   topo.participants, log=logging.getLogger("insp.sim"),
                   stop=stop or threading.Event())
-    sim.run()
+    with frozen_heap():  # what the start made is not walked by every full collection
+        sim.run()
     return sim, executives

@@ -21,6 +21,7 @@ from interfaces.runtime.bus import Bus
 from interfaces.runtime.cds import CriticalDataStore
 from interfaces.runtime.executive import Executive, TickClient, serve_together
 from interfaces.runtime.fleet import fleets_of
+from interfaces.runtime.heap import frozen_heap
 from interfaces.runtime.link_stage import LinkStageFactory
 from interfaces.runtime.recent import depth_for
 from interfaces.runtime.restart import resume_together
@@ -157,7 +158,8 @@ def run_participants(
         for client in clients:
             _join(client)
         start.log.info("ready")
-        serve_together(clients, start.stop)
+        with frozen_heap():  # what the start made is not walked by every full collection
+            serve_together(clients, start.stop)
         lost = [c.executive.bus.node for c in clients if c.sim_lost and not c.finished.is_set()]
         if lost:
             start.log.error("sim lost before the end of the run (%s)", ", ".join(lost))
