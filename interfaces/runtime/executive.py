@@ -281,36 +281,43 @@ def step_together(members: Sequence[Executive], tick: Tick) -> None:
             m.bus.dispatch(t)
         spent = [0.0] * len(members)
         for slot in zip(*(m.groups[g] for m in members), strict=True):
-            _step_slot(members, list(slot), t, spent)
+            _step_slot(members, slot, t, spent)
         for m, s in zip(members, spent, strict=True):
             m.count_group(g, 1e3 * s)
 
 
-def _step_slot(members: Sequence[Executive], apps: list[App], t: float,
+def _step_slot(members: Sequence[Executive], apps: Sequence[App], t: float,
                spent: list[float]) -> None:
-    """One app slot of ``members`` at ``t`` (s): stepped together where the class batches
-    (its CPU time shared evenly among the members it stepped; a failure of the shared step is
-    every member's), the rest each alone.  ``spent``: each member's wall time so far (s)."""
-    left = apps
-    if type(apps[0]).step_all is not App.step_all:
-        wall, cpu = time.perf_counter(), time.thread_time()
-        try:
-            left = list(type(apps[0]).step_all(apps, t))
-        except Exception:  # noqa: BLE001 - the fleet's failure must not stop the process
-            left = []
-            for m, app in zip(members, apps, strict=True):
-                m.app_failed(app, t, batched=True)
-        done = [i for i, app in enumerate(apps) if all(app is not x for x in left)]
-        cpu_ms = 1e3 * (time.thread_time() - cpu) / max(1, len(done))
-        wall_s = (time.perf_counter() - wall) / max(1, len(done))
-        for i in done:
-            members[i].note_app(apps[i], cpu_ms, t)
-            spent[i] += wall_s
-    for i, app in enumerate(apps):
-        if any(app is x for x in left):
-            start = time.perf_counter()
-            members[i].run_app(app, t)
-            spent[i] += time.perf_counter() - start
+    """One app slot of ``members`` at ``t`` (s): the members' apps stepped together where
+    their class batches (:func:`_step_shared`), the others each alone.  ``spent``: each
+    member's wall time so far (s)."""
+    alone = (range(len(apps)) if type(apps[0]).step_all is App.step_all
+             else _step_shared(members, apps, t, spent))
+    for i in alone:
+        start = time.perf_counter()
+        members[i].run_app(apps[i], t)
+        spent[i] += time.perf_counter() - start
+
+
+def _step_shared(members: Sequence[Executive], apps: Sequence[App], t: float,
+                 spent: list[float]) -> list[int]:
+    """Step ``apps`` together (``App.step_all``); the indices of those it left to their own
+    step.  Its CPU and wall time are shared evenly among the members it stepped; a failure of
+    the shared step is every member's."""
+    wall, cpu = time.perf_counter(), time.thread_time()
+    try:
+        left = {id(a) for a in type(apps[0]).step_all(apps, t)}
+    except Exception:  # noqa: BLE001 - the fleet's failure must not stop the process
+        left = set()
+        for m, app in zip(members, apps, strict=True):
+            m.app_failed(app, t, batched=True)
+    done = [i for i, app in enumerate(apps) if id(app) not in left]
+    cpu_ms = 1e3 * (time.thread_time() - cpu) / max(1, len(done))
+    wall_s = (time.perf_counter() - wall) / max(1, len(done))
+    for i in done:
+        members[i].note_app(apps[i], cpu_ms, t)
+        spent[i] += wall_s
+    return [i for i, app in enumerate(apps) if id(app) in left]
 
 
 def serve_together(clients: Sequence[TickClient], stop: threading.Event | None = None) -> None:
