@@ -20,6 +20,11 @@ account       may publish (put, liveliness token, schemas)  may subscribe
               any Zenoh client)
 ============  ===========================================  ======================================
 
+Each node may besides put its process's bundles of hardware traffic
+(``interfaces.contracts.bundle``): ``insp/<m>/bundle/<node>``, and the first node of a process
+hosting several that process's, ``insp/<m>/bundle/sc1-sc2-sc3``: the key names the nodes whose
+rows a receiver takes from it, so no account can carry a node its process does not host.
+
 A client without an account cannot open a session at all; a put outside the publisher's own key
 space is dropped by the router (silently, for the publisher).  The key space a message came on
 therefore names its sender, which the Bus checks against the body
@@ -38,11 +43,13 @@ import base64
 import json
 import os
 import secrets
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from interfaces.contracts import topics
+from interfaces.contracts.bundle import bundle_key
 
 TLM_ACCOUNT = "tlm"
 """The read-only telemetry account."""
@@ -95,12 +102,24 @@ PUBLISH = ["put", "delete", "liveliness_token", "declare_queryable", "reply"]
 """What a node may do in its own key space."""
 
 
-def grants(mission: str, account: str) -> list[tuple[list[str], list[str]]]:
+def grants(mission: str, account: str, processes: Sequence[Sequence[str]] = ()
+           ) -> list[tuple[list[str], list[str]]]:
     """What ``account`` (a node, or the recorder) may publish, as (messages, key expressions):
-    a node everything in its key space, the recorder its liveliness token alone."""
+    a node everything in its key space and the bundles of its process
+    (:func:`bundle_keys`), the recorder its liveliness token alone."""
     if account == RECORDER_ACCOUNT:
         return [(["liveliness_token"], [topics.recorder_token(mission)])]
-    return [(PUBLISH, [f"{topics.node_prefix(mission, account)}/**"])]
+    return [(PUBLISH, [f"{topics.node_prefix(mission, account)}/**"]),
+            (["put"], bundle_keys(mission, account, processes))]
+
+
+def bundle_keys(mission: str, node: str, processes: Sequence[Sequence[str]]) -> list[str]:
+    """The bundle keys node ``node`` may publish (``interfaces.contracts.bundle``): its own,
+    as a node alone in its process, and, as the first node of one of the run's ``processes``
+    (the node names each hosts) hosting several, that process's: its session sends the
+    process's bundles.  No account may name a node its process does not host."""
+    return [bundle_key(mission, [node])] + [bundle_key(mission, p) for p in processes
+                                           if len(p) > 1 and p[0] == node]
 
 
 EVERY_MESSAGE = ["put", "delete", "reply", "liveliness_token", "declare_subscriber",
@@ -111,7 +130,8 @@ EVERY_MESSAGE = ["put", "delete", "reply", "liveliness_token", "declare_subscrib
 
 def access_control(mission: str, n_observers: int,
                    relays: dict[str, list[str]] | None = None,
-                   hub_common_name: str | None = None) -> dict[str, Any]:
+                   hub_common_name: str | None = None,
+                   processes: Sequence[Sequence[str]] = ()) -> dict[str, Any]:
     """The router's ``access_control`` block: default deny; every account may subscribe to the
     mission, query schemas and watch liveliness; each publisher may publish, declare its token
     and serve its schemas in its own key space only; the recorder may declare its token.
@@ -120,7 +140,8 @@ def access_control(mission: str, n_observers: int,
     each with the nodes of its host: a relay may publish what those nodes may, and is sent
     everything in the mission.  A router that links to the hub trusts, in and out, the link
     whose certificate (verified against the run's authority) bears the common name
-    ``hub_common_name``: the hub enforced the rules already."""
+    ``hub_common_name``: the hub enforced the rules already.  ``processes``: the node names
+    each of the run's processes hosts (the bundle keys, :func:`bundle_keys`)."""
     mission_keys = [topics.mission_wildcard(mission)]
     relays = relays or {}
     everyone = [*publishers(n_observers), RECORDER_ACCOUNT, TLM_ACCOUNT, *relays]
@@ -135,8 +156,9 @@ def access_control(mission: str, n_observers: int,
     subjects: list[dict[str, Any]] = [{"id": f"user-{u}", "usernames": [u]} for u in everyone]
     policies = [{"rules": ["receive", "see-subscribers", "subscribe"],
                  "subjects": [f"user-{u}" for u in everyone]}]
-    own = {a: grants(mission, a) for a in [*publishers(n_observers), RECORDER_ACCOUNT]}
-    own.update({relay: [g for n in nodes for g in grants(mission, n)]
+    own = {a: grants(mission, a, processes)
+           for a in [*publishers(n_observers), RECORDER_ACCOUNT]}
+    own.update({relay: [g for n in nodes for g in grants(mission, n, processes)]
                 for relay, nodes in relays.items()})
     for user, granted in own.items():
         ids = []
@@ -190,11 +212,13 @@ NO_SCOUTING = {"multicast": {"enabled": False}, "gossip": {"enabled": False}}
 
 
 def write_run_access(directory: Path, mission: str, n_observers: int, endpoint: str,
-                     tls: TlsFiles | None = None, clients_connect: str | None = None) -> RunAccess:
+                     tls: TlsFiles | None = None, clients_connect: str | None = None,
+                     processes: Sequence[Sequence[str]] = ()) -> RunAccess:
     """Create fresh accounts (random passwords) and write the router's dictionary and
     configuration (listening on ``endpoint``) and every account's client configuration
     (connecting to ``clients_connect``, by default ``endpoint``) into ``directory`` (mode 0700,
-    files 0600).  ``tls`` is required for a ``tls/`` endpoint."""
+    files 0600).  ``tls`` is required for a ``tls/`` endpoint.  ``processes``: the node names
+    each process of the run hosts (its bundles, :func:`bundle_keys`)."""
     if endpoint.startswith("tls/") and tls is None:
         raise ValueError(f"{endpoint} needs the router's certificate (TlsFiles)")
     directory.mkdir(parents=True, exist_ok=True)
@@ -210,7 +234,8 @@ def write_run_access(directory: Path, mission: str, n_observers: int, endpoint: 
                                   indent=2))
     router = directory / "router.json5"
     write_private(router, json.dumps(router_config(
-        endpoint, dictionary, access_control(mission, n_observers), tls), indent=2))
+        endpoint, dictionary, access_control(mission, n_observers, processes=processes), tls),
+        indent=2))
     return RunAccess(directory, router, endpoint)
 
 

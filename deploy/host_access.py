@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import json
 import secrets
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -74,11 +75,14 @@ class HostAccess:
 
 
 def write_host_access(directory: Path, mission: str, n_observers: int,
-                      host_map: HostMap, portable: bool = False) -> HostAccess:
+                      host_map: HostMap, portable: bool = False,
+                      processes: Sequence[Sequence[str]] = ()) -> HostAccess:
     """Fresh accounts, certificates and router configurations for every host of ``host_map``
     (see the module docstring); the map is assumed checked against the run.  ``portable``: the
     routers name their files as ``access/<file>`` (the folder copied to its host as
-    ``access/``, the router started beside it), else by their paths here."""
+    ``access/``, the router started beside it), else by their paths here.  ``processes``:
+    the node names each process of the run hosts (their bundles,
+    ``deploy.access.bundle_keys``)."""
     directory.mkdir(parents=True, exist_ok=True)
     directory.chmod(0o700)
     authority = write_authority(directory)
@@ -90,7 +94,7 @@ def write_host_access(directory: Path, mission: str, n_observers: int,
     relays = {router_name(h): h.nodes for h in spokes}
     hosts = {h.name: _write_host(directory / h.name, mission, n_observers, host_map, h,
                                  authority, accounts,
-                                 relays if h.name == hub.name else {}, portable)
+                                 relays if h.name == hub.name else {}, portable, processes)
              for h in host_map.hosts}
     tlm = directory / f"{TLM_ACCOUNT}.json5"
     write_private(tlm, json.dumps(client_config(
@@ -100,7 +104,8 @@ def write_host_access(directory: Path, mission: str, n_observers: int,
 
 def _write_host(folder: Path, mission: str, n_observers: int, host_map: HostMap,
                 host: HostSpec, authority: Authority, accounts: dict[str, Account],
-                relays: dict[str, list[str]], portable: bool) -> HostFiles:
+                relays: dict[str, list[str]], portable: bool,
+                processes: Sequence[Sequence[str]]) -> HostFiles:
     folder.mkdir(exist_ok=True)
     folder.chmod(0o700)
     (folder / "authority.pem").write_bytes(authority.pem.read_bytes())
@@ -120,7 +125,8 @@ def _write_host(folder: Path, mission: str, n_observers: int, host_map: HostMap,
     hub = host_map.hub
     uplink = None if host.name == hub.name else accounts[router_name(host)]
     acl = access_control(mission, n_observers, relays=relays,
-                         hub_common_name=None if uplink is None else router_name(hub))
+                         hub_common_name=None if uplink is None else router_name(hub),
+                         processes=processes)
     config = host_router_config(host_map, host, here / dictionary.name, tls, acl, uplink)
     router = folder / "router.json5"
     write_private(router, json.dumps(config, indent=2))

@@ -63,16 +63,22 @@ class Placement:
         ground alone."""
         if self.host_map is None:
             return hosting(topo, mode, processes, alone)
-        out: list[NodeProcess] = []
-        for h in self.host_map.hosts:
-            nodes = [topo.node(n) for n in h.nodes if n in topo.participants]
-            spacecraft = tuple(n for n in nodes if n.spacecraft is not None)
-            if spacecraft and mode == "packed":
-                out.append(NodeProcess(spacecraft))
-            else:
-                out += [NodeProcess((n,)) for n in spacecraft]
-            out += [NodeProcess((n,)) for n in nodes if n.spacecraft is None]
-        return tuple(out)
+        return host_processes(self.host_map, topo, mode)
+
+
+def host_processes(host_map: HostMap, topo: Topology, mode: Hosting) -> tuple[NodeProcess, ...]:
+    """The processes of the lockstep nodes across hosts: each host's spacecraft in one process
+    (``packed``) or each alone, the ground alone."""
+    out: list[NodeProcess] = []
+    for h in host_map.hosts:
+        nodes = [topo.node(n) for n in h.nodes if n in topo.participants]
+        spacecraft = tuple(n for n in nodes if n.spacecraft is not None)
+        if spacecraft and mode == "packed":
+            out.append(NodeProcess(spacecraft))
+        else:
+            out += [NodeProcess((n,)) for n in spacecraft]
+        out += [NodeProcess((n,)) for n in nodes if n.spacecraft is None]
+    return tuple(out)
 
 
 def one_host(access: RunAccess) -> Placement:

@@ -60,7 +60,12 @@ from deploy.interrupts import Interrupts  # noqa: E402
 from deploy.link_events import LinkEvents, check_cuts  # noqa: E402
 from deploy.out_folder import OutFolderError, written  # noqa: E402
 from deploy.out_folder import prepare as prepare_out  # noqa: E402
-from deploy.placement import Placement, across_hosts, one_host  # noqa: E402
+from deploy.placement import (  # noqa: E402
+    Placement,
+    across_hosts,
+    host_processes,
+    one_host,
+)
 from deploy.processes import Child, Incident, Supervisor, host_cores  # noqa: E402
 from deploy.progress_line import progress_line  # noqa: E402
 from deploy.recorder_guard import RecorderGuard  # noqa: E402
@@ -84,6 +89,7 @@ from interfaces.contracts.topology import (  # noqa: E402
     ROUTER,
     SIM,
     NodeProcess,
+    hosting,
     topology,
 )
 from interfaces.runtime.arguments import (  # noqa: E402
@@ -486,7 +492,7 @@ def _run_zenoh(scenario: Scenario, mission: str, out: Path, args: argparse.Names
 
     try:
         access_h = write_host_access(out / "access", mission, scenario.observers.count,
-                                     host_map)
+                                     host_map, processes=_hosted(scenario, args, host_map))
         with RehearsedNetwork(host_map.hosts, host_map.network, out / "logs",
                               seed=scenario.seed) as net:
             placement = across_hosts(access_h, host_map,
@@ -562,7 +568,7 @@ def _print_hosts(scenario: Scenario, mission: str, out: Path, args: argparse.Nam
     from deploy.host_access import write_host_access  # cryptography: only across hosts
 
     access = write_host_access(out / "access", mission, scenario.observers.count, host_map,
-                               portable=True)
+                               portable=True, processes=_hosted(scenario, args, host_map))
     placement = across_hosts(access, host_map)
     common = _common_args(args, mission, args.scenario.name)
     topo = topology(scenario)
@@ -601,7 +607,18 @@ def _write_access(out: Path, mission: str, scenario: Scenario,
         tls = write_tls_files(out / "access" / "tls",
                               tuple(args.tls_host) + ((advertised,) if advertised else ()))
     return write_run_access(out / "access", mission, scenario.observers.count, args.endpoint,
-                            tls, clients_connect=args.advertise)
+                            tls, clients_connect=args.advertise,
+                            processes=_hosted(scenario, args, None))
+
+
+def _hosted(scenario: Scenario, args: argparse.Namespace,
+            host_map: HostMap | None) -> list[list[str]]:
+    """The node names each process of the run hosts (as ``_supervise`` starts them): the
+    bundles their accounts may publish (``deploy.access.bundle_keys``)."""
+    topo = topology(scenario)
+    processes = (host_processes(host_map, topo, args.hosting) if host_map is not None else
+                 hosting(topo, args.hosting, args.processes or host_cores(), args.external))
+    return [[n.name for n in p.nodes] for p in processes]
 
 
 def _host_of(endpoint: str) -> str:

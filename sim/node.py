@@ -227,6 +227,7 @@ class SimNode:
                            final=k == n_ticks - 1)
             self.bus.publish(self._keys["tick"], tick(rejoin=self.lockstep.open_tick(k)),
                              announce=False)
+            self.bus.flush_bundle()  # the hardware frames and the tick, as one
             deadline = (self.pacer.answer_deadline(t, dt, sc.sim.lockstep_timeout_s)
                         if self.pacer is not None
                         else time.monotonic() + sc.sim.lockstep_timeout_s)
@@ -277,6 +278,7 @@ class SimNode:
         self.log.warning("sending tick again for %s", ", ".join(back))
         self.bus.publish(self._keys["tick"], tick(rejoin=sorted(self.lockstep.rejoining)),
                          announce=False)
+        self.bus.flush_bundle()
 
     def _publish_hardware(self, k: int, t: float) -> None:
         """What the sim publishes before tick k (t, s): the faults switching, the truth, then

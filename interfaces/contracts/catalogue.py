@@ -42,13 +42,16 @@ M = TypeVar("M", bound=m.Message)
 
 @dataclass(frozen=True)
 class Topic(Generic[M]):
-    """One kind of message: ``type`` on the key ``app/name`` of the key space ``space``."""
+    """One kind of message: ``type`` on the key ``app/name`` of the key space ``space``.
+    ``bundled``: hardware traffic, which never passes the link stage and travels over Zenoh in
+    its process's bundle of the tick (``interfaces.contracts.bundle``)."""
 
     space: Space
     app: str
     name: str
     type: type[M]
     doc: str = ""
+    bundled: bool = False
 
     def key(self, mission: str, node: str | None = None) -> str:
         """The concrete key.  ``node`` is the publisher for SPACECRAFT and EVERY_NODE topics,
@@ -97,20 +100,24 @@ class Topic(Generic[M]):
 
 
 # --- the sim: time master, truth and hardware -------------------------------------------------
-TICK = Topic(Space.SIM, "clock", "tick", m.Tick, "lockstep tick k (the sim is the time master)")
+TICK = Topic(Space.SIM, "clock", "tick", m.Tick, "lockstep tick k (the sim is the time master)",
+             bundled=True)
 SIM_STATUS = Topic(Space.SIM, "clock", "status", m.SimStatus, "run state, progress, counters")
-TRUTH = Topic(Space.SIM, "truth", "state", m.TruthState, "true states (channel model, evaluation)")
+TRUTH = Topic(Space.SIM, "truth", "state", m.TruthState, "true states (channel model, evaluation)",
+              bundled=True)
 FAULT_EVENTS = Topic(Space.SIM, "truth", "faults", m.FaultEvent, "injected faults switching")
 RELNAV = Topic(Space.SIM_HARDWARE, "sensors", "relnav", m.RelNavMeasurement,
-               "relative navigation sensor")
+               "relative navigation sensor", bundled=True)
 ATTITUDE_SENSORS = Topic(Space.SIM_HARDWARE, "sensors", "attitude", m.AttitudeMeasurement,
-                         "gyro and star tracker")
+                         "gyro and star tracker", bundled=True)
 CAMERA_IMAGE = Topic(Space.SIM_HARDWARE, "sensors", "camera", m.CameraImage,
-                     "the POIs in the camera's view, with their precisions")
+                     "the POIs in the camera's view, with their precisions", bundled=True)
 
 # --- a spacecraft's flight software ---------------------------------------------------------
-THRUST = Topic(Space.SPACECRAFT, "act", "thrust", m.ThrustCommand, "thruster command")
-WHEELS = Topic(Space.SPACECRAFT, "act", "wheels", m.WheelCommand, "reaction-wheel torque")
+THRUST = Topic(Space.SPACECRAFT, "act", "thrust", m.ThrustCommand, "thruster command",
+               bundled=True)
+WHEELS = Topic(Space.SPACECRAFT, "act", "wheels", m.WheelCommand, "reaction-wheel torque",
+               bundled=True)
 NAV_ESTIMATE = Topic(Space.SPACECRAFT, "nav", "estimate", m.StateEstimate,
                      "relative state estimate")
 ATTITUDE_ESTIMATE = Topic(Space.SPACECRAFT, "attitude", "estimate", m.AttitudeEstimate,
@@ -135,7 +142,8 @@ NEIGHBOUR_DECLARATION = Topic(Space.SPACECRAFT, "neighbours", "declaration",
                               m.NeighbourDeclaration, "a fault declared by neighbours' agreement")
 
 # --- every lockstep node's executive --------------------------------------------------------
-TICK_DONE = Topic(Space.EVERY_NODE, "exec", "tick_done", m.TickDone, "lockstep answer to a tick")
+TICK_DONE = Topic(Space.EVERY_NODE, "exec", "tick_done", m.TickDone, "lockstep answer to a tick",
+                  bundled=True)
 HEARTBEAT = Topic(Space.EVERY_NODE, "exec", "heartbeat", m.Heartbeat, "node alive, its apps")
 EXEC_STATS = Topic(Space.EVERY_NODE, "exec", "stats", m.ExecStats, "rate-group timing, errors")
 LINK_STATS = Topic(Space.EVERY_NODE, "bus", "link_stats", m.LinkStats, "channel model counters")

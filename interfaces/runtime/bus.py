@@ -24,6 +24,11 @@ What the Bus guarantees, identically on every transport:
   ``ChannelModel`` (range at send time, loss, cuts, delay) at dispatch.  With ground passes
   the space-ground ones wait there (stored onboard, or held on the ground) and come back
   from it when they reach the receiver (``links.space_ground``).
+* **Bundles.** With a process bundle (``bundle``), what never passes the link stage (the
+  catalogue's ``bundled`` topics) is handed to it instead of the transport and travels, over
+  Zenoh, as one message per process and tick (``interfaces.contracts.bundle``,
+  ``interfaces.runtime.bundle_out``).  A bundle received is taken row by row as if each had
+  come alone, each row only from the process that hosts its node (else refused, ``stranger``).
 * **Barrier.** ``wait_for(expect)`` blocks until the messages announced in a Tick have arrived.
 * **Recovery.** Each node keeps what it sent in its last ticks and sends it again to a node that
   asks (``interfaces.runtime.recent``): ``recover`` fetches what a tick announced and never came.
@@ -48,8 +53,10 @@ from typing import Any, TypeVar
 from pydantic import ValidationError
 
 from interfaces.contracts import catalogue, topics
+from interfaces.contracts.bundle import BundleError, bundle_space, decode_bundle, hosted_nodes
 from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
+from interfaces.runtime.bundle_out import BundleOut
 from interfaces.runtime.inbox import Envelope, Inbox
 from interfaces.runtime.link_stage import LinkStage
 from interfaces.runtime.recent import RECENT_TICKS, RecentSent, archived_queryable
@@ -86,6 +93,8 @@ class Bus:
     admission: Admission = field(default_factory=Admission)
     recent_ticks: int = RECENT_TICKS
     """Ticks of sent messages kept for resend requests (``interfaces.runtime.recent``)."""
+    bundle: BundleOut | None = None
+    """The process's outgoing bundle, shared by its Buses (None: every message goes alone)."""
     _seq: dict[str, int] = field(default_factory=dict)
     _published_since: dict[str, int] = field(default_factory=dict)
     _raw: dict[str, list[RawHandler]] = field(default_factory=dict)
@@ -102,6 +111,7 @@ class Bus:
         feed = self.channel.truth_feed() if self.channel is not None else None
         if feed is not None:
             self.subscribe(catalogue.TRUTH.key(self.mission), TruthState, feed, immediate=True)
+        self.transport.subscribe_samples(bundle_space(self.mission), self._on_bundle)
 
     # --- publishing ------------------------------------------------------------------------
 
@@ -114,7 +124,7 @@ class Bus:
         route = self.table.routes.get(key)
         if route is None:
             route = self._route(key)
-        expected, local = route
+        expected, local, bundled = route
         if expected is not None and type(msg) is not expected:
             raise TypeError(f"{key} carries {expected.__name__}, not {type(msg).__name__}")
         seq = self._seq.get(key, 0) + 1
@@ -130,7 +140,15 @@ class Bus:
                     inbox.pending.append(Envelope(msg, key, self.node, True, [sub]))
         sample = Sample(key, type(msg).__name__, message=msg)
         self.recent.add(sample)
-        self.transport.send(sample)
+        if bundled and self.bundle is not None:
+            self.bundle.add(sample)
+        else:
+            self.transport.send(sample)
+
+    def flush_bundle(self) -> None:
+        """Send the process's bundle (the end of its tick; nothing without one)."""
+        if self.bundle is not None:
+            self.bundle.flush()
 
     def _route(self, key: str) -> Route:
         """What publishing on ``key`` needs, checked and resolved once: the key is in this
@@ -207,6 +225,30 @@ class Bus:
                     self._call(sub, decoded[sub.msg_type], key)
         finally:
             self._queue(key, group, decoded, (key, first.seq))
+
+    def _on_bundle(self, sample: Sample) -> None:
+        """A bundle (``interfaces.contracts.bundle``, any thread): every row but this node's
+        own taken as if it had come alone, on each subscription its key matches; a row on a
+        node its process does not host is refused (``stranger``), a malformed bundle dropped
+        whole.  Its rows are unpacked once for every Bus of the process."""
+        try:
+            if sample.rows is None:
+                sample.rows = tuple(Sample(k, t, payload=p)
+                                    for k, t, p in decode_bundle(sample.payload))
+        except BundleError as e:
+            self.drop_invalid(sample.key, f"not a valid bundle: {e}")
+            return
+        hosts = hosted_nodes(sample.key)
+        for row in sample.rows:
+            owner = self.admission.owner(row.key)
+            if owner == self.node:
+                continue
+            if owner not in hosts:
+                self.refuse(row.key, "stranger", f"in the bundle of {sample.key}, whose "
+                            f"process does not host {owner}")
+                continue
+            for expr in self.table.matching(row.key):
+                self._on_sample(expr, row)
 
     def _claim(self, key: str, msg: Message) -> bool:
         """Whether ``msg`` is new to this node (not admitted yet, nor arriving on another

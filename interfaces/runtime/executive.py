@@ -137,6 +137,7 @@ class Executive:
             return
         step_together([self], tick)  # an executive alone is a fleet of one
         self.end_tick(tick)
+        self.bus.flush_bundle()
 
     def begin_tick(self, tick: Tick, barrier: bool) -> bool:
         """The start of ``tick``: False when this node ran it already (its answer is then sent

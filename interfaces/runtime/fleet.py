@@ -65,6 +65,8 @@ class Fleet:
         step_together(started, tick)
         for m in started:
             m.end_tick(tick)
+        for m in started:  # the process's bundle, once every member answered
+            m.bus.flush_bundle()
 
 
 def fleets_of(nodes: list[Node], executives: dict[str, Executive]) -> dict[str, Fleet]:

@@ -50,9 +50,12 @@ class Group:
                    [s for s in subs if s.immediate], [s for s in subs if not s.immediate])
 
 
-Route = tuple[type[Message] | None, list[Sub]]
-"""What publishing on a key needs: its catalogue type (None: not catalogued) and the node's own
-subscribers of it."""
+Route = tuple[type[Message] | None, list[Sub], bool]
+"""What publishing on a key needs: its catalogue type (None: not catalogued), the node's own
+subscribers of it, and whether it travels in its process's bundle (the catalogue's
+``bundled``)."""
+_MAX_CACHED_KEYS = 4096
+"""Keys whose matching expressions are kept (beyond: looked up every time)."""
 
 
 @dataclass(eq=False)
@@ -69,6 +72,8 @@ class SubscriptionTable:
     _awaited: dict[str, bool] = field(default_factory=dict)
     _key_types: dict[str, object] = field(default_factory=dict)
     """Catalogue type of each key published or subscribed (None: not catalogued)."""
+    _matching: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """Per key received in a bundle: the key expressions subscribed that match it."""
 
     def add(self, sub: Sub) -> None:
         """Add ``sub``, of a type ``check_type`` accepted; forget what was resolved."""
@@ -77,6 +82,7 @@ class SubscriptionTable:
         self.split[sub.key_expr] = Group.of(group)
         self.routes.clear()
         self._awaited.clear()
+        self._matching.clear()
 
     def types(self) -> dict[str, list[type[Message]]]:
         """Key expression -> subscribed message types."""
@@ -98,10 +104,22 @@ class SubscriptionTable:
 
     def route(self, key: str) -> Route:
         """Resolve and cache ``key``'s route: its catalogue type, the node's own subscribers."""
+        topic = catalogue.topic_of(key)
         route = self.routes[key] = (
             self.catalogue_type(key),
-            [s for e, g in self.groups.items() if topics.matches(e, key) for s in g])
+            [s for e, g in self.groups.items() if topics.matches(e, key) for s in g],
+            topic is not None and topic.bundled)
         return route
+
+    def matching(self, key: str) -> tuple[str, ...]:
+        """The subscribed key expressions that match ``key`` (cached for a bounded number of
+        keys)."""
+        hit = self._matching.get(key)
+        if hit is None:
+            hit = tuple(e for e in self.groups if topics.matches(e, key))
+            if len(self._matching) < _MAX_CACHED_KEYS:
+                self._matching[key] = hit
+        return hit
 
     def awaits(self, key: str) -> bool:
         """Whether ``key`` is another node's key that a deferred/immediate subscription covers."""

@@ -23,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
+from interfaces.contracts.bundle import BUNDLE_TYPE, raw_rows
 from interfaces.contracts.topics import matches
 from interfaces.runtime.encoding import encode
 
@@ -33,15 +34,17 @@ if TYPE_CHECKING:
 class Sample:
     """One message on its way between endpoints: ``key``, ``type_name``, and the message as
     ``message`` (the object, in one process; None when it came as bytes) and/or ``payload``
-    (its JSON bytes, encoded from the object on first use and kept)."""
+    (its JSON bytes, encoded from the object on first use and kept).  A bundle's sample
+    keeps its rows, unpacked once for every Bus of the process (``rows``)."""
 
-    __slots__ = ("key", "type_name", "message", "_payload")
+    __slots__ = ("key", "type_name", "message", "_payload", "rows")
 
     def __init__(self, key: str, type_name: str, payload: bytes | None = None,
                  message: Message | None = None) -> None:
         if payload is None and message is None:
             raise ValueError("a sample needs a payload or a message")
         self.key, self.type_name, self.message, self._payload = key, type_name, message, payload
+        self.rows: tuple[Sample, ...] | None = None
 
     @property
     def payload(self) -> bytes:
@@ -75,6 +78,10 @@ class Transport(Protocol):
     def send(self, sample: Sample) -> None:
         """Publish a sample a Bus made (the Bus's path: bytes only if this transport needs
         them)."""
+
+    def send_bundle(self, key: str, rows: list[Sample]) -> None:
+        """Publish samples Buses of this process made as one bundle on ``key``
+        (``interfaces.contracts.bundle``)."""
 
     def publish(self, key: str, type_name: str, payload: bytes) -> None:
         """Publish raw bytes (tools, tests: a hostile or foreign publisher)."""
@@ -136,7 +143,10 @@ class InprocNetwork:
     def _deliver(self, origin: InprocTransport, sample: Sample, made_here: bool) -> None:
         key = sample.key
         for handler, raw, made in self._targets(origin, key):
-            if raw:
+            if raw and sample.type_name == BUNDLE_TYPE:  # raw bytes of a bundle: its rows
+                for row in raw_rows(key, sample.type_name, sample.payload):
+                    handler(*row)
+            elif raw:
                 handler(key, sample.type_name, sample.payload)
             elif made is not None and made_here:
                 made(key, sample.message)
@@ -178,6 +188,12 @@ class InprocTransport:
 
     def send(self, sample: Sample) -> None:
         self.network._deliver(self, sample, made_here=sample.message is not None)
+
+    def send_bundle(self, key: str, rows: list[Sample]) -> None:
+        """In one process nothing travels: the rows go one after the other, as the receivers
+        of a bundle take them."""
+        for row in rows:
+            self.send(row)
 
     def publish(self, key: str, type_name: str, payload: bytes) -> None:
         self.network._deliver(self, Sample(key, type_name, payload=payload), made_here=False)

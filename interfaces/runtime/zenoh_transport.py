@@ -32,6 +32,7 @@ from typing import Any, Literal
 import zenoh
 
 from interfaces.contracts import topics
+from interfaces.contracts.bundle import BUNDLE_TYPE, bundle_space, encode_bundle, raw_rows
 from interfaces.runtime.transport import (
     LivenessHandler,
     MadeHereHandler,
@@ -103,6 +104,11 @@ class ZenohTransport:
     def send(self, sample: Sample) -> None:
         self.publish(sample.key, sample.type_name, sample.payload)
 
+    def send_bundle(self, key: str, rows: list[Sample]) -> None:
+        """One message on ``key`` for all ``rows`` (``interfaces.contracts.bundle``)."""
+        self.publish(key, BUNDLE_TYPE, encode_bundle((r.key, r.type_name, r.payload)
+                                                     for r in rows))
+
     def publish(self, key: str, type_name: str, payload: bytes) -> None:
         pub = self._publishers.get((key, type_name))
         if pub is None:
@@ -118,11 +124,22 @@ class ZenohTransport:
         pub.put(payload)
 
     def subscribe(self, key_expr: str, handler: RawHandler) -> None:
+        """Raw samples on ``key_expr``; of a bundle, its rows on keys ``key_expr`` matches, as
+        if each had come alone (``interfaces.contracts.bundle``): also from bundles on keys
+        outside ``key_expr``."""
         def on_sample(sample: zenoh.Sample) -> None:
-            handler(str(sample.key_expr), type_of_encoding(sample.encoding),
-                    sample.payload.to_bytes())
+            key, type_name = str(sample.key_expr), type_of_encoding(sample.encoding)
+            if type_name != BUNDLE_TYPE:
+                handler(key, type_name, sample.payload.to_bytes())
+                return
+            for row in raw_rows(key, type_name, sample.payload.to_bytes()):
+                if topics.matches(key_expr, row[0]):
+                    handler(*row)
 
         self.declare_subscriber(key_expr, on_sample, zenoh.Locality.REMOTE)
+        bundles = _bundles_for(key_expr)
+        if bundles is not None:
+            self.declare_subscriber(bundles, on_sample, zenoh.Locality.REMOTE)
 
     def declare_subscriber(self, key_expr: str, callback: Callable[[zenoh.Sample], None],
                            origin: zenoh.Locality) -> None:
@@ -137,7 +154,7 @@ class ZenohTransport:
         if self.shared is not None:
             self.shared.subscribe(self, key_expr, handler)
             return
-        self.subscribe(key_expr, lambda k, t, p: handler(Sample(k, t, payload=p)))
+        self.declare_subscriber(key_expr, lambda s: handler(_sample(s)), zenoh.Locality.REMOTE)
 
     def serve(self, key_expr: str, responder: Responder) -> None:
         def on_query(query: zenoh.Query) -> None:
@@ -221,9 +238,8 @@ class SharedReceiver:
                     key_expr, lambda s, e=key_expr: self._on_sample(e, s), zenoh.Locality.ANY)
 
     def _on_sample(self, key_expr: str, zsample: zenoh.Sample) -> None:
-        key = str(zsample.key_expr)
-        sample = Sample(key, type_of_encoding(zsample.encoding),
-                        payload=zsample.payload.to_bytes())
+        sample = _sample(zsample)
+        key = sample.key
         publisher = topics.node_of_key(key)
         for node, handler in self._receivers[key_expr]:
             if node != publisher:
@@ -232,6 +248,22 @@ class SharedReceiver:
                 except Exception:  # noqa: BLE001 - one node's failure is not the others'
                     logging.getLogger(f"insp.bus.{node}").exception(
                         "%s: taking in a sample on %s failed", node, key)
+
+
+def _sample(zsample: zenoh.Sample) -> Sample:
+    """A Zenoh sample as the Bus takes it: key, type name, JSON bytes."""
+    return Sample(str(zsample.key_expr), type_of_encoding(zsample.encoding),
+                  payload=zsample.payload.to_bytes())
+
+
+def _bundles_for(key_expr: str) -> str | None:
+    """The bundles whose rows a raw subscription on ``key_expr`` may need and does not receive
+    by its own expression (None: it receives them, or none can match)."""
+    parts = key_expr.split("/")
+    if len(parts) < 3 or parts[0] != topics.ROOT or parts[1] == "**":
+        return None
+    space = bundle_space(parts[1])
+    return None if topics.matches(key_expr, space.replace("*", "x")) else space
 
 
 def _node_from_token(token_key: str) -> str | None:

@@ -16,6 +16,7 @@ from deploy.access import RunAccess, write_run_access
 from deploy.certificates import write_tls_files
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
+from interfaces.contracts.bundle import bundle_key
 from tests.conftest import settle
 
 M = "acc"
@@ -110,4 +111,36 @@ def test_tls_needs_the_runs_authority(tmp_path: Path, free_port: int) -> None:
         with pytest.raises(zenoh.ZError):
             _open(config)
     finally:
+        router.close()
+
+
+def test_a_process_publishes_only_the_bundles_of_the_nodes_it_hosts(tmp_path: Path,
+                                                                     free_port: int) -> None:
+    """The bundle key names the nodes its rows may belong to (interfaces/contracts/bundle.py):
+    the router lets only the first node of that process put on it, and a node alone its own."""
+    access = write_run_access(tmp_path / "access", M, 3, f"tcp/127.0.0.1:{free_port}",
+                              processes=[["sc1", "sc2"], ["sc3"], ["ground"]])
+    router = _open(access.router_config)
+    sessions = {a: _open(access.client_config(a)) for a in ("sim", "sc1", "sc2", "sc3", "tlm")}
+    got: list[str] = []
+    try:
+        sessions["tlm"].declare_subscriber(f"{topics.ROOT}/**", lambda s: got.append(
+            str(s.key_expr)))
+        time.sleep(0.5)
+        allowed = {"sim": bundle_key(M, ["sim"]), "sc1": bundle_key(M, ["sc1", "sc2"]),
+                   "sc3": bundle_key(M, ["sc3"])}
+        forged = {"sc2": [bundle_key(M, ["sc1", "sc2"]), bundle_key(M, ["sc2", "sc1"])],
+                  "sc1": [bundle_key(M, ["sc1", "sc2", "sc3"]), bundle_key(M, ["sim"])],
+                  "sc3": [bundle_key(M, ["sc3", "sc1"])]}
+        for account, key in allowed.items():
+            sessions[account].put(key, b"[]\n")
+        for account, keys in forged.items():
+            for key in keys:
+                sessions[account].put(key, b"[]\n")
+        settle(lambda: len(got) >= len(allowed))
+        time.sleep(0.3)
+        assert sorted(got) == sorted(allowed.values())
+    finally:
+        for s in sessions.values():
+            s.close()
         router.close()

@@ -21,6 +21,7 @@ from deploy.access import access_control
 from deploy.host_access import HostAccess, router_name, write_host_access
 from deploy.host_map import HostMap, parse_host_map
 from interfaces.contracts import topics
+from interfaces.contracts.bundle import bundle_key
 from tests.conftest import settle
 
 M = "hx"
@@ -157,7 +158,8 @@ def test_a_relay_may_do_no_more_than_its_hosts_nodes() -> None:
                                                                    "serve-router-x"))}
     assert mine["publish-router-x-0"]["key_exprs"] == [f"insp/{M}/sc/1/**"]
     assert "put" in mine["publish-router-x-0"]["messages"]
-    assert mine["publish-router-x-1"]["messages"] == ["liveliness_token"]
-    assert mine["publish-router-x-1"]["key_exprs"] == [topics.recorder_token(M)]
-    assert sorted(mine) == ["publish-router-x-0", "publish-router-x-1", "serve-router-x-0",
-                            "serve-router-x-1"]
+    assert mine["publish-router-x-1"]["messages"] == ["put"]  # sc1's bundles, alone
+    assert mine["publish-router-x-1"]["key_exprs"] == [bundle_key(M, ["sc1"])]
+    assert mine["publish-router-x-2"]["messages"] == ["liveliness_token"]
+    assert mine["publish-router-x-2"]["key_exprs"] == [topics.recorder_token(M)]
+    assert sorted(mine) == [f"{w}-router-x-{i}" for w in ("publish", "serve") for i in range(3)]

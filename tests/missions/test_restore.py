@@ -86,6 +86,7 @@ def test_a_fresh_node_given_the_state_is_the_same_node(node: str) -> None:
     assert canonical(capture(client.executive)) == canonical(capture(ran))
     twin, twin_sent = _fresh(node)  # the running node's messages, on a network of its own
     ran.bus.transport = twin.executive.bus.transport
+    ran.bus.bundle = None  # each message alone, as the fresh node's (no process around it)
     last = Tick(sender="sim", t_sim=ran.last_done.t_sim, k=ran.last_done.k,  # type: ignore[union-attr]
                 dt_s=SC.rates.dt_s)
     _ticks(ran, last, 25)

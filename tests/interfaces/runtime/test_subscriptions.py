@@ -29,17 +29,28 @@ def test_a_catalogued_key_takes_its_type_only() -> None:
 
 def test_routes_and_awaited_keys_follow_the_subscriptions() -> None:
     table = _table()
-    assert table.route(HB_1) == (Heartbeat, []) and HB_1 in table.routes
+    assert table.route(HB_1) == (Heartbeat, [], False) and HB_1 in table.routes
     assert not table.awaits(HB_2)
     everyone = f"{topics.ROOT}/{M}/**/exec/heartbeat"
     own, other = Sub(everyone, Heartbeat, print, False), Sub(everyone, Heartbeat, print, True)
     table.add(own)
     assert table.routes == {}  # resolved again after a subscription
-    assert table.route(HB_1) == (Heartbeat, [own])
+    assert table.route(HB_1) == (Heartbeat, [own], False)
     assert table.awaits(HB_2) and not table.awaits(HB_1)  # its own keys are never awaited
     table.add(other)
     assert table.types() == {everyone: [Heartbeat, Heartbeat]}
     assert table.split[everyone] == Group(Heartbeat, [other], [own])
+
+
+def test_bundled_topics_are_routed_to_the_bundle_and_matching_is_cached() -> None:
+    table = _table()
+    done = catalogue.TICK_DONE.key(M, "sc1")
+    assert table.route(done)[2] and not table.route(HB_1)[2]  # the catalogue decides
+    everyone = f"{topics.ROOT}/{M}/**/exec/heartbeat"
+    table.add(Sub(everyone, Heartbeat, print, False))
+    assert table.matching(HB_2) == (everyone,) and table.matching(done) == ()
+    table.add(Sub(HB_2, Heartbeat, print, False))
+    assert table.matching(HB_2) == (everyone, HB_2)  # forgotten when a subscription came
 
 
 def test_a_group_of_mixed_types_has_no_kind() -> None:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import pytest
 
 from interfaces.contracts import topics
+from interfaces.contracts.bundle import bundle_space
 from interfaces.contracts.messages import Heartbeat
 from interfaces.runtime.bus import Bus
 from interfaces.runtime.zenoh_transport import SharedReceiver, ZenohSettings, ZenohTransport
@@ -57,7 +58,7 @@ def _heard(bus: Bus) -> list[Heartbeat]:
 def test_each_node_hears_every_other_once_and_a_message_is_validated_once(
         process: Process) -> None:
     heard = {b.node: _heard(b) for b in (process.sc1, process.sc2, process.sc3)}
-    assert list(process.receiver._receivers) == [EVERY_HEARTBEAT]  # one Zenoh subscriber
+    assert list(process.receiver._receivers) == [bundle_space(M), EVERY_HEARTBEAT]  # once
     assert [n for n, _ in process.receiver._receivers[EVERY_HEARTBEAT]] == ["sc1", "sc2"]
     time.sleep(0.3)  # subscription propagation
     for bus in (process.sc1, process.sc2, process.sc3):
