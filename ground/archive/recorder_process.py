@@ -73,6 +73,25 @@ def _blocked(signals: tuple[signal.Signals, ...]) -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
+@contextmanager
+def _main_left_behind() -> Iterator[None]:
+    """A child spawned in the block does not import the parent's main module: a fresh
+    interpreter runs the parent's script again up to its ``__main__`` guard (the launcher's
+    imports, about a second of CPU the run needs), where the recorder needs this module
+    alone.  ``multiprocessing``'s spawn reads the main module's ``__spec__`` and ``__file__``
+    when the child starts; they are hidden for that instant."""
+    main = sys.modules["__main__"]
+    saved = {a: main.__dict__[a] for a in ("__spec__", "__file__") if a in main.__dict__}
+    main.__dict__.pop("__file__", None)
+    main.__spec__ = None
+    try:
+        yield
+    finally:
+        main.__dict__.update(saved)
+        if "__spec__" not in saved:
+            del main.__spec__
+
+
 def _shield() -> None:
     """In the child, first: a session of its own, the run's signals ignored, then unblocked
     (what came while blocked is discarded)."""
@@ -128,7 +147,7 @@ class RecorderProcess:
         self._conn, child_conn = ctx.Pipe(duplex=False)[::-1]
         self._proc = ctx.Process(target=_serve, args=(child_conn, str(path), metadata, chunk_size),
                                  name="recorder", daemon=True)
-        with _blocked(SHIELDED):
+        with _blocked(SHIELDED), _main_left_behind():
             self._proc.start()
         child_conn.close()
         _widen(self._conn.fileno())
