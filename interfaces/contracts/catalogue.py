@@ -20,7 +20,9 @@ has exactly one producer of its type.
 from __future__ import annotations
 
 import enum
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Generic, TypeVar
 
 from interfaces.contracts import messages as m
@@ -214,7 +216,12 @@ def topic_of(key: str) -> Topic | None:
 
 
 def _find(spaces: tuple[Space, ...], app: str, name: str) -> Topic | None:
-    return next((t for t in ALL if t.space in spaces and t.app == app and t.name == name), None)
+    return next((t for s in spaces if (t := _BY_PLACE.get((s, app, name))) is not None), None)
+
+
+_BY_PLACE: Mapping[tuple[Space, str, str], Topic] = MappingProxyType(
+    {(t.space, t.app, t.name): t for t in ALL})
+"""Every topic by its place: (space, app, name)."""
 
 
 def table() -> str:

@@ -118,6 +118,9 @@ class InprocNetwork:
     _endpoints: list[InprocTransport] = field(default_factory=list)
     _lock: threading.RLock = field(default_factory=threading.RLock)
     _routes: dict[tuple[int, str], list[_Route]] = field(default_factory=dict)
+    _matched: dict[tuple[str, str], bool] = field(default_factory=dict)
+    """Whether a key expression matches a key, once per pair (the same expression is
+    subscribed by every node of a constellation)."""
 
     def endpoint(self) -> InprocTransport:
         t = InprocTransport(self)
@@ -136,9 +139,15 @@ class InprocNetwork:
         if targets is None:
             with self._lock:
                 targets = [sub[1:] for ep in self._endpoints if ep is not origin and not ep.closed
-                           for sub in ep.subs if matches(sub[0], key)]
+                           for sub in ep.subs if self._matches(sub[0], key)]
                 self._routes[(id(origin), key)] = targets
         return targets
+
+    def _matches(self, key_expr: str, key: str) -> bool:
+        hit = self._matched.get((key_expr, key))
+        if hit is None:
+            hit = self._matched[(key_expr, key)] = matches(key_expr, key)
+        return hit
 
     def _deliver(self, origin: InprocTransport, sample: Sample, made_here: bool) -> None:
         key = sample.key
