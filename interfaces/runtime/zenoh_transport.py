@@ -260,9 +260,9 @@ def _bundles_for(key_expr: str) -> str | None:
     """The bundles whose rows a raw subscription on ``key_expr`` may need and does not receive
     by its own expression (None: it receives them, or none can match)."""
     parts = key_expr.split("/")
-    if len(parts) < 3 or parts[0] != topics.ROOT or parts[1] == "**":
+    if len(parts) < 2 or parts[0] != topics.ROOT:
         return None
-    space = bundle_space(parts[1])
+    space = bundle_space("*" if parts[1] == "**" else parts[1])
     return None if topics.matches(key_expr, space.replace("*", "x")) else space
 
 
