@@ -13,13 +13,15 @@ bundle, so the archive's topics and messages are what they would be without bund
 publishing process hosts (``sim``; ``sc1-sc2-sc3``; ``ground``).  The process is the trust
 boundary: the run's router lets only that process's account publish on that key
 (``deploy/access.py``), and a receiver takes a row only if its key belongs to one of the nodes
-the bundle's key names (:func:`hosted_nodes`); any other row is refused and counted.
+the bundle's key names, in that node's own key space of the bundle's mission
+(:func:`row_spaces`); any other row is refused and counted.
 
 **Wire format** (type name ``Bundle``): one header line, the JSON array of rows
 ``[[key, type name, payload length in bytes], ...]``, then ``\\n``, then the rows' JSON payloads
-back to back, exactly as each would have travelled alone.  A bundle that does not parse, has
-more than :data:`MAX_ROWS` rows, a row key or type name too long, or lengths that do not add up
-to what follows the header is dropped whole (:class:`BundleError`).
+back to back, exactly as each would have travelled alone.  A bundle whose header is longer
+than :data:`MAX_HEADER_BYTES` (checked before it is parsed) or does not parse, has more than
+:data:`MAX_ROWS` rows, a row key or type name too long, or lengths that do not add up to what
+follows the header is dropped whole (:class:`BundleError`).
 """
 
 from __future__ import annotations
@@ -39,6 +41,8 @@ MAX_ROWS: Final = 4096
 """Rows a bundle may hold (a 10 Hz tick of 500 spacecraft needs about 1,500)."""
 MAX_BUNDLE_BYTES: Final = 16 << 20
 """Bytes a bundle may hold (each row is held to the Bus's own limit besides)."""
+MAX_HEADER_BYTES: Final = 1 << 20
+"""Bytes a bundle's header line may hold, as one message (about 80 a row)."""
 MAX_KEY_CHARS: Final = 1024
 MAX_TYPE_CHARS: Final = 128
 _SEPARATOR: Final = "-"
@@ -80,10 +84,23 @@ def hosted_nodes(key: str) -> frozenset[str]:
     return frozenset(parts[3].split(_SEPARATOR))
 
 
-def row_admissible(hosts: frozenset[str], row_key: str) -> bool:
-    """Whether a bundle whose key names ``hosts`` may carry a row on ``row_key``: the row's key
-    belongs to one of them."""
-    return topics.node_of_key(row_key) in hosts
+def row_spaces(key: str) -> tuple[str, ...]:
+    """The key spaces (``<node prefix>/``) the rows of a bundle on ``key`` may lie in: those of
+    the nodes it names, in its mission (none for a key that is not a bundle's)."""
+    parts = key.split("/")
+    spaces = []
+    for node in hosted_nodes(key):
+        try:
+            spaces.append(topics.node_prefix(parts[1], node) + "/")
+        except ValueError:  # not a node's name, or not a mission's
+            continue
+    return tuple(spaces)
+
+
+def row_admissible(spaces: tuple[str, ...], row_key: str) -> bool:
+    """Whether a row on ``row_key`` lies in one of ``spaces`` (:func:`row_spaces`): exactly
+    where the router would let its node put it alone."""
+    return row_key.startswith(spaces)
 
 
 def encode_bundle(rows: Iterable[Row]) -> bytes:
@@ -97,9 +114,9 @@ def decode_bundle(payload: bytes) -> list[Row]:
     """The rows of a bundle's wire bytes; :class:`BundleError` if malformed."""
     if len(payload) > MAX_BUNDLE_BYTES:
         raise BundleError(f"{len(payload)} bytes exceed {MAX_BUNDLE_BYTES}")
-    end = payload.find(b"\n")
+    end = payload.find(b"\n", 0, MAX_HEADER_BYTES + 1)
     if end < 0:
-        raise BundleError("no header line")
+        raise BundleError(f"no header line in its first {MAX_HEADER_BYTES} bytes")
     try:
         header = from_json(payload[:end], allow_inf_nan=False)
     except ValueError as e:
@@ -128,8 +145,8 @@ def raw_rows(key: str, type_name: str, payload: bytes) -> list[Row]:
         rows = decode_bundle(payload)
     except BundleError:
         return [(key, type_name, payload)]
-    hosts = hosted_nodes(key)
-    return [r for r in rows if row_admissible(hosts, r[0])]
+    spaces = row_spaces(key)
+    return [r for r in rows if row_admissible(spaces, r[0])]
 
 
 def _entry(entry: object) -> tuple[str, str, int]:

@@ -53,7 +53,13 @@ from typing import Any, TypeVar
 from pydantic import ValidationError
 
 from interfaces.contracts import catalogue, topics
-from interfaces.contracts.bundle import BundleError, bundle_space, decode_bundle, hosted_nodes
+from interfaces.contracts.bundle import (
+    BundleError,
+    bundle_space,
+    decode_bundle,
+    row_admissible,
+    row_spaces,
+)
 from interfaces.contracts.messages import Message, TruthState, stamp
 from interfaces.runtime.admission import MAX_SEQ_JUMP, Admission
 from interfaces.runtime.bundle_out import BundleOut
@@ -228,26 +234,29 @@ class Bus:
 
     def _on_bundle(self, sample: Sample) -> None:
         """A bundle (``interfaces.contracts.bundle``, any thread): every row but this node's
-        own taken as if it had come alone, on each subscription its key matches; a row on a
-        node its process does not host is refused (``stranger``), a malformed bundle dropped
-        whole.  Its rows are unpacked once for every Bus of the process."""
-        try:
-            if sample.rows is None:
+        own taken as if it had come alone, on each subscription its key matches; a row outside
+        the key spaces of the nodes its process hosts is refused (``stranger``), a malformed
+        bundle dropped whole.  Its rows, or why it has none, are unpacked once for every Bus
+        of the process."""
+        if sample.rows is None:
+            try:
                 sample.rows = tuple(Sample(k, t, payload=p)
                                     for k, t, p in decode_bundle(sample.payload))
-        except BundleError as e:
-            self.drop_invalid(sample.key, f"not a valid bundle: {e}")
+            except BundleError as e:
+                sample.rows = e
+        if isinstance(sample.rows, BundleError):
+            self.drop_invalid(sample.key, f"not a valid bundle: {sample.rows}")
             return
-        hosts = hosted_nodes(sample.key)
+        spaces, own = row_spaces(sample.key), self.prefix + "/"
         for row in sample.rows:
-            owner = self.admission.owner(row.key)
-            if owner == self.node:
+            exprs = self.table.matching(row.key)
+            if not exprs or row.key.startswith(own):
                 continue
-            if owner not in hosts:
-                self.refuse(row.key, "stranger", f"in the bundle of {sample.key}, whose "
-                            f"process does not host {owner}")
+            if not row_admissible(spaces, row.key):
+                self.refuse(row.key, "stranger", f"in the bundle of {sample.key}, outside the "
+                            "key spaces of the nodes its process hosts")
                 continue
-            for expr in self.table.matching(row.key):
+            for expr in exprs:
                 self._on_sample(expr, row)
 
     def _claim(self, key: str, msg: Message) -> bool:

@@ -138,6 +138,7 @@ class Executive:
         step_together([self], tick)  # an executive alone is a fleet of one
         self.end_tick(tick)
         self.bus.flush_bundle()
+        self.tick_ended()
 
     def begin_tick(self, tick: Tick, barrier: bool) -> bool:
         """The start of ``tick``: False when this node ran it already (its answer is then sent
@@ -208,14 +209,18 @@ class Executive:
                          wall_ms, self._run_t, self.stats[g].budget_ms, app, app_ms, what)
 
     def end_tick(self, tick: Tick) -> None:
-        """The end of ``tick``: housekeeping at ω_mid, the answer (TickDone), the
-        critical-data store."""
+        """The end of ``tick``: housekeeping at ω_mid and the answer (TickDone); once the
+        process's bundle is sent, :meth:`tick_ended`."""
         self.ticks += 1
         if tick.k % self.period["mid"] == 0:
             self._publish_housekeeping(tick.t_sim, tick.k)
         self.last_done = TickDone(sender=self.bus.node, t_sim=tick.t_sim, k=tick.k,
                                   published=self.bus.published_since_last())
         self.bus.publish(self._keys["done"], self.last_done, announce=False)
+
+    def tick_ended(self) -> None:
+        """After the answer went: the critical-data store (``at_tick_end``), off the sim's
+        wait."""
         if self.at_tick_end is not None:
             self.at_tick_end()
 

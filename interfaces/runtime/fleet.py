@@ -67,6 +67,8 @@ class Fleet:
             m.end_tick(tick)
         for m in started:  # the process's bundle, once every member answered
             m.bus.flush_bundle()
+        for m in started:
+            m.tick_ended()
 
 
 def fleets_of(nodes: list[Node], executives: dict[str, Executive]) -> dict[str, Fleet]:

@@ -13,6 +13,7 @@ Everything resolved per key is cached until the next subscription.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -73,16 +74,19 @@ class SubscriptionTable:
     _key_types: dict[str, object] = field(default_factory=dict)
     """Catalogue type of each key published or subscribed (None: not catalogued)."""
     _matching: dict[str, tuple[str, ...]] = field(default_factory=dict)
-    """Per key received in a bundle: the key expressions subscribed that match it."""
+    """Per key received in a bundle: the key expressions subscribed that match it (looked up
+    on the transport's threads, under ``_lock`` with ``add``)."""
+    _lock: threading.Lock = field(default_factory=threading.Lock)
 
     def add(self, sub: Sub) -> None:
         """Add ``sub``, of a type ``check_type`` accepted; forget what was resolved."""
-        group = self.groups.setdefault(sub.key_expr, [])
-        group.append(sub)
-        self.split[sub.key_expr] = Group.of(group)
-        self.routes.clear()
-        self._awaited.clear()
-        self._matching.clear()
+        with self._lock:
+            group = self.groups.setdefault(sub.key_expr, [])
+            group.append(sub)
+            self.split[sub.key_expr] = Group.of(group)
+            self.routes.clear()
+            self._awaited.clear()
+            self._matching.clear()
 
     def types(self) -> dict[str, list[type[Message]]]:
         """Key expression -> subscribed message types."""
@@ -116,9 +120,10 @@ class SubscriptionTable:
         keys)."""
         hit = self._matching.get(key)
         if hit is None:
-            hit = tuple(e for e in self.groups if topics.matches(e, key))
-            if len(self._matching) < _MAX_CACHED_KEYS:
-                self._matching[key] = hit
+            with self._lock:  # never a match made before a subscription kept after it
+                hit = tuple(e for e in self.groups if topics.matches(e, key))
+                if len(self._matching) < _MAX_CACHED_KEYS:
+                    self._matching[key] = hit
         return hit
 
     def awaits(self, key: str) -> bool:

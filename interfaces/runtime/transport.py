@@ -44,7 +44,8 @@ class Sample:
         if payload is None and message is None:
             raise ValueError("a sample needs a payload or a message")
         self.key, self.type_name, self.message, self._payload = key, type_name, message, payload
-        self.rows: tuple[Sample, ...] | None = None
+        self.rows: tuple[Sample, ...] | Exception | None = None
+        """A bundle's rows once unpacked, or why it has none."""
 
     @property
     def payload(self) -> bytes:
@@ -67,8 +68,8 @@ LivenessHandler = Callable[[str, bool], None]
 """Receives (node, alive) when a node's liveliness token appears or disappears."""
 
 
-_Route = tuple[Callable[..., None], bool, "MadeHereHandler | None"]
-"""A receiver of a key: (handler, raw, made_here), as subscribed."""
+_Route = tuple[str, Callable[..., None], bool, "MadeHereHandler | None"]
+"""A receiver of a key: (key expression, handler, raw, made_here), as subscribed."""
 
 
 class Transport(Protocol):
@@ -138,7 +139,7 @@ class InprocNetwork:
         targets = self._routes.get((id(origin), key))
         if targets is None:
             with self._lock:
-                targets = [sub[1:] for ep in self._endpoints if ep is not origin and not ep.closed
+                targets = [sub for ep in self._endpoints if ep is not origin and not ep.closed
                            for sub in ep.subs if self._matches(sub[0], key)]
                 self._routes[(id(origin), key)] = targets
         return targets
@@ -151,10 +152,11 @@ class InprocNetwork:
 
     def _deliver(self, origin: InprocTransport, sample: Sample, made_here: bool) -> None:
         key = sample.key
-        for handler, raw, made in self._targets(origin, key):
+        for expr, handler, raw, made in self._targets(origin, key):
             if raw and sample.type_name == BUNDLE_TYPE:  # raw bytes of a bundle: its rows
                 for row in raw_rows(key, sample.type_name, sample.payload):
-                    handler(*row)
+                    if self._matches(expr, row[0]):
+                        handler(*row)
             elif raw:
                 handler(key, sample.type_name, sample.payload)
             elif made is not None and made_here:

@@ -260,9 +260,10 @@ def _bundles_for(key_expr: str) -> str | None:
     """The bundles whose rows a raw subscription on ``key_expr`` may need and does not receive
     by its own expression (None: it receives them, or none can match)."""
     parts = key_expr.split("/")
-    if len(parts) < 2 or parts[0] != topics.ROOT:
-        return None
-    space = bundle_space("*" if parts[1] == "**" else parts[1])
+    if parts[0] not in (topics.ROOT, "*", "**"):
+        return None  # nothing under insp/ matches it
+    named = parts[0] == topics.ROOT and len(parts) > 1 and parts[1] not in ("*", "**")
+    space = bundle_space(parts[1] if named else "*")
     return None if topics.matches(key_expr, space.replace("*", "x")) else space
 
 
