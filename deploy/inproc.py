@@ -16,7 +16,6 @@ import logging
 import threading
 
 from interfaces.contracts import topics
-from interfaces.contracts.bundle import bundle_key
 from interfaces.contracts.scenario import Scenario
 from interfaces.contracts.topology import topology
 from interfaces.runtime.assembly import executive_of
@@ -71,22 +70,15 @@ def run_inproc(
         fleet = fleets.get(node.name)
         TickClient(executives[node.name], synchronous=True,
                    fleet=fleet.take if fleet is not None else None)
-    _bundle([[m.bus for m in f.members] for f in {id(f): f for f in fleets.values()}.values()]
-            + [[e.bus] for n, e in executives.items() if n not in fleets], mission)
     sim_bus = Bus(topics.SIM, mission, net.endpoint(), recent_ticks=0)
-    _bundle([[sim_bus]], mission)
+    # each fleet, node alone and the sim shares a bundle, as a process over Zenoh; in one
+    # process nothing travels: the rows go one by one when its tick ends
+    for buses in ([[m.bus for m in f.members] for f in {id(f): f for f in fleets.values()}.values()]
+                  + [[e.bus] for n, e in executives.items() if n not in fleets] + [[sim_bus]]):
+        BundleOut.share(buses, mission)
     sim = SimNode(sim_bus, scenario, topo.participants, log=logging.getLogger("insp.sim"),
                   stop=stop or threading.Event())
     with frozen_heap():  # what the start made is not walked by every full collection
         sim.run()
     return sim, executives
 
-
-def _bundle(groups: list[list[Bus]], mission: str) -> None:
-    """Each group of buses (a fleet, a node alone, the sim) shares one bundle, as the nodes of
-    one process over Zenoh (``interfaces.runtime.bundle_out``): in one process nothing
-    travels, so the rows go one by one when its tick ends."""
-    for buses in groups:
-        bundle = BundleOut(bundle_key(mission, [b.node for b in buses]), buses[0].transport)
-        for bus in buses:
-            bus.bundle = bundle

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 
 from interfaces.contracts import topics
-from interfaces.contracts.bundle import bundle_key
 from interfaces.contracts.topology import topology
 from interfaces.runtime.bundle_out import BundleOut
 from interfaces.runtime.bus import Bus
@@ -38,10 +37,9 @@ def main(argv: list[str] | None = None) -> int:
     start = start_node(args, topics.SIM)
     log, scenario = start.log, start.scenario
     participants = topology(scenario, ground=not args.no_ground).participants
-    transport = open_zenoh(args)
-    bus = Bus(topics.SIM, start.mission, transport,
-              recent_ticks=depth_for(scenario.rates.ticks_per("mid")),
-              bundle=BundleOut(bundle_key(start.mission, [topics.SIM]), transport))
+    bus = Bus(topics.SIM, start.mission, open_zenoh(args),
+              recent_ticks=depth_for(scenario.rates.ticks_per("mid")))
+    BundleOut.share([bus], start.mission)
     try:
         sim = SimNode(bus, scenario, participants, realtime_speed=args.realtime,
                       hard_deadline=args.hard_deadline, hold_lost_s=args.hold_lost, log=log,

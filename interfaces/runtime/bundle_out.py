@@ -10,9 +10,15 @@ calls :meth:`BundleOut.flush`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
+from interfaces.contracts.bundle import bundle_key
 from interfaces.runtime.transport import Sample, Transport
+
+if TYPE_CHECKING:
+    from interfaces.runtime.bus import Bus
 
 
 @dataclass(eq=False)
@@ -25,6 +31,15 @@ class BundleOut:
     rows: list[Sample] = field(default_factory=list)
     sent: int = 0
     """Bundles sent."""
+
+    @classmethod
+    def share(cls, buses: Sequence[Bus], mission: str) -> BundleOut:
+        """One bundle for the nodes of one process (``buses``), sent on the first one's
+        transport, given to each of them."""
+        bundle = cls(bundle_key(mission, [b.node for b in buses]), buses[0].transport)
+        for bus in buses:
+            bus.bundle = bundle
+        return bundle
 
     def add(self, sample: Sample) -> None:
         self.rows.append(sample)

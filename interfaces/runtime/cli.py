@@ -12,7 +12,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from interfaces.contracts import topics
-from interfaces.contracts.bundle import bundle_key
 from interfaces.contracts.messages import Tick
 from interfaces.contracts.scenario import Scenario, ScenarioError, load_scenario
 from interfaces.contracts.topology import topology
@@ -150,9 +149,7 @@ def run_participants(
             buses.append(Bus(node, start.mission, open_zenoh(args, node, receiver),
                              channel=links(node, start.scenario),
                              recent_ticks=depth_for(start.scenario.rates.ticks_per("mid"))))
-        bundle = BundleOut(bundle_key(start.mission, nodes), buses[0].transport)
-        for bus in buses:  # the process's bundle, sent on its first node's session
-            bus.bundle = bundle
+        BundleOut.share(buses, start.mission)  # sent on its first node's session
         shared: queue.Queue[tuple[TickClient, int, Tick] | None] = queue.Queue()
         clients = [TickClient(build(bus, start.scenario), tick_queue=shared) for bus in buses]
         _step_together(clients, start.scenario)

@@ -72,7 +72,7 @@ class SubscriptionTable:
     """Per key published: its route (``route``), once resolved."""
     _awaited: dict[str, bool] = field(default_factory=dict)
     _key_types: dict[str, object] = field(default_factory=dict)
-    """Catalogue type of each key published or subscribed (None: not catalogued)."""
+    """Catalogue topic of each key published or subscribed (None: not catalogued)."""
     _matching: dict[str, tuple[str, ...]] = field(default_factory=dict)
     """Per key received in a bundle: the key expressions subscribed that match it (looked up
     on the transport's threads, under ``_lock`` with ``add``)."""
@@ -94,11 +94,15 @@ class SubscriptionTable:
 
     def catalogue_type(self, key: str) -> type[Message] | None:
         """The message type the catalogue gives ``key`` (None: not catalogued), cached."""
-        expected = self._key_types.get(key, _UNKNOWN)
-        if expected is _UNKNOWN:
-            topic = catalogue.topic_of(key)
-            self._key_types[key] = expected = None if topic is None else topic.type
-        return expected  # type: ignore[return-value]
+        topic = self._topic(key)
+        return None if topic is None else topic.type
+
+    def _topic(self, key: str) -> catalogue.Topic | None:
+        """The catalogue's topic of ``key`` (None: not catalogued), looked up once a key."""
+        topic = self._key_types.get(key, _UNKNOWN)
+        if topic is _UNKNOWN:
+            topic = self._key_types[key] = catalogue.topic_of(key)
+        return topic  # type: ignore[return-value]
 
     def check_type(self, key: str, msg_type: type[Message]) -> None:
         """A catalogued key carries its catalogue type only (``interfaces.contracts.catalogue``)."""
@@ -107,10 +111,11 @@ class SubscriptionTable:
             raise TypeError(f"{key} carries {expected.__name__}, not {msg_type.__name__}")
 
     def route(self, key: str) -> Route:
-        """Resolve and cache ``key``'s route: its catalogue type, the node's own subscribers."""
-        topic = catalogue.topic_of(key)
+        """Resolve and cache ``key``'s route: its catalogue type, the node's own subscribers,
+        whether it is bundled."""
+        topic = self._topic(key)
         route = self.routes[key] = (
-            self.catalogue_type(key),
+            None if topic is None else topic.type,
             [s for e, g in self.groups.items() if topics.matches(e, key) for s in g],
             topic is not None and topic.bundled)
         return route
