@@ -12,13 +12,18 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from interfaces.contracts.bundle import bundle_key
 from interfaces.runtime.transport import Sample, Transport
 
-if TYPE_CHECKING:
-    from interfaces.runtime.bus import Bus
+
+class Member(Protocol):
+    """What sharing a bundle needs of a Bus (no import of the Bus, which imports this)."""
+
+    node: str
+    transport: Transport
+    bundle: BundleOut | None
 
 
 @dataclass(eq=False)
@@ -33,7 +38,7 @@ class BundleOut:
     """Bundles sent."""
 
     @classmethod
-    def share(cls, buses: Sequence[Bus], mission: str) -> BundleOut:
+    def share(cls, buses: Sequence[Member], mission: str) -> BundleOut:
         """One bundle for the nodes of one process (``buses``), sent on the first one's
         transport, given to each of them."""
         bundle = cls(bundle_key(mission, [b.node for b in buses]), buses[0].transport)
