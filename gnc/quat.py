@@ -31,6 +31,7 @@ quaternions (:func:`normalize` first when in doubt).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -73,8 +74,10 @@ def _pack(parts: tuple[_Part, ...] | list[_Part], single: bool) -> FloatArray:
     return np.stack(np.broadcast_arrays(*parts), axis=-1)
 
 
-def _hamilton(p: list[_Part], q: list[_Part]) -> tuple[_Part, _Part, _Part, _Part]:
-    """Components of p ⊗ q: ``[p_w q_v + q_w p_v + p_v × q_v, p_w q_w − p_v·q_v]``."""
+def hamilton(p: Sequence[_Part], q: Sequence[_Part]) -> tuple[_Part, _Part, _Part, _Part]:
+    """Components of p ⊗ q: ``[p_w q_v + q_w p_v + p_v × q_v, p_w q_w − p_v·q_v]``, the
+    components given as x, y, z, w: plain arithmetic that a compiled kernel compiles as it is
+    (``fsw/lib/attitude_rows.py``), so the two give the same bits as :func:`mul`."""
     px, py, pz, pw = p
     qx, qy, qz, qw = q
     return (
@@ -121,7 +124,7 @@ def mul(p: npt.ArrayLike, q: npt.ArrayLike) -> FloatArray:
     """
     pa = np.asarray(p, dtype=float)
     qa = np.asarray(q, dtype=float)
-    return _pack(_hamilton(_parts(pa), _parts(qa)), pa.ndim == 1 and qa.ndim == 1)
+    return _pack(hamilton(_parts(pa), _parts(qa)), pa.ndim == 1 and qa.ndim == 1)
 
 
 def conj(q: npt.ArrayLike) -> FloatArray:

@@ -25,12 +25,13 @@ initial zero momentum, which the gyroscopic compensation uses.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from fsw.lib import attitude_kernels as kern
-from fsw.lib import mekf
+from fsw.lib import attitude_rows, mekf
 from fsw.lib.attitude import AttitudePlan, repoint, scp_slew, slerp_plan
 from fsw.lib.attitude_control import gains_for
 from gnc import quat
@@ -45,6 +46,7 @@ from interfaces.contracts.messages import (
 )
 from interfaces.contracts.timing import TIME_TOL_S
 from interfaces.runtime.app import App, AppContext, Input, Output
+from interfaces.runtime.rows import Row, joined
 
 DESIRED_RATE_STEP_S = 1.0
 """Finite-difference step for the desired angular velocity, s."""
@@ -63,9 +65,27 @@ class AttitudeApp(App):
                 "target_accel", "target_t", "slew", "slew_t0", "slew_end", "q_point", "mode",
                 "_meas", "t_att", "_est", "_x_est", "t_star")
 
+    # the hot state, in this app's row of the fleet's block (``fsw.lib.attitude_rows``)
+    q = Row("q")
+    """the MEKF attitude R_eci_body (scalar last); None before the first star-tracker fix"""
+    b, P, nis = Row("b"), Row("P"), Row("nis")
+    h_wheels, tau, w_est = Row("h_wheels"), Row("tau"), Row("w_est")
+    target = Row("target")
+    """the pointing target (LVLH, m) at ``target_t``"""
+    target_rate, target_accel = Row("target_rate"), Row("target_accel")
+    """its motion (LVLH, m/s, m/s²)"""
+    target_t, slew_t0, slew_end = Row("target_t"), Row("slew_t0"), Row("slew_end")
+    q_point = Row("q_point")
+    """the last desired attitude (quaternion) while tracking"""
+    t_att, t_star = Row("t_att"), Row("t_star")
+    """the time of the MEKF state and of the last star-tracker attitude, s"""
+    _x_est = Row("x_est")
+    """the nav estimate as an array (LVLH, m, m/s)"""
+
     def __init__(self, ctx: AppContext) -> None:
         super().__init__(ctx)
         sc = ctx.scenario
+        self.rows, self.row = attitude_rows.new_rows(), 0  # alone: a block of one row
         self.sc_id = ctx.spacecraft or 0
         self.n = ctx.constants.n_rad_s
         self.orbit = (math.radians(sc.orbit.inclination_deg), math.radians(sc.orbit.raan_deg),
@@ -86,39 +106,43 @@ class AttitudeApp(App):
         s = sc.sensors
         self.sigma_v, self.sigma_u = s.gyro_arw_rad_rts, s.gyro_bias_rw_rad_s15
         self.bias_sigma0 = s.gyro_bias_sigma_radps
-        self.q: np.ndarray | None = None     # MEKF attitude R_eci_body (scalar last)
-        self.b = np.zeros(3)
-        self.P = np.zeros((6, 6))
-        self.nis: float | None = None
-        self.h_wheels = np.zeros(3)
-        self.tau = np.zeros(3)
-        self.w_est = np.zeros(3)
-        self.target = np.zeros(3)       # pointing target (LVLH, m) at self.target_t
-        self.target_rate = np.zeros(3)  # its motion (LVLH, m/s, m/s²)
-        self.target_accel = np.zeros(3)
-        self.target_t = 0.0
-        self.slew: AttitudePlan | None = None
-        self.slew_t0 = 0.0
-        self.slew_end = 0.0
-        self.q_point: np.ndarray | None = None  # last desired attitude (quaternion) while tracking
+        self._constants()
+        self._slew: AttitudePlan | None = None
         self.mode = "init"
         self._meas: list[AttitudeMeasurement] = []
-        self.t_att: float | None = None  # time of the MEKF state, s
-        self.t_star: float | None = None  # time of the last star-tracker attitude, s
         self._est: StateEstimate | None = None
-        self._x_est = np.zeros(6)  # the nav estimate as an array (LVLH, m, m/s)
+        self._failure: Exception | None = None
+        """an error of this cycle's publications when stepped with the fleet (``step_all``)"""
+
+    def _constants(self) -> None:
+        """This app's constants in its row (``attitude_rows.CONSTANTS``)."""
+        d, i = self.rows.data, self.row
+        d["J"][i], d["boresight"][i] = self.J, self.boresight
+        d["const"][i] = (self.gains.kp, self.gains.kd, self._w_limit, self.tau_max,
+                         self._slew_threshold_rad, self.sigma_v, self.sigma_u, self.n,
+                         *self.orbit)
+
+    @property
+    def slew(self) -> AttitudePlan | None:
+        """The slew plan in force (its nodes also in this app's row)."""
+        return self._slew
+
+    @slew.setter
+    def slew(self, plan: AttitudePlan | None) -> None:
+        self._slew = plan
+        attitude_rows.set_slew(self.rows, self.row, None if plan is None else plan.nodes())
 
     def on_sensors(self, msg: AttitudeMeasurement) -> None:
         self._meas.append(msg)
 
     def on_estimate(self, msg: StateEstimate) -> None:
         self._est = msg
-        self._x_est = np.array(msg.x)
+        self._x_est = msg.x
 
     def on_target(self, msg: PointingTarget) -> None:
-        self.target = np.array(msg.target_lvlh_m)
-        self.target_rate = np.array(msg.target_rate_lvlh_mps)
-        self.target_accel = np.array(msg.target_accel_lvlh_mps2)
+        self.target = msg.target_lvlh_m
+        self.target_rate = msg.target_rate_lvlh_mps
+        self.target_accel = msg.target_accel_lvlh_mps2
         self.target_t = msg.t_sim
 
     def _target_at(self, t: float) -> np.ndarray:
@@ -129,6 +153,9 @@ class AttitudeApp(App):
     # --- cycle ---------------------------------------------------------------------------------
 
     def step(self, t: float) -> None:
+        if self._failure is not None:  # its cycle was stepped with its fleet's, then failed
+            failure, self._failure = self._failure, None
+            raise failure
         pending, self._meas = sorted(self._meas, key=lambda m: m.t_sim), []
         meas = pending[-1] if pending else None
         self.tau = np.zeros(3)
@@ -142,11 +169,67 @@ class AttitudeApp(App):
                 self.tau = self._control(t)
         finally:  # safe mode on any failure: zero torque is still commanded, then the error
             self.h_wheels -= self.tau * self.dt  # propagates to the executive's counter
-            self.publish("wheels", WheelCommand(sender=self.ctx.node, t_sim=t,
-                                                spacecraft=self.sc_id,
-                                                torque_body_nm=self.tau.tolist()))
-        if round(t / self.dt) % self.mid_every == 0 and self.q is not None:
+            self._command(t)
+        self._report_due(t)
+
+    @classmethod
+    def step_all(cls, apps: Sequence[AttitudeApp], t: float) -> Sequence[AttitudeApp]:
+        """The cycle at ``t`` (s) of a fleet's attitude apps together: their rows stepped by
+        one compiled call (``fsw.lib.attitude_rows.step_rows``, the bits of :meth:`step`),
+        then each app's command and report published on its own bus.  An app whose row the
+        compiled cycle cannot take (no star-tracker fix yet, no nav estimate, not exactly one
+        measurement pending) or leaves (a slew to plan, no line of sight, a torque not
+        finite) is returned, untouched, to step alone."""
+        rows = joined(apps)
+        ready = [app._stage(t) for app in apps]
+        first = apps[0]
+        status = attitude_rows.step_rows(rows, np.flatnonzero(ready), t, first.dt,
+                                         DESIRED_RATE_STEP_S, first._reports(t))
+        left: list[AttitudeApp] = []
+        for app, done in zip(apps, status.tolist(), strict=True):
+            if done not in attitude_rows.DONE:
+                left.append(app)
+                continue
+            app._meas = []
+            if done == attitude_rows.TRACKED:
+                app.mode = "track"
+            try:
+                app._command(t)
+                app._report_due(t)
+            except Exception as exc:  # noqa: BLE001 - its own failure: raised by its own step
+                app._failure = exc
+                left.append(app)
+        return left
+
+    def _stage(self, t: float) -> bool:
+        """This cycle's inputs in the app's row (the pending measurement, the nav estimate's
+        time, whether a slew plan is followed), if the compiled cycle can take it."""
+        if len(self._meas) != 1 or self._est is None or self.t_att is None:
+            return False
+        m, d, i = self._meas[0], self.rows.data, self.row
+        d["t_meas"][i], d["gyro"][i], d["t_est"][i] = m.t_sim, m.gyro_radps, self._est.t_sim
+        d["star_on"][i] = m.star_tracker is not None
+        if m.star_tracker is not None:
+            d["star"][i] = m.star_tracker
+            d["r_diag"][i] = m.st_sigma_cross_rad**2
+            d["r_diag"][i, self.st_axis] = m.st_sigma_roll_rad**2
+        d["slewing"][i] = (self.mode == "slew" and self._slew is not None
+                           and t - self.slew_t0 <= self.slew_end)
+        return True
+
+    def _command(self, t: float) -> None:
+        """Publish this cycle's wheel torque."""
+        self.publish("wheels", WheelCommand(sender=self.ctx.node, t_sim=t, spacecraft=self.sc_id,
+                                            torque_body_nm=self.tau.tolist()))
+
+    def _report_due(self, t: float) -> None:
+        """The attitude estimate, at ω_mid once the MEKF is initialised."""
+        if self._reports(t) and self.q is not None:
             self._report(t)
+
+    def _reports(self, t: float) -> bool:
+        """Whether the cycle at ``t`` (s) reports the estimate (at ω_mid)."""
+        return round(t / self.dt) % self.mid_every == 0
 
     def _determine(self, meas: AttitudeMeasurement) -> None:
         """MEKF: propagate with the gyro to the sample's time, update with the star tracker

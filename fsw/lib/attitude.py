@@ -72,6 +72,16 @@ class AttitudePlan(Protocol):
         """As :meth:`at`, the attitude as its quaternion (4,), scalar last."""
         ...
 
+    def nodes(self) -> PlanNodes:
+        """The plan as its node path (:data:`PlanNodes`): what the compiled cycle over a
+        fleet's attitude rows samples (``fsw.lib.attitude_rows.slew_sample``)."""
+        ...
+
+
+PlanNodes = tuple[FloatArray, FloatArray, FloatArray, FloatArray]
+"""A plan's node path: node times s (M,), unit quaternions (M, 4), the rotation vector of
+each interval (M − 1, 3), and the piecewise-constant body rates rad/s (K, 3) (``_NodePath``)."""
+
 
 # ---------------------------------------------------------------------------
 # input checks
@@ -338,6 +348,10 @@ class SlerpPlan:
         out: tuple[FloatArray, FloatArray, FloatArray] = self._path.sample(self._rate, t, True)
         return out
 
+    def nodes(self) -> PlanNodes:
+        """The plan as its node path (:data:`PlanNodes`): two nodes, one rate."""
+        return self._path.t_s, self._path.q, self._path.phi, self._rate
+
 
 def slerp_plan(r0: Rotation, r1: Rotation, t0_s: float, t1_s: float) -> SlerpPlan:
     """Constant-rate short-way geodesic plan from r0 at t0_s to r1 at t1_s (see SlerpPlan)."""
@@ -396,6 +410,10 @@ class SlewPlan:
         """As :meth:`at` with the attitude as a quaternion (4,), scalar last."""
         out: tuple[FloatArray, FloatArray, FloatArray] = self._path.sample(self.w, t, True)
         return out
+
+    def nodes(self) -> PlanNodes:
+        """The plan as its node path (:data:`PlanNodes`)."""
+        return self._path.t_s, self._path.q, self._path.phi, self.w
 
 
 # ---------------------------------------------------------------------------

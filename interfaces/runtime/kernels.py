@@ -42,6 +42,10 @@ T3 = types.Array(F8, 3, "C")
 """a contiguous float64 array of 3 dimensions (a stack of matrices)"""
 IV = types.Array(I8, 1, "C")
 """a contiguous int64 vector"""
+IM = types.Array(I8, 2, "C")
+"""a contiguous int64 matrix"""
+BV = types.Array(BOOL, 1, "C")
+"""a contiguous boolean vector"""
 V_READ = types.Array(F8, 1, "C", readonly=True)
 """a contiguous read-only float64 vector (a message's unpacked array)"""
 IV_READ = types.Array(I8, 1, "C", readonly=True)
@@ -103,6 +107,9 @@ KERNELS: tuple[Kernel, ...] = (
     Kernel("fsw.lib.attitude_kernels", "track_cycle",
            ((F8, F8, F8, F8, F8, F8, V, F8, V, V, V, F8, V, V, V, V, M, V, F8, F8, F8, F8,
              F8),)),
+    Kernel("fsw.lib.attitude_rows", "_step_rows",
+           ((IV, F8, F8, F8, BOOL, M, M, T3, V, BV, V, V, BV, M, M, M, M, M, M, M, V, M, BV, V,
+             M, T3, T3, T3, IM, V, M, M, BV, M, V, BV, T3, M, M),)),
     Kernel("gnc.infocost_kernels", "_fill",
            tuple((p, M, V, V, V, V, V, V, V, V, BOOL, F8, F8, F8, M) for p in (M, M_ANY))),
     Kernel("ground.fdir.trilateration", "normal_equations_each", ((M_READ, IV, V, IV),)),
