@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
+from numba import njit
 from scipy.special import chdtrc, chdtri, ndtr, ndtri
 
 FloatArray = npt.NDArray[np.float64]
@@ -119,8 +120,42 @@ class ScanBuffer:
         self.last_t = self.scored_t = t
 
     def scan(self) -> ScanResult | None:
-        """The scan at the newest residual (:func:`scan_statistic`)."""
-        return scan_statistic(np.array(self.r), np.array(self.sigma_e), np.array(self.sigma_b))
+        """The scan at the newest residual (:func:`scan_statistic`, compiled:
+        :func:`scan_compiled`)."""
+        z, signed, span = scan_compiled(np.array(self.r), np.array(self.sigma_e),
+                                        np.array(self.sigma_b), _LENGTHS)
+        return ScanResult(z, signed, span) if span else None
+
+
+_LENGTHS = np.array(SCAN_LENGTHS, dtype=np.int64)
+
+
+@njit(cache=True, error_model="numpy")  # x/0: inf or NaN, as numpy
+def scan_compiled(residuals: FloatArray, sigma_e: FloatArray, sigma_b: FloatArray,
+                  lengths: npt.NDArray[np.int64]) -> tuple[float, float, int]:
+    """:func:`scan_statistic` of one value per residual, compiled (the same bits: the same
+    sums in the same order): (max |Z_n|, its signed value, its span n), span 0 with no
+    residual."""
+    k = len(residuals)
+    best, signed, span, nan = -1.0, 0.0, 0, False
+    sum_r = sum_b = sum_e2 = 0.0
+    done = 0
+    for n in lengths:
+        if n > k:
+            continue
+        while done < n:  # the newest first, as the reference's cumulative sums
+            i = k - 1 - done
+            sum_r += residuals[i]
+            sum_b += sigma_b[i]
+            sum_e2 += sigma_e[i] ** 2
+            done += 1
+        sd = math.sqrt((sum_b / n) ** 2 + sum_e2 / n**2)
+        z = sum_r / n / sd
+        if math.isnan(z) and not nan:  # numpy's argmax: the first NaN
+            best, signed, span, nan = abs(z), z, n, True
+        elif not nan and abs(z) > best:
+            best, signed, span = abs(z), z, n
+    return (best if span else 0.0), signed, span
 
 
 def image_evidence(gains: FloatArray, weights: FloatArray, mean: float,

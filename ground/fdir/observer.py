@@ -14,6 +14,7 @@ from itertools import pairwise
 import numpy as np
 from scipy.special import betainc
 
+from gnc.interpolate import columns_at
 from gnc.twin import FlightPlan, plans_in_force
 
 
@@ -81,14 +82,7 @@ class TimeSeries:
         if not self.t:
             return None
         t, columns = self._current()
-        j = np.searchsorted(t, times)  # in [0, N]
-        before = np.abs(times - t[np.maximum(j - 1, 0)])
-        after = np.abs(t[np.minimum(j, len(t) - 1)] - times)
-        out = np.empty((len(times), len(columns)))
-        for c, column in enumerate(columns):
-            out[:, c] = np.interp(times, t, column)
-        out[np.minimum(before, after) > self.MAX_GAP_S] = np.nan
-        return out
+        return columns_at(np.ascontiguousarray(times, dtype=float), t, columns, self.MAX_GAP_S)
 
     def forget_before(self, t: float) -> None:
         """Drop samples no later window needs (keep the last one before t)."""

@@ -110,6 +110,8 @@ KERNELS: tuple[Kernel, ...] = (
     Kernel("fsw.lib.attitude_rows", "_step_rows",
            ((IV, F8, F8, F8, BOOL, M, M, T3, V, BV, V, V, BV, M, M, M, M, M, M, M, V, M, BV, V,
              M, T3, T3, T3, IM, V, M, M, BV, M, V, BV, T3, M, M),)),
+    Kernel("gnc.sequential_test", "scan_compiled", ((V, V, V, IV),)),
+    Kernel("gnc.interpolate", "columns_at", ((V, V, M, F8), (V, V, M_ANY, F8))),
     Kernel("gnc.infocost_kernels", "_fill",
            tuple((p, M, V, V, V, V, V, V, V, V, BOOL, F8, F8, F8, M) for p in (M, M_ANY))),
     Kernel("ground.fdir.trilateration", "normal_equations_each", ((M_READ, IV, V, IV),)),

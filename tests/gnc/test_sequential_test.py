@@ -184,3 +184,28 @@ def test_a_growing_nis_crosses_within_a_few_updates() -> None:
     values = [6.0] * 20 + [150.0, 150.0, 150.0]
     crossed = [k for k in range(20, 23) if chi2_scan(values[: k + 1], 6).z > c]
     assert crossed and crossed[0] <= 21
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_compiled_scan_gives_the_references_bits(seed: int) -> None:
+    """``ScanBuffer.scan`` runs :func:`scan_compiled`: the same statistic, sign and span as
+    :func:`scan_statistic` to the bit, on any number of residuals up to the longest span,
+    with zero residuals and with a zero spread (NaN, as numpy's argmax takes it)."""
+    from gnc.sequential_test import _LENGTHS, ScanBuffer, scan_compiled
+
+    rng = np.random.default_rng(seed)
+    for trial in range(1000):
+        k = int(rng.integers(1, 40))
+        r = rng.normal(size=k) * 10.0 ** rng.integers(-4, 2)
+        se, sb = rng.uniform(0.0, 0.1, k), rng.uniform(0.001, 0.05, k)
+        if trial % 7 == 0:
+            r[:] = 0.0
+        if trial % 11 == 0:
+            se[-1] = sb[-1] = 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):  # a zero spread: inf, NaN
+            want = scan_statistic(r, se, sb)
+        got = scan_compiled(r, se, sb, _LENGTHS)
+        assert want is not None
+        assert np.array_equal([want.z, want.signed], got[:2], equal_nan=True)
+        assert want.span == got[2], trial
+    assert ScanBuffer().scan() is None
