@@ -64,6 +64,10 @@ class AttitudeApp(App):
     CRITICAL = ("q", "b", "P", "nis", "h_wheels", "tau", "w_est", "target", "target_rate",
                 "target_accel", "target_t", "slew", "slew_t0", "slew_end", "q_point", "mode",
                 "_meas", "t_att", "_est", "_x_est", "t_star")
+    REBUILT = ("rows", "row", "_slew")
+    """The fleet's block and this app's row in it (its learnt fields are ``CRITICAL`` above,
+    each a ``Row``: ``attitude_rows.STATE``; the rest is rebuilt: the plan's nodes from
+    ``slew``, each cycle's staged inputs, the constants), and the plan behind ``slew``."""
 
     # the hot state, in this app's row of the fleet's block (``fsw.lib.attitude_rows``)
     q = Row("q")

@@ -29,25 +29,40 @@ CONSTANTS = ("kp", "kd", "w_limit", "tau_max", "slew_threshold_rad", "sigma_v", 
 limit < 0: none), torque limit N·m, slew threshold rad, gyro noise (ARW rad/√s, bias walk
 rad/s^1.5), and the target's orbit as the LVLH model flies it (rad/s, rad)."""
 
-SPEC: dict[str, Field] = {
-    # the MEKF and the loop (the app's CRITICAL state)
+STATE: dict[str, Field] = {
     "q": Field((4,), optional=True), "b": Field((3,)), "P": Field((6, 6)),
     "nis": Field(optional=True), "t_att": Field(optional=True), "t_star": Field(optional=True),
     "h_wheels": Field((3,)), "tau": Field((3,)), "w_est": Field((3,)),
     "x_est": Field((6,)), "target": Field((3,)), "target_rate": Field((3,)),
     "target_accel": Field((3,)), "target_t": Field(), "q_point": Field((4,), optional=True),
     "slew_t0": Field(), "slew_end": Field(),
-    # the slew plan in force: node times s, unit quaternions, rotation vectors, body rates
+}
+"""The MEKF and the loop: what the app learns while running, each field one of its
+``CRITICAL`` attributes (a ``Row``), checkpointed and restored through it."""
+
+NODES: dict[str, Field] = {
     "slew_t": Field((MAX_NODES,)), "slew_q": Field((MAX_NODES, 4)),
     "slew_phi": Field((MAX_NODES, 3)), "slew_w": Field((MAX_NODES, 3)),
     "slew_count": Field((2,), dtype=np.int64),
-    # this cycle's inputs: the measurement, the nav estimate's time, whether it slews
+}
+"""The slew plan in force as its nodes (times s, unit quaternions, rotation vectors, body
+rates; their counts): written from the plan whenever it is set (:func:`set_slew`), restored
+with it."""
+
+INPUTS: dict[str, Field] = {
     "t_meas": Field(), "gyro": Field((3,)), "star": Field((4,)), "star_on": Field(dtype=bool),
     "r_diag": Field((3,)), "t_est": Field(), "slewing": Field(dtype=bool),
-    # constants
+}
+"""This cycle's inputs, staged by each app before the compiled call: the measurement, the
+nav estimate's time, whether the slew plan is followed."""
+
+CONSTANT: dict[str, Field] = {
     "J": Field((3, 3)), "boresight": Field((3,)), "const": Field((len(CONSTANTS),)),
 }
-"""The fields of the attitude apps' block."""
+"""What the scenario sets, written when the app is built."""
+
+SPEC: dict[str, Field] = STATE | NODES | INPUTS | CONSTANT
+"""The fields of the attitude apps' block: only :data:`STATE` is learnt while running."""
 
 TRACKED, SLEW, NO_LINE_OF_SIGHT = kern.TRACKED, kern.SLEW, kern.NO_LINE_OF_SIGHT
 FOLLOWED = 3

@@ -4,6 +4,8 @@ its own spacecraft's failure."""
 
 from __future__ import annotations
 
+import pickle
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -13,6 +15,7 @@ from fsw.lib import attitude_kernels as kern
 from fsw.lib import attitude_rows
 from fsw.lib.attitude import scp_slew, slerp_plan
 from interfaces.contracts.messages import AttitudeMeasurement, PointingTarget, StateEstimate
+from interfaces.runtime.rows import Row, joined
 from tests.conftest import app_alone, small_scenario
 
 
@@ -127,3 +130,23 @@ def test_a_row_without_a_line_of_sight_fails_alone_as_it_would_and_its_mates_fly
             else:
                 app.step(t)
     _assert_same(together, alone, sent_together, sent_alone)
+
+
+def test_every_learnt_field_of_the_block_is_a_critical_attribute_of_the_app() -> None:
+    """The block holds the app's learnt state only in ``attitude_rows.STATE``, each field an
+    attribute the app declares ``CRITICAL`` (so it is checkpointed and restored through it);
+    the rest of the block is rebuilt (the plan's nodes, each cycle's inputs, constants)."""
+    rows = {name: d.name for name, d in vars(AttitudeApp).items() if isinstance(d, Row)}
+    assert set(rows.values()) == set(attitude_rows.STATE)
+    assert set(rows) <= set(AttitudeApp.CRITICAL)
+    parts = (attitude_rows.STATE, attitude_rows.NODES, attitude_rows.INPUTS,
+             attitude_rows.CONSTANT)
+    assert sum(len(p) for p in parts) == len(attitude_rows.SPEC)  # a partition
+    apps, _ = _apps(2)
+    apps[0].slew = scp_slew(Rotation.random(random_state=5), Rotation.random(random_state=6),
+                            40.0, 10, 0.05)
+    saved = pickle.loads(pickle.dumps(apps[0].checkpoint()))
+    joined(apps)  # into the fleet's block, then restored: the nodes come back with the plan
+    apps[1].restore(saved)
+    for name in attitude_rows.NODES:
+        assert np.array_equal(apps[1].rows.data[name][1], apps[0].rows.data[name][0]), name
