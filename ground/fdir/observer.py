@@ -112,6 +112,10 @@ class ObserverState:
     """reported (time s, Δv commanded so far m/s, holding its PRO), in time order"""
     nis: list[tuple[float, float]] = field(default_factory=list)
     """the nav's reported (time s, NIS of that step's measurement update), in arrival order"""
+    _on_grid: tuple[tuple[FlightPlan, ...], np.ndarray, tuple[np.ndarray, np.ndarray,
+                                                               np.ndarray] | None] | None = \
+        field(default=None, repr=False, compare=False)
+    """the plans, a grid of times and :meth:`planned` over it (``planned_on``)"""
     camera_off_s: float | None = None
     """when its onboard FDIR turned its camera off (s; None: on): no image is expected since"""
     silent: int = 0
@@ -249,6 +253,27 @@ class ObserverState:
             moving[sel] = plans[k].on_transfer(times[sel])
             known[sel] = plans[k].known(times[sel])
         return pos, moving, known
+
+    def planned_on(self, n: float, times: np.ndarray, grid: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """:meth:`planned` at ``times`` (K,), taken from the plans evaluated once over
+        ``grid`` (s, ascending: a window's image times) when every time is one of the grid's,
+        else evaluated at the times themselves: the same bits either way (a time's planned
+        position does not depend on the times evaluated with it: ``gnc.hcw``'s one-time and
+        stacked paths are one arithmetic).  The plans' evaluation is kept until the plans or
+        the grid change."""
+        plans = tuple(self.plans.values())
+        held = self._on_grid
+        if (held is None or held[1] is not grid or len(held[0]) != len(plans)
+                or any(a is not b for a, b in zip(held[0], plans, strict=True))):
+            held = self._on_grid = (plans, grid, self.planned(n, grid))
+        full = held[2]
+        at = np.searchsorted(grid, times)
+        if full is None or not len(grid) or at.max(initial=0) >= len(grid) \
+                or not np.array_equal(grid[at], times):
+            return self.planned(n, times)
+        pos, moving, known = full
+        return pos[at], moving[at], known[at]
 
     def plan_at(self, t: float) -> FlightPlan | None:
         valid = [p for p in self.plans.values() if p.t_from_s <= t]

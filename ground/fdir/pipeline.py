@@ -76,6 +76,10 @@ class FdirPipeline:
         sc, cfg = scenario, scenario.fdir
         self.node, self.log, self.settle_s, self.latency_s = node, log, cfg.settle_s, cfg.latency_s
         self.schedule = FdiSchedule(sc.rates.fdi_period_s)
+        self._tick = (sc.rates.dt_s, sc.rates.ticks_per("mid"))
+        """the tick (s) and the ticks per image (ω_mid): an image's time is its tick's, k dt"""
+        self._grid: tuple[float, np.ndarray] = (math.nan, np.empty(0))
+        """the start (s) of the window whose image times were made last, and those times"""
         self.contact = ContactPlan.of(sc)
         """when the ground hears (None: continuously)"""
         self.n = constants.n_rad_s
@@ -355,7 +359,8 @@ class FdirPipeline:
             if not mine:
                 continue
             settled = settled or SettledMap.of(self.settled)
-            ctx = (window_context(sc, obs, mine, a, b, settled, self.n, self.settle_s)[0]
+            ctx = (window_context(sc, obs, mine, a, b, settled, self.n, self.settle_s,
+                                  self._image_times(a, b))[0]
                    if obs.plan_at(a) is not None and not obs.camera_off_before(b) else None)
             plan = (obs.planned(self.n, self.sequential.plan_times(a, b))
                     if ctx is not None and not self.sequential.modelled(sc, a) else None)
@@ -371,6 +376,15 @@ class FdirPipeline:
                 self._crossings[sc] = crossing
         return (own + self._scan_nis(a, b) + self._decide_crossings(a, b, final)
                 + self._statuses())
+
+    def _image_times(self, a: float, b: float) -> np.ndarray:
+        """The times (s) of the images window [a, b) can hold: one every ω_mid period, each
+        its tick's time k·dt as the sim makes it (made once a window)."""
+        if self._grid[0] != a:
+            dt, every = self._tick
+            first, end = math.ceil(a / dt - 0.5), math.ceil(b / dt - 0.5)
+            self._grid = (a, np.array([k * dt for k in range(first, end) if k % every == 0]))
+        return self._grid[1]
 
     def _identify_part(self, k: int) -> list[Message]:
         """With the sequential test: each declared fault still without a class judged, as a

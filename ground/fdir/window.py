@@ -96,16 +96,20 @@ class WindowContext:
 
 
 def window_context(spacecraft: int, obs: ObserverState, images: list[PoiObservations],
-                   a: float, b: float, settled: SettledMap, n: float, settle_s: float
+                   a: float, b: float, settled: SettledMap, n: float, settle_s: float,
+                   grid: np.ndarray | None = None
                    ) -> tuple[WindowContext | None, int, Unjudged | None]:
     """The context of a window with a plan and images (``images``: those received, in time
     order), the count of images the window message reports, and why there is no context when
-    none can be judged.  ``n``: the mean motion (rad/s) the plans' PROs fly."""
+    none can be judged.  ``n``: the mean motion (rad/s) the plans' PROs fly; ``grid``: the
+    window's image times (s), over which the plans are evaluated once
+    (``ObserverState.planned_on``; None: at the images' times)."""
     received = len(images)
     images = [m for m in images if obs.tracking_at(m.image_t_s, settle_s)]
     if not images:
         return None, 0, "not_tracking"
-    planned = obs.planned(n, np.array([m.image_t_s for m in images]))
+    at = np.array([m.image_t_s for m in images])
+    planned = obs.planned(n, at) if grid is None else obs.planned_on(n, at, grid)
     if planned is None:  # no plan in force at an image time: nothing to compare with
         return None, received, "no_plan"
     pos, moving, known = planned  # unknown: on a transfer whose plan was lost

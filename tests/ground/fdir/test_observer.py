@@ -117,3 +117,29 @@ def test_sampled_threshold_is_seeded_and_grows_with_the_cone() -> None:
     floored = sampled_threshold(twin, pos, bore, psi, phi, 0.0, math.radians(0.5), 10, 0.5,
                                 np.random.default_rng(1))
     assert floored == 0.5
+
+
+def test_plans_evaluated_once_over_a_window_give_each_images_own_bits() -> None:
+    """``planned_on``: an image's planned position taken from the plans evaluated once over
+    the window's image times is the one evaluated at its time alone, to the bit, on a transfer
+    and on the PRO; a time off the grid is evaluated alone; a new plan is taken up."""
+    from fsw.lib.scp import plan_transfer
+    from gnc.hcw import mean_motion
+    from gnc.pro import Pro
+    from gnc.twin import FlightPlan, Transfer
+
+    n = mean_motion(500e3)
+    old, new = Pro(20.0, 0.0, 0.0, 25.0, 0.0), Pro(12.0, 1.0, 0.0, 15.0, 2.0)
+    plan = plan_transfer(n, old.state(n, 30.0), new.state(n, 330.0), 300.0, 30, 1e-3, 8.0)
+    obs = ObserverState()
+    obs.plans[1] = FlightPlan(0.0, old)
+    obs.plans[2] = FlightPlan(30.0, new, Transfer(plan.t_s + 30.0, plan.x, plan.u))
+    grid = np.array([k * 0.1 for k in range(0, 4000, 10)])  # the ticks' own times, k dt
+    for t in (grid[[5]], grid[[100, 101]], grid[[390]], np.array([12.345])):
+        alone, on = obs.planned(n, t), obs.planned_on(n, t, grid)
+        assert alone is not None and on is not None
+        assert all(np.array_equal(a, b) for a, b in zip(alone, on, strict=True)), t
+    obs.plans[2] = FlightPlan(30.0, old)  # replaced: evaluated again
+    replaced = obs.planned_on(n, grid[[100]], grid)
+    assert replaced is not None
+    assert np.array_equal(replaced[0], old.states(n, grid[[100]])[:, :3])
