@@ -78,7 +78,7 @@ class FdirPipeline:
         self.schedule = FdiSchedule(sc.rates.fdi_period_s)
         self._tick = (sc.rates.dt_s, sc.rates.ticks_per("mid"))
         """the tick (s) and the ticks per image (ω_mid): an image's time is its tick's, k dt"""
-        self._grid: tuple[float, np.ndarray] = (math.nan, np.empty(0))
+        self._grid: tuple[float, np.ndarray] | None = None
         """the start (s) of the window whose image times were made last, and those times"""
         self.contact = ContactPlan.of(sc)
         """when the ground hears (None: continuously)"""
@@ -380,7 +380,7 @@ class FdirPipeline:
     def _image_times(self, a: float, b: float) -> np.ndarray:
         """The times (s) of the images window [a, b) can hold: one every ω_mid period, each
         its tick's time k·dt as the sim makes it (made once a window)."""
-        if self._grid[0] != a:
+        if self._grid is None or self._grid[0] != a:
             dt, every = self._tick
             first, end = math.ceil(a / dt - 0.5), math.ceil(b / dt - 0.5)
             self._grid = (a, np.array([k * dt for k in range(first, end) if k % every == 0]))
