@@ -113,7 +113,6 @@ def step_rows(rows: Rows, which: np.ndarray, t: float, dt: float, h: float, repo
 
 
 _hamilton = njit(cache=True)(quat.hamilton)
-_exp_xyz = njit(cache=True)(quat.exp_xyz)
 
 
 @njit(cache=True)
@@ -127,7 +126,7 @@ def slew_sample(t_nodes: np.ndarray, q_nodes: np.ndarray, phi: np.ndarray, rates
     k = max(int(np.searchsorted(t_nodes[:m], tc, side="left")) - 1, 0)
     frac = (tc - t_nodes[k]) / (t_nodes[k + 1] - t_nodes[k])
     qk, v = q_nodes[k], phi[k] * frac
-    q_t = np.array(_hamilton((qk[0], qk[1], qk[2], qk[3]), _exp_xyz(v[0], v[1], v[2])))
+    q_t = np.array(_hamilton((qk[0], qk[1], qk[2], qk[3]), kern._exp_xyz(v[0], v[1], v[2])))
     if t < t_nodes[0] or t > t_nodes[m - 1]:
         return q_t, zero, zero.copy()
     j = int(np.searchsorted(t_nodes[:m], t, side="right")) - 1
