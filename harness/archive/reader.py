@@ -408,7 +408,7 @@ class RecordLoader:
     sequence accounting (fed record by record from the files of a run here, segment by segment,
     or sample by sample as a run is recorded: ``harness.archive.live``)."""
 
-    def __init__(self, sinks: Mapping[str, RecordSink]) -> None:
+    def __init__(self, sinks: Mapping[str, RecordSink | None]) -> None:
         self.sinks = dict(sinks)
         self.schemas_by_id: dict[int, Schema] = {}
         """The schemas of the segment being read, by their id in it."""
@@ -460,8 +460,12 @@ class RecordLoader:
             sink(record)
 
     def sink_of(self, key: str) -> RecordSink | None:
-        """The sink of ``key`` (the first matching expression), or None to keep its records."""
+        """The sink of ``key`` (the first matching expression), or None to keep its records
+        (also where the first matching expression's sink is None)."""
         return next((f for e, f in self.sinks.items() if matches(e, key)), None)
+
+    def end_record(self, rec: object) -> None:
+        """A record of the file (a chunk: every item of it) was taken whole."""
 
     def _schema_infos(self) -> dict[str, SchemaInfo]:
         return {s.name: SchemaInfo(s.name, s.encoding, s.data)
@@ -538,6 +542,7 @@ def _read_records(reader: StreamReader, loader: RecordLoader, source: _ExactRead
             stop = loader.item(item)
             if stop is not None:
                 return stop, kept
+        loader.end_record(rec)
         kept = source.offset
 
 
@@ -551,16 +556,7 @@ def _read_segment(path: Path, loader: RecordLoader) -> SegmentInfo:
             raise ArchiveError(
                 f"{path}: not an MCAP file (starts with {head!r}, expected {MCAP_MAGIC!r})"
             )
-        file.seek(0)
-        size = os.fstat(file.fileno()).st_size
-        source = _ExactReader(file)
-        reader = StreamReader(
-            source,  # type: ignore[arg-type]  # duck-typed binary stream
-            skip_magic=False,
-            emit_chunks=True,
-            validate_crcs=True,
-            record_size_limit=max(size, 1),
-        )
+        reader, source, size = _records_of(file)
         stop_reason, kept = _read_records(reader, loader, source)
     if stop_reason is None and not loader.footer_seen:  # pragma: no cover - StreamReader
         stop_reason = "no footer"  # stops at the footer
@@ -568,6 +564,37 @@ def _read_segment(path: Path, loader: RecordLoader) -> SegmentInfo:
         return SegmentInfo(path, False, None, size_bytes=size)
     _warn_cut(path, stop_reason, kept, size, loader.end_ns)
     return SegmentInfo(path, True, stop_reason, cut_at_byte=kept, size_bytes=size)
+
+
+def _records_of(file: IO[bytes]) -> tuple[StreamReader, _ExactReader, int]:
+    """A reader of the records of ``file`` from its start (chunks not expanded), the exact
+    reader under it (its offset: the bytes read) and the file's size (bytes)."""
+    file.seek(0)
+    size = os.fstat(file.fileno()).st_size
+    source = _ExactReader(file)
+    reader = StreamReader(source,  # type: ignore[arg-type]  # duck-typed binary stream
+                          skip_magic=False, emit_chunks=True, validate_crcs=True,
+                          record_size_limit=max(size, 1))
+    return reader, source, size
+
+
+def unit_starts(path: Path) -> list[int]:
+    """The log time (ns) of the first message of each chunk of ``path``, and of each message
+    outside a chunk, in file order, read without decompressing a chunk; as far as the file can
+    be parsed (nothing for a file that is not MCAP or cannot be read)."""
+    starts: list[int] = []
+    try:
+        with open(path, "rb") as file:
+            if file.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
+                return starts
+            for rec in _records_of(file)[0].records:
+                if isinstance(rec, Chunk):
+                    starts.append(rec.message_start_time)
+                elif isinstance(rec, McapMessage):
+                    starts.append(rec.log_time)
+    except (OSError, *_READ_ERRORS):
+        pass  # the second pass says why (the first file) or reports it (a later one)
+    return starts
 
 
 def _warn_cut(path: Path, reason: str, kept: int, size: int, end_ns: int | None) -> None:
@@ -587,19 +614,27 @@ def _read_later_segment(path: Path, loader: RecordLoader) -> SegmentInfo:
         return SegmentInfo(path, True, str(exc))
 
 
-def load_run(path: str | Path, stream: Mapping[str, RecordSink] | None = None) -> RunArchive:
+def load_run(path: str | Path, stream: Mapping[str, RecordSink | None] | None = None
+             ) -> RunArchive:
     """Read a run archive (complete or cut short by a kill), every segment of it: ``path``
     (``run.mcap``) and the segments after it (``run-1.mcap``, ...:
     :func:`ground.archive.segments.segment_paths`), as one run; see the module docstring.
 
     ``stream`` maps key expressions to sinks: a record of a matching key (the first matching
-    expression decides) goes to its sink as it is read, in file order, and is not kept.
+    expression decides) goes to its sink as it is read, in file order, and is not kept; an
+    expression mapped to None keeps its records (before a broader one that streams).
+    :func:`harness.archive.stream.stream_run` hands them on in time order instead.
 
     Raises :class:`ArchiveError` if the (first) file is not MCAP, ``OSError`` if it cannot be
     read.
     """
     paths = segment_paths(path)
-    loader = RecordLoader(stream or {})
+    return read_segments(paths, RecordLoader(stream or {}))
+
+
+def read_segments(paths: list[Path], loader: RecordLoader) -> RunArchive:
+    """The files of one run (its first, then each later segment) read into ``loader``, as
+    :func:`load_run` reads them."""
     segments = []
     for index, segment in enumerate(paths):
         loader.begin_segment(more_follow=index + 1 < len(paths))
@@ -609,4 +644,4 @@ def load_run(path: str | Path, stream: Mapping[str, RecordSink] | None = None) -
 
 
 __all__ = ["ArchiveError", "MCAP_MAGIC", "Record", "RecordLoader", "RecordSink", "RunArchive",
-           "SchemaInfo", "SegmentInfo", "load_run"]
+           "SchemaInfo", "SegmentInfo", "load_run", "read_segments", "unit_starts"]

@@ -1,0 +1,124 @@
+"""A run's archive read in time order, in bounded memory.
+
+:func:`harness.archive.reader.load_run` holds every record it keeps and sorts them by log time
+at the end; the records of keys it streams go to their sinks in file order.  A replay needs the
+bulk of an archive (the other nodes' messages) in time order, which held whole grows with the
+run (a 6,000 s run under ground passes: past 17 GB).  :func:`stream_run` reads the same archive
+into the same :class:`~harness.archive.reader.RunArchive`, but hands the streamed records to
+their sinks in the held records' order (log time, ties in segment then file order), holding
+only those that a chunk not yet read could still precede:
+
+* a first pass reads each file's records without decompressing its chunks and notes, for each
+  chunk (and each message outside one), the log time of its first message: an MCAP chunk
+  record carries its messages' time range;
+* the second reads the files as :func:`load_run` does (the same admission of each record in
+  file order, a chunk decoded and checked whole, a file cut short read up to its cut) and hands
+  a streamed record on once no chunk still to be read starts before it.
+
+The recorder writes messages as they come, so chunks follow one another in time, and what is
+held is about one chunk (4 MiB of messages).  A message found earlier than one already handed
+on (a chunk whose recorded range is wrong: never written by this project's recorder) is handed
+on at once, out of order, and counted in :attr:`TimeOrder.late`.
+"""
+
+from __future__ import annotations
+
+import heapq
+import logging
+import math
+from collections.abc import Mapping
+from pathlib import Path
+
+from mcap.records import Chunk
+from mcap.records import Message as McapMessage
+
+from ground.archive.segments import segment_paths
+from harness.archive.reader import (
+    Record,
+    RecordLoader,
+    RecordSink,
+    RunArchive,
+    SegmentInfo,
+    read_segments,
+    unit_starts,
+)
+
+log = logging.getLogger("insp.archive")
+
+
+class TimeOrder(RecordLoader):
+    """A :class:`RecordLoader` whose streamed records wait in a heap, by (log time, order
+    read), until no chunk still to be read can start before them.  ``starts``: each segment's
+    :func:`unit_starts`."""
+
+    def __init__(self, sinks: Mapping[str, RecordSink | None], starts: list[list[int]]) -> None:
+        super().__init__({e: (None if s is None else self._waiting(s)) for e, s in sinks.items()})
+        self._first = [0]
+        for seg in starts:
+            self._first.append(self._first[-1] + len(seg))
+        flat = [t for seg in starts for t in seg]
+        self._suffix_min = [math.inf] * (len(flat) + 1)
+        for i in range(len(flat) - 1, -1, -1):
+            self._suffix_min[i] = min(flat[i], self._suffix_min[i + 1])
+        self._unit = 0
+        self._heap: list[tuple[int, int, Record, RecordSink]] = []
+        self._order = 0
+        self._last_out = -1
+        self.late = 0
+        """Records handed on after a later one (a chunk's recorded range was wrong)."""
+        self.peak_waiting = 0
+        """The most records that waited at once."""
+
+    def _waiting(self, sink: RecordSink) -> RecordSink:
+        def wait(record: Record) -> None:
+            self._order += 1
+            heapq.heappush(self._heap, (record.log_time_ns, self._order, record, sink))
+            self.peak_waiting = max(self.peak_waiting, len(self._heap))
+
+        return wait
+
+    def begin_segment(self, more_follow: bool) -> None:
+        super().begin_segment(more_follow)
+        self._unit = self._first[self.segment]  # a cut segment's unread chunks are passed over
+
+    def end_record(self, rec: object) -> None:
+        if isinstance(rec, (Chunk, McapMessage)):
+            self._unit += 1
+            self._hand_on(self._bound())
+
+    def _bound(self) -> float:
+        """The earliest log time a record still to be read may have (ns); -inf past what the
+        first pass saw of this segment (nothing is then known of the rest)."""
+        if self._unit > self._first[self.segment + 1]:
+            return -math.inf
+        return self._suffix_min[self._unit]
+
+    def _hand_on(self, bound: float) -> None:
+        """Hand on, in order, every waiting record not after ``bound`` (ns)."""
+        heap = self._heap
+        while heap and heap[0][0] <= bound:
+            t_ns, _, record, sink = heapq.heappop(heap)
+            if t_ns < self._last_out:
+                self.late += 1
+                log.warning("%s at %d ns: read after a later message (count %d)",
+                            record.key, t_ns, self.late)
+            self._last_out = max(self._last_out, t_ns)
+            sink(record)
+
+    def archive(self, path: Path, segments: list[SegmentInfo]) -> RunArchive:
+        self._hand_on(math.inf)
+        return super().archive(path, segments)
+
+
+def stream_run(path: str | Path, stream: Mapping[str, RecordSink | None]
+               ) -> tuple[RunArchive, TimeOrder]:
+    """:func:`harness.archive.reader.load_run` (the same arguments, the same archive), with
+    each streamed record handed to its sink in time order (log time, ties in segment then file
+    order: the order of the held records), in bounded memory (module docstring); and the
+    order's account (:attr:`TimeOrder.late`, :attr:`TimeOrder.peak_waiting`)."""
+    paths = segment_paths(path)
+    order = TimeOrder(stream, [unit_starts(p) for p in paths])
+    return read_segments(paths, order), order
+
+
+__all__ = ["TimeOrder", "stream_run"]
