@@ -56,7 +56,6 @@ import logging
 import re
 import sys
 import time
-from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -64,15 +63,17 @@ from typing import Any
 from pydantic import ValidationError
 
 from harness.archive.locate import archive_file
-from harness.archive.reader import ArchiveError, Record, RunArchive, load_run
-from harness.archive.run_scenario import archived_scenario, scenario_from_metadata
+from harness.archive.reader import ArchiveError, Record, RunArchive
+from harness.archive.run_scenario import archived_scenario
 from harness.archive.span import ArchiveSpan
+from harness.archive.stream import stream_run
 from harness.destination import DestinationError, check_file, write_whole
 from harness.summary import ReplayResults
 from harness.summary.delay_bound import NisSeries
 from harness.summary.fdir import archived_nis, fdir_results
 from interfaces.contracts import catalogue as cat
 from interfaces.contracts import topics
+from interfaces.contracts.catalogue import Topic, topic_of
 from interfaces.contracts.errors import describe, did_you_mean
 from interfaces.contracts.messages import (
     BaselineVerdict,
@@ -80,6 +81,7 @@ from interfaces.contracts.messages import (
     FaultReport,
     FdirWindow,
     ProAssignments,
+    StateEstimate,
 )
 from interfaces.contracts.scenario import Scenario, ScenarioError
 from interfaces.contracts.topology import topology
@@ -214,11 +216,6 @@ def _same(a: list[Any], b: list[Any]) -> bool:
 # --- settings ---------------------------------------------------------------------------------
 
 
-def scenario_of(archive: RunArchive) -> Scenario:
-    """The scenario a run ran with, from its metadata (written by every run and campaign)."""
-    return scenario_from_metadata(archive.metadata)
-
-
 def with_settings(scenario: Scenario, settings: dict[str, str]) -> Scenario:
     """``scenario`` with ``section.key = value`` settings (values parsed as JSON where they
     are, else kept as text); only detector settings (``SETTABLE``).  Raises ScenarioError."""
@@ -267,54 +264,103 @@ def replay_run(path: Path, settings: dict[str, str] | None = None,
     """Replay the ground of the run archived at ``path`` (its archive or its folder; module
     docstring), judging nothing past the archive's end.  ``scenario``: the run's scenario when
     its archive carries none; ``settings``: detector settings changed from the run's.
+    The archive streams past in time order (``harness.archive.stream``): what the replay
+    holds is the ground's own output and the nav estimates, not the archive.
     Raises ArchiveError (ArchivePathError for a path naming no archive), ScenarioError.  This
     process's BLAS runs on one thread from then on (``interfaces.runtime.blas_threads``)."""
     one_blas_thread()
     start = time.perf_counter()
-    archive = load_run(archive_file(path), stream={t.any_mission(): _drop for t in UNREAD})
-    flown = scenario or scenario_of(archive)
+    file = archive_file(path)
+    flown = scenario or archived_scenario(file)
     replay_scenario = with_settings(flown, settings or {})
+    feed = GroundFeed(replay_scenario)
+    archive, _ = stream_run(file, {**{t.any_mission(): _drop for t in UNREAD},
+                                   OWN_OUTPUT: None, "**": feed})
+    feed.finish()
     mission = archive.mission()
     span = ArchiveSpan.of(archive, flown)
-    replayed = _run_ground(archive, mission, replay_scenario).within(
-        span, replay_scenario.fdir.latency_s)
+    replayed = feed.out.within(span, replay_scenario.fdir.latency_s)
     live = GroundOutput.of_archive(archive, mission).within(span, flown.fdir.latency_s)
     return Replay(replay_scenario, live, replayed, time.perf_counter() - start, span,
-                  archived_nis(archive, replay_scenario, mission))
+                  archived_nis(feed.estimates(), replay_scenario))
 
 
-def _run_ground(archive: RunArchive, mission: str, scenario: Scenario) -> GroundOutput:
-    """The ground station, built as a run builds it, fed the archive; what it published."""
-    net = InprocNetwork()
-    bus = Bus(topics.GROUND, mission, net.endpoint(),
-              channel=ChannelModel.of(topics.GROUND, scenario))
-    executive = executive_of(topology(scenario).node(topics.GROUND), bus, scenario)
-    executive.barrier_timeout_s = 0.0  # everything the archive holds is delivered before a tick
-    TickClient(executive, synchronous=True)
-    own = topics.node_prefix(mission, topics.GROUND)
-    out = GroundOutput()
-    net.endpoint().subscribe_samples(own + "/**", lambda s: out.add(s.message))
-    _play(archive.held(), net.endpoint(), own + "/")
-    return out
+OWN_OUTPUT = f"{topics.ROOT}/*/{topics.GROUND}/**"
+"""The live ground's own messages: held for the comparison, never played to the replay's."""
+
+
+class GroundFeed:
+    """The replay's sink: the other nodes' records, as they stream past in time order, played
+    to a ground station built as a run builds it (``interfaces.contracts.topology``: the code
+    the live ground runs), in lockstep order: per sim time, every message, then the Tick.  The
+    station is built at the first Tick (its key names the mission); the nav estimates are also
+    kept (the delay bounds read them)."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.scenario = scenario
+        self.out = GroundOutput()
+        self._nav: list[Record] = []
+        self._group: list[Record] = []
+        self._waiting: list[list[Record]] = []  # instants before the first Tick
+        self._player: Any = None
+        self._topics: dict[str, Topic | None] = {}
+
+    def __call__(self, rec: Record) -> None:
+        if self._group and rec.log_time_ns != self._group[0].log_time_ns:
+            self._instant(self._group)
+            self._group = []
+        self._group.append(rec)
+        if self._topic(rec.key) is cat.NAV_ESTIMATE:
+            self._nav.append(rec)
+
+    def _topic(self, key: str) -> Topic | None:
+        """The catalogued topic of ``key`` (looked up once per key)."""
+        if key not in self._topics:
+            self._topics[key] = topic_of(key)
+        return self._topics[key]
+
+    def finish(self) -> None:
+        """Play the last instant (none is played without a Tick: the archive's mission is
+        then unknown, which reading it says)."""
+        self._instant(self._group)
+        self._group = []
+
+    def estimates(self) -> list[StateEstimate]:
+        """The nav estimates streamed past."""
+        model = cat.NAV_ESTIMATE.type
+        return [r.decode(model) for r in self._nav if r.type_name == model.__name__]
+
+    def _instant(self, group: list[Record]) -> None:
+        """Play one sim time's records (those before the first Tick wait for it)."""
+        instants = [group]
+        if self._player is None:
+            self._waiting.append(group)
+            tick = next((r for r in group if self._topic(r.key) is cat.TICK), None)
+            if tick is None:
+                return
+            self._player = self._ground(tick.key)
+            instants, self._waiting = self._waiting, []
+        for instant in instants:
+            _send_group(instant, self._player)
+
+    def _ground(self, key: str) -> Any:
+        """The ground station of the mission ``key`` lies in, built as a run builds it, whose
+        output goes to :attr:`out`; the endpoint that plays to it."""
+        mission = key.split("/")[1]
+        net = InprocNetwork()
+        bus = Bus(topics.GROUND, mission, net.endpoint(),
+                  channel=ChannelModel.of(topics.GROUND, self.scenario))
+        executive = executive_of(topology(self.scenario).node(topics.GROUND), bus,
+                                 self.scenario)
+        executive.barrier_timeout_s = 0.0  # everything archived is delivered before a tick
+        TickClient(executive, synchronous=True)
+        own = topics.node_prefix(mission, topics.GROUND)
+        net.endpoint().subscribe_samples(own + "/**", lambda s: self.out.add(s.message))
+        return net.endpoint()
 
 
 def _drop(_rec: Record) -> None:
     """Sink of the records a replay does not read."""
-
-
-def _play(records: Iterable[Record], player: Any, own_prefix: str) -> None:
-    """Send the other nodes' records in lockstep order: per sim time, every message, then the
-    Tick (archives are in sim-time order; a Tick may have been recorded before a message of
-    its own time arrived)."""
-    group: list[Record] = []
-    for rec in records:
-        if rec.key.startswith(own_prefix):
-            continue
-        if group and rec.log_time_ns != group[0].log_time_ns:
-            _send_group(group, player)
-            group = []
-        group.append(rec)
-    _send_group(group, player)
 
 
 def _send_group(group: list[Record], player: Any) -> None:

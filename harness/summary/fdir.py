@@ -32,6 +32,7 @@ from interfaces.contracts.messages import (
     BaselineVerdict,
     FaultReport,
     FdirWindow,
+    StateEstimate,
 )
 from interfaces.contracts.scenario import FdirSettings, Scenario
 
@@ -241,15 +242,16 @@ def fdir_summary(archive: RunArchive, scenario: Scenario, mission: str) -> FdirR
     faults (harness/summary/scoring.py; grace of one FDI window)."""
     return fdir_results(archive.of(cat.FAULT_REPORT, mission),
                         archive.of(cat.FDIR_WINDOW, mission), archive.of(cat.BASELINE, mission),
-                        scenario, archived_nis(archive, scenario, mission))
+                        scenario, archived_nis(archive.of(cat.NAV_ESTIMATE, mission), scenario))
 
 
-def archived_nis(archive: RunArchive, scenario: Scenario, mission: str) -> NisSeries | None:
-    """Where the sequential test runs, each observer's nav updates as archived (their NIS
-    bound each fault's delay, ``harness/summary/delay_bound.py``); else None."""
+def archived_nis(estimates: list[StateEstimate], scenario: Scenario) -> NisSeries | None:
+    """Where the sequential test runs, each observer's nav updates as archived (``estimates``:
+    the run's; their NIS bound each fault's delay, ``harness/summary/delay_bound.py``); else
+    None."""
     if scenario.fdir.detector != "sequential":
         return None
-    return nis_series(archive.of(cat.NAV_ESTIMATE, mission))
+    return nis_series(estimates)
 
 
 def fdir_results(reports: list[FaultReport], windows: list[FdirWindow],
