@@ -49,10 +49,12 @@ from operator import attrgetter
 from pathlib import Path
 from typing import IO, Final, TypeVar, overload
 
+import numpy as np
 import zstandard
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import EndOfFile, McapError, RecordLengthLimitExceeded
 from mcap.opcode import Opcode
+from mcap.reader import make_reader
 from mcap.records import (
     Channel,
     Chunk,
@@ -578,23 +580,73 @@ def _records_of(file: IO[bytes]) -> tuple[StreamReader, _ExactReader, int]:
     return reader, source, size
 
 
-def unit_starts(path: Path) -> list[int]:
-    """The log time (ns) of the first message of each chunk of ``path``, and of each message
-    outside a chunk, in file order, read without decompressing a chunk; as far as the file can
-    be parsed (nothing for a file that is not MCAP or cannot be read)."""
-    starts: list[int] = []
+_RECORD_HEAD = struct.Struct("<BQ")
+"""A record's opcode and body length (MCAP spec: every record outside the magic)."""
+_INDEX_HEAD = struct.Struct("<HI")
+"""A message index's channel id and the byte length of its (log time, offset) pairs."""
+_LOOSE_HEAD = struct.Struct("<HIQ")
+"""A message's channel id, sequence and log time."""
+UnitTimes = list[tuple[int, int]]
+"""One chunk's (or loose message's) first log time per channel id, (channel id, ns); a
+channel id of -1 stands for every channel of a chunk whose message indexes are missing."""
+
+
+def unit_times(path: Path) -> list[UnitTimes]:
+    """For each chunk of ``path`` (and each message outside one), in file order, the first log
+    time of its messages on each channel: from the message indexes written after the chunk, or
+    the chunk's own start time for all its channels where they are missing.  Each record's head
+    is read and its body skipped (nothing decompressed), as far as whole records reach (nothing
+    for a file that is not MCAP or cannot be read; the full read says why)."""
+    units: list[UnitTimes] = []
+    indexing = False  # reading the message indexes after a chunk
     try:
         with open(path, "rb") as file:
             if file.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
-                return starts
-            for rec in _records_of(file)[0].records:
-                if isinstance(rec, Chunk):
-                    starts.append(rec.message_start_time)
-                elif isinstance(rec, McapMessage):
-                    starts.append(rec.log_time)
+                return units
+            size, pos = os.fstat(file.fileno()).st_size, len(MCAP_MAGIC)
+            while pos + _RECORD_HEAD.size <= size:
+                opcode, length = _RECORD_HEAD.unpack(file.read(_RECORD_HEAD.size))
+                pos += _RECORD_HEAD.size + length
+                if opcode == Opcode.FOOTER:
+                    indexing = False
+                if pos > size or opcode == Opcode.FOOTER:
+                    break
+                body = file.read(length) if opcode != Opcode.CHUNK else file.read(8)
+                indexing = _take_unit(units, opcode, body, indexing)
+                file.seek(pos)
+    except (OSError, struct.error):
+        pass
+    cut = len(units) - 1 if indexing else -1  # its indexes may have been cut: keep its start
+    return [u[1:] if len(u) > 1 and i != cut and u[0][0] == -1 else u
+            for i, u in enumerate(units)]
+
+
+def summary_topics(path: Path) -> dict[int, str]:
+    """The topic of each channel id of ``path``, from its summary section (read from the end of
+    the file, no message read); empty for a file without one (its writer was killed)."""
+    try:
+        with open(path, "rb") as file:
+            summary = make_reader(file).get_summary()
     except (OSError, *_READ_ERRORS):
-        pass  # the second pass says why (the first file) or reports it (a later one)
-    return starts
+        return {}
+    return {} if summary is None else {i: c.topic for i, c in summary.channels.items()}
+
+
+def _take_unit(units: list[UnitTimes], opcode: int, body: bytes, indexing: bool) -> bool:
+    """Note one record's times in ``units``; whether message indexes of a chunk may follow."""
+    if opcode == Opcode.CHUNK:
+        units.append([(-1, _U64.unpack_from(body)[0])])
+        return True
+    if opcode == Opcode.MESSAGE_INDEX and indexing:
+        channel, nbytes = _INDEX_HEAD.unpack_from(body)
+        times = np.frombuffer(body, "<u8", count=nbytes // 8, offset=_INDEX_HEAD.size)[0::2]
+        if times.size:  # after the chunk's start time, which they stand for once complete
+            units[-1].append((channel, int(times.min())))
+        return True
+    if opcode == Opcode.MESSAGE:
+        channel, _seq, log_time = _LOOSE_HEAD.unpack_from(body)
+        units.append([(channel, log_time)])
+    return False
 
 
 def _warn_cut(path: Path, reason: str, kept: int, size: int, end_ns: int | None) -> None:
@@ -644,4 +696,4 @@ def read_segments(paths: list[Path], loader: RecordLoader) -> RunArchive:
 
 
 __all__ = ["ArchiveError", "MCAP_MAGIC", "Record", "RecordLoader", "RecordSink", "RunArchive",
-           "SchemaInfo", "SegmentInfo", "load_run", "read_segments", "unit_starts"]
+           "SchemaInfo", "SegmentInfo", "load_run", "read_segments", "summary_topics", "unit_times"]

@@ -29,7 +29,8 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-from mcap.records import Chunk
+import numpy as np
+from mcap.records import Channel, Chunk
 from mcap.records import Message as McapMessage
 
 from ground.archive.segments import segment_paths
@@ -39,8 +40,10 @@ from harness.archive.reader import (
     RecordSink,
     RunArchive,
     SegmentInfo,
+    UnitTimes,
     read_segments,
-    unit_starts,
+    summary_topics,
+    unit_times,
 )
 
 log = logging.getLogger("insp.archive")
@@ -48,18 +51,31 @@ log = logging.getLogger("insp.archive")
 
 class TimeOrder(RecordLoader):
     """A :class:`RecordLoader` whose streamed records wait in a heap, by (log time, order
-    read), until no chunk still to be read can start before them.  ``starts``: each segment's
-    :func:`unit_starts`."""
+    read), until no chunk still to be read can hold a streamed record before them.  ``units``:
+    each segment's :func:`~harness.archive.reader.unit_times`; ``topics``: each segment's
+    :func:`~harness.archive.reader.summary_topics`.  A channel whose records are held (its key
+    streams to no sink) does not count, from the start where the segment's summary names it,
+    else from its channel record on: the ground's judgements of a pass, stamped with the time of
+    the data they judge, are archived long after it and would otherwise hold back everything
+    between."""
 
-    def __init__(self, sinks: Mapping[str, RecordSink | None], starts: list[list[int]]) -> None:
+    def __init__(self, sinks: Mapping[str, RecordSink | None], units: list[list[UnitTimes]],
+                 topics: list[dict[int, str]]) -> None:
         super().__init__({e: (None if s is None else self._waiting(s)) for e, s in sinks.items()})
         self._first = [0]
-        for seg in starts:
+        for seg in units:
             self._first.append(self._first[-1] + len(seg))
-        flat = [t for seg in starts for t in seg]
-        self._suffix_min = [math.inf] * (len(flat) + 1)
-        for i in range(len(flat) - 1, -1, -1):
-            self._suffix_min[i] = min(flat[i], self._suffix_min[i + 1])
+        rows = [(self._first[s] + i, s, channel, t) for s, seg in enumerate(units)
+                for i, unit in enumerate(seg) for channel, t in unit]
+        table = np.array(rows, dtype=np.float64).reshape(-1, 4)
+        self._unit_of = table[:, 0].astype(np.int64)
+        self._segment_of, self._channel_of, self._t_of = table[:, 1], table[:, 2], table[:, 3]
+        self._held = np.zeros(len(rows), dtype=bool)
+        for seg, known in enumerate(topics):  # channels a segment's summary names
+            for channel, topic in known.items():
+                if self.sink_of(topic) is None:
+                    self._held |= (self._segment_of == seg) & (self._channel_of == channel)
+        self._suffix_min = self._earliest_from_each_unit()
         self._unit = 0
         self._heap: list[tuple[int, int, Record, RecordSink]] = []
         self._order = 0
@@ -68,6 +84,22 @@ class TimeOrder(RecordLoader):
         """Records handed on after a later one (a chunk's recorded range was wrong)."""
         self.peak_waiting = 0
         """The most records that waited at once."""
+
+    def _earliest_from_each_unit(self) -> np.ndarray:
+        """For each unit, the earliest first log time of a channel not held in it or any unit
+        after it (ns; inf past the last)."""
+        earliest = np.full(self._first[-1] + 1, np.inf)
+        counted = ~self._held
+        np.minimum.at(earliest, self._unit_of[counted], self._t_of[counted])
+        return np.minimum.accumulate(earliest[::-1])[::-1]
+
+    def _channel(self, rec: Channel) -> None:
+        super()._channel(rec)
+        if self.channels[rec.id][2] is None:  # held: its times no longer hold anything back
+            mine = (self._segment_of == self.segment) & (self._channel_of == rec.id)
+            if (mine & ~self._held).any():
+                self._held |= mine
+                self._suffix_min = self._earliest_from_each_unit()
 
     def _waiting(self, sink: RecordSink) -> RecordSink:
         def wait(record: Record) -> None:
@@ -87,11 +119,11 @@ class TimeOrder(RecordLoader):
             self._hand_on(self._bound())
 
     def _bound(self) -> float:
-        """The earliest log time a record still to be read may have (ns); -inf past what the
-        first pass saw of this segment (nothing is then known of the rest)."""
+        """The earliest log time a streamed record still to be read may have (ns); -inf past
+        what the first pass saw of this segment (nothing is then known of the rest)."""
         if self._unit > self._first[self.segment + 1]:
             return -math.inf
-        return self._suffix_min[self._unit]
+        return float(self._suffix_min[self._unit])
 
     def _hand_on(self, bound: float) -> None:
         """Hand on, in order, every waiting record not after ``bound`` (ns)."""
@@ -117,7 +149,7 @@ def stream_run(path: str | Path, stream: Mapping[str, RecordSink | None]
     order: the order of the held records), in bounded memory (module docstring); and the
     order's account (:attr:`TimeOrder.late`, :attr:`TimeOrder.peak_waiting`)."""
     paths = segment_paths(path)
-    order = TimeOrder(stream, [unit_starts(p) for p in paths])
+    order = TimeOrder(stream, [unit_times(p) for p in paths], [summary_topics(p) for p in paths])
     return read_segments(paths, order), order
 
 

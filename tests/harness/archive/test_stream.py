@@ -13,10 +13,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from mcap.records import Chunk
+from mcap.records import Message as McapMessage
+from mcap.stream_reader import StreamReader, breakup_chunk
 
 from ground.archive.recorder import McapRecorder
 from ground.archive.segments import with_segment
-from harness.archive.reader import Record, load_run
+from harness.archive.reader import Record, load_run, unit_times
 from harness.archive.stream import TimeOrder, stream_run
 from interfaces.contracts.messages import Heartbeat, StateEstimate
 
@@ -142,3 +145,51 @@ def test_not_an_archive_is_refused_as_the_whole_read_refuses_it(tmp_path: Path) 
         load_run(path)
     with pytest.raises(type(whole.value)):
         stream_run(path, {"**": lambda _r: None})
+
+
+def _library_units(path: Path) -> list[dict[int, int]]:
+    """Each chunk's first log time per channel, split by the mcap library itself."""
+    out = []
+    with open(path, "rb") as f:
+        for rec in StreamReader(f, emit_chunks=True).records:
+            if isinstance(rec, Chunk):
+                first: dict[int, int] = {}
+                for item in breakup_chunk(rec):
+                    if isinstance(item, McapMessage):
+                        first[item.channel_id] = min(first.get(item.channel_id, item.log_time),
+                                                     item.log_time)
+                out.append(first)
+    return out
+
+
+def test_each_chunks_first_log_time_per_channel_as_the_mcap_library_splits_it(
+        tmp_path: Path) -> None:
+    path = _write(tmp_path / "run.mcap", _jittered(1200, np.random.default_rng(8)))
+    units = unit_times(path)
+    assert [dict(u) for u in units] == _library_units(path) and len(units) > 20
+    data = path.read_bytes()
+    (tmp_path / "cut.mcap").write_bytes(data[:len(data) // 2])
+    cut = unit_times(tmp_path / "cut.mcap")
+    assert 0 < len(cut) < len(units) and cut[:-1] == units[:len(cut) - 1]
+
+
+def test_a_held_key_archived_late_holds_nothing_back(tmp_path: Path) -> None:
+    """Judgements archived long after the time they are stamped with (the ground's at a pass)
+    wait for nothing when held; streamed, they are still put in order."""
+    late_key = f"insp/{M}/ground/fdir/window"
+    messages = []
+    for i, m in enumerate(_jittered(3000, np.random.default_rng(9))):
+        messages.append(m)
+        if i % 1000 == 999:  # a pass: the last 40 s judged at once, stamped with their times
+            t_now = i / 3000 * 250.0
+            messages += [(late_key, "Heartbeat", _beat(9, i + j, t_now - 40.0 + 4 * j))
+                         for j in range(10)]
+    path = _write(tmp_path / "run.mcap", messages)
+    whole = load_run(path)
+    got: list[Record] = []
+    archive, order = stream_run(path, {late_key: None, "**": got.append})
+    assert _same(archive.held(), whole.records(late_key)) and len(archive.held()) == 30
+    assert _same(got, [r for r in whole.held() if r.key != late_key])
+    assert order.late == 0 and order.peak_waiting <= 60
+    streamed_too = _check_equal(path)
+    assert streamed_too.peak_waiting > 300  # in order, they hold back what came since
