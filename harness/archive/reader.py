@@ -607,9 +607,10 @@ def unit_times(path: Path) -> list[UnitTimes]:
             while pos + _RECORD_HEAD.size <= size:
                 opcode, length = _RECORD_HEAD.unpack(file.read(_RECORD_HEAD.size))
                 pos += _RECORD_HEAD.size + length
-                if opcode == Opcode.FOOTER:
+                if opcode == Opcode.FOOTER:  # a whole file: every chunk's indexes written
                     indexing = False
-                if pos > size or opcode == Opcode.FOOTER:
+                    break
+                if pos > size:
                     break
                 body = file.read(length) if opcode != Opcode.CHUNK else file.read(8)
                 indexing = _take_unit(units, opcode, body, indexing)
